@@ -1,0 +1,1 @@
+//! Writers for CSV, JSON, plots and the HTML report.

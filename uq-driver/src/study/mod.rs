@@ -1,0 +1,1 @@
+//! Study files, runner and results store.

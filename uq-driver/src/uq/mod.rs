@@ -1,0 +1,1 @@
+//! Uncertainty-quantification numerics.
