@@ -1,0 +1,78 @@
+# railuq — thin convenience over cargo and pytest.
+#   make run    build everything, run the default study, write results and plots to out/
+#   make test   every test: fmt, clippy, Rust unit + integration tests, fmpy checks
+#   make bench  benchmarks, writes BENCHMARKS.md
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+CARGO ?= cargo
+PYTHON ?= python3
+VENV := .venv
+VPY := $(VENV)/bin/python
+FMU_DIR := target/fmu
+LIB := target/release/librailuq.so
+DRIVER := target/release/uq-driver
+FMUS := $(FMU_DIR)/Wheel.fmu
+# Headers of the FMI 2.0 standard as fmpy ships them (for the C test FMU).
+FMI2_HEADERS = $(shell $(VPY) -c 'import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), "c-code"))')
+
+.PHONY: all build fmu xml run test test-rust test-python lint fmt bench paper clean venv
+
+all: build fmu
+
+build:
+	$(CARGO) build --release --workspace
+
+fmu:
+	$(CARGO) build --release -p railuq --lib --bin railuq-fmu
+	target/release/railuq-fmu package $(LIB) $(FMU_DIR)
+
+# Regenerate the checked-in model descriptions from the Rust variable tables.
+xml:
+	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
+
+$(VPY): tests/python/requirements.txt
+	$(PYTHON) -m venv $(VENV)
+	$(VPY) -m pip install -q --upgrade pip
+	$(VPY) -m pip install -q -r tests/python/requirements.txt
+	touch $(VPY)
+
+venv: $(VPY)
+
+run: build fmu
+	@if [ -x $(DRIVER) ] && $(DRIVER) list >/dev/null 2>&1; then \
+	  $(DRIVER) run builtin:wheel-scm --out out/wheel-scm && \
+	  $(DRIVER) run builtin:wheel-lhs-10000 --out out/wheel-lhs-10000 && \
+	  echo "reports: out/wheel-scm/index.html out/wheel-lhs-10000/index.html"; \
+	else \
+	  echo "driver not built yet: the FMUs are in $(FMU_DIR)/"; ls $(FMU_DIR); \
+	fi
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+fmt:
+	$(CARGO) fmt --all
+
+test: lint venv fmu
+	$(MAKE) test-rust
+	$(MAKE) test-python
+
+# The debug build carries the test-only panic trigger used by tests/fmi_abi.rs.
+test-rust:
+	$(CARGO) build -p railuq --lib --features test-panic
+	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
+	  $(CARGO) test --workspace --features railuq/test-panic
+
+test-python: venv
+	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
+
+bench: build fmu venv
+	@echo "benchmarks not written yet"
+
+paper: build fmu
+	@echo "paper studies not written yet"
+
+clean:
+	$(CARGO) clean
+	rm -rf out
