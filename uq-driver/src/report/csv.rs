@@ -1,0 +1,242 @@
+//! CSV writers: columns side by side, and density grids in long format.
+//!
+//! Numbers are written with Rust's `Display` for `f64`, which is the shortest decimal that
+//! parses back to the same value (never exponent notation). NaN is written as `nan` and
+//! infinities as `inf` / `-inf`; pandas and spreadsheets read all three.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{write_bytes, ReportError};
+
+/// Writes a CSV file with one header line and one row per index of the columns.
+///
+/// `header[j]` names `columns[j]`; all columns must have the same length, and there must be
+/// as many names as columns, otherwise [`ReportError::LengthMismatch`] is returned and no
+/// file is written. Header names containing a comma, quote or line break are quoted.
+pub fn write_columns(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<(), ReportError> {
+    if header.len() != columns.len() {
+        return Err(ReportError::LengthMismatch {
+            path: path.to_path_buf(),
+            what: "header".to_string(),
+            len: header.len(),
+            expected: columns.len(),
+        });
+    }
+    let rows = columns.first().map_or(0, |c| c.len());
+    for (j, column) in columns.iter().enumerate() {
+        if column.len() != rows {
+            return Err(ReportError::LengthMismatch {
+                path: path.to_path_buf(),
+                what: format!("column {j} ({:?})", header[j]),
+                len: column.len(),
+                expected: rows,
+            });
+        }
+    }
+
+    let mut out = String::with_capacity(16 * (rows + 1) * columns.len().max(1));
+    push_header(&mut out, header);
+    for i in 0..rows {
+        for (j, column) in columns.iter().enumerate() {
+            if j > 0 {
+                out.push(',');
+            }
+            push_number(&mut out, column[i]);
+        }
+        out.push('\n');
+    }
+    write_bytes(path, out.as_bytes())
+}
+
+/// Writes densities on a grid over time in long format: header `time,x,density`, then one row
+/// per (time, grid point), time-major.
+///
+/// `density[k][i]` is the density at `times[k]` and `grid[i]`. `density` must have one entry
+/// per time and each entry one value per grid point, otherwise
+/// [`ReportError::LengthMismatch`] is returned and no file is written. Load with
+/// `pd.read_csv(p).pivot(index="x", columns="time", values="density")`.
+pub fn write_grid(
+    path: &Path,
+    times: &[f64],
+    grid: &[f64],
+    density: &[Vec<f64>],
+) -> Result<(), ReportError> {
+    if density.len() != times.len() {
+        return Err(ReportError::LengthMismatch {
+            path: path.to_path_buf(),
+            what: "density (number of times)".to_string(),
+            len: density.len(),
+            expected: times.len(),
+        });
+    }
+    for (k, row) in density.iter().enumerate() {
+        if row.len() != grid.len() {
+            return Err(ReportError::LengthMismatch {
+                path: path.to_path_buf(),
+                what: format!("density at time index {k}"),
+                len: row.len(),
+                expected: grid.len(),
+            });
+        }
+    }
+
+    let mut out = String::with_capacity(32 * (times.len() * grid.len() + 1));
+    push_header(&mut out, &["time", "x", "density"]);
+    for (&t, row) in times.iter().zip(density) {
+        for (&x, &d) in grid.iter().zip(row) {
+            push_number(&mut out, t);
+            out.push(',');
+            push_number(&mut out, x);
+            out.push(',');
+            push_number(&mut out, d);
+            out.push('\n');
+        }
+    }
+    write_bytes(path, out.as_bytes())
+}
+
+fn push_header(out: &mut String, header: &[&str]) {
+    for (j, name) in header.iter().enumerate() {
+        if j > 0 {
+            out.push(',');
+        }
+        if name.contains([',', '"', '\n', '\r']) {
+            out.push('"');
+            out.push_str(&name.replace('"', "\"\""));
+            out.push('"');
+        } else {
+            out.push_str(name);
+        }
+    }
+    out.push('\n');
+}
+
+fn push_number(out: &mut String, v: f64) {
+    if v.is_nan() {
+        out.push_str("nan");
+    } else {
+        // `Display` of f64 is the shortest round-trip representation; infinities print as
+        // `inf` / `-inf`. Writing to a String cannot fail.
+        let _ = write!(out, "{v}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Vec<Vec<f64>> {
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|f| f.parse::<f64>().unwrap()).collect())
+            .collect()
+    }
+
+    #[test]
+    fn columns_round_trip_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.csv");
+        let t = [0.0, 0.1, 1.0 / 3.0, 1e-300, 1.7976931348623157e308];
+        let q = [
+            -0.0,
+            f64::MIN_POSITIVE,
+            std::f64::consts::PI,
+            -2.5e-7,
+            123456789.125,
+        ];
+        write_columns(&path, &["time", "q"], &[&t, &q]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("time,q\n"));
+        let body = text.split_once('\n').unwrap().1;
+        assert!(!body.contains('e'), "no exponent notation expected: {body}");
+        let rows = parse(&text);
+        assert_eq!(rows.len(), t.len());
+        for (i, row) in rows.iter().enumerate() {
+            assert_eq!(row[0].to_bits(), t[i].to_bits());
+            assert_eq!(row[1].to_bits(), q[i].to_bits());
+        }
+    }
+
+    #[test]
+    fn non_finite_values_are_written_readably() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("nan.csv");
+        write_columns(
+            &path,
+            &["a"],
+            &[&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY]],
+        )
+        .unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "a\nnan\ninf\n-inf\n");
+        let rows = parse(&text);
+        assert!(rows[0][0].is_nan());
+        assert_eq!(rows[1][0], f64::INFINITY);
+        assert_eq!(rows[2][0], f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn header_names_with_commas_are_quoted() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("h.csv");
+        write_columns(&path, &["mean", "q, \"lateral\""], &[&[1.0], &[2.0]]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "mean,\"q, \"\"lateral\"\"\"\n1,2\n");
+    }
+
+    #[test]
+    fn empty_columns_give_header_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("e.csv");
+        write_columns(&path, &["a", "b"], &[&[], &[]]).unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "a,b\n");
+    }
+
+    #[test]
+    fn mismatched_column_lengths_are_an_error_and_write_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.csv");
+        let err = write_columns(&path, &["a", "b"], &[&[1.0, 2.0], &[1.0]]).unwrap_err();
+        assert!(matches!(
+            err,
+            ReportError::LengthMismatch {
+                len: 1,
+                expected: 2,
+                ..
+            }
+        ));
+        assert!(err.to_string().contains("\"b\""), "{err}");
+        assert!(!path.exists());
+        let err = write_columns(&path, &["a"], &[&[1.0], &[1.0]]).unwrap_err();
+        assert!(matches!(err, ReportError::LengthMismatch { .. }));
+    }
+
+    #[test]
+    fn grid_is_long_format_time_major() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.csv");
+        let times = [0.0, 0.5];
+        let grid = [-1.0, 0.0, 1.0];
+        let density = vec![vec![0.1, 0.2, 0.3], vec![0.4, f64::NAN, 0.6]];
+        write_grid(&path, &times, &grid, &density).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "time,x,density");
+        assert_eq!(lines.len(), 1 + 6);
+        assert_eq!(lines[1], "0,-1,0.1");
+        assert_eq!(lines[5], "0.5,0,nan");
+        assert_eq!(lines[6], "0.5,1,0.6");
+    }
+
+    #[test]
+    fn grid_shape_mismatch_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.csv");
+        let err = write_grid(&path, &[0.0, 1.0], &[0.0], &[vec![1.0]]).unwrap_err();
+        assert!(matches!(err, ReportError::LengthMismatch { .. }));
+        let err = write_grid(&path, &[0.0], &[0.0, 1.0], &[vec![1.0]]).unwrap_err();
+        assert!(matches!(err, ReportError::LengthMismatch { .. }));
+        assert!(!path.exists());
+    }
+}
