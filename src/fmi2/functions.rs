@@ -35,12 +35,16 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// # Safety
 /// `c` must be NULL or a pointer returned by [`fmi2Instantiate`] and not yet freed.
 unsafe fn instance_mut<'a>(c: Fmi2Component) -> Option<&'a mut Instance> {
-    if c.is_null() || (c as usize) % std::mem::align_of::<Instance>() != 0 {
+    if c.is_null() || !(c as usize).is_multiple_of(std::mem::align_of::<Instance>()) {
         return None;
     }
-    // SAFETY: the caller guarantees `c` came from fmi2Instantiate (a Box<Instance>) and is live.
-    let inst = unsafe { &mut *(c as *mut Instance) };
-    (inst.magic == INSTANCE_MAGIC).then_some(inst)
+    // SAFETY: `Instance` is repr(C) with the magic first: reading one u64 at a non-NULL, aligned
+    // pointer from the importer checks it is ours before any reference is made.
+    if unsafe { std::ptr::read(c as *const u64) } != INSTANCE_MAGIC {
+        return None;
+    }
+    // SAFETY: the magic matches, so `c` is a live Box<Instance> made by fmi2Instantiate.
+    Some(unsafe { &mut *(c as *mut Instance) })
 }
 
 /// A slice from a C array, or None when the pointer is NULL.
@@ -156,11 +160,10 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
             // SAFETY: FMI contract: `categories` points to `n` strings.
             let ptrs = unsafe { slice(categories, n) }.ok_or_else(|| null_arg("categories"))?;
             ptrs.iter()
-                // SAFETY: each entry is a NUL-terminated string (FMI contract).
                 .map(|&p| {
-                    unsafe { c_str(p) }
-                        .map(str::to_owned)
-                        .ok_or_else(|| null_arg("categories[i]"))
+                    // SAFETY: each entry is a NUL-terminated string (FMI contract).
+                    let s = unsafe { c_str(p) };
+                    s.map(str::to_owned).ok_or_else(|| null_arg("categories[i]"))
                 })
                 .collect::<Result<_, _>>()?
         };
@@ -353,10 +356,10 @@ macro_rules! getter {
             nvr: usize,
             value: *mut $cty,
         ) -> Fmi2Status {
-            if nvr == 0 {
-                return FMI2_OK;
-            }
             with_instance(c, Func::GetValues, stringify!($fname), |inst| {
+                if nvr == 0 {
+                    return Ok(FMI2_OK);
+                }
                 // SAFETY: FMI contract: `nvr` value references.
                 let vrs = unsafe { slice(vr, nvr) }.ok_or_else(|| null_arg("vr"))?;
                 // SAFETY: FMI contract: room for `nvr` values.
@@ -380,10 +383,10 @@ macro_rules! setter {
             nvr: usize,
             value: *const $cty,
         ) -> Fmi2Status {
-            if nvr == 0 {
-                return FMI2_OK;
-            }
             with_instance(c, Func::SetValues, stringify!($fname), |inst| {
+                if nvr == 0 {
+                    return Ok(FMI2_OK);
+                }
                 // SAFETY: FMI contract: `nvr` value references.
                 let vrs = unsafe { slice(vr, nvr) }.ok_or_else(|| null_arg("vr"))?;
                 // SAFETY: FMI contract: `nvr` values.
@@ -466,10 +469,10 @@ pub unsafe extern "C" fn fmi2GetString(
     nvr: usize,
     value: *mut Fmi2String,
 ) -> Fmi2Status {
-    if nvr == 0 {
-        return FMI2_OK;
-    }
     with_instance(c, Func::GetValues, "fmi2GetString", |inst| {
+        if nvr == 0 {
+            return Ok(FMI2_OK);
+        }
         // SAFETY: FMI contract: `nvr` value references.
         let vrs = unsafe { slice(vr, nvr) }.ok_or_else(|| null_arg("vr"))?;
         // SAFETY: FMI contract: room for `nvr` pointers.
@@ -497,21 +500,20 @@ pub unsafe extern "C" fn fmi2SetString(
     nvr: usize,
     value: *const Fmi2String,
 ) -> Fmi2Status {
-    if nvr == 0 {
-        return FMI2_OK;
-    }
     with_instance(c, Func::SetValues, "fmi2SetString", |inst| {
+        if nvr == 0 {
+            return Ok(FMI2_OK);
+        }
         // SAFETY: FMI contract: `nvr` value references.
         let vrs = unsafe { slice(vr, nvr) }.ok_or_else(|| null_arg("vr"))?;
         // SAFETY: FMI contract: `nvr` string pointers.
         let ptrs = unsafe { slice(value, nvr) }.ok_or_else(|| null_arg("value"))?;
         let owned: Vec<String> = ptrs
             .iter()
-            // SAFETY: each entry is a NUL-terminated string (FMI contract).
             .map(|&p| {
-                unsafe { c_str(p) }
-                    .map(str::to_owned)
-                    .ok_or_else(|| null_arg("value[i]"))
+                // SAFETY: each entry is a NUL-terminated string (FMI contract).
+                let s = unsafe { c_str(p) };
+                s.map(str::to_owned).ok_or_else(|| null_arg("value[i]"))
             })
             .collect::<Result<_, _>>()?;
         let idx: Vec<usize> = (0..owned.len()).collect();
@@ -554,12 +556,15 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: Fmi2Component, state: *mut Fmi2FmuSt
 /// # Safety
 /// `s` must be NULL or a pointer we returned from fmi2GetFMUstate/fmi2DeSerializeFMUstate.
 unsafe fn snapshot_mut<'a>(s: Fmi2FmuState) -> Option<&'a mut Snapshot> {
-    if s.is_null() || (s as usize) % std::mem::align_of::<Snapshot>() != 0 {
+    if s.is_null() || !(s as usize).is_multiple_of(std::mem::align_of::<Snapshot>()) {
         return None;
     }
-    // SAFETY: by the caller's contract `s` is a live Box<Snapshot>.
-    let snap = unsafe { &mut *(s as *mut Snapshot) };
-    (snap.magic == SNAPSHOT_MAGIC).then_some(snap)
+    // SAFETY: `Snapshot` is repr(C) with the magic first; read it before making a reference.
+    if unsafe { std::ptr::read(s as *const u64) } != SNAPSHOT_MAGIC {
+        return None;
+    }
+    // SAFETY: the magic matches, so `s` is a live Box<Snapshot> we allocated.
+    Some(unsafe { &mut *(s as *mut Snapshot) })
 }
 
 /// fmi2SetFMUstate.

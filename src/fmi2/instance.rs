@@ -58,8 +58,10 @@ impl From<ModelError> for Failure {
 /// What a successful call returns: fmi2OK or fmi2Warning.
 pub type Outcome = Result<Fmi2Status, Failure>;
 
-/// A snapshot for fmi2GetFMUstate / fmi2SetFMUstate.
+/// A snapshot for fmi2GetFMUstate / fmi2SetFMUstate (repr(C): the magic comes first, so the
+/// C boundary can check it before making a reference).
 #[derive(Debug)]
+#[repr(C)]
 pub struct Snapshot {
     /// [`SNAPSHOT_MAGIC`] while alive.
     pub magic: u64,
@@ -71,8 +73,10 @@ pub struct Snapshot {
     dirty: bool,
 }
 
-/// One FMU instance.
+/// One FMU instance (repr(C): the magic comes first, so the C boundary can check it before
+/// making a reference).
 #[derive(Debug)]
+#[repr(C)]
 pub struct Instance {
     /// [`INSTANCE_MAGIC`] while alive.
     pub magic: u64,
@@ -270,7 +274,9 @@ impl Instance {
         Err(Failure::error(format!("cannot set '{}': {why}", var.name)))
     }
 
-    /// Sets values of one type: every reference is checked, then each is set in order.
+    /// Sets values of one type: every reference is checked, then each is set in order (a
+    /// value refused by the model leaves the earlier ones of the same call set, and the
+    /// instance in Error state).
     pub fn set_values<T: Copy + std::fmt::Debug>(
         &mut self,
         vrs: &[u32],

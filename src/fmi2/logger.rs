@@ -49,7 +49,6 @@ impl Category {
 pub struct Logger {
     callbacks: Option<Fmi2CallbackFunctions>,
     name: CString,
-    debug_on: bool,
     enabled: [bool; LOG_CATEGORIES.len()],
 }
 
@@ -57,7 +56,6 @@ impl std::fmt::Debug for Logger {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Logger")
             .field("name", &self.name)
-            .field("debug_on", &self.debug_on)
             .field("enabled", &self.enabled)
             .finish()
     }
@@ -69,23 +67,21 @@ impl std::fmt::Debug for Logger {
 unsafe impl Send for Logger {}
 
 impl Logger {
-    /// A logger for instance `name`; `callbacks` None means silent.
-    pub fn new(callbacks: Option<Fmi2CallbackFunctions>, name: &str, debug_on: bool) -> Self {
+    /// A logger for instance `name`; `callbacks` None means silent. As in the FMI fmuTemplate,
+    /// `logging_on` (fmi2Instantiate's loggingOn) switches every category on or off.
+    pub fn new(callbacks: Option<Fmi2CallbackFunctions>, name: &str, logging_on: bool) -> Self {
         let name = CString::new(name.replace('\0', "?")).unwrap_or_default();
-        let mut enabled = [true; LOG_CATEGORIES.len()];
-        enabled[Category::Calls as usize] = false;
         Logger {
             callbacks,
             name,
-            debug_on,
-            enabled,
+            enabled: [logging_on; LOG_CATEGORIES.len()],
         }
     }
 
-    /// fmi2SetDebugLogging: `categories` empty means all categories.
+    /// fmi2SetDebugLogging: `categories` empty means all categories; otherwise only the listed
+    /// categories change.
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Result<(), String> {
         if categories.is_empty() {
-            self.debug_on = on;
             self.enabled = [on; LOG_CATEGORIES.len()];
             return Ok(());
         }
@@ -105,9 +101,6 @@ impl Logger {
         for i in idx {
             self.enabled[i] = on;
         }
-        if on {
-            self.debug_on = true;
-        }
         Ok(())
     }
 
@@ -116,11 +109,10 @@ impl Logger {
         if self.callbacks.and_then(|c| c.logger).is_none() {
             return false;
         }
-        matches!(status, FMI2_ERROR | FMI2_FATAL)
-            || (self.debug_on && self.enabled[category as usize])
+        matches!(status, FMI2_ERROR | FMI2_FATAL) || self.enabled[category as usize]
     }
 
-    /// Sends a message (errors always; others if debug logging enables their category).
+    /// Sends a message (errors always; others if their category is enabled).
     pub fn log(&self, status: Fmi2Status, category: Category, message: &str) {
         if !self.would_log(status, category) {
             return;
