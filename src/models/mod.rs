@@ -3,6 +3,7 @@
 //! methods to read and write those variables and to advance time.
 #![forbid(unsafe_code)]
 
+pub mod bogie;
 pub mod wheel;
 
 use std::fmt;
@@ -336,10 +337,16 @@ pub struct ModelEntry {
 
 /// Every model this library serves.
 pub fn registry() -> &'static [ModelEntry] {
-    static REGISTRY: [ModelEntry; 1] = [ModelEntry {
-        info: &wheel::INFO,
-        create: wheel::Wheel::boxed,
-    }];
+    static REGISTRY: [ModelEntry; 2] = [
+        ModelEntry {
+            info: &wheel::INFO,
+            create: wheel::Wheel::boxed,
+        },
+        ModelEntry {
+            info: &bogie::INFO,
+            create: bogie::Bogie::boxed,
+        },
+    ];
     &REGISTRY
 }
 

@@ -1,0 +1,317 @@
+//! Radix-2 complex FFT, and the discrete sine transform DST-I built on it.
+//!
+//! The rail of the vehicle–track model is expanded in the modes `sin(kπx/l)` of a simply
+//! supported beam; at the evenly spaced sleepers `x_i = i l/(N+1)` the matrix
+//! `sin(kπ i/(N+1))` is a DST-I, which [`DstI`] applies in O(N log N) instead of O(N²):
+//!
+//! ```text
+//! S_i = Σ_{k=1}^{N} b_k sin(π k i / n),   i = 1..N,   n = N + 1 a power of two.
+//! ```
+//!
+//! Algorithm (the classical one, e.g. Press et al., *Numerical Recipes*, §12.3 "sinft"):
+//! form `y_j = sin(jπ/n)(b_j + b_{n−j}) + ½(b_j − b_{n−j})`, take its real DFT
+//! `R_k − i I_k = Σ_j y_j e^{−2πijk/n}` (a complex FFT of length n/2 plus one twiddle pass),
+//! then `S_{2k} = I_k`, `S_1 = R_0/2`, `S_{2k+1} = S_{2k−1} + R_k`. The DST-I matrix is
+//! symmetric and `D·D = (n/2) I`, so the same routine maps modes to sleepers and sleeper
+//! forces back to modal forces, and `(2/n) D` inverts it.
+//!
+//! Everything is planned once (twiddles, bit reversal, scratch); [`DstI::transform`] and
+//! [`Fft::forward`] never allocate.
+#![forbid(unsafe_code)]
+
+use std::f64::consts::PI;
+
+/// A complex number (no arithmetic traits: the few operations needed are written out).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Complex {
+    /// Real part.
+    pub re: f64,
+    /// Imaginary part.
+    pub im: f64,
+}
+
+impl Complex {
+    /// `re + i im`.
+    pub const fn new(re: f64, im: f64) -> Self {
+        Self { re, im }
+    }
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        Self::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+    #[inline]
+    fn conj(self) -> Self {
+        Self::new(self.re, -self.im)
+    }
+}
+
+/// In-place iterative radix-2 FFT plan of a fixed power-of-two length.
+#[derive(Clone, Debug)]
+pub struct Fft {
+    n: usize,
+    /// `e^{−2πik/n}`, k = 0..n/2.
+    twiddles: Vec<Complex>,
+    /// Bit-reversed index of each position.
+    bitrev: Vec<u32>,
+}
+
+impl Fft {
+    /// Plans an FFT of length `n` (a power of two, ≥ 1).
+    pub fn new(n: usize) -> Result<Self, String> {
+        if n == 0 || !n.is_power_of_two() || n > (1 << 30) {
+            return Err(format!(
+                "FFT length {n} must be a power of two between 1 and 2^30"
+            ));
+        }
+        let twiddles = (0..n / 2)
+            .map(|k| {
+                let a = -2.0 * PI * k as f64 / n as f64;
+                Complex::new(a.cos(), a.sin())
+            })
+            .collect();
+        let bits = n.trailing_zeros();
+        let bitrev = (0..n as u32)
+            .map(|i| if bits == 0 { 0 } else { i.reverse_bits() >> (32 - bits) })
+            .collect();
+        Ok(Self {
+            n,
+            twiddles,
+            bitrev,
+        })
+    }
+
+    /// The planned length.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Whether the planned length is zero (never: kept for the `len` convention).
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// `X_k = Σ_j x_j e^{−2πijk/n}` in place (no normalisation).
+    pub fn forward(&self, data: &mut [Complex]) {
+        let n = self.n;
+        assert_eq!(data.len(), n, "FFT buffer length");
+        for i in 0..n {
+            let j = self.bitrev[i] as usize;
+            if i < j {
+                data.swap(i, j);
+            }
+        }
+        let mut half = 1;
+        while half < n {
+            let stride = n / (2 * half);
+            for start in (0..n).step_by(2 * half) {
+                for k in 0..half {
+                    let w = self.twiddles[k * stride];
+                    let a = data[start + k];
+                    let b = data[start + k + half].mul(w);
+                    data[start + k] = Complex::new(a.re + b.re, a.im + b.im);
+                    data[start + k + half] = Complex::new(a.re - b.re, a.im - b.im);
+                }
+            }
+            half *= 2;
+        }
+    }
+
+    /// `x_j = Σ_k X_k e^{+2πijk/n}` in place (no 1/n factor).
+    pub fn backward(&self, data: &mut [Complex]) {
+        for z in data.iter_mut() {
+            *z = z.conj();
+        }
+        self.forward(data);
+        for z in data.iter_mut() {
+            *z = z.conj();
+        }
+    }
+}
+
+/// DST-I plan of size `N` (with `N + 1` a power of two), see the module documentation.
+#[derive(Clone, Debug)]
+pub struct DstI {
+    /// N, the number of interior points.
+    size: usize,
+    /// n = N + 1.
+    n: usize,
+    /// Complex FFT of length n/2 (the real FFT of length n).
+    fft: Fft,
+    /// `sin(jπ/n)`, j = 0..n.
+    sin_j: Vec<f64>,
+    /// `e^{−2πik/n}`, k = 0..n/2 (real-FFT post-processing).
+    w: Vec<Complex>,
+    /// Scratch: the packed real sequence.
+    z: Vec<Complex>,
+}
+
+impl DstI {
+    /// Plans a DST-I of `size` points; `size + 1` must be a power of two ≥ 2.
+    pub fn new(size: usize) -> Result<Self, String> {
+        let n = size + 1;
+        if size == 0 || !n.is_power_of_two() {
+            return Err(format!(
+                "DST-I size {size}: size + 1 must be a power of two (e.g. 63, 127, 255, 511)"
+            ));
+        }
+        let m = n / 2;
+        Ok(Self {
+            size,
+            n,
+            fft: Fft::new(m)?,
+            sin_j: (0..n).map(|j| (PI * j as f64 / n as f64).sin()).collect(),
+            w: (0..m)
+                .map(|k| {
+                    let a = -2.0 * PI * k as f64 / n as f64;
+                    Complex::new(a.cos(), a.sin())
+                })
+                .collect(),
+            z: vec![Complex::default(); m],
+        })
+    }
+
+    /// The number of points N.
+    pub fn len(&self) -> usize {
+        self.size
+    }
+
+    /// Whether N is zero (never).
+    pub fn is_empty(&self) -> bool {
+        self.size == 0
+    }
+
+    /// `out[i−1] = Σ_{k=1}^{N} input[k−1] sin(π k i/(N+1))`, i = 1..N. No allocation.
+    pub fn transform(&mut self, input: &[f64], out: &mut [f64]) {
+        let (n, size) = (self.n, self.size);
+        assert!(input.len() == size && out.len() == size, "DST-I buffer length");
+        let b = |j: usize| if j == 0 || j == n { 0.0 } else { input[j - 1] };
+        let y = |j: usize| {
+            if j == 0 {
+                0.0
+            } else {
+                let (bj, bc) = (b(j), b(n - j));
+                self.sin_j[j] * (bj + bc) + 0.5 * (bj - bc)
+            }
+        };
+        let m = n / 2;
+        if m == 1 {
+            // n = 2, N = 1: S_1 = b_1 sin(π/2).
+            out[0] = input[0];
+            return;
+        }
+        let mut z = std::mem::take(&mut self.z);
+        for (p, zp) in z.iter_mut().enumerate() {
+            *zp = Complex::new(y(2 * p), y(2 * p + 1));
+        }
+        self.fft.forward(&mut z);
+        // Real DFT Y_k = R_k − i I_k of y from the half-length complex FFT, k = 0..m−1.
+        let mut s_odd = 0.0; // S_{2k−1}
+        for k in 0..m {
+            let zk = z[k];
+            let zmk = z[(m - k) % m].conj();
+            let e = Complex::new(0.5 * (zk.re + zmk.re), 0.5 * (zk.im + zmk.im));
+            // O = (Z_k − conj Z_{m−k}) / (2i)
+            let o = Complex::new(0.5 * (zk.im - zmk.im), -0.5 * (zk.re - zmk.re));
+            let yk = Complex::new(e.re, e.im);
+            let wo = self.w[k].mul(o);
+            let (r, i) = (yk.re + wo.re, -(yk.im + wo.im));
+            if k == 0 {
+                s_odd = 0.5 * r;
+                out[0] = s_odd;
+            } else {
+                out[2 * k - 1] = i; // S_{2k}
+                s_odd += r; // S_{2k+1}
+                out[2 * k] = s_odd;
+            }
+        }
+        self.z = z;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn direct_dst(b: &[f64]) -> Vec<f64> {
+        let n = b.len() + 1;
+        (1..n)
+            .map(|i| {
+                (1..n)
+                    .map(|k| b[k - 1] * (PI * (k * i) as f64 / n as f64).sin())
+                    .sum()
+            })
+            .collect()
+    }
+
+    fn pseudo_random(len: usize, seed: u64) -> Vec<f64> {
+        let mut s = seed;
+        (0..len)
+            .map(|_| {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fft_matches_direct_dft() {
+        for &n in &[1usize, 2, 4, 8, 64, 256] {
+            let re = pseudo_random(n, 1);
+            let im = pseudo_random(n, 2);
+            let mut data: Vec<Complex> =
+                re.iter().zip(&im).map(|(&a, &b)| Complex::new(a, b)).collect();
+            Fft::new(n).unwrap().forward(&mut data);
+            for k in 0..n {
+                let (mut sr, mut si) = (0.0, 0.0);
+                for j in 0..n {
+                    let a = -2.0 * PI * (j * k) as f64 / n as f64;
+                    sr += re[j] * a.cos() - im[j] * a.sin();
+                    si += re[j] * a.sin() + im[j] * a.cos();
+                }
+                assert!((data[k].re - sr).abs() < 1e-12 * n as f64, "n={n} k={k}");
+                assert!((data[k].im - si).abs() < 1e-12 * n as f64, "n={n} k={k}");
+            }
+        }
+        assert!(Fft::new(12).is_err());
+    }
+
+    #[test]
+    fn fast_dst_matches_direct_sum() {
+        for &size in &[1usize, 3, 7, 15, 63, 255, 1023] {
+            let b = pseudo_random(size, size as u64);
+            let mut out = vec![0.0; size];
+            let mut plan = DstI::new(size).unwrap();
+            plan.transform(&b, &mut out);
+            let reference = direct_dst(&b);
+            let err = out
+                .iter()
+                .zip(&reference)
+                .map(|(a, r)| (a - r).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12 * size as f64, "size {size}: max error {err:e}");
+        }
+    }
+
+    #[test]
+    fn dst_is_its_own_inverse_up_to_n_over_2() {
+        let size = 127;
+        let b = pseudo_random(size, 9);
+        let mut plan = DstI::new(size).unwrap();
+        let (mut s, mut back) = (vec![0.0; size], vec![0.0; size]);
+        plan.transform(&b, &mut s);
+        plan.transform(&s, &mut back);
+        for (x, y) in b.iter().zip(&back) {
+            assert!((x - y * 2.0 / 128.0).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn dst_refuses_sizes_without_power_of_two() {
+        assert!(DstI::new(0).is_err());
+        assert!(DstI::new(100).is_err());
+        assert!(DstI::new(127).is_ok());
+    }
+}

@@ -1,0 +1,529 @@
+//! Ballasted track under one rail (Zhai): an Euler–Bernoulli rail, simply supported over the
+//! computing length l, by modal superposition; discrete rail pads, half sleepers, ballast
+//! blocks coupled in shear, and subgrade springs.
+//!
+//! ```text
+//! Z_k(x) = √(2/(m_r l)) sin(kπx/l), k = 1..NM,        Zr(x) = Σ_k Z_k(x) q_k
+//! q_k'' + (EI/m_r)(kπ/l)⁴ q_k = −Σ_i F_rsi Z_k(x_i) + Σ_j P_j Z_k(x_wj)
+//! F_rsi = Kp (Zr(x_i) − Z_si) + Cp (Zr'(x_i) − Z_si')                         rail pad
+//! Ms Z_si'' = F_rsi − F_bi,   F_bi = Kb (Z_si − Z_bi) + Cb (Z_si' − Z_bi')    half sleeper
+//! Mb Z_bi'' = F_bi − Kf Z_bi − Cf Z_bi' − Kw (2Z_bi − Z_b,i−1 − Z_b,i+1)
+//!             − Cw (2Z_bi' − Z_b,i−1' − Z_b,i+1')  (end blocks: one neighbour)  ballast
+//! ```
+//!
+//! N sleepers sit at x_i = i·l_s, i = 1..N, l = (N+1) l_s, so Z_k(x_i) ∝ sin(kπi/(N+1)): the
+//! maps modes → sleepers and sleeper forces → modal forces are DST-I's of size N
+//! ([`super::fft::DstI`], N + 1 a power of two), O(N log N) per step. Modes k > N alias onto
+//! the sleeper grid (sin(kπi/n) = ± sin(k'πi/n)), which a fold of the modal vector handles,
+//! so any NM ≤ 2N + 1 works. The wheels sit anywhere: their mode values come from the
+//! recurrence sin((k+1)a) = 2 cos a sin(ka) − sin((k−1)a), 4 × NM operations.
+//!
+//! Track state layout (one slice): `[q_1..q_NM | Z_s1..Z_sN | Z_b1..Z_bN]`.
+//! Displacements are measured from the unloaded track (self-weight not modelled).
+#![forbid(unsafe_code)]
+
+use super::fft::DstI;
+use std::f64::consts::PI;
+
+/// Track data (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrackParams {
+    /// Rail mass per length m_r (kg/m).
+    pub mr: f64,
+    /// Rail bending stiffness EI (N·m²).
+    pub ei: f64,
+    /// Half-sleeper mass Ms (kg).
+    pub ms: f64,
+    /// Ballast block mass Mb (kg).
+    pub mb: f64,
+    /// Pad stiffness Kp (N/m).
+    pub kp: f64,
+    /// Pad damping Cp (N·s/m).
+    pub cp: f64,
+    /// Ballast stiffness Kb (N/m).
+    pub kb: f64,
+    /// Ballast damping Cb (N·s/m).
+    pub cb: f64,
+    /// Subgrade stiffness Kf (N/m).
+    pub kf: f64,
+    /// Subgrade damping Cf (N·s/m).
+    pub cf: f64,
+    /// Ballast shear stiffness Kw (N/m).
+    pub kw: f64,
+    /// Ballast shear damping Cw (N·s/m).
+    pub cw: f64,
+    /// Sleeper spacing l_s (m).
+    pub ls: f64,
+    /// Number of sleepers N (N + 1 a power of two).
+    pub n_sleepers: usize,
+    /// Number of rail modes NM (1..=2N+1).
+    pub n_modes: usize,
+}
+
+/// The track: parameters, transforms and scratch (allocated once).
+#[derive(Clone, Debug)]
+pub struct Track {
+    /// Parameters.
+    pub p: TrackParams,
+    /// N.
+    pub n: usize,
+    /// NM.
+    pub nm: usize,
+    /// Computing length l = (N + 1) l_s (m).
+    pub length: f64,
+    /// √(2/(m_r l)) (1/√kg): amplitude of the mass-normalised modes.
+    pub scale: f64,
+    /// ω_k² = (EI/m_r)(kπ/l)⁴ (1/s²).
+    omega2: Vec<f64>,
+    /// Sleeper-grid bin (0-based) of mode k, or `usize::MAX` when it vanishes at every sleeper.
+    fold_bin: Vec<usize>,
+    /// Sign of the fold.
+    fold_sign: Vec<f64>,
+    dst: DstI,
+    dst_fine: DstI,
+    bins: Vec<f64>,
+    r: Vec<f64>,
+    rd: Vec<f64>,
+    frs: Vec<f64>,
+    fine: Vec<f64>,
+    fine_out: Vec<f64>,
+    /// sin(kπ x_wj / l) for the four wheels, row-major 4 × NM.
+    wheel_sin: Vec<f64>,
+}
+
+impl Track {
+    /// Builds the track (validates N and NM).
+    pub fn new(p: TrackParams) -> Result<Self, String> {
+        let (n, nm) = (p.n_sleepers, p.n_modes);
+        let dst = DstI::new(n).map_err(|e| format!("n_sleepers = {n}: {e}"))?;
+        if nm == 0 || nm > 2 * n + 1 {
+            return Err(format!(
+                "n_modes = {nm} must be between 1 and 2 n_sleepers + 1 = {}",
+                2 * n + 1
+            ));
+        }
+        let dst_fine = DstI::new(2 * n + 1)?;
+        let length = (n + 1) as f64 * p.ls;
+        let period = 2 * (n + 1);
+        let (mut fold_bin, mut fold_sign) = (Vec::with_capacity(nm), Vec::with_capacity(nm));
+        for k in 1..=nm {
+            let r = k % period;
+            if r == 0 || r == n + 1 {
+                fold_bin.push(usize::MAX);
+                fold_sign.push(0.0);
+            } else if r <= n {
+                fold_bin.push(r - 1);
+                fold_sign.push(1.0);
+            } else {
+                fold_bin.push(period - r - 1);
+                fold_sign.push(-1.0);
+            }
+        }
+        Ok(Self {
+            p,
+            n,
+            nm,
+            length,
+            scale: (2.0 / (p.mr * length)).sqrt(),
+            omega2: (1..=nm)
+                .map(|k| p.ei / p.mr * (k as f64 * PI / length).powi(4))
+                .collect(),
+            fold_bin,
+            fold_sign,
+            dst,
+            dst_fine,
+            bins: vec![0.0; n],
+            r: vec![0.0; n],
+            rd: vec![0.0; n],
+            frs: vec![0.0; n],
+            fine: vec![0.0; 2 * n + 1],
+            fine_out: vec![0.0; 2 * n + 1],
+            wheel_sin: vec![0.0; 4 * nm],
+        })
+    }
+
+    /// Length of the track part of the state: NM + 2N.
+    pub fn dim(&self) -> usize {
+        self.nm + 2 * self.n
+    }
+
+    /// Highest natural frequency of a rail mode (rad/s).
+    pub fn max_rail_omega(&self) -> f64 {
+        self.omega2[self.nm - 1].sqrt()
+    }
+
+    /// Zr at the sleepers, `out[i] = Σ_k Z_k(x_{i+1}) q_k`.
+    fn synthesize(
+        dst: &mut DstI,
+        fold_bin: &[usize],
+        fold_sign: &[f64],
+        scale: f64,
+        q: &[f64],
+        bins: &mut [f64],
+        out: &mut [f64],
+    ) {
+        bins.iter_mut().for_each(|b| *b = 0.0);
+        for ((&b, &s), &qk) in fold_bin.iter().zip(fold_sign).zip(q) {
+            if b != usize::MAX {
+                bins[b] += s * qk;
+            }
+        }
+        dst.transform(bins, out);
+        out.iter_mut().for_each(|v| *v *= scale);
+    }
+
+    /// Adds `factor · Σ_i Z_k(x_i) f_i` to `out[k]` for every mode (the transpose map).
+    fn analyze_add(&mut self, factor: f64, out: &mut [f64]) {
+        self.dst.transform(&self.frs, &mut self.bins);
+        let c = factor * self.scale;
+        for ((o, &b), &s) in out.iter_mut().zip(&self.fold_bin).zip(&self.fold_sign) {
+            if b != usize::MAX {
+                *o += c * s * self.bins[b];
+            }
+        }
+    }
+
+    /// Stores sin(kπx/l), k = 1..NM, for the wheels at local positions `x` (m, 0 < x < l).
+    pub fn set_wheels(&mut self, x: &[f64; 4]) {
+        let nm = self.nm;
+        for (j, &xj) in x.iter().enumerate() {
+            let a = PI * xj / self.length;
+            let (s1, c2) = (a.sin(), 2.0 * a.cos());
+            let row = &mut self.wheel_sin[j * nm..(j + 1) * nm];
+            let (mut prev, mut cur) = (0.0, s1);
+            for (k, v) in row.iter_mut().enumerate() {
+                *v = cur;
+                let next = c2 * cur - prev;
+                prev = cur;
+                cur = next;
+                // Re-seed from the exact value every 64 terms to bound round-off growth.
+                if (k + 2) % 64 == 0 {
+                    cur = ((k + 2) as f64 * a).sin();
+                    prev = ((k + 1) as f64 * a).sin();
+                }
+            }
+        }
+    }
+
+    /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`.
+    pub fn rail_at_wheels(&self, q: &[f64]) -> [f64; 4] {
+        let nm = self.nm;
+        let mut out = [0.0; 4];
+        for (j, o) in out.iter_mut().enumerate() {
+            let row = &self.wheel_sin[j * nm..(j + 1) * nm];
+            *o = self.scale * row.iter().zip(q).map(|(s, q)| s * q).sum::<f64>();
+        }
+        out
+    }
+
+    /// Track accelerations `acc` from positions `y`, velocities `yd` (track layout) and the
+    /// wheel–rail forces `p` (N) at the wheels set by [`Track::set_wheels`]. No allocation.
+    pub fn accelerations(&mut self, y: &[f64], yd: &[f64], p: &[f64; 4], acc: &mut [f64]) {
+        let (n, nm) = (self.n, self.nm);
+        let (q, zs, zb) = (&y[..nm], &y[nm..nm + n], &y[nm + n..nm + 2 * n]);
+        let (qd, zsd, zbd) = (&yd[..nm], &yd[nm..nm + n], &yd[nm + n..nm + 2 * n]);
+        Self::synthesize(
+            &mut self.dst,
+            &self.fold_bin,
+            &self.fold_sign,
+            self.scale,
+            q,
+            &mut self.bins,
+            &mut self.r,
+        );
+        Self::synthesize(
+            &mut self.dst,
+            &self.fold_bin,
+            &self.fold_sign,
+            self.scale,
+            qd,
+            &mut self.bins,
+            &mut self.rd,
+        );
+        let t = self.p;
+        let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
+        let (acc_q, rest) = acc.split_at_mut(nm);
+        let (acc_s, acc_b) = rest.split_at_mut(n);
+        for i in 0..n {
+            let frs = t.kp * (self.r[i] - zs[i]) + t.cp * (self.rd[i] - zsd[i]);
+            let fb = t.kb * (zs[i] - zb[i]) + t.cb * (zsd[i] - zbd[i]);
+            let (mut dz, mut dv) = (0.0, 0.0);
+            if i > 0 {
+                dz += zb[i] - zb[i - 1];
+                dv += zbd[i] - zbd[i - 1];
+            }
+            if i + 1 < n {
+                dz += zb[i] - zb[i + 1];
+                dv += zbd[i] - zbd[i + 1];
+            }
+            self.frs[i] = frs;
+            acc_s[i] = (frs - fb) * inv_ms;
+            acc_b[i] = (fb - t.kf * zb[i] - t.cf * zbd[i] - t.kw * dz - t.cw * dv) * inv_mb;
+        }
+        for ((a, &w2), &qk) in acc_q.iter_mut().zip(&self.omega2).zip(q) {
+            *a = -w2 * qk;
+        }
+        self.analyze_add(-1.0, acc_q);
+        for (j, &pj) in p.iter().enumerate() {
+            if pj != 0.0 {
+                let c = self.scale * pj;
+                let row = &self.wheel_sin[j * nm..(j + 1) * nm];
+                for (a, s) in acc_q.iter_mut().zip(row) {
+                    *a += c * s;
+                }
+            }
+        }
+    }
+
+    /// Static stiffness product `out = K y` (track layout).
+    fn stiffness_product(&mut self, y: &[f64], out: &mut [f64]) {
+        let (n, nm) = (self.n, self.nm);
+        let t = self.p;
+        let (q, zs, zb) = (&y[..nm], &y[nm..nm + n], &y[nm + n..]);
+        Self::synthesize(
+            &mut self.dst,
+            &self.fold_bin,
+            &self.fold_sign,
+            self.scale,
+            q,
+            &mut self.bins,
+            &mut self.r,
+        );
+        let (out_q, rest) = out.split_at_mut(nm);
+        let (out_s, out_b) = rest.split_at_mut(n);
+        for i in 0..n {
+            let f = t.kp * (self.r[i] - zs[i]);
+            let fb = t.kb * (zs[i] - zb[i]);
+            let mut dz = 0.0;
+            if i > 0 {
+                dz += zb[i] - zb[i - 1];
+            }
+            if i + 1 < n {
+                dz += zb[i] - zb[i + 1];
+            }
+            self.frs[i] = f;
+            out_s[i] = -f + fb;
+            out_b[i] = -fb + t.kf * zb[i] + t.kw * dz;
+        }
+        for ((o, &w2), &qk) in out_q.iter_mut().zip(&self.omega2).zip(q) {
+            *o = w2 * qk;
+        }
+        self.analyze_add(1.0, out_q);
+    }
+
+    /// Static deflection of the track under wheel loads `p` (N) at the wheels set by
+    /// [`Track::set_wheels`], by Jacobi-preconditioned conjugate gradients on the symmetric
+    /// positive definite stiffness. Writes the track positions into `y`; returns the
+    /// number of iterations.
+    pub fn static_solve(&mut self, p: &[f64; 4], y: &mut [f64]) -> Result<usize, String> {
+        let (n, nm, dim) = (self.n, self.nm, self.dim());
+        let t = self.p;
+        let mut b = vec![0.0; dim];
+        for (j, &pj) in p.iter().enumerate() {
+            for k in 0..nm {
+                b[k] += self.scale * pj * self.wheel_sin[j * nm + k];
+            }
+        }
+        let half = (n + 1) as f64 / 2.0;
+        let mut diag = vec![0.0; dim];
+        for k in 0..nm {
+            let sup = if self.fold_bin[k] == usize::MAX {
+                0.0
+            } else {
+                t.kp * self.scale * self.scale * half
+            };
+            diag[k] = self.omega2[k] + sup;
+        }
+        for i in 0..n {
+            let deg = (i > 0) as usize + (i + 1 < n) as usize;
+            diag[nm + i] = t.kp + t.kb;
+            diag[nm + n + i] = t.kb + t.kf + t.kw * deg as f64;
+        }
+        y.iter_mut().for_each(|v| *v = 0.0);
+        let mut r = b.clone();
+        let mut z: Vec<f64> = r.iter().zip(&diag).map(|(r, d)| r / d).collect();
+        let mut d = z.clone();
+        let mut kd = vec![0.0; dim];
+        let norm_b = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if norm_b == 0.0 {
+            return Ok(0);
+        }
+        let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let max_iter = 50 * dim + 100;
+        for it in 1..=max_iter {
+            self.stiffness_product(&d, &mut kd);
+            let dkd: f64 = d.iter().zip(&kd).map(|(a, b)| a * b).sum();
+            let alpha = rz / dkd;
+            for i in 0..dim {
+                y[i] += alpha * d[i];
+                r[i] -= alpha * kd[i];
+            }
+            let norm_r = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if norm_r <= 1e-13 * norm_b {
+                return Ok(it);
+            }
+            for i in 0..dim {
+                z[i] = r[i] / diag[i];
+            }
+            let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for i in 0..dim {
+                d[i] = z[i] + beta * d[i];
+            }
+        }
+        Err(format!(
+            "static track deflection: conjugate gradients did not converge in {max_iter} iterations"
+        ))
+    }
+
+    /// Moves the computing window forward by `m` sleepers for one state array `y` (track
+    /// layout): a point at local x moves to x − m l_s. Sleepers and ballast shift by m
+    /// entries (new ones ahead start at rest); the rail is sampled on the half-spacing grid
+    /// (a DST-I of size 2N+1, exact for NM ≤ 2N+1), shifted, and projected back on the NM modes.
+    pub fn shift(&mut self, m: usize, y: &mut [f64]) {
+        let (n, nm) = (self.n, self.nm);
+        let nf = 2 * n + 1;
+        self.fine.iter_mut().for_each(|v| *v = 0.0);
+        self.fine[..nm].copy_from_slice(&y[..nm]);
+        self.dst_fine.transform(&self.fine, &mut self.fine_out);
+        for j in 0..nf {
+            self.fine[j] = if j + 2 * m < nf {
+                self.fine_out[j + 2 * m]
+            } else {
+                0.0
+            };
+        }
+        self.dst_fine.transform(&self.fine, &mut self.fine_out);
+        let c = 2.0 / (nf + 1) as f64;
+        for k in 0..nm {
+            y[k] = c * self.fine_out[k];
+        }
+        for part in [&mut y[nm..nm + n], &mut y[nm + n..nm + 2 * n]] {
+            for i in 0..n {
+                part[i] = if i + m < n { part[i + m] } else { 0.0 };
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn paper_track(n: usize, nm: usize) -> TrackParams {
+        TrackParams {
+            mr: 60.64,
+            ei: 6.6e6,
+            ms: 125.5,
+            mb: 310.0,
+            kp: 60e6,
+            cp: 75e3,
+            kb: 150e6,
+            cb: 60e3,
+            kf: 70e6,
+            cf: 100e3,
+            kw: 78e6,
+            cw: 80e3,
+            ls: 0.6,
+            n_sleepers: n,
+            n_modes: nm,
+        }
+    }
+
+    /// Deflection under one load P at x (m) of a track with `kw`.
+    fn bowl(n: usize, nm: usize, kw: f64, x: f64, p: f64) -> (Track, Vec<f64>, usize) {
+        let mut tp = paper_track(n, nm);
+        tp.kw = kw;
+        let mut t = Track::new(tp).unwrap();
+        t.set_wheels(&[x, x, x, x]);
+        let mut y = vec![0.0; t.dim()];
+        let it = t.static_solve(&[p, 0.0, 0.0, 0.0], &mut y).unwrap();
+        (t, y, it)
+    }
+
+    #[test]
+    fn wheel_sines_by_recurrence_are_accurate() {
+        let mut t = Track::new(paper_track(255, 511)).unwrap();
+        t.set_wheels(&[0.3, 76.9, 100.123, 153.0]);
+        for j in 0..4 {
+            let x = [0.3, 76.9, 100.123, 153.0][j];
+            for k in 1..=511 {
+                let exact = (k as f64 * PI * x / t.length).sin();
+                assert!((t.wheel_sin[j * 511 + k - 1] - exact).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn static_load_is_carried_to_the_subgrade() {
+        // Far from the ends, the subgrade springs carry the whole load (Σ Kf Zb = P).
+        let p = 69e3;
+        let (t, y, it) = bowl(255, 128, 78e6, 76.8, p);
+        let zb = &y[t.nm + t.n..];
+        let sum: f64 = zb.iter().map(|z| t.p.kf * z).sum();
+        assert!((sum / p - 1.0).abs() < 1e-6, "subgrade carries {sum} N, iterations {it}");
+        assert!(it < 2000, "{it} iterations");
+    }
+
+    #[test]
+    fn deflection_close_to_a_winkler_beam() {
+        // Without ballast shear the supports are independent springs in series, smeared
+        // over l_s: a beam on an elastic foundation k = Kp·Kb·Kf/(…)/l_s. Peak deflection
+        // P/(8 EI β³), β = (k/(4EI))^¼, within the error of smearing discrete supports.
+        let p = 69e3;
+        let (t, y, _) = bowl(255, 255, 0.0, 76.8, p);
+        let zr = t.rail_at_wheels(&y[..t.nm])[0];
+        let tp = t.p;
+        let ks = 1.0 / (1.0 / tp.kp + 1.0 / tp.kb + 1.0 / tp.kf) / tp.ls;
+        let beta = (ks / (4.0 * tp.ei)).powf(0.25);
+        let w = p / (8.0 * tp.ei * beta.powi(3));
+        assert!((zr / w - 1.0).abs() < 0.05, "rail {zr:e} m, Winkler {w:e} m");
+    }
+
+    #[test]
+    fn dynamic_forces_vanish_in_the_static_state() {
+        let p = 69e3;
+        let (mut t, y, _) = bowl(127, 64, 78e6, 40.0, p);
+        let mut acc = vec![0.0; t.dim()];
+        let yd = vec![0.0; t.dim()];
+        t.accelerations(&y, &yd, &[p, 0.0, 0.0, 0.0], &mut acc);
+        let max = acc.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        assert!(max < 1e-6, "max residual acceleration {max:e}");
+    }
+
+    #[test]
+    fn window_shift_moves_the_deflection_bowl() {
+        // The bowl under a load at x, shifted by m sleepers, is the bowl under x − m l_s.
+        for nm in [255usize, 128] {
+            let (mut t, mut y, _) = bowl(255, nm, 78e6, 90.0, 69e3);
+            t.shift(20, &mut y);
+            let (t2, y2, _) = bowl(255, nm, 78e6, 90.0 - 20.0 * 0.6, 69e3);
+            let peak = y2.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let err = y.iter().zip(&y2).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            // Sleepers and ballast are exact; the rail is re-projected on the NM modes.
+            let zr = t.rail_at_wheels(&y[..nm]);
+            let mut t2 = t2;
+            t2.set_wheels(&[78.0; 4]);
+            t.set_wheels(&[78.0; 4]);
+            let zr1 = t.rail_at_wheels(&y[..nm])[0];
+            let zr2 = t2.rail_at_wheels(&y2[..nm])[0];
+            assert!(zr[0].is_finite());
+            assert!((zr1 - zr2).abs() < 1e-3 * zr2.abs(), "NM {nm}: {zr1:e} vs {zr2:e}");
+            let nodal_err = y[nm..]
+                .iter()
+                .zip(&y2[nm..])
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(nodal_err < 1e-9 * peak.max(1e-12) + 1e-15, "NM {nm}: {nodal_err:e}");
+            let _ = err;
+        }
+    }
+
+    #[test]
+    fn refuses_bad_sizes() {
+        assert!(Track::new(paper_track(100, 50)).is_err());
+        assert!(Track::new(paper_track(63, 0)).is_err());
+        assert!(Track::new(paper_track(63, 128)).is_err());
+        assert!(Track::new(paper_track(63, 127)).is_ok());
+    }
+}
