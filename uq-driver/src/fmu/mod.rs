@@ -1,1 +1,258 @@
 //! FMI 2.0 Co-Simulation import.
+//!
+//! [`Fmu::open`] extracts a `.fmu` archive safely ([`archive`]), parses its
+//! `modelDescription.xml` ([`ModelDescription`]) and loads its binary for this platform
+//! ([`FmuLibrary`]), resolving every FMI 2.0 Co-Simulation function. [`Fmu::instantiate`] then
+//! creates [`Instance`]s, one per worker thread, with a typed API whose errors carry the FMU's
+//! log messages.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), uq_driver::fmu::FmuError> {
+//! use uq_driver::fmu::Fmu;
+//! let fmu = Fmu::open("target/fmu/Wheel.fmu".as_ref())?;
+//! let mut inst = fmu.instantiate("w0", false)?;
+//! inst.set_real_by_name("k", 2.0)?;
+//! inst.setup_experiment(None, 0.0, Some(1.0))?;
+//! inst.enter_initialization_mode()?;
+//! inst.exit_initialization_mode()?;
+//! inst.do_step(0.0, 0.01, true)?;
+//! # Ok(()) }
+//! ```
+//!
+//! Every `Fmu::open` extracts and loads its own copy of the binary, so an FMU that keeps global
+//! state (`canBeInstantiatedOnlyOncePerProcess`) can still run in parallel by opening it once
+//! per worker.
+
+pub mod archive;
+mod binary;
+pub mod description;
+mod error;
+mod instance;
+mod logger;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize};
+use std::sync::Arc;
+
+pub use archive::ExtractLimits;
+pub use binary::{binary_path_in_fmu, platform, FmuLibrary};
+pub use description::{
+    Causality, CoSimulation, DefaultExperiment, DescriptionError, Initial, ModelDescription,
+    ScalarVariable, Unit, Variability, VariableKind, VariableNamingConvention,
+};
+pub use error::{FmuError, LogMessage, Status};
+pub use instance::{FmuState, Instance, InstanceState, StatusKind};
+
+/// An opened FMU: extracted, described and loaded, ready to instantiate.
+///
+/// Cloning is cheap and shares the extraction and the library; `Fmu` is `Send + Sync`, so one
+/// `Fmu` can serve instances on many threads. The extracted folder is deleted and the library
+/// unloaded when the last `Fmu` clone and the last [`Instance`] are gone.
+#[derive(Clone, Debug)]
+pub struct Fmu {
+    inner: Arc<FmuInner>,
+}
+
+/// What instances share with their `Fmu`.
+#[derive(Debug)]
+pub(crate) struct FmuInner {
+    /// The `.fmu` file (or folder) as given by the user.
+    pub(crate) path: PathBuf,
+    pub(crate) description: ModelDescription,
+    /// Declared before `extracted`: the library is unloaded before its folder is deleted.
+    pub(crate) library: FmuLibrary,
+    /// `file:///...resources/` of the extracted folder.
+    pub(crate) resource_uri: String,
+    root: PathBuf,
+    binary: PathBuf,
+    pub(crate) live_instances: AtomicUsize,
+    /// Set when a call returned fmi2Fatal: no function of this FMU may be called again.
+    pub(crate) fatal: AtomicBool,
+    _extracted: Option<tempfile::TempDir>,
+}
+
+impl Fmu {
+    /// Opens an FMU: a `.fmu` archive (extracted into a temporary folder, deleted on drop) or
+    /// an already extracted FMU folder (used in place).
+    pub fn open(path: &Path) -> Result<Fmu, FmuError> {
+        let io = |source| FmuError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let metadata = fs::metadata(path).map_err(io)?;
+        let (extracted, root) = if metadata.is_dir() {
+            (None, path.to_path_buf())
+        } else {
+            let dir = archive::extract_to_temp(path)?;
+            let root = dir.path().to_path_buf();
+            (Some(dir), root)
+        };
+        let root = fs::canonicalize(&root).map_err(io)?;
+
+        let md_path = root.join("modelDescription.xml");
+        if !md_path.is_file() {
+            return Err(FmuError::MissingModelDescription {
+                path: path.to_path_buf(),
+            });
+        }
+        let xml = fs::read(&md_path).map_err(|source| FmuError::Io {
+            path: md_path.clone(),
+            source,
+        })?;
+        let description =
+            ModelDescription::parse(&xml).map_err(|e| FmuError::from_description(path, e))?;
+
+        let relative = binary_path_in_fmu(&description.co_simulation.model_identifier)?;
+        let binary = root.join(&relative);
+        if !binary.is_file() {
+            return Err(FmuError::MissingBinary {
+                path: path.to_path_buf(),
+                expected: relative,
+                available: platform_folders(&root),
+            });
+        }
+        // Name the binary by its place in the FMU, not in the temporary folder.
+        let shown = path.join(&relative);
+        let library = FmuLibrary::load(&binary).map_err(|e| match e {
+            FmuError::Load { reason, .. } => FmuError::Load {
+                path: shown.clone(),
+                reason,
+            },
+            FmuError::MissingSymbol { symbol, .. } => FmuError::MissingSymbol {
+                path: shown.clone(),
+                symbol,
+            },
+            FmuError::IncompatibleBinary { reason, .. } => FmuError::IncompatibleBinary {
+                path: shown.clone(),
+                reason,
+            },
+            other => other,
+        })?;
+
+        let resource_uri = format!("{}/", file_uri(&root.join("resources")));
+        Ok(Fmu {
+            inner: Arc::new(FmuInner {
+                path: path.to_path_buf(),
+                description,
+                library,
+                resource_uri,
+                root,
+                binary,
+                live_instances: AtomicUsize::new(0),
+                fatal: AtomicBool::new(false),
+                _extracted: extracted,
+            }),
+        })
+    }
+
+    /// The parsed `modelDescription.xml`.
+    pub fn description(&self) -> &ModelDescription {
+        &self.inner.description
+    }
+
+    /// The path given to [`Fmu::open`].
+    pub fn path(&self) -> &Path {
+        &self.inner.path
+    }
+
+    /// The folder holding the extracted FMU.
+    pub fn root(&self) -> &Path {
+        &self.inner.root
+    }
+
+    /// The loaded shared library's path (inside [`Fmu::root`]).
+    pub fn binary_path(&self) -> &Path {
+        &self.inner.binary
+    }
+
+    /// The loaded library.
+    pub fn library(&self) -> &FmuLibrary {
+        &self.inner.library
+    }
+
+    /// The `fmuResourceLocation` passed to `fmi2Instantiate`: a percent-encoded `file:///` URI
+    /// of the extracted `resources/` folder, ending with `/`.
+    pub fn resource_uri(&self) -> &str {
+        &self.inner.resource_uri
+    }
+
+    /// Creates a Co-Simulation instance (`fmi2Instantiate` with this FMU's GUID, not visible).
+    /// `logging_on` asks the FMU for debug logging and echoes its messages to stderr; errors
+    /// are logged and kept whatever it is.
+    pub fn instantiate(&self, instance_name: &str, logging_on: bool) -> Result<Instance, FmuError> {
+        Instance::new(Arc::clone(&self.inner), instance_name, logging_on)
+    }
+}
+
+/// The folders under `root/binaries`, for error messages.
+fn platform_folders(root: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(root.join("binaries"))
+        .map(|entries| {
+            entries
+                .filter_map(Result::ok)
+                .filter(|e| e.path().is_dir())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// A `file:///` URI for an absolute path, percent-encoding all but unreserved characters,
+/// `/` and `:`.
+pub fn file_uri(path: &Path) -> String {
+    #[cfg(unix)]
+    let bytes: Vec<u8> = {
+        use std::os::unix::ffi::OsStrExt;
+        path.as_os_str().as_bytes().to_vec()
+    };
+    #[cfg(windows)]
+    let bytes: Vec<u8> = {
+        let text = path.to_string_lossy().replace('\\', "/");
+        let text = text.strip_prefix("//?/").unwrap_or(&text);
+        format!("/{text}").into_bytes()
+    };
+    #[cfg(not(any(unix, windows)))]
+    let bytes: Vec<u8> = path.to_string_lossy().as_bytes().to_vec();
+    let mut uri = String::from("file://");
+    for b in bytes {
+        if b.is_ascii_alphanumeric() || b"-._~/:".contains(&b) {
+            uri.push(char::from(b));
+        } else {
+            uri.push_str(&format!("%{b:02X}"));
+        }
+    }
+    uri
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_uri_percent_encodes() {
+        #[cfg(unix)]
+        assert_eq!(
+            file_uri(Path::new("/tmp/a b/ü%/resources")),
+            "file:///tmp/a%20b/%C3%BC%25/resources"
+        );
+    }
+
+    #[test]
+    fn fmu_is_send_and_sync_and_instance_is_send() {
+        fn send_sync<T: Send + Sync>() {}
+        fn send<T: Send>() {}
+        send_sync::<Fmu>();
+        send::<Instance>();
+        send::<FmuError>();
+    }
+
+    #[test]
+    fn open_reports_missing_file() {
+        let err = Fmu::open(Path::new("/nonexistent/M.fmu")).unwrap_err();
+        assert!(matches!(err, FmuError::Io { .. }), "{err}");
+        assert!(err.to_string().starts_with("/nonexistent/M.fmu: "), "{err}");
+    }
+}

@@ -1,0 +1,1441 @@
+//! `modelDescription.xml` of an FMI 2.0 Co-Simulation FMU, parsed into typed structs.
+//!
+//! Only what an importer needs is kept: the header attributes, the Co-Simulation capabilities,
+//! the default experiment, units, log categories, the scalar variables and the list of outputs.
+//! Defaults follow the FMI 2.0 standard (causality `local`, variability `continuous` for Real
+//! variables; see [`ScalarVariable`] for the others).
+
+use std::collections::HashMap;
+use std::str::FromStr;
+
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::Reader;
+
+/// Why a `modelDescription.xml` could not be accepted. Lines and columns are 1-based.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DescriptionError {
+    /// The document is not well-formed XML.
+    #[error("malformed XML at line {line}, column {column}: {reason}")]
+    Malformed {
+        /// Line of the error.
+        line: usize,
+        /// Column (in bytes) of the error.
+        column: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// `fmiVersion` is not `"2.0"`.
+    #[error("unsupported FMI version \"{found}\" (expected \"2.0\")")]
+    UnsupportedFmiVersion {
+        /// The `fmiVersion` attribute found.
+        found: String,
+    },
+    /// The description has no `CoSimulation` element.
+    #[error("no CoSimulation element{}", if *.model_exchange_present { " (Model Exchange only)" } else { "" })]
+    NoCoSimulation {
+        /// Whether a `ModelExchange` element is present.
+        model_exchange_present: bool,
+    },
+    /// The root element is not `fmiModelDescription`.
+    #[error("line {line}: the root element is <{found}>, expected <fmiModelDescription>")]
+    WrongRoot {
+        /// The root element found.
+        found: String,
+        /// Its line.
+        line: usize,
+    },
+    /// A required attribute is missing.
+    #[error("line {line}: <{element}> has no {attribute} attribute")]
+    MissingAttribute {
+        /// The element.
+        element: String,
+        /// The attribute.
+        attribute: &'static str,
+        /// The element's line.
+        line: usize,
+    },
+    /// An attribute has a value that FMI 2.0 does not allow.
+    #[error("line {line}: <{element}> has invalid {attribute}=\"{value}\" ({expected})")]
+    InvalidAttribute {
+        /// The element.
+        element: String,
+        /// The attribute.
+        attribute: String,
+        /// The value found.
+        value: String,
+        /// What was expected.
+        expected: String,
+        /// The element's line.
+        line: usize,
+    },
+    /// An element that may appear once appears again.
+    #[error("line {line}: more than one <{element}> element")]
+    Repeated {
+        /// The element.
+        element: String,
+        /// The line of the second one.
+        line: usize,
+    },
+    /// A `ScalarVariable` has no type element (`Real`, `Integer`, ...), or more than one.
+    #[error("line {line}: variable '{name}' must have exactly one type element (Real, Integer, Boolean, String or Enumeration)")]
+    BadTypeElement {
+        /// The variable.
+        name: String,
+        /// The variable's line.
+        line: usize,
+    },
+    /// Two variables have the same name.
+    #[error("duplicate variable name '{name}'")]
+    DuplicateName {
+        /// The name.
+        name: String,
+    },
+    /// Two variables of the same base type share a value reference but are not valid aliases
+    /// (FMI 2.0 allows aliases, but at most one per alias set may have a start value, and at
+    /// most one may be a parameter or an input).
+    #[error(
+        "variables '{first}' and '{second}' share the {base_type} value reference \
+         {value_reference} but cannot be aliases: {reason}"
+    )]
+    DuplicateValueReference {
+        /// The base type (Real, Integer, Boolean or String; Enumeration counts as Integer).
+        base_type: &'static str,
+        /// The shared value reference.
+        value_reference: u32,
+        /// The first variable.
+        first: String,
+        /// The second variable.
+        second: String,
+        /// Why they cannot be aliases.
+        reason: &'static str,
+    },
+    /// `ModelStructure/Outputs/Unknown` refers to a variable that does not exist.
+    #[error(
+        "ModelStructure/Outputs refers to variable index {index}, but there are {count} variables"
+    )]
+    BadOutputIndex {
+        /// The 1-based index found.
+        index: usize,
+        /// The number of variables.
+        count: usize,
+    },
+}
+
+/// The parsed `modelDescription.xml` of an FMI 2.0 Co-Simulation FMU.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelDescription {
+    /// Always `"2.0"`.
+    pub fmi_version: String,
+    /// `modelName`.
+    pub model_name: String,
+    /// `guid`, passed to `fmi2Instantiate`.
+    pub guid: String,
+    /// `description`.
+    pub description: Option<String>,
+    /// `generationTool`.
+    pub generation_tool: Option<String>,
+    /// `variableNamingConvention` (default flat).
+    pub variable_naming_convention: VariableNamingConvention,
+    /// `numberOfEventIndicators`.
+    pub number_of_event_indicators: Option<u32>,
+    /// The Co-Simulation capabilities. Always present: [`ModelDescription::parse`] refuses a
+    /// description without a `CoSimulation` element.
+    pub co_simulation: CoSimulation,
+    /// Whether the FMU also implements Model Exchange.
+    pub model_exchange_present: bool,
+    /// `DefaultExperiment`, if any.
+    pub default_experiment: Option<DefaultExperiment>,
+    /// `UnitDefinitions`.
+    pub unit_definitions: Vec<Unit>,
+    /// `LogCategories`: (name, description).
+    pub log_categories: Vec<(String, Option<String>)>,
+    /// `ModelVariables`, in document order (index `i` is the variable `i + 1` of `ModelStructure`).
+    pub variables: Vec<ScalarVariable>,
+    /// 1-based indices into `variables` from `ModelStructure/Outputs`.
+    pub outputs: Vec<usize>,
+}
+
+/// `variableNamingConvention`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VariableNamingConvention {
+    /// Any string (the default).
+    #[default]
+    Flat,
+    /// Hierarchical names such as `a.b[2].c`.
+    Structured,
+}
+
+/// The attributes of the `CoSimulation` element. Flags default to `false`.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CoSimulation {
+    /// Prefix of the binary's file name (`binaries/<platform>/<modelIdentifier>.so`).
+    pub model_identifier: String,
+    /// `needsExecutionTool`.
+    pub needs_execution_tool: bool,
+    /// `canHandleVariableCommunicationStepSize`.
+    pub can_handle_variable_communication_step_size: bool,
+    /// `canInterpolateInputs`.
+    pub can_interpolate_inputs: bool,
+    /// `maxOutputDerivativeOrder` (default 0).
+    pub max_output_derivative_order: u32,
+    /// `canRunAsynchronuously` (sic, as spelled by FMI 2.0).
+    pub can_run_asynchronuously: bool,
+    /// `canBeInstantiatedOnlyOncePerProcess`.
+    pub can_be_instantiated_only_once_per_process: bool,
+    /// `canNotUseMemoryManagementFunctions`.
+    pub can_not_use_memory_management_functions: bool,
+    /// `canGetAndSetFMUstate`.
+    pub can_get_and_set_fmu_state: bool,
+    /// `canSerializeFMUstate`.
+    pub can_serialize_fmu_state: bool,
+    /// `providesDirectionalDerivative`.
+    pub provides_directional_derivative: bool,
+}
+
+/// `DefaultExperiment`: times in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DefaultExperiment {
+    /// `startTime` (s).
+    pub start_time: Option<f64>,
+    /// `stopTime` (s).
+    pub stop_time: Option<f64>,
+    /// `tolerance` (relative).
+    pub tolerance: Option<f64>,
+    /// `stepSize` (s): the suggested communication step.
+    pub step_size: Option<f64>,
+}
+
+/// A unit of `UnitDefinitions`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Unit {
+    /// The unit's name, e.g. `m/s2`.
+    pub name: String,
+}
+
+/// `causality` of a variable (default `local`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Causality {
+    /// Set by the environment before initialization (and during the run if tunable).
+    Parameter,
+    /// Computed from parameters during initialization.
+    CalculatedParameter,
+    /// Set by the environment at communication points.
+    Input,
+    /// Read by the environment.
+    Output,
+    /// Internal.
+    #[default]
+    Local,
+    /// The independent variable (time).
+    Independent,
+}
+
+/// `variability` of a variable (default `continuous`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Variability {
+    /// Never changes.
+    Constant,
+    /// Fixed after initialization.
+    Fixed,
+    /// Changes only at communication points (or events), when set by the environment.
+    Tunable,
+    /// Changes only at events.
+    Discrete,
+    /// May change at any time (Real variables only).
+    #[default]
+    Continuous,
+}
+
+/// `initial` of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Initial {
+    /// Initialized with the start value.
+    Exact,
+    /// The start value is a guess for an iteration.
+    Approx,
+    /// Computed during initialization.
+    Calculated,
+}
+
+/// A `ScalarVariable`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarVariable {
+    /// Unique name.
+    pub name: String,
+    /// Handle used by `fmi2Get*`/`fmi2Set*`; unique per base type except for aliases.
+    pub value_reference: u32,
+    /// `description`.
+    pub description: Option<String>,
+    /// `causality`.
+    pub causality: Causality,
+    /// `variability`. If the attribute is absent: continuous for Real, discrete for the others
+    /// (FMI 2.0 allows continuous only for Real).
+    pub variability: Variability,
+    /// `initial` as written; see [`ScalarVariable::effective_initial`] for the default.
+    pub initial: Option<Initial>,
+    /// Type and type-specific attributes.
+    pub kind: VariableKind,
+}
+
+/// The type element of a variable, with its attributes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum VariableKind {
+    /// `Real` (`fmi2Real`, a C `double`).
+    Real {
+        /// `start`.
+        start: Option<f64>,
+        /// `unit`.
+        unit: Option<String>,
+        /// `declaredType`.
+        declared_type: Option<String>,
+        /// `min`.
+        min: Option<f64>,
+        /// `max`.
+        max: Option<f64>,
+        /// `nominal`.
+        nominal: Option<f64>,
+    },
+    /// `Integer` (`fmi2Integer`, a C `int`).
+    Integer {
+        /// `start`.
+        start: Option<i32>,
+        /// `min`.
+        min: Option<i32>,
+        /// `max`.
+        max: Option<i32>,
+    },
+    /// `Boolean` (`fmi2Boolean`, a C `int`).
+    Boolean {
+        /// `start`.
+        start: Option<bool>,
+    },
+    /// `String` (`fmi2String`).
+    String {
+        /// `start`.
+        start: Option<String>,
+    },
+    /// `Enumeration` (accessed as `fmi2Integer`).
+    Enumeration {
+        /// `start`.
+        start: Option<i32>,
+        /// `declaredType` (required by FMI 2.0).
+        declared_type: String,
+    },
+}
+
+impl VariableKind {
+    /// The type element's name: `Real`, `Integer`, `Boolean`, `String` or `Enumeration`.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            VariableKind::Real { .. } => "Real",
+            VariableKind::Integer { .. } => "Integer",
+            VariableKind::Boolean { .. } => "Boolean",
+            VariableKind::String { .. } => "String",
+            VariableKind::Enumeration { .. } => "Enumeration",
+        }
+    }
+
+    /// The FMI base type used to get and set it (`Enumeration` is accessed as `Integer`).
+    pub fn base_type(&self) -> &'static str {
+        match self {
+            VariableKind::Enumeration { .. } => "Integer",
+            other => other.type_name(),
+        }
+    }
+
+    /// Whether a `start` attribute is present.
+    pub fn has_start(&self) -> bool {
+        match self {
+            VariableKind::Real { start, .. } => start.is_some(),
+            VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
+                start.is_some()
+            }
+            VariableKind::Boolean { start } => start.is_some(),
+            VariableKind::String { start } => start.is_some(),
+        }
+    }
+}
+
+impl Causality {
+    /// The attribute value as written in modelDescription.xml, e.g. `calculatedParameter`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Causality::Parameter => "parameter",
+            Causality::CalculatedParameter => "calculatedParameter",
+            Causality::Input => "input",
+            Causality::Output => "output",
+            Causality::Local => "local",
+            Causality::Independent => "independent",
+        }
+    }
+}
+
+impl Variability {
+    /// The attribute value as written in modelDescription.xml, e.g. `tunable`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Variability::Constant => "constant",
+            Variability::Fixed => "fixed",
+            Variability::Tunable => "tunable",
+            Variability::Discrete => "discrete",
+            Variability::Continuous => "continuous",
+        }
+    }
+}
+
+impl Initial {
+    /// The attribute value as written in modelDescription.xml, e.g. `exact`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Initial::Exact => "exact",
+            Initial::Approx => "approx",
+            Initial::Calculated => "calculated",
+        }
+    }
+}
+
+impl ScalarVariable {
+    /// `initial`, or its FMI 2.0 default from causality and variability when absent
+    /// (`None` for inputs and the independent variable, which have no `initial`).
+    pub fn effective_initial(&self) -> Option<Initial> {
+        if self.initial.is_some() {
+            return self.initial;
+        }
+        match (self.causality, self.variability) {
+            (Causality::Input | Causality::Independent, _) => None,
+            (Causality::Parameter, _) => Some(Initial::Exact),
+            (Causality::CalculatedParameter, _) => Some(Initial::Calculated),
+            (Causality::Output | Causality::Local, Variability::Constant) => Some(Initial::Exact),
+            (Causality::Output | Causality::Local, _) => Some(Initial::Calculated),
+        }
+    }
+
+    /// Whether `fmi2Set*` may set this variable after instantiation, before
+    /// `fmi2EnterInitializationMode` (FMI 2.0: variability not constant and initial exact or
+    /// approx; this covers fixed and tunable parameters and inputs).
+    pub fn settable_before_init(&self) -> bool {
+        self.variability != Variability::Constant
+            && (self.causality == Causality::Input
+                || matches!(
+                    self.effective_initial(),
+                    Some(Initial::Exact | Initial::Approx)
+                ))
+    }
+
+    /// Whether `fmi2Set*` may set this variable in initialization mode (FMI 2.0: variability not
+    /// constant and initial exact, or an input).
+    pub fn settable_in_initialization_mode(&self) -> bool {
+        self.variability != Variability::Constant
+            && (self.causality == Causality::Input
+                || self.effective_initial() == Some(Initial::Exact))
+    }
+
+    /// Whether `fmi2Set*` may set this variable after initialization, at communication points
+    /// (FMI 2.0: inputs and tunable parameters only).
+    pub fn settable_after_init(&self) -> bool {
+        self.causality == Causality::Input
+            || (self.causality == Causality::Parameter && self.variability == Variability::Tunable)
+    }
+}
+
+impl ModelDescription {
+    /// Parses `modelDescription.xml` from its bytes (UTF-8, an optional byte-order mark allowed).
+    pub fn parse(xml: &[u8]) -> Result<ModelDescription, DescriptionError> {
+        let xml = xml.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(xml);
+        let mut reader = Reader::from_reader(xml);
+        let mut builder = Builder::default();
+        let mut stack: Vec<Elem> = Vec::new();
+        let mut root_seen = false;
+        loop {
+            let pos = to_usize(reader.buffer_position());
+            let event = reader
+                .read_event()
+                .map_err(|e| malformed(xml, to_usize(reader.error_position()), e.to_string()))?;
+            match event {
+                Event::Start(ref e) | Event::Empty(ref e) => {
+                    if stack.is_empty() {
+                        if root_seen {
+                            return Err(malformed(xml, pos, "more than one root element".into()));
+                        }
+                        root_seen = true;
+                    }
+                    let line = line_col(xml, pos).0;
+                    let elem = builder.open(e, stack.last().copied(), line)?;
+                    if matches!(event, Event::Start(_)) {
+                        stack.push(elem);
+                    } else {
+                        builder.close(elem)?;
+                    }
+                }
+                Event::End(_) => {
+                    if let Some(elem) = stack.pop() {
+                        builder.close(elem)?;
+                    }
+                }
+                Event::Eof => break,
+                _ => {}
+            }
+        }
+        if !stack.is_empty() {
+            return Err(malformed(
+                xml,
+                xml.len(),
+                "unexpected end of document: an element is not closed".into(),
+            ));
+        }
+        if !root_seen {
+            return Err(malformed(xml, xml.len(), "no root element".into()));
+        }
+        builder.finish()
+    }
+
+    /// The variable with this name, if any.
+    pub fn variable(&self, name: &str) -> Option<&ScalarVariable> {
+        self.variables.iter().find(|v| v.name == name)
+    }
+
+    /// The variables listed in `ModelStructure/Outputs`, in that order.
+    pub fn output_variables(&self) -> impl Iterator<Item = &ScalarVariable> + '_ {
+        self.outputs
+            .iter()
+            .filter_map(|&i| self.variables.get(i.wrapping_sub(1)))
+    }
+
+    /// Whether `var` may be set before initialization; see [`ScalarVariable::settable_before_init`].
+    pub fn settable_before_init(&self, var: &ScalarVariable) -> bool {
+        var.settable_before_init()
+    }
+
+    /// Whether `var` may be set after initialization; see [`ScalarVariable::settable_after_init`].
+    pub fn settable_after_init(&self, var: &ScalarVariable) -> bool {
+        var.settable_after_init()
+    }
+}
+
+// ----------------------------------------------------------------------------------------------
+// Parsing machinery.
+
+/// The elements whose content matters, as context for their children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Elem {
+    Root,
+    UnitDefinitions,
+    LogCategories,
+    ModelVariables,
+    ScalarVariable,
+    ModelStructure,
+    Outputs,
+    /// Anything else (annotations, type definitions, ...): its content is skipped.
+    Other,
+}
+
+/// A variable whose type element has not been seen yet.
+struct PendingVar {
+    name: String,
+    value_reference: u32,
+    description: Option<String>,
+    causality: Causality,
+    variability: Option<Variability>,
+    initial: Option<Initial>,
+    kind: Option<VariableKind>,
+    type_elements: usize,
+    line: usize,
+}
+
+#[derive(Default)]
+struct Builder {
+    fmi_version: String,
+    model_name: String,
+    guid: String,
+    description: Option<String>,
+    generation_tool: Option<String>,
+    variable_naming_convention: VariableNamingConvention,
+    number_of_event_indicators: Option<u32>,
+    co_simulation: Option<CoSimulation>,
+    model_exchange_present: bool,
+    default_experiment: Option<DefaultExperiment>,
+    unit_definitions: Vec<Unit>,
+    log_categories: Vec<(String, Option<String>)>,
+    variables: Vec<ScalarVariable>,
+    outputs: Vec<usize>,
+    pending: Option<PendingVar>,
+}
+
+/// The attributes of one element, unescaped.
+struct Attrs {
+    element: String,
+    line: usize,
+    list: Vec<(String, String)>,
+}
+
+impl Attrs {
+    fn read(e: &BytesStart<'_>, element: &str, line: usize) -> Result<Attrs, DescriptionError> {
+        let mut list = Vec::new();
+        for attr in e.attributes() {
+            let attr = attr.map_err(|err| DescriptionError::Malformed {
+                line,
+                column: 1,
+                reason: format!("in <{element}>: {err}"),
+            })?;
+            let key = String::from_utf8_lossy(attr.key.local_name().as_ref()).into_owned();
+            let value = attr
+                .unescape_value()
+                .map_err(|err| DescriptionError::Malformed {
+                    line,
+                    column: 1,
+                    reason: format!("in <{element}> attribute {key}: {err}"),
+                })?
+                .into_owned();
+            list.push((key, value));
+        }
+        Ok(Attrs {
+            element: element.to_string(),
+            line,
+            list,
+        })
+    }
+
+    fn get(&self, key: &str) -> Option<&str> {
+        self.list
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+
+    fn string(&self, key: &str) -> Option<String> {
+        self.get(key).map(str::to_string)
+    }
+
+    fn required(&self, key: &'static str) -> Result<String, DescriptionError> {
+        self.string(key)
+            .ok_or_else(|| DescriptionError::MissingAttribute {
+                element: self.element.clone(),
+                attribute: key,
+                line: self.line,
+            })
+    }
+
+    fn invalid(&self, key: &str, value: &str, expected: &str) -> DescriptionError {
+        DescriptionError::InvalidAttribute {
+            element: self.element.clone(),
+            attribute: key.to_string(),
+            value: value.to_string(),
+            expected: expected.to_string(),
+            line: self.line,
+        }
+    }
+
+    fn number<T: FromStr>(&self, key: &str, expected: &str) -> Result<Option<T>, DescriptionError> {
+        match self.get(key) {
+            None => Ok(None),
+            Some(v) => v
+                .trim()
+                .parse()
+                .map(Some)
+                .map_err(|_| self.invalid(key, v, expected)),
+        }
+    }
+
+    fn real(&self, key: &str) -> Result<Option<f64>, DescriptionError> {
+        self.number(key, "a real number")
+    }
+
+    fn boolean(&self, key: &str) -> Result<Option<bool>, DescriptionError> {
+        match self.get(key).map(str::trim) {
+            None => Ok(None),
+            Some("true" | "1") => Ok(Some(true)),
+            Some("false" | "0") => Ok(Some(false)),
+            Some(v) => Err(self.invalid(key, v, "true or false")),
+        }
+    }
+
+    fn flag(&self, key: &str) -> Result<bool, DescriptionError> {
+        Ok(self.boolean(key)?.unwrap_or(false))
+    }
+
+    fn choice<T: Copy>(
+        &self,
+        key: &str,
+        options: &[(&str, T)],
+    ) -> Result<Option<T>, DescriptionError> {
+        let Some(v) = self.get(key) else {
+            return Ok(None);
+        };
+        options
+            .iter()
+            .find(|(name, _)| *name == v)
+            .map(|&(_, t)| Some(t))
+            .ok_or_else(|| {
+                let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
+                self.invalid(key, v, &format!("one of {}", names.join(", ")))
+            })
+    }
+}
+
+impl Builder {
+    fn open(
+        &mut self,
+        e: &BytesStart<'_>,
+        parent: Option<Elem>,
+        line: usize,
+    ) -> Result<Elem, DescriptionError> {
+        let local = e.local_name();
+        let name = String::from_utf8_lossy(local.as_ref());
+        let attrs = || Attrs::read(e, &name, line);
+        let elem = match (parent, name.as_ref()) {
+            (None, "fmiModelDescription") => {
+                self.root(&attrs()?)?;
+                Elem::Root
+            }
+            (None, other) => {
+                return Err(DescriptionError::WrongRoot {
+                    found: other.to_string(),
+                    line,
+                })
+            }
+            (Some(Elem::Root), "CoSimulation") => {
+                if self.co_simulation.is_some() {
+                    return Err(DescriptionError::Repeated {
+                        element: name.to_string(),
+                        line,
+                    });
+                }
+                self.co_simulation = Some(co_simulation(&attrs()?)?);
+                Elem::Other
+            }
+            (Some(Elem::Root), "ModelExchange") => {
+                self.model_exchange_present = true;
+                Elem::Other
+            }
+            (Some(Elem::Root), "UnitDefinitions") => Elem::UnitDefinitions,
+            (Some(Elem::UnitDefinitions), "Unit") => {
+                let name = attrs()?.required("name")?;
+                self.unit_definitions.push(Unit { name });
+                Elem::Other
+            }
+            (Some(Elem::Root), "LogCategories") => Elem::LogCategories,
+            (Some(Elem::LogCategories), "Category") => {
+                let a = attrs()?;
+                self.log_categories
+                    .push((a.required("name")?, a.string("description")));
+                Elem::Other
+            }
+            (Some(Elem::Root), "DefaultExperiment") => {
+                let a = attrs()?;
+                self.default_experiment = Some(DefaultExperiment {
+                    start_time: a.real("startTime")?,
+                    stop_time: a.real("stopTime")?,
+                    tolerance: a.real("tolerance")?,
+                    step_size: a.real("stepSize")?,
+                });
+                Elem::Other
+            }
+            (Some(Elem::Root), "ModelVariables") => Elem::ModelVariables,
+            (Some(Elem::ModelVariables), "ScalarVariable") => {
+                self.pending = Some(pending_variable(&attrs()?)?);
+                Elem::ScalarVariable
+            }
+            (
+                Some(Elem::ScalarVariable),
+                "Real" | "Integer" | "Boolean" | "String" | "Enumeration",
+            ) => {
+                let kind = variable_kind(&attrs()?)?;
+                if let Some(p) = self.pending.as_mut() {
+                    p.type_elements += 1;
+                    p.kind = Some(kind);
+                }
+                Elem::Other
+            }
+            (Some(Elem::Root), "ModelStructure") => Elem::ModelStructure,
+            (Some(Elem::ModelStructure), "Outputs") => Elem::Outputs,
+            (Some(Elem::Outputs), "Unknown") => {
+                let a = attrs()?;
+                let index: usize = a.number("index", "a positive integer")?.ok_or_else(|| {
+                    DescriptionError::MissingAttribute {
+                        element: a.element.clone(),
+                        attribute: "index",
+                        line,
+                    }
+                })?;
+                self.outputs.push(index);
+                Elem::Other
+            }
+            _ => Elem::Other,
+        };
+        Ok(elem)
+    }
+
+    fn close(&mut self, elem: Elem) -> Result<(), DescriptionError> {
+        if elem != Elem::ScalarVariable {
+            return Ok(());
+        }
+        let Some(p) = self.pending.take() else {
+            return Ok(());
+        };
+        let kind = match (p.kind, p.type_elements) {
+            (Some(kind), 1) => kind,
+            _ => {
+                return Err(DescriptionError::BadTypeElement {
+                    name: p.name,
+                    line: p.line,
+                })
+            }
+        };
+        let variability = p.variability.unwrap_or(match kind {
+            VariableKind::Real { .. } => Variability::Continuous,
+            _ => Variability::Discrete,
+        });
+        self.variables.push(ScalarVariable {
+            name: p.name,
+            value_reference: p.value_reference,
+            description: p.description,
+            causality: p.causality,
+            variability,
+            initial: p.initial,
+            kind,
+        });
+        Ok(())
+    }
+
+    fn root(&mut self, a: &Attrs) -> Result<(), DescriptionError> {
+        // The version first: an FMI 1.0 or 3.0 file would fail later checks confusingly.
+        let version = a.required("fmiVersion")?;
+        if version.trim() != "2.0" {
+            return Err(DescriptionError::UnsupportedFmiVersion { found: version });
+        }
+        self.fmi_version = "2.0".to_string();
+        self.model_name = a.required("modelName")?;
+        self.guid = a.required("guid")?;
+        self.description = a.string("description");
+        self.generation_tool = a.string("generationTool");
+        self.variable_naming_convention = a
+            .choice(
+                "variableNamingConvention",
+                &[
+                    ("flat", VariableNamingConvention::Flat),
+                    ("structured", VariableNamingConvention::Structured),
+                ],
+            )?
+            .unwrap_or_default();
+        self.number_of_event_indicators =
+            a.number("numberOfEventIndicators", "a non-negative integer")?;
+        Ok(())
+    }
+
+    fn finish(self) -> Result<ModelDescription, DescriptionError> {
+        let Some(co_simulation) = self.co_simulation else {
+            return Err(DescriptionError::NoCoSimulation {
+                model_exchange_present: self.model_exchange_present,
+            });
+        };
+        let mut names: HashMap<&str, ()> = HashMap::with_capacity(self.variables.len());
+        // Per (base type, value reference): the first variable with a start value and the first
+        // parameter or input of the alias set.
+        struct AliasSet {
+            with_start: Option<usize>,
+            settable: Option<usize>,
+        }
+        let mut sets: HashMap<(&'static str, u32), AliasSet> = HashMap::new();
+        for (i, v) in self.variables.iter().enumerate() {
+            if names.insert(v.name.as_str(), ()).is_some() {
+                return Err(DescriptionError::DuplicateName {
+                    name: v.name.clone(),
+                });
+            }
+            let key = (v.kind.base_type(), v.value_reference);
+            let has_start = v.kind.has_start();
+            let settable = matches!(v.causality, Causality::Parameter | Causality::Input);
+            let set = sets.entry(key).or_insert(AliasSet {
+                with_start: None,
+                settable: None,
+            });
+            let conflict =
+                |other: usize, reason: &'static str| DescriptionError::DuplicateValueReference {
+                    base_type: key.0,
+                    value_reference: key.1,
+                    first: self.variables[other].name.clone(),
+                    second: v.name.clone(),
+                    reason,
+                };
+            if has_start {
+                if let Some(other) = set.with_start {
+                    return Err(conflict(other, "both have a start value"));
+                }
+                set.with_start = Some(i);
+            }
+            if settable {
+                if let Some(other) = set.settable {
+                    return Err(conflict(other, "both are parameters or inputs"));
+                }
+                set.settable = Some(i);
+            }
+        }
+        let count = self.variables.len();
+        if let Some(&index) = self.outputs.iter().find(|&&i| i == 0 || i > count) {
+            return Err(DescriptionError::BadOutputIndex { index, count });
+        }
+        Ok(ModelDescription {
+            fmi_version: self.fmi_version,
+            model_name: self.model_name,
+            guid: self.guid,
+            description: self.description,
+            generation_tool: self.generation_tool,
+            variable_naming_convention: self.variable_naming_convention,
+            number_of_event_indicators: self.number_of_event_indicators,
+            co_simulation,
+            model_exchange_present: self.model_exchange_present,
+            default_experiment: self.default_experiment,
+            unit_definitions: self.unit_definitions,
+            log_categories: self.log_categories,
+            variables: self.variables,
+            outputs: self.outputs,
+        })
+    }
+}
+
+fn co_simulation(a: &Attrs) -> Result<CoSimulation, DescriptionError> {
+    let model_identifier = a.required("modelIdentifier")?;
+    // It names a file inside the FMU: refuse anything that is not a plain file-name stem.
+    let plain = !model_identifier.is_empty()
+        && model_identifier != "."
+        && model_identifier != ".."
+        && !model_identifier.contains(['/', '\\', '\0', ':']);
+    if !plain {
+        return Err(a.invalid(
+            "modelIdentifier",
+            &model_identifier,
+            "a C identifier usable as a file name",
+        ));
+    }
+    Ok(CoSimulation {
+        model_identifier,
+        needs_execution_tool: a.flag("needsExecutionTool")?,
+        can_handle_variable_communication_step_size: a
+            .flag("canHandleVariableCommunicationStepSize")?,
+        can_interpolate_inputs: a.flag("canInterpolateInputs")?,
+        max_output_derivative_order: a
+            .number("maxOutputDerivativeOrder", "a non-negative integer")?
+            .unwrap_or(0),
+        can_run_asynchronuously: a.flag("canRunAsynchronuously")?,
+        can_be_instantiated_only_once_per_process: a.flag("canBeInstantiatedOnlyOncePerProcess")?,
+        can_not_use_memory_management_functions: a.flag("canNotUseMemoryManagementFunctions")?,
+        can_get_and_set_fmu_state: a.flag("canGetAndSetFMUstate")?,
+        can_serialize_fmu_state: a.flag("canSerializeFMUstate")?,
+        provides_directional_derivative: a.flag("providesDirectionalDerivative")?,
+    })
+}
+
+fn pending_variable(a: &Attrs) -> Result<PendingVar, DescriptionError> {
+    let name = a.required("name")?;
+    let value_reference = a
+        .number("valueReference", "an unsigned 32-bit integer")?
+        .ok_or_else(|| DescriptionError::MissingAttribute {
+            element: a.element.clone(),
+            attribute: "valueReference",
+            line: a.line,
+        })?;
+    let causality = a
+        .choice(
+            "causality",
+            &[
+                ("parameter", Causality::Parameter),
+                ("calculatedParameter", Causality::CalculatedParameter),
+                ("input", Causality::Input),
+                ("output", Causality::Output),
+                ("local", Causality::Local),
+                ("independent", Causality::Independent),
+            ],
+        )?
+        .unwrap_or_default();
+    let variability = a.choice(
+        "variability",
+        &[
+            ("constant", Variability::Constant),
+            ("fixed", Variability::Fixed),
+            ("tunable", Variability::Tunable),
+            ("discrete", Variability::Discrete),
+            ("continuous", Variability::Continuous),
+        ],
+    )?;
+    let initial = a.choice(
+        "initial",
+        &[
+            ("exact", Initial::Exact),
+            ("approx", Initial::Approx),
+            ("calculated", Initial::Calculated),
+        ],
+    )?;
+    Ok(PendingVar {
+        name,
+        value_reference,
+        description: a.string("description"),
+        causality,
+        variability,
+        initial,
+        kind: None,
+        type_elements: 0,
+        line: a.line,
+    })
+}
+
+fn variable_kind(a: &Attrs) -> Result<VariableKind, DescriptionError> {
+    const INT: &str = "a 32-bit integer";
+    Ok(match a.element.as_str() {
+        "Real" => VariableKind::Real {
+            start: a.real("start")?,
+            unit: a.string("unit"),
+            declared_type: a.string("declaredType"),
+            min: a.real("min")?,
+            max: a.real("max")?,
+            nominal: a.real("nominal")?,
+        },
+        "Integer" => VariableKind::Integer {
+            start: a.number("start", INT)?,
+            min: a.number("min", INT)?,
+            max: a.number("max", INT)?,
+        },
+        "Boolean" => VariableKind::Boolean {
+            start: a.boolean("start")?,
+        },
+        "String" => VariableKind::String {
+            start: a.string("start"),
+        },
+        _ => VariableKind::Enumeration {
+            start: a.number("start", INT)?,
+            declared_type: a.required("declaredType")?,
+        },
+    })
+}
+
+fn to_usize(pos: u64) -> usize {
+    usize::try_from(pos).unwrap_or(usize::MAX)
+}
+
+/// 1-based line and column (in bytes) of byte offset `pos`.
+fn line_col(xml: &[u8], pos: usize) -> (usize, usize) {
+    let before = &xml[..pos.min(xml.len())];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    (line, before.len() - line_start + 1)
+}
+
+fn malformed(xml: &[u8], pos: usize, reason: String) -> DescriptionError {
+    let (line, column) = line_col(xml, pos);
+    DescriptionError::Malformed {
+        line,
+        column,
+        reason,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MINIMAL: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="M" guid="{abc}">
+  <CoSimulation modelIdentifier="M"/>
+  <ModelVariables>
+    <ScalarVariable name="x" valueReference="0"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure/>
+</fmiModelDescription>"#;
+
+    fn parse(s: &str) -> Result<ModelDescription, DescriptionError> {
+        ModelDescription::parse(s.as_bytes())
+    }
+
+    #[test]
+    fn minimal_description_gets_fmi_defaults() {
+        let md = parse(MINIMAL).unwrap();
+        assert_eq!(md.fmi_version, "2.0");
+        assert_eq!(md.guid, "{abc}");
+        assert_eq!(md.co_simulation.model_identifier, "M");
+        assert!(!md.co_simulation.can_get_and_set_fmu_state);
+        assert_eq!(md.co_simulation.max_output_derivative_order, 0);
+        assert!(!md.model_exchange_present);
+        assert_eq!(md.default_experiment, None);
+        assert_eq!(
+            md.variable_naming_convention,
+            VariableNamingConvention::Flat
+        );
+        let x = md.variable("x").unwrap();
+        assert_eq!(x.causality, Causality::Local);
+        assert_eq!(x.variability, Variability::Continuous);
+        assert_eq!(x.initial, None);
+        assert_eq!(x.effective_initial(), Some(Initial::Calculated));
+        assert!(md.variable("y").is_none());
+    }
+
+    #[test]
+    fn full_description_is_parsed() {
+        let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="Wheel" guid="g-1" description="a &amp; b"
+    generationTool="railuq" variableNamingConvention="structured" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="Wheel"/>
+  <CoSimulation modelIdentifier="Wheel" canHandleVariableCommunicationStepSize="true"
+      canGetAndSetFMUstate="true" canSerializeFMUstate="false" maxOutputDerivativeOrder="1"/>
+  <UnitDefinitions><Unit name="m"><BaseUnit m="1"/></Unit><Unit name="s"/></UnitDefinitions>
+  <TypeDefinitions>
+    <SimpleType name="Mode"><Enumeration><Item name="a" value="1"/></Enumeration></SimpleType>
+    <SimpleType name="Length"><Real unit="m"/></SimpleType>
+  </TypeDefinitions>
+  <LogCategories><Category name="logAll" description="everything"/><Category name="x"/></LogCategories>
+  <DefaultExperiment startTime="0" stopTime="2.5" tolerance="1e-6" stepSize="0.001"/>
+  <ModelVariables>
+    <ScalarVariable name="time" valueReference="0" causality="independent"><Real unit="s"/></ScalarVariable>
+    <ScalarVariable name="k" valueReference="1" causality="parameter" variability="tunable" description="stiffness">
+      <Real start="2.5e6" unit="N/m" min="0" max="INF" nominal="1e6"/>
+    </ScalarVariable>
+    <ScalarVariable name="n" valueReference="0" causality="parameter" variability="fixed"><Integer start="-3" min="-10" max="10"/></ScalarVariable>
+    <ScalarVariable name="on" valueReference="0" causality="input"><Boolean start="true"/></ScalarVariable>
+    <ScalarVariable name="label" valueReference="0" causality="parameter" variability="fixed"><String start="a&lt;b"/></ScalarVariable>
+    <ScalarVariable name="mode" valueReference="7" causality="parameter" variability="fixed"><Enumeration declaredType="Mode" start="1"/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="2" causality="output" initial="exact">
+      <Real declaredType="Length" start="0"/><Annotations><Tool name="t"/></Annotations>
+    </ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="7" dependencies=""/></Outputs>
+    <InitialUnknowns><Unknown index="1"/></InitialUnknowns>
+  </ModelStructure>
+</fmiModelDescription>"#;
+        let md = parse(xml).unwrap();
+        assert_eq!(md.model_name, "Wheel");
+        assert_eq!(md.description.as_deref(), Some("a & b"));
+        assert_eq!(md.generation_tool.as_deref(), Some("railuq"));
+        assert_eq!(
+            md.variable_naming_convention,
+            VariableNamingConvention::Structured
+        );
+        assert_eq!(md.number_of_event_indicators, Some(0));
+        assert!(md.model_exchange_present);
+        let cs = &md.co_simulation;
+        assert!(cs.can_handle_variable_communication_step_size && cs.can_get_and_set_fmu_state);
+        assert!(!cs.can_serialize_fmu_state);
+        assert_eq!(cs.max_output_derivative_order, 1);
+        assert_eq!(
+            md.unit_definitions,
+            vec![Unit { name: "m".into() }, Unit { name: "s".into() }]
+        );
+        assert_eq!(
+            md.log_categories,
+            vec![
+                ("logAll".to_string(), Some("everything".to_string())),
+                ("x".to_string(), None)
+            ]
+        );
+        let de = md.default_experiment.unwrap();
+        assert_eq!(
+            (de.start_time, de.stop_time, de.tolerance, de.step_size),
+            (Some(0.0), Some(2.5), Some(1e-6), Some(0.001))
+        );
+        assert_eq!(md.variables.len(), 7);
+        let k = md.variable("k").unwrap();
+        assert_eq!(k.description.as_deref(), Some("stiffness"));
+        assert_eq!(
+            k.kind,
+            VariableKind::Real {
+                start: Some(2.5e6),
+                unit: Some("N/m".into()),
+                declared_type: None,
+                min: Some(0.0),
+                max: Some(f64::INFINITY),
+                nominal: Some(1e6)
+            }
+        );
+        assert_eq!(
+            md.variable("n").unwrap().kind,
+            VariableKind::Integer {
+                start: Some(-3),
+                min: Some(-10),
+                max: Some(10)
+            }
+        );
+        let on = md.variable("on").unwrap();
+        assert_eq!(on.kind, VariableKind::Boolean { start: Some(true) });
+        assert_eq!(on.variability, Variability::Discrete);
+        assert_eq!(
+            md.variable("label").unwrap().kind,
+            VariableKind::String {
+                start: Some("a<b".into())
+            }
+        );
+        assert_eq!(
+            md.variable("mode").unwrap().kind,
+            VariableKind::Enumeration {
+                start: Some(1),
+                declared_type: "Mode".into()
+            }
+        );
+        let y = md.variable("y").unwrap();
+        assert_eq!(y.initial, Some(Initial::Exact));
+        assert!(matches!(
+            &y.kind,
+            VariableKind::Real { declared_type: Some(t), .. } if t == "Length"
+        ));
+        assert_eq!(md.outputs, vec![7]);
+        assert_eq!(
+            md.output_variables()
+                .map(|v| v.name.as_str())
+                .collect::<Vec<_>>(),
+            vec!["y"]
+        );
+    }
+
+    fn var(
+        causality: Causality,
+        variability: Variability,
+        initial: Option<Initial>,
+    ) -> ScalarVariable {
+        ScalarVariable {
+            name: "v".into(),
+            value_reference: 0,
+            description: None,
+            causality,
+            variability,
+            initial,
+            kind: VariableKind::Real {
+                start: Some(1.0),
+                unit: None,
+                declared_type: None,
+                min: None,
+                max: None,
+                nominal: None,
+            },
+        }
+    }
+
+    #[test]
+    fn settable_rules_follow_fmi_2_0() {
+        use Causality::*;
+        use Variability::*;
+        let cases = [
+            // causality, variability, initial, before init, in init mode, after init
+            (Parameter, Fixed, None, true, true, false),
+            (Parameter, Tunable, None, true, true, true),
+            (Input, Continuous, None, true, true, true),
+            (Input, Discrete, None, true, true, true),
+            (Output, Continuous, None, false, false, false),
+            (Output, Continuous, Some(Initial::Exact), true, true, false),
+            (Local, Continuous, Some(Initial::Approx), true, false, false),
+            (Local, Constant, None, false, false, false),
+            (CalculatedParameter, Fixed, None, false, false, false),
+            (Independent, Continuous, None, false, false, false),
+        ];
+        for (c, v, i, before, init, after) in cases {
+            let sv = var(c, v, i);
+            assert_eq!(sv.settable_before_init(), before, "{c:?} {v:?} {i:?}");
+            assert_eq!(
+                sv.settable_in_initialization_mode(),
+                init,
+                "{c:?} {v:?} {i:?}"
+            );
+            assert_eq!(sv.settable_after_init(), after, "{c:?} {v:?} {i:?}");
+        }
+    }
+
+    #[test]
+    fn malformed_xml_reports_line_and_column() {
+        let xml = "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"M\" guid=\"g\">\n  <CoSimulation modelIdentifier=\"M\"/>\n  <ModelVariables>\n  </ModelVariablez>\n</fmiModelDescription>";
+        let err = parse(xml).unwrap_err();
+        let DescriptionError::Malformed { line, .. } = &err else {
+            panic!("{err:?}")
+        };
+        assert_eq!(*line, 4, "{err}");
+        assert!(matches!(
+            parse("<fmiModelDescription fmiVersion=\"2.0\""),
+            Err(DescriptionError::Malformed { .. })
+        ));
+        assert!(matches!(parse(""), Err(DescriptionError::Malformed { .. })));
+        let unclosed = "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"M\" guid=\"g\"><CoSimulation modelIdentifier=\"M\"/>";
+        assert!(matches!(
+            parse(unclosed),
+            Err(DescriptionError::Malformed { .. })
+        ));
+    }
+
+    #[test]
+    fn other_fmi_versions_are_refused_by_name() {
+        let xml = MINIMAL.replace("fmiVersion=\"2.0\"", "fmiVersion=\"1.0\"");
+        let err = parse(&xml).unwrap_err();
+        assert_eq!(
+            err,
+            DescriptionError::UnsupportedFmiVersion {
+                found: "1.0".into()
+            }
+        );
+        assert!(err.to_string().contains("\"1.0\""));
+        let xml = MINIMAL.replace("fmiVersion=\"2.0\"", "fmiVersion=\"3.0\"");
+        assert!(matches!(
+            parse(&xml),
+            Err(DescriptionError::UnsupportedFmiVersion { found }) if found == "3.0"
+        ));
+    }
+
+    #[test]
+    fn model_exchange_only_is_refused() {
+        let xml = MINIMAL.replace("CoSimulation", "ModelExchange");
+        assert_eq!(
+            parse(&xml).unwrap_err(),
+            DescriptionError::NoCoSimulation {
+                model_exchange_present: true
+            }
+        );
+    }
+
+    #[test]
+    fn missing_guid_and_model_identifier_are_named() {
+        let err = parse(&MINIMAL.replace(" guid=\"{abc}\"", "")).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                DescriptionError::MissingAttribute {
+                    attribute: "guid",
+                    line: 2,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let err = parse(&MINIMAL.replace(" modelIdentifier=\"M\"", "")).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                DescriptionError::MissingAttribute {
+                    attribute: "modelIdentifier",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let err = parse(&MINIMAL.replace("modelIdentifier=\"M\"", "modelIdentifier=\"../x\""))
+            .unwrap_err();
+        assert!(
+            matches!(err, DescriptionError::InvalidAttribute { .. }),
+            "{err:?}"
+        );
+    }
+
+    fn with_variables(vars: &str) -> String {
+        MINIMAL.replace(
+            r#"<ScalarVariable name="x" valueReference="0"><Real/></ScalarVariable>"#,
+            vars,
+        )
+    }
+
+    #[test]
+    fn duplicate_value_references_within_a_type_are_refused() {
+        let xml = with_variables(
+            r#"<ScalarVariable name="a" valueReference="3" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
+               <ScalarVariable name="b" valueReference="3" causality="parameter" variability="fixed"><Real start="2"/></ScalarVariable>"#,
+        );
+        let err = parse(&xml).unwrap_err();
+        assert_eq!(
+            err,
+            DescriptionError::DuplicateValueReference {
+                base_type: "Real",
+                value_reference: 3,
+                first: "a".into(),
+                second: "b".into(),
+                reason: "both have a start value",
+            }
+        );
+        let xml = with_variables(
+            r#"<ScalarVariable name="a" valueReference="3" causality="input"><Real/></ScalarVariable>
+               <ScalarVariable name="b" valueReference="3" causality="parameter" variability="tunable"><Real start="2"/></ScalarVariable>"#,
+        );
+        assert!(matches!(
+            parse(&xml),
+            Err(DescriptionError::DuplicateValueReference {
+                reason: "both are parameters or inputs",
+                ..
+            })
+        ));
+        // Integer and Enumeration share fmi2Integer.
+        let xml = with_variables(
+            r#"<ScalarVariable name="a" valueReference="3" causality="parameter" variability="fixed"><Integer start="1"/></ScalarVariable>
+               <ScalarVariable name="b" valueReference="3" causality="parameter" variability="fixed"><Enumeration declaredType="E" start="2"/></ScalarVariable>"#,
+        );
+        assert!(matches!(
+            parse(&xml),
+            Err(DescriptionError::DuplicateValueReference {
+                base_type: "Integer",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn same_value_reference_in_other_types_and_aliases_are_accepted() {
+        let xml = with_variables(
+            r#"<ScalarVariable name="a" valueReference="3"><Real/></ScalarVariable>
+               <ScalarVariable name="b" valueReference="3"><Integer/></ScalarVariable>
+               <ScalarVariable name="c" valueReference="3"><Boolean/></ScalarVariable>
+               <ScalarVariable name="d" valueReference="3"><String/></ScalarVariable>
+               <ScalarVariable name="e" valueReference="4" causality="output"><Real/></ScalarVariable>
+               <ScalarVariable name="e_alias" valueReference="4"><Real/></ScalarVariable>"#,
+        );
+        assert_eq!(parse(&xml).unwrap().variables.len(), 6);
+    }
+
+    #[test]
+    fn structural_errors_are_typed() {
+        let dup = with_variables(
+            r#"<ScalarVariable name="a" valueReference="1"><Real/></ScalarVariable>
+               <ScalarVariable name="a" valueReference="2"><Real/></ScalarVariable>"#,
+        );
+        assert!(matches!(
+            parse(&dup),
+            Err(DescriptionError::DuplicateName { .. })
+        ));
+        let untyped = with_variables(r#"<ScalarVariable name="a" valueReference="1"/>"#);
+        assert!(matches!(
+            parse(&untyped),
+            Err(DescriptionError::BadTypeElement { .. })
+        ));
+        let bad_causality = with_variables(
+            r#"<ScalarVariable name="a" valueReference="1" causality="inout"><Real/></ScalarVariable>"#,
+        );
+        let err = parse(&bad_causality).unwrap_err();
+        assert!(err.to_string().contains("causality=\"inout\""), "{err}");
+        let bad_start = with_variables(
+            r#"<ScalarVariable name="a" valueReference="1"><Integer start="1.5"/></ScalarVariable>"#,
+        );
+        assert!(matches!(
+            parse(&bad_start),
+            Err(DescriptionError::InvalidAttribute { .. })
+        ));
+        let no_vr = with_variables(r#"<ScalarVariable name="a"><Real/></ScalarVariable>"#);
+        assert!(matches!(
+            parse(&no_vr),
+            Err(DescriptionError::MissingAttribute {
+                attribute: "valueReference",
+                ..
+            })
+        ));
+        let bad_output = MINIMAL.replace(
+            "<ModelStructure/>",
+            "<ModelStructure><Outputs><Unknown index=\"2\"/></Outputs></ModelStructure>",
+        );
+        assert_eq!(
+            parse(&bad_output).unwrap_err(),
+            DescriptionError::BadOutputIndex { index: 2, count: 1 }
+        );
+        assert!(matches!(
+            parse("<fmiModelDescriptio fmiVersion=\"2.0\"/>"),
+            Err(DescriptionError::WrongRoot { .. })
+        ));
+    }
+
+    #[test]
+    fn byte_order_mark_is_accepted() {
+        let mut bytes = b"\xEF\xBB\xBF".to_vec();
+        bytes.extend_from_slice(MINIMAL.as_bytes());
+        assert!(ModelDescription::parse(&bytes).is_ok());
+    }
+}
