@@ -54,15 +54,18 @@ lint:
 fmt:
 	$(CARGO) fmt --all
 
-test: lint venv fmu
+test: lint venv build fmu
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
-# The debug build carries the test-only panic trigger used by tests/fmi_abi.rs.
+# The FMU crate's tests run on a debug build that carries the test-only panic trigger
+# (tests/fmi_abi.rs); the packaged FMUs in target/fmu come from the release build without it.
+# The driver's tests run in release mode: they run real studies.
 test-rust:
 	$(CARGO) build -p railuq --lib --features test-panic
+	$(CARGO) test -p railuq --features test-panic
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
-	  $(CARGO) test --workspace --features railuq/test-panic
+	  $(CARGO) test --release -p uq-driver
 
 test-python: venv
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python

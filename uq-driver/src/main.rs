@@ -55,6 +55,35 @@ enum Command {
         /// The .fmu file.
         fmu: PathBuf,
     },
+    /// Run an FMU once at given parameter values and write its outputs as CSV.
+    Simulate {
+        /// The .fmu file.
+        fmu: PathBuf,
+        /// Parameter values, NAME=VALUE (repeatable).
+        #[arg(long = "set", value_parser = parse_assignment)]
+        set: Vec<(String, f64)>,
+        /// Outputs to record (repeatable; default: every Real output).
+        #[arg(long = "output")]
+        outputs: Vec<String>,
+        /// Start time (s; default: the FMU's default experiment, else 0).
+        #[arg(long)]
+        start: Option<f64>,
+        /// Stop time (s; default: the FMU's default experiment).
+        #[arg(long)]
+        stop: Option<f64>,
+        /// Communication step (s; default: the FMU's default experiment).
+        #[arg(long)]
+        step: Option<f64>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
+    let v: f64 = value.trim().parse().map_err(|e| format!("value of {name}: {e}"))?;
+    Ok((name.trim().to_owned(), v))
 }
 
 fn main() -> ExitCode {
@@ -120,7 +149,61 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Inspect { fmu } => inspect(&fmu),
+        Command::Simulate {
+            fmu,
+            set,
+            outputs,
+            start,
+            stop,
+            step,
+            out,
+        } => simulate(&fmu, &set, &outputs, start, stop, step, out.as_deref()),
     }
+}
+
+fn simulate(
+    path: &std::path::Path,
+    set: &[(String, f64)],
+    outputs: &[String],
+    start: Option<f64>,
+    stop: Option<f64>,
+    step: Option<f64>,
+    out: Option<&std::path::Path>,
+) -> Result<()> {
+    let fmu = Fmu::open(path)?;
+    let de = fmu.description().default_experiment.clone().unwrap_or_default();
+    let start = start.or(de.start_time).unwrap_or(0.0);
+    let stop = stop.or(de.stop_time).context("no --stop and no default stop time in the FMU")?;
+    let step = step.or(de.step_size).context("no --step and no default step size in the FMU")?;
+    let experiment = uq_driver::study::spec::Experiment { start, stop, step };
+    anyhow::ensure!(
+        step > 0.0 && stop > start && {
+            let r = (stop - start) / step;
+            (r - r.round()).abs() < 1e-6 * r.max(1.0)
+        },
+        "stop − start must be a positive whole number of steps"
+    );
+    let times = experiment.times();
+    let (names, series) = uq_driver::study::runner::simulate(&fmu, set, outputs, &times)?;
+    let mut text = String::from("time");
+    for n in &names {
+        text.push(',');
+        text.push_str(n);
+    }
+    text.push('\n');
+    for (k, t) in times.iter().enumerate() {
+        text.push_str(&t.to_string());
+        for s in &series {
+            text.push(',');
+            text.push_str(&s[k].to_string());
+        }
+        text.push('\n');
+    }
+    match out {
+        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?,
+        None => print!("{text}"),
+    }
+    Ok(())
 }
 
 fn inspect(path: &std::path::Path) -> Result<()> {

@@ -412,3 +412,55 @@ pub fn check_failures(
     }
     Ok(failed.len())
 }
+
+/// One deterministic run of `fmu` with `params` set before initialization, recording `outputs`
+/// (names; all the FMU's outputs when empty) at `times`. Returns the names and, per name,
+/// the series.
+pub fn simulate(
+    fmu: &Fmu,
+    params: &[(String, f64)],
+    outputs: &[String],
+    times: &[f64],
+) -> Result<(Vec<String>, Vec<Vec<f64>>), RunError> {
+    let md = fmu.description();
+    let names: Vec<String> = if outputs.is_empty() {
+        md.output_variables()
+            .filter(|v| matches!(v.kind, VariableKind::Real { .. }))
+            .map(|v| v.name.clone())
+            .collect()
+    } else {
+        outputs.to_vec()
+    };
+    let mut random = Vec::new();
+    let mut values = Vec::new();
+    for (n, v) in params {
+        let var = real_var(fmu, n)?;
+        if !md.settable_before_init(var) {
+            return Err(RunError::Interface {
+                fmu: fmu.path().display().to_string(),
+                message: format!("variable '{n}' may not be set before initialization"),
+            });
+        }
+        random.push(var.value_reference);
+        values.push(*v);
+    }
+    let signals = names
+        .iter()
+        .map(|n| Ok(real_var(fmu, n)?.value_reference))
+        .collect::<Result<Vec<_>, RunError>>()?;
+    let iface = Interface {
+        random,
+        fixed: Vec::new(),
+        signals,
+        signal_names: names.clone(),
+        n_stored: names.len(),
+        qois: Vec::new(),
+    };
+    let mut slot = None;
+    let flat = run_point(fmu, &mut slot, &iface, &values, times).map_err(|message| RunError::Interface {
+        fmu: fmu.path().display().to_string(),
+        message,
+    })?;
+    let nt = times.len();
+    Ok((names, flat.chunks(nt).map(<[f64]>::to_vec).collect()))
+}

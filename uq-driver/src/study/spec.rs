@@ -831,7 +831,7 @@ mod tests {
         let cases = [
             (base.replace("stop = 5.0", "stop = -1.0"), "start < stop"),
             (
-                base.replace("nodes = 6", "nodes = 6\norder = 6"),
+                base.replace("order = 5", "order = 6"),
                 "below the nodes",
             ),
             (base.replace("std = 10.0", "std = -10.0"), "parameter 'K'"),
