@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bogie;
+pub mod vehicle_track;
 pub mod wheel;
 
 use std::fmt;
@@ -337,7 +338,7 @@ pub struct ModelEntry {
 
 /// Every model this library serves.
 pub fn registry() -> &'static [ModelEntry] {
-    static REGISTRY: [ModelEntry; 2] = [
+    static REGISTRY: [ModelEntry; 3] = [
         ModelEntry {
             info: &wheel::INFO,
             create: wheel::Wheel::boxed,
@@ -345,6 +346,10 @@ pub fn registry() -> &'static [ModelEntry] {
         ModelEntry {
             info: &bogie::INFO,
             create: bogie::Bogie::boxed,
+        },
+        ModelEntry {
+            info: &vehicle_track::INFO,
+            create: vehicle_track::VehicleTrack::boxed,
         },
     ];
     &REGISTRY

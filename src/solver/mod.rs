@@ -1,6 +1,8 @@
 //! Fixed-step integrators shared by the models.
 #![forbid(unsafe_code)]
 
+pub mod zhai;
+
 /// Number of equal substeps of length <= `h_max` that cover `span` (at least 1).
 ///
 /// A communication step of 0.010000000000000009 s with `h_max` = 1e-3 s gives 10 substeps,

@@ -52,7 +52,8 @@ impl Complex {
 #[derive(Clone, Debug)]
 pub struct Fft {
     n: usize,
-    /// `e^{−2πik/n}`, k = 0..n/2.
+    /// Twiddles of every stage, contiguous: for the stage of half-length h (h = 2, 4, ..,
+    /// n/2), `e^{−iπk/h}`, k = 0..h, starting at offset h − 2.
     twiddles: Vec<Complex>,
     /// Bit-reversed index of each position.
     bitrev: Vec<u32>,
@@ -66,15 +67,24 @@ impl Fft {
                 "FFT length {n} must be a power of two between 1 and 2^30"
             ));
         }
-        let twiddles = (0..n / 2)
-            .map(|k| {
-                let a = -2.0 * PI * k as f64 / n as f64;
-                Complex::new(a.cos(), a.sin())
-            })
-            .collect();
+        let mut twiddles = Vec::with_capacity(n);
+        let mut h = 2;
+        while h < n {
+            for k in 0..h {
+                let a = -PI * k as f64 / h as f64;
+                twiddles.push(Complex::new(a.cos(), a.sin()));
+            }
+            h *= 2;
+        }
         let bits = n.trailing_zeros();
         let bitrev = (0..n as u32)
-            .map(|i| if bits == 0 { 0 } else { i.reverse_bits() >> (32 - bits) })
+            .map(|i| {
+                if bits == 0 {
+                    0
+                } else {
+                    i.reverse_bits() >> (32 - bits)
+                }
+            })
             .collect();
         Ok(Self {
             n,
@@ -103,16 +113,25 @@ impl Fft {
                 data.swap(i, j);
             }
         }
-        let mut half = 1;
+        if n < 2 {
+            return;
+        }
+        // Stage h = 1: butterflies without twiddles.
+        for pair in data.chunks_exact_mut(2) {
+            let (a, b) = (pair[0], pair[1]);
+            pair[0] = Complex::new(a.re + b.re, a.im + b.im);
+            pair[1] = Complex::new(a.re - b.re, a.im - b.im);
+        }
+        let mut half = 2;
         while half < n {
-            let stride = n / (2 * half);
-            for start in (0..n).step_by(2 * half) {
-                for k in 0..half {
-                    let w = self.twiddles[k * stride];
-                    let a = data[start + k];
-                    let b = data[start + k + half].mul(w);
-                    data[start + k] = Complex::new(a.re + b.re, a.im + b.im);
-                    data[start + k + half] = Complex::new(a.re - b.re, a.im - b.im);
+            let tw = &self.twiddles[half - 2..2 * half - 2];
+            for block in data.chunks_exact_mut(2 * half) {
+                let (lo, hi) = block.split_at_mut(half);
+                for ((a, b), w) in lo.iter_mut().zip(hi.iter_mut()).zip(tw) {
+                    let t = b.mul(*w);
+                    let u = *a;
+                    *a = Complex::new(u.re + t.re, u.im + t.im);
+                    *b = Complex::new(u.re - t.re, u.im - t.im);
                 }
             }
             half *= 2;
@@ -186,48 +205,44 @@ impl DstI {
     /// `out[i−1] = Σ_{k=1}^{N} input[k−1] sin(π k i/(N+1))`, i = 1..N. No allocation.
     pub fn transform(&mut self, input: &[f64], out: &mut [f64]) {
         let (n, size) = (self.n, self.size);
-        assert!(input.len() == size && out.len() == size, "DST-I buffer length");
-        let b = |j: usize| if j == 0 || j == n { 0.0 } else { input[j - 1] };
-        let y = |j: usize| {
-            if j == 0 {
-                0.0
-            } else {
-                let (bj, bc) = (b(j), b(n - j));
-                self.sin_j[j] * (bj + bc) + 0.5 * (bj - bc)
-            }
-        };
+        assert!(
+            input.len() == size && out.len() == size,
+            "DST-I buffer length"
+        );
         let m = n / 2;
         if m == 1 {
             // n = 2, N = 1: S_1 = b_1 sin(π/2).
             out[0] = input[0];
             return;
         }
-        let mut z = std::mem::take(&mut self.z);
-        for (p, zp) in z.iter_mut().enumerate() {
-            *zp = Complex::new(y(2 * p), y(2 * p + 1));
+        // y_j = sin(jπ/n)(b_j + b_{n−j}) + ½(b_j − b_{n−j}), y_0 = 0, with b_j = input[j − 1];
+        // packed as z_p = y_{2p} + i y_{2p+1}.
+        let y = |j: usize| {
+            let (bj, bc) = (input[j - 1], input[n - j - 1]);
+            self.sin_j[j] * (bj + bc) + 0.5 * (bj - bc)
+        };
+        self.z[0] = Complex::new(0.0, y(1));
+        for p in 1..m {
+            self.z[p] = Complex::new(y(2 * p), y(2 * p + 1));
         }
-        self.fft.forward(&mut z);
-        // Real DFT Y_k = R_k − i I_k of y from the half-length complex FFT, k = 0..m−1.
-        let mut s_odd = 0.0; // S_{2k−1}
-        for k in 0..m {
-            let zk = z[k];
-            let zmk = z[(m - k) % m].conj();
-            let e = Complex::new(0.5 * (zk.re + zmk.re), 0.5 * (zk.im + zmk.im));
-            // O = (Z_k − conj Z_{m−k}) / (2i)
-            let o = Complex::new(0.5 * (zk.im - zmk.im), -0.5 * (zk.re - zmk.re));
-            let yk = Complex::new(e.re, e.im);
-            let wo = self.w[k].mul(o);
-            let (r, i) = (yk.re + wo.re, -(yk.im + wo.im));
-            if k == 0 {
-                s_odd = 0.5 * r;
-                out[0] = s_odd;
-            } else {
-                out[2 * k - 1] = i; // S_{2k}
-                s_odd += r; // S_{2k+1}
-                out[2 * k] = s_odd;
-            }
+        self.fft.forward(&mut self.z);
+        // Real DFT Y_k = R_k − i I_k = E_k + w_k O_k of y, with E_k = (Z_k + conj Z_{m−k})/2 and
+        // O_k = (Z_k − conj Z_{m−k})/(2i); then S_1 = R_0/2, S_{2k} = I_k, S_{2k+1} = S_{2k−1} + R_k.
+        let z0 = self.z[0];
+        let mut s_odd = 0.5 * (z0.re + z0.im); // R_0 = Re Z_0 + Im Z_0
+        out[0] = s_odd;
+        for k in 1..m {
+            let zk = self.z[k];
+            let zc = self.z[m - k];
+            let (er, ei) = (0.5 * (zk.re + zc.re), 0.5 * (zk.im - zc.im));
+            let (or, oi) = (0.5 * (zk.im + zc.im), -0.5 * (zk.re - zc.re));
+            let w = self.w[k];
+            let r = er + w.re * or - w.im * oi;
+            let i = -(ei + w.re * oi + w.im * or);
+            out[2 * k - 1] = i;
+            s_odd += r;
+            out[2 * k] = s_odd;
         }
-        self.z = z;
     }
 }
 
@@ -250,7 +265,9 @@ mod tests {
         let mut s = seed;
         (0..len)
             .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
             })
             .collect()
@@ -261,8 +278,11 @@ mod tests {
         for &n in &[1usize, 2, 4, 8, 64, 256] {
             let re = pseudo_random(n, 1);
             let im = pseudo_random(n, 2);
-            let mut data: Vec<Complex> =
-                re.iter().zip(&im).map(|(&a, &b)| Complex::new(a, b)).collect();
+            let mut data: Vec<Complex> = re
+                .iter()
+                .zip(&im)
+                .map(|(&a, &b)| Complex::new(a, b))
+                .collect();
             Fft::new(n).unwrap().forward(&mut data);
             for k in 0..n {
                 let (mut sr, mut si) = (0.0, 0.0);

@@ -480,7 +480,10 @@ mod tests {
         for c in 1..6u8 {
             assert!(Spectrum::Fra(c).psd(0.1) > Spectrum::Fra(c + 1).psd(0.1));
         }
-        assert_eq!(IrregularityKind::from_code(9), Some(IrregularityKind::Spectrum(Spectrum::Fra(6))));
+        assert_eq!(
+            IrregularityKind::from_code(9),
+            Some(IrregularityKind::Spectrum(Spectrum::Fra(6)))
+        );
         assert_eq!(IrregularityKind::from_code(11), None);
     }
 
@@ -527,7 +530,10 @@ mod tests {
             );
         }
         // Nothing outside the wavelength range.
-        let outside: f64 = (1..n / 2).filter(|&k| k as f64 / 1024.0 > 0.51).map(|k| p[k]).sum();
+        let outside: f64 = (1..n / 2)
+            .filter(|&k| k as f64 / 1024.0 > 0.51)
+            .map(|k| p[k])
+            .sum();
         assert!(outside < 1e-6 * p.iter().sum::<f64>());
     }
 
@@ -554,7 +560,10 @@ mod tests {
         }
         let df = 1.0 / (seg as f64 * h);
         let spec = Spectrum::ChineseBallastless;
-        for (lo, hi) in octave_bands().into_iter().filter(|b| b.0 > 0.03 && b.1 < 0.45) {
+        for (lo, hi) in octave_bands()
+            .into_iter()
+            .filter(|b| b.0 > 0.03 && b.1 < 0.45)
+        {
             let ks: Vec<usize> = (1..seg / 2)
                 .filter(|&k| (lo..hi).contains(&(k as f64 * df)))
                 .collect();
@@ -578,13 +587,21 @@ mod tests {
         );
         assert_eq!(a.z, b.z);
         let rms = (a.z.iter().map(|v| v * v).sum::<f64>() / a.z.len() as f64).sqrt();
-        let diff = a.z.iter().zip(&c.z).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let diff =
+            a.z.iter()
+                .zip(&c.z)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
         assert!(diff > 0.5 * rms, "seeds 1 and 2 give nearly the same track");
         // Variance = ∫S df (Parseval): about 1.2 mm rms for this spectrum and band.
         let var: f64 = (6..=512)
             .map(|k| 2.0 * Spectrum::ChineseBallastless.psd(k as f64 / 1024.0) / 1024.0 / 2.0)
             .sum();
-        assert!((rms * rms / var - 1.0).abs() < 1e-6, "{} vs {var}", rms * rms);
+        assert!(
+            (rms * rms / var - 1.0).abs() < 1e-6,
+            "{} vs {var}",
+            rms * rms
+        );
         assert!((0.8e-3..1.6e-3).contains(&rms), "rms {rms}");
     }
 
@@ -598,8 +615,8 @@ mod tests {
         assert!(MeasuredProfile::parse("0,0\nfoo\n", "t").is_err());
         assert!(MeasuredProfile::parse("0,0\n", "t").is_err());
         assert!(MeasuredProfile::read("", None).is_err());
-        let e = MeasuredProfile::read("no_such_file.csv", Some(Path::new("/nonexistent")))
-            .unwrap_err();
+        let e =
+            MeasuredProfile::read("no_such_file.csv", Some(Path::new("/nonexistent"))).unwrap_err();
         assert!(e.contains("/nonexistent/no_such_file.csv"), "{e}");
     }
 

@@ -87,7 +87,8 @@ impl HalfVehicle {
         let fs1 = s.ksz * (x[ZC] - s.lc * x[BC] - x[ZT1]) + s.csz * (v[ZC] - s.lc * v[BC] - v[ZT1]);
         let fs2 = s.ksz * (x[ZC] + s.lc * x[BC] - x[ZT2]) + s.csz * (v[ZC] + s.lc * v[BC] - v[ZT2]);
         let prim = |zt: usize, bt: usize, sign: f64, w: usize| {
-            s.kpz * (x[zt] + sign * s.lt * x[bt] - x[w]) + s.cpz * (v[zt] + sign * s.lt * v[bt] - v[w])
+            s.kpz * (x[zt] + sign * s.lt * x[bt] - x[w])
+                + s.cpz * (v[zt] + sign * s.lt * v[bt] - v[w])
         };
         let fp = [
             prim(ZT1, BT1, -1.0, ZW1),
@@ -217,7 +218,9 @@ pub(crate) mod tests {
         let mut out: Vec<_> = (0..n)
             .map(|c| {
                 let f = eig.eigenvalues[c].sqrt() / (2.0 * std::f64::consts::PI);
-                let shape = (0..n).map(|i| eig.eigenvectors[(i, c)] / m[(i, i)].sqrt()).collect();
+                let shape = (0..n)
+                    .map(|i| eig.eigenvectors[(i, c)] / m[(i, i)].sqrt())
+                    .collect();
                 (f, shape)
             })
             .collect();
@@ -247,7 +250,9 @@ pub(crate) mod tests {
         };
         z.init_accel(f).unwrap();
         // Follow the largest component of the shape.
-        let dof = (0..6).max_by(|&a, &b| shape[a].abs().total_cmp(&shape[b].abs())).unwrap();
+        let dof = (0..6)
+            .max_by(|&a, &b| shape[a].abs().total_cmp(&shape[b].abs()))
+            .unwrap();
         let sign = shape[dof].signum();
         let mut crossings = Vec::new();
         let mut prev = z.x[dof] * sign;
@@ -294,7 +299,10 @@ pub(crate) mod tests {
             checked.push((name, *f));
         }
         for name in ["carbody bounce", "carbody pitch", "bogie bounce"] {
-            assert!(checked.iter().any(|c| c.0 == name), "{name} not found: {checked:?}");
+            assert!(
+                checked.iter().any(|c| c.0 == name),
+                "{name} not found: {checked:?}"
+            );
         }
         // Sanity: carbody bounce near 1.2 Hz for these suspensions.
         let fb = checked.iter().find(|c| c.0 == "carbody bounce").unwrap().1;

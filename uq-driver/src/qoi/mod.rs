@@ -7,6 +7,7 @@ pub mod critical_speed;
 pub mod kde;
 pub mod moments;
 pub mod scalar;
+pub mod sperling;
 
 pub use kde::{auto_grid, gaussian_kde, silverman_bandwidth};
 pub use moments::{

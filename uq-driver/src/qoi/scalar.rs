@@ -2,6 +2,7 @@
 //! declares them (`[[qoi]]`): critical speed, Sperling index, peak |signal|, final value.
 
 use crate::qoi::critical_speed::{critical_speed, CriticalSpeed};
+use crate::qoi::sperling::{sperling_index, Direction, SperlingSettings};
 use crate::study::spec::QoiSpec;
 
 /// Outcome code stored beside a scalar value.
@@ -48,7 +49,30 @@ pub fn evaluate<'a>(
             CriticalSpeed::NeverHunts => Ok((f64::NAN, Code::NeverHunts)),
             CriticalSpeed::NeverStops => Ok((f64::NAN, Code::NeverStops)),
         },
-        QoiSpec::Sperling { .. } => Err("TEMPORARY: Sperling not wired yet".into()),
+        QoiSpec::Sperling {
+            signal: s,
+            direction,
+            segment,
+            f_min,
+            f_max,
+            skip,
+            ..
+        } => {
+            let dt = times.get(1).map(|t1| t1 - times[0]).ok_or("fewer than two samples")?;
+            let start = times.partition_point(|&t| t < times[0] + skip - 1e-9 * dt);
+            let settings = SperlingSettings {
+                direction: if direction == "lateral" {
+                    Direction::Lateral
+                } else {
+                    Direction::Vertical
+                },
+                segment_length_s: *segment,
+                f_min: *f_min,
+                f_max: *f_max,
+            };
+            let r = sperling_index(&signal(s)[start..], dt, &settings).map_err(|e| e.to_string())?;
+            Ok((r.w, Code::Ok))
+        }
         QoiSpec::MaxAbs { signal: s, from, to, .. } => {
             let x = signal(s);
             let to = to.unwrap_or(f64::INFINITY);

@@ -173,6 +173,7 @@ fn points_csv(study: &Study, design: &Design, records: &[Option<Record>]) -> Str
 fn run_sgm(study: &Study, out_dir: &Path, _opts: &RunOptions) -> Result<StudyResult, StudyRunError> {
     let started = Instant::now();
     let (gs, coeffs) = sgm::solve(study).map_err(StudyRunError::Analysis)?;
+    let wall_time = started.elapsed().as_secs_f64();
     let definiteness = gs.check_definiteness();
     let stats: Vec<analysis::OutputStats> = study
         .file
@@ -182,7 +183,6 @@ fn run_sgm(study: &Study, out_dir: &Path, _opts: &RunOptions) -> Result<StudyRes
         .zip(coeffs)
         .map(|(name, c)| analysis::stats_from_pce(study, name, &gs.pce(c)))
         .collect();
-    let wall_time = started.elapsed().as_secs_f64();
     let m = &study.file.method;
     let ctx = output::RunContext {
         model_runs: 1,

@@ -509,6 +509,8 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/wheel-lhs-50000.toml"),
     ),
     ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
+    ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
+    ("paper-wheel", include_str!("../../studies/paper-wheel.toml")),
 ];
 
 /// Folders searched for an FMU named by a relative path that is not next to the study file:
