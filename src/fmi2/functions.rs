@@ -109,8 +109,10 @@ fn with_instance(
         }
         match catch_unwind(AssertUnwindSafe(|| body(&mut *inst))) {
             Ok(Ok(status)) => {
-                inst.logger
-                    .log(FMI2_OK, Category::Calls, &format!("{fname}: ok"));
+                if inst.logger.would_log(FMI2_OK, Category::Calls) {
+                    inst.logger
+                        .log(FMI2_OK, Category::Calls, &format!("{fname}: ok"));
+                }
                 status
             }
             Ok(Err(f)) => inst.fail(fname, f),

@@ -166,8 +166,30 @@ pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError
     })
 }
 
-/// SHA-256 of a file, hex.
+/// SHA-256 of an FMU, hex: of the file, or, for an extracted FMU folder, of every file's
+/// relative path and content in sorted order.
 pub fn sha256_file(path: &Path) -> std::io::Result<String> {
+    fn walk(dir: &Path, root: &Path, h: &mut Sha256) -> std::io::Result<()> {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)?.collect::<Result<_, _>>()?;
+        entries.sort_by_key(|e| e.file_name());
+        for e in entries {
+            let p = e.path();
+            if e.file_type()?.is_dir() {
+                walk(&p, root, h)?;
+            } else {
+                let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().into_owned();
+                h.update(rel.as_bytes());
+                h.update([0]);
+                h.update(std::fs::read(&p)?);
+            }
+        }
+        Ok(())
+    }
+    if path.is_dir() {
+        let mut h = Sha256::new();
+        walk(path, path, &mut h)?;
+        return Ok(format!("{:x}", h.finalize()));
+    }
     let bytes = std::fs::read(path)?;
     Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
