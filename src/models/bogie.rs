@@ -95,6 +95,7 @@ const VR_XI_X1: u32 = 114;
 const VR_XI_Y1: u32 = 115;
 const VR_XI_X2: u32 = 116;
 const VR_XI_Y2: u32 = 117;
+const VR_V_CR_LINEAR: u32 = 120;
 
 /// Lowest speed (m/s) the model runs at: the creepages divide by V.
 pub const MIN_SPEED: f64 = 1.0;
@@ -144,7 +145,7 @@ const fn output(
 use Variability::{Fixed, Tunable};
 
 /// The bogie's variable table (parameters from vr 0, outputs from vr 100).
-pub static VARIABLES: [Variable; 38] = [
+pub static VARIABLES: [Variable; 39] = [
     param("m_b", VR_M_B, 4963.0, Fixed, Some("kg"), Some(0.0), "Bogie mass: frame 2918.9 + 2 wheelsets x 1022 [paper]"),
     param("I_b", VR_I_B, 8135.0, Fixed, Some("kg.m2"), Some(0.0), "Bogie yaw moment of inertia: 6780 + 2 x 678 [paper]"),
     param("h", VR_H, 1.5, Fixed, Some("m"), Some(0.0), "Half wheelbase; leading wheelset at +h [paper]"),
@@ -183,6 +184,17 @@ pub static VARIABLES: [Variable; 38] = [
     output("xi_y1", VR_XI_Y1, None, "Lateral creepage of the leading wheelset (dimensionless)"),
     output("xi_x2", VR_XI_X2, None, "Longitudinal creepage, left wheel of the trailing wheelset (dimensionless)"),
     output("xi_y2", VR_XI_Y2, None, "Lateral creepage of the trailing wheelset (dimensionless)"),
+    Variable {
+        name: "v_cr_linear",
+        vr: VR_V_CR_LINEAR,
+        start: Start::Real(None),
+        causality: Causality::CalculatedParameter,
+        variability: Fixed,
+        initial: Some(Initial::Calculated),
+        unit: Some("m/s"),
+        min: None,
+        description: "Linear (Hopf) critical speed of the linearised model at the parameters of the initialization (eigenvalues; clamped to the search range 2..1000 m/s)",
+    },
 ];
 
 /// Static description of the bogie model.
@@ -497,11 +509,13 @@ pub struct Bogie {
     pub t: f64,
     /// State [Y (m), φ (rad), Y' (m/s), φ' (rad/s)].
     pub x: [f64; 4],
+    /// Linear critical speed at the initialization's parameters (m/s).
+    pub v_cr_linear: f64,
 }
 
 impl Default for Bogie {
     fn default() -> Self {
-        Bogie {
+        let mut b = Bogie {
             p: BogieParams::default(),
             v0: 100.0,
             ramp: 10.0,
@@ -511,7 +525,20 @@ impl Default for Bogie {
             t_start: 0.0,
             t: 0.0,
             x: [0.012, 0.0, 0.0, 0.0],
-        }
+            v_cr_linear: f64::NAN,
+        };
+        b.v_cr_linear = clamped_linear_critical_speed(&b);
+        b
+    }
+}
+
+/// [`linear_critical_speed`] clamped to the search range 2..1000 m/s, so the output is finite.
+fn clamped_linear_critical_speed(b: &Bogie) -> f64 {
+    let v = linear_critical_speed(b);
+    if v.is_nan() {
+        2.0
+    } else {
+        v.min(1000.0)
     }
 }
 
@@ -622,6 +649,7 @@ impl Model for Bogie {
             VR_XI_Y1 => f.xi_y1,
             VR_XI_X2 => f.xi_x2,
             VR_XI_Y2 => f.xi_y2,
+            VR_V_CR_LINEAR => self.v_cr_linear,
             _ => return Err(ModelError::NoSuchVariable(VarType::Real, vr)),
         })
     }
@@ -727,6 +755,7 @@ impl Model for Bogie {
         self.t_start = ctx.start_time;
         self.t = ctx.start_time;
         self.x = [self.y0, self.phi0, 0.0, 0.0];
+        self.v_cr_linear = clamped_linear_critical_speed(self);
         Ok(())
     }
 
@@ -840,7 +869,9 @@ impl Model for Bogie {
             t_start: v[20],
             t: v[21],
             x: [v[22], v[23], v[24], v[25]],
+            v_cr_linear: f64::NAN,
         };
+        self.v_cr_linear = clamped_linear_critical_speed(self);
         Ok(())
     }
 }

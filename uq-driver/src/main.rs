@@ -127,6 +127,16 @@ fn dispatch(cmd: Command) -> Result<()> {
                 r.summary["wall_time_s"].as_f64().unwrap_or(0.0),
                 out.join("index.html").display()
             );
+            for q in &r.scalars {
+                if r.model_runs == 1 {
+                    println!("  {} = {:.6}", q.name, q.mean);
+                } else {
+                    println!("  {}: mean {:.6}, std {:.6} ({} valid runs)", q.name, q.mean, q.std, q.n_valid);
+                }
+                for (l, p, se) in &q.exceedance {
+                    println!("  P({} > {l}) = {p:.5} (standard error {se:.1e})", q.name);
+                }
+            }
             if r.n_failed > 0 {
                 println!("{} points failed (see points.csv)", r.n_failed);
             }

@@ -191,7 +191,8 @@ pub fn analyse(study: &Study, design: &Design, records: &[Option<Record>]) -> Re
     let times = study.file.experiment.times();
     let nt = times.len();
     let ok = ok_points(records);
-    if ok.len() < 2 {
+    let needed = if design.method == MethodKind::Nominal { 1 } else { 2 };
+    if ok.len() < needed {
         return Err(format!("only {} successful runs: nothing to analyse", ok.len()));
     }
     let mut out = Vec::new();
@@ -209,6 +210,10 @@ pub fn analyse(study: &Study, design: &Design, records: &[Option<Record>]) -> Re
                 let pce = project(study, design, w, &data)?;
                 let samples = surrogate_basis(study, &pce.basis) * &pce.coeffs;
                 out.push(finish(study, name, &times, mean, std, Some(pce.std()), Some(&pce), &samples));
+            }
+            (MethodKind::Nominal, Some(w)) => {
+                let (mean, std) = moments::weighted_mean_std(&data, w);
+                out.push(finish(study, name, &times, mean, std, None, None, &data));
             }
             _ => {
                 let (mean, std) = moments::sample_mean_std(&data);
@@ -271,6 +276,7 @@ pub fn analyse_scalars(
                 let sur = (surrogate_basis(study, &pce.basis) * &pce.coeffs).column(0).iter().copied().collect();
                 (m[0], s[0], 0.0, sur, Some(pce.sobol_first(0)), Some(pce.sobol_total(0)))
             }
+            (MethodKind::Nominal, _) => (valid[0], 0.0, 0.0, valid.clone(), None, None),
             _ => {
                 let sum = moments::ScalarSummary::from_samples(&valid);
                 (sum.mean, sum.std, sum.std_error_mean, valid.clone(), None, None)

@@ -78,6 +78,7 @@ impl Design {
                 )
             }
             MethodKind::Sgm => return Err(DesignError::NoDesign("sgm")),
+            MethodKind::Nominal => (vec![vec![0.0; d]], Some(vec![1.0]), vec![], 0),
         };
         let values: Vec<Vec<f64>> = germ
             .iter()
@@ -86,6 +87,7 @@ impl Design {
                     .zip(&study.parameters)
                     .map(|(&x, p)| match m.kind {
                         MethodKind::Scm => p.distribution.from_standard_normal(x),
+                        MethodKind::Nominal => p.distribution.mean(),
                         _ => p.distribution.inverse_cdf(x),
                     })
                     .collect()

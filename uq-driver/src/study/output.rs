@@ -269,6 +269,34 @@ pub fn write_all(
         });
         scalars_json.insert(name.clone(), serde_json::to_value(q).expect("serializable"));
     }
+    // Signal against speed for the critical-speed quantities (the paper's Fig. 5a) when both
+    // are recorded as outputs.
+    for q in &study.file.qoi {
+        if let crate::study::spec::QoiSpec::CriticalSpeed { name, signal, speed, threshold, .. } = q {
+            let find = |n: &str| stats.iter().find(|s| s.name == n);
+            if let (Some(y), Some(v)) = (find(signal), find(speed)) {
+                let mut plot = LinePlot::new(
+                    format!("{signal} against {speed} ({})", study.file.name),
+                    speed.clone(),
+                    signal.clone(),
+                );
+                let up: Vec<f64> = y.mean.iter().zip(&y.std).map(|(m, d)| m + 3.0 * d).collect();
+                let lo: Vec<f64> = y.mean.iter().zip(&y.std).map(|(m, d)| m - 3.0 * d).collect();
+                if y.std.iter().any(|d| *d > 0.0) {
+                    plot.bands.push(Band::new("mean ± 3σ", v.mean.clone(), lo, up, report::palette(0)));
+                }
+                plot.series.push(Series::new(format!("{signal} (mean)"), v.mean.clone(), y.mean.clone(), report::palette(0)));
+                let ends = vec![v.mean[0], v.mean[v.mean.len() - 1]];
+                plot.series.push(Series::new(format!("threshold ±{threshold}"), ends.clone(), vec![*threshold; 2], report::palette(3)).dashed());
+                plot.series.push(Series::new("", ends, vec![-*threshold; 2], report::palette(3)).dashed());
+                let file = format!("{signal}_vs_{speed}.svg");
+                plot.write(&dir.join(&file))?;
+                if let Some(sec) = sections.iter_mut().find(|s| s.heading == format!("Quantity {name}")) {
+                    sec.images.insert(0, file);
+                }
+            }
+        }
+    }
     if let Some(points) = &ctx.points_csv {
         let ppath = dir.join("points.csv");
         std::fs::write(&ppath, points).map_err(|source| ReportError::Io { path: ppath, source })?;

@@ -92,6 +92,8 @@ pub enum MethodKind {
     Scm,
     /// Stochastic Galerkin method on a linear system given in the study file.
     Sgm,
+    /// One deterministic run at the parameters' means.
+    Nominal,
 }
 
 impl MethodKind {
@@ -102,6 +104,7 @@ impl MethodKind {
             MethodKind::Lhs => "lhs",
             MethodKind::Scm => "scm",
             MethodKind::Sgm => "sgm",
+            MethodKind::Nominal => "nominal",
         }
     }
 }
@@ -511,6 +514,11 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
     ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
     ("paper-wheel", include_str!("../../studies/paper-wheel.toml")),
+    ("bogie-nominal", include_str!("../../studies/bogie-nominal.toml")),
+    ("bogie-scm", include_str!("../../studies/bogie-scm.toml")),
+    ("bogie-lhs-500", include_str!("../../studies/bogie-lhs-500.toml")),
+    ("bogie-lhs-20000", include_str!("../../studies/bogie-lhs-20000.toml")),
+    ("paper-bogie", include_str!("../../studies/paper-bogie.toml")),
 ];
 
 /// Folders searched for an FMU named by a relative path that is not next to the study file:
@@ -699,6 +707,7 @@ impl Study {
                     )));
                 }
             }
+            MethodKind::Nominal => {}
             MethodKind::Sgm => {
                 let order = m.order.ok_or_else(|| invalid("method sgm needs `order`".into()))?;
                 if order > 12 {
