@@ -73,8 +73,10 @@ pub enum RunError {
 pub struct Interface {
     /// Random parameters, in study order.
     pub random: Vec<u32>,
-    /// Fixed parameters (name order) and values.
+    /// Fixed Real parameters (name order) and values.
     pub fixed: Vec<(u32, f64)>,
+    /// Fixed Integer parameters (e.g. a spectrum or seed number).
+    pub fixed_int: Vec<(u32, i32)>,
     /// Every variable read at each communication point: the outputs, then the signals the
     /// quantities of interest need.
     pub signals: Vec<u32>,
@@ -116,21 +118,65 @@ fn real_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError
     Ok(var)
 }
 
+fn check_settable(fmu: &Fmu, var: &ScalarVariable) -> Result<(), RunError> {
+    if fmu.description().settable_before_init(var) {
+        return Ok(());
+    }
+    Err(RunError::Interface {
+        fmu: fmu.path().display().to_string(),
+        message: format!(
+            "variable '{}' (causality {}, variability {}) may not be set before initialization, \
+             so a study cannot set it",
+            var.name,
+            var.causality.as_str(),
+            var.variability.as_str()
+        ),
+    })
+}
+
+/// Splits deterministic values into Real and Integer settings, checking each variable.
+fn fixed_values<'a>(
+    fmu: &Fmu,
+    values: impl Iterator<Item = (&'a str, f64)>,
+) -> Result<(Vec<(u32, f64)>, Vec<(u32, i32)>), RunError> {
+    let mut reals = Vec::new();
+    let mut ints = Vec::new();
+    for (name, v) in values {
+        let var = fmu.description().variable(name).ok_or_else(|| RunError::Interface {
+            fmu: fmu.path().display().to_string(),
+            message: format!(
+                "the study names variable '{name}', which the FMU ({}) does not have",
+                fmu.description().model_name
+            ),
+        })?;
+        check_settable(fmu, var)?;
+        match var.kind {
+            VariableKind::Real { .. } => reals.push((var.value_reference, v)),
+            VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => {
+                if v.fract() != 0.0 || v.abs() > f64::from(i32::MAX) {
+                    return Err(RunError::Interface {
+                        fmu: fmu.path().display().to_string(),
+                        message: format!("'{name}' is an Integer; {v} is not a whole number"),
+                    });
+                }
+                ints.push((var.value_reference, v as i32));
+            }
+            _ => {
+                return Err(RunError::Interface {
+                    fmu: fmu.path().display().to_string(),
+                    message: format!("'{name}' is a {}; only Real and Integer values can be set", var.kind.type_name()),
+                })
+            }
+        }
+    }
+    Ok((reals, ints))
+}
+
 /// Checks the study's variables against the FMU and resolves their value references.
 pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError> {
     let settable = |name: &str| -> Result<u32, RunError> {
         let var = real_var(fmu, name)?;
-        if !fmu.description().settable_before_init(var) {
-            return Err(RunError::Interface {
-                fmu: fmu.path().display().to_string(),
-                message: format!(
-                    "variable '{name}' (causality {}, variability {}) may not be set before initialization, \
-                     so the study cannot vary it",
-                    var.causality.as_str(),
-                    var.variability.as_str()
-                ),
-            });
-        }
+        check_settable(fmu, var)?;
         Ok(var.value_reference)
     };
     let random = study
@@ -138,12 +184,7 @@ pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError
         .iter()
         .map(|p| settable(&p.name))
         .collect::<Result<_, _>>()?;
-    let fixed = study
-        .file
-        .fixed
-        .iter()
-        .map(|(n, v)| Ok((settable(n)?, *v)))
-        .collect::<Result<_, RunError>>()?;
+    let (fixed, fixed_int) = fixed_values(fmu, study.file.fixed.iter().map(|(n, v)| (n.as_str(), *v)))?;
     let mut signal_names: Vec<String> = study.file.outputs.variables.clone();
     for q in &study.file.qoi {
         for s in q.signals() {
@@ -159,6 +200,7 @@ pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError
     Ok(Interface {
         random,
         fixed,
+        fixed_int,
         signals,
         signal_names,
         n_stored: study.file.outputs.variables.len(),
@@ -230,6 +272,8 @@ pub fn run_point(
         };
         let (fixed_vr, fixed_v): (Vec<u32>, Vec<f64>) = iface.fixed.iter().copied().unzip();
         inst.set_real(&fixed_vr, &fixed_v)?;
+        let (int_vr, int_v): (Vec<u32>, Vec<i32>) = iface.fixed_int.iter().copied().unzip();
+        inst.set_integer(&int_vr, &int_v)?;
         inst.set_real(&iface.random, values)?;
         let start = times[0];
         let stop = *times.last().expect("at least one time");
@@ -453,33 +497,22 @@ pub fn simulate(
     } else {
         outputs.to_vec()
     };
-    let mut random = Vec::new();
-    let mut values = Vec::new();
-    for (n, v) in params {
-        let var = real_var(fmu, n)?;
-        if !md.settable_before_init(var) {
-            return Err(RunError::Interface {
-                fmu: fmu.path().display().to_string(),
-                message: format!("variable '{n}' may not be set before initialization"),
-            });
-        }
-        random.push(var.value_reference);
-        values.push(*v);
-    }
+    let (fixed, fixed_int) = fixed_values(fmu, params.iter().map(|(n, v)| (n.as_str(), *v)))?;
     let signals = names
         .iter()
         .map(|n| Ok(real_var(fmu, n)?.value_reference))
         .collect::<Result<Vec<_>, RunError>>()?;
     let iface = Interface {
-        random,
-        fixed: Vec::new(),
+        random: Vec::new(),
+        fixed,
+        fixed_int,
         signals,
         signal_names: names.clone(),
         n_stored: names.len(),
         qois: Vec::new(),
     };
     let mut slot = None;
-    let flat = run_point(fmu, &mut slot, &iface, &values, times).map_err(|message| RunError::Interface {
+    let flat = run_point(fmu, &mut slot, &iface, &[], times).map_err(|message| RunError::Interface {
         fmu: fmu.path().display().to_string(),
         message,
     })?;

@@ -519,6 +519,12 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ("bogie-lhs-500", include_str!("../../studies/bogie-lhs-500.toml")),
     ("bogie-lhs-20000", include_str!("../../studies/bogie-lhs-20000.toml")),
     ("paper-bogie", include_str!("../../studies/paper-bogie.toml")),
+    ("vehicle-track-nominal", include_str!("../../studies/vehicle-track-nominal.toml")),
+    ("vehicle-track-scm-cov10", include_str!("../../studies/vehicle-track-scm-cov10.toml")),
+    ("vehicle-track-scm-cov20", include_str!("../../studies/vehicle-track-scm-cov20.toml")),
+    ("vehicle-track-scm-cov30", include_str!("../../studies/vehicle-track-scm-cov30.toml")),
+    ("vehicle-track-defect", include_str!("../../studies/vehicle-track-defect.toml")),
+    ("paper-vehicle-track", include_str!("../../studies/paper-vehicle-track.toml")),
 ];
 
 /// Folders searched for an FMU named by a relative path that is not next to the study file:
