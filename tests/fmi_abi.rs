@@ -1791,7 +1791,11 @@ fn eight_instances_alive_at_once() {
     }
     for ((inst, traj), &k) in insts.iter().zip(&trajs).zip(&ks) {
         assert_eq!(bits(traj), bits(&simulate(&[(VR_K, k)], h, 300)), "K = {k}");
-        assert!(inst.log().iter().all(|e| e.category == "logCalls"), "{:#?}", inst.log());
+        assert!(
+            inst.log().iter().all(|e| e.category == "logCalls"),
+            "{:#?}",
+            inst.log()
+        );
     }
     for w in trajs.windows(2) {
         assert_ne!(bits(&w[0]), bits(&w[1]));
@@ -1881,7 +1885,11 @@ fn logging_off_silences_warnings_but_not_errors() {
     for inst in [off_at_instantiation, off_later] {
         inst.clear_log();
         assert_eq!(inst.set(VR_K, -3.0), WARNING);
-        assert!(inst.log().iter().all(|e| e.category == "logCalls"), "{:#?}", inst.log());
+        assert!(
+            inst.log().iter().all(|e| e.category == "logCalls"),
+            "{:#?}",
+            inst.log()
+        );
         assert_eq!(inst.set(999, 1.0), ERROR);
         inst.assert_logged(ERROR, &["999"]);
         assert!(inst.log().iter().all(|e| e.status == ERROR));

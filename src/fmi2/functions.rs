@@ -165,7 +165,8 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
                 .map(|&p| {
                     // SAFETY: each entry is a NUL-terminated string (FMI contract).
                     let s = unsafe { c_str(p) };
-                    s.map(str::to_owned).ok_or_else(|| null_arg("categories[i]"))
+                    s.map(str::to_owned)
+                        .ok_or_else(|| null_arg("categories[i]"))
                 })
                 .collect::<Result<_, _>>()?
         };

@@ -81,8 +81,13 @@ enum Command {
 }
 
 fn parse_assignment(s: &str) -> Result<(String, f64), String> {
-    let (name, value) = s.split_once('=').ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
-    let v: f64 = value.trim().parse().map_err(|e| format!("value of {name}: {e}"))?;
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("value of {name}: {e}"))?;
     Ok((name.trim().to_owned(), v))
 }
 
@@ -131,7 +136,10 @@ fn dispatch(cmd: Command) -> Result<()> {
                 if r.model_runs == 1 {
                     println!("  {} = {:.6}", q.name, q.mean);
                 } else {
-                    println!("  {}: mean {:.6}, std {:.6} ({} valid runs)", q.name, q.mean, q.std, q.n_valid);
+                    println!(
+                        "  {}: mean {:.6}, std {:.6} ({} valid runs)",
+                        q.name, q.mean, q.std, q.n_valid
+                    );
                 }
                 for (l, p, se) in &q.exceedance {
                     println!("  P({} > {l}) = {p:.5} (standard error {se:.1e})", q.name);
@@ -181,10 +189,14 @@ fn simulate(
     out: Option<&std::path::Path>,
 ) -> Result<()> {
     let fmu = Fmu::open(path)?;
-    let de = fmu.description().default_experiment.clone().unwrap_or_default();
+    let de = fmu.description().default_experiment.unwrap_or_default();
     let start = start.or(de.start_time).unwrap_or(0.0);
-    let stop = stop.or(de.stop_time).context("no --stop and no default stop time in the FMU")?;
-    let step = step.or(de.step_size).context("no --step and no default step size in the FMU")?;
+    let stop = stop
+        .or(de.stop_time)
+        .context("no --stop and no default stop time in the FMU")?;
+    let step = step
+        .or(de.step_size)
+        .context("no --step and no default step size in the FMU")?;
     let experiment = uq_driver::study::spec::Experiment { start, stop, step };
     anyhow::ensure!(
         step > 0.0 && stop > start && {

@@ -18,7 +18,11 @@ fn fmu_dir() -> PathBuf {
 
 fn wheel_fmu() -> PathBuf {
     let p = fmu_dir().join("Wheel.fmu");
-    assert!(p.is_file(), "{} is missing: run `make fmu` first", p.display());
+    assert!(
+        p.is_file(),
+        "{} is missing: run `make fmu` first",
+        p.display()
+    );
     p
 }
 
@@ -37,7 +41,10 @@ fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
         .collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let s: f64 = pairs.iter().map(|p| p.1).sum();
-    (pairs.iter().map(|p| p.0).collect(), pairs.iter().map(|p| p.1 / s).collect())
+    (
+        pairs.iter().map(|p| p.0).collect(),
+        pairs.iter().map(|p| p.1 / s).collect(),
+    )
 }
 
 /// q(t) of m q'' + c q' + k q = 0, q(0) = q0, q'(0) = 0, every regime.
@@ -62,7 +69,10 @@ fn reference(t: f64) -> (f64, f64) {
     let mut vals = Vec::new();
     for (xi, wi) in x.iter().zip(&w) {
         for (xj, wj) in x.iter().zip(&w) {
-            vals.push((wi * wj, closed_form(10.0, 100.0 + 10.0 * xi, 20.0 + 2.0 * xj, 0.1, t)));
+            vals.push((
+                wi * wj,
+                closed_form(10.0, 100.0 + 10.0 * xi, 20.0 + 2.0 * xj, 0.1, t),
+            ));
         }
     }
     let mean: f64 = vals.iter().map(|(w, v)| w * v).sum();
@@ -78,7 +88,12 @@ struct Csv {
 fn read_csv(path: &Path) -> Csv {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
     let rows = lines
         .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
         .collect();
@@ -162,24 +177,49 @@ fn scm_6x6_matches_the_reference() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["model_runs"], 36);
     assert_eq!(summary["method"]["kind"], "scm");
-    for f in ["index.html", "q_band.svg", "q_pdf.svg", "q_pdf.png", "q_pdf.csv", "points.csv"] {
+    for f in [
+        "index.html",
+        "q_band.svg",
+        "q_pdf.svg",
+        "q_pdf.png",
+        "q_pdf.csv",
+        "points.csv",
+    ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
 }
 
 fn check_sampling(kind: &str, n: usize) {
     let dir = tempfile::tempdir().unwrap();
-    let study = study_file(dir.path(), kind, &format!("kind = \"{kind}\"\nsamples = {n}"), "");
+    let study = study_file(
+        dir.path(),
+        kind,
+        &format!("kind = \"{kind}\"\nsamples = {n}"),
+        "",
+    );
     let out = dir.path().join("out");
-    run_ok(&["run", study.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     let csv = read_csv(&out.join("q.csv"));
     for t in TIMES {
         let (m, s) = reference(t);
         let se_mean = s / (n as f64).sqrt();
         let se_std = s / (2.0 * (n as f64 - 1.0)).sqrt();
         let (dm, ds) = (csv.at(t, "mean") - m, csv.at(t, "std") - s);
-        assert!(dm.abs() < 4.0 * se_mean, "{kind} t = {t}: mean off by {dm:e} (4 SE = {:e})", 4.0 * se_mean);
-        assert!(ds.abs() < 4.0 * se_std, "{kind} t = {t}: std off by {ds:e} (4 SE = {:e})", 4.0 * se_std);
+        assert!(
+            dm.abs() < 4.0 * se_mean,
+            "{kind} t = {t}: mean off by {dm:e} (4 SE = {:e})",
+            4.0 * se_mean
+        );
+        assert!(
+            ds.abs() < 4.0 * se_std,
+            "{kind} t = {t}: std off by {ds:e} (4 SE = {:e})",
+            4.0 * se_std
+        );
     }
 }
 
@@ -198,10 +238,28 @@ fn one_and_two_threads_give_identical_files() {
     let dir = tempfile::tempdir().unwrap();
     let study = study_file(dir.path(), "t", "kind = \"lhs\"\nsamples = 300", "");
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
-    run_ok(&["run", study.to_str().unwrap(), "--out", a.to_str().unwrap(), "--threads", "1"]);
-    run_ok(&["run", study.to_str().unwrap(), "--out", b.to_str().unwrap(), "--threads", "2"]);
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        a.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        b.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
     for f in ["q.csv", "q_pdf.csv", "points.csv"] {
-        assert_eq!(std::fs::read(a.join(f)).unwrap(), std::fs::read(b.join(f)).unwrap(), "{f}");
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
     }
 }
 
@@ -210,10 +268,22 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
     let dir = tempfile::tempdir().unwrap();
     let study = study_file(dir.path(), "r", "kind = \"lhs\"\nsamples = 40000", "");
     let full = dir.path().join("full");
-    run_ok(&["run", study.to_str().unwrap(), "--out", full.to_str().unwrap()]);
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        full.to_str().unwrap(),
+    ]);
     let part = dir.path().join("part");
     let mut child = Command::new(DRIVER)
-        .args(["run", study.to_str().unwrap(), "--out", part.to_str().unwrap(), "--threads", "1"])
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--out",
+            part.to_str().unwrap(),
+            "--threads",
+            "1",
+        ])
         .spawn()
         .unwrap();
     let records = part.join("store/records.bin");
@@ -224,22 +294,41 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
         if len > 10_000 * 4_037 {
             break;
         }
-        assert!(child.try_wait().unwrap().is_none(), "finished before it could be killed");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before it could be killed"
+        );
         assert!(std::time::Instant::now() < deadline, "no progress");
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(!part.join("q.csv").exists(), "killed before the end");
-    let out = run(&["run", study.to_str().unwrap(), "--out", part.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        part.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(part.join("summary.json")).unwrap()).unwrap();
     let resumed = summary["runs_resumed"].as_u64().unwrap();
-    assert!(resumed >= 10_000 && resumed < 40_000, "resumed {resumed}");
-    assert_eq!(summary["runs_this_invocation"].as_u64().unwrap() + resumed, 40_000);
+    assert!((10_000..40_000).contains(&resumed), "resumed {resumed}");
+    assert_eq!(
+        summary["runs_this_invocation"].as_u64().unwrap() + resumed,
+        40_000
+    );
     for f in ["q.csv", "q_pdf.csv", "points.csv"] {
-        assert_eq!(std::fs::read(full.join(f)).unwrap(), std::fs::read(part.join(f)).unwrap(), "{f}");
+        assert_eq!(
+            std::fs::read(full.join(f)).unwrap(),
+            std::fs::read(part.join(f)).unwrap(),
+            "{f}"
+        );
     }
 }
 
@@ -247,16 +336,35 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
 fn failed_points_stop_the_study_or_are_counted_when_allowed() {
     let dir = tempfile::tempdir().unwrap();
     // m ~ N(1, 1): about 16 % of the samples have m <= 0, which the FMU refuses.
-    let text = std::fs::read_to_string(study_file(dir.path(), "f", "kind = \"lhs\"\nsamples = 200", ""))
-        .unwrap()
-        .replace("name = \"C\"\nmean = 20.0\ncov = 0.1", "name = \"m\"\nmean = 1.0\nstd = 1.0");
+    let text = std::fs::read_to_string(study_file(
+        dir.path(),
+        "f",
+        "kind = \"lhs\"\nsamples = 200",
+        "",
+    ))
+    .unwrap()
+    .replace(
+        "name = \"C\"\nmean = 20.0\ncov = 0.1",
+        "name = \"m\"\nmean = 1.0\nstd = 1.0",
+    );
     let study = dir.path().join("fail.toml");
     std::fs::write(&study, text).unwrap();
-    let out = run(&["run", study.to_str().unwrap(), "--out", dir.path().join("a").to_str().unwrap()]);
+    let out = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        dir.path().join("a").to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("points failed") && err.contains("m = -"), "{err}");
-    assert!(err.contains("fmi2SetReal"), "the FMU's reason is shown: {err}");
+    assert!(
+        err.contains("points failed") && err.contains("m = -"),
+        "{err}"
+    );
+    assert!(
+        err.contains("fmi2SetReal"),
+        "the FMU's reason is shown: {err}"
+    );
     let out = run(&[
         "run",
         study.to_str().unwrap(),
@@ -264,9 +372,14 @@ fn failed_points_stop_the_study_or_are_counted_when_allowed() {
         dir.path().join("b").to_str().unwrap(),
         "--allow-failures",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b/summary.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b/summary.json")).unwrap())
+            .unwrap();
     let failed = summary["failed_runs"].as_u64().unwrap();
     assert!((15..60).contains(&failed), "failed {failed}");
     let points = std::fs::read_to_string(dir.path().join("b/points.csv")).unwrap();
@@ -278,24 +391,55 @@ fn bad_inputs_give_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let bad_fmu = dir.path().join("bad.fmu");
     std::fs::write(&bad_fmu, b"this is not a zip").unwrap();
-    let text = std::fs::read_to_string(study_file(dir.path(), "x", "kind = \"lhs\"\nsamples = 10", "")).unwrap();
+    let text = std::fs::read_to_string(study_file(
+        dir.path(),
+        "x",
+        "kind = \"lhs\"\nsamples = 10",
+        "",
+    ))
+    .unwrap();
     let cases = [
-        (text.replace(&wheel_fmu().display().to_string(), &bad_fmu.display().to_string()), "not a zip archive"),
+        (
+            text.replace(
+                &wheel_fmu().display().to_string(),
+                &bad_fmu.display().to_string(),
+            ),
+            "not a zip archive",
+        ),
         (text.replace("name = \"K\"", "name = \"Kx\""), "'Kx'"),
-        (text.replace("variables = [\"q\"]", "variables = [\"nope\"]"), "'nope'"),
-        (text.replace("name = \"K\"", "name = \"q\""), "may not be set"),
-        (text.replace("samples = 10", "samples = 10\ncolour = 3"), "unknown field"),
+        (
+            text.replace("variables = [\"q\"]", "variables = [\"nope\"]"),
+            "'nope'",
+        ),
+        (
+            text.replace("name = \"K\"", "name = \"q\""),
+            "may not be set",
+        ),
+        (
+            text.replace("samples = 10", "samples = 10\ncolour = 3"),
+            "unknown field",
+        ),
     ];
     for (i, (t, needle)) in cases.iter().enumerate() {
         let p = dir.path().join(format!("case{i}.toml"));
         std::fs::write(&p, t).unwrap();
-        let out = run(&["run", p.to_str().unwrap(), "--out", dir.path().join(format!("o{i}")).to_str().unwrap()]);
+        let out = run(&[
+            "run",
+            p.to_str().unwrap(),
+            "--out",
+            dir.path().join(format!("o{i}")).to_str().unwrap(),
+        ]);
         assert!(!out.status.success());
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "case {i}: {err}");
         assert!(!err.contains("panicked"), "case {i}: {err}");
     }
-    let out = run(&["run", "builtin:nope", "--out", dir.path().join("n").to_str().unwrap()]);
+    let out = run(&[
+        "run",
+        "builtin:nope",
+        "--out",
+        dir.path().join("n").to_str().unwrap(),
+    ]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("no built-in study 'nope'"));
 }
 
@@ -309,5 +453,11 @@ fn a_folder_of_another_study_is_refused() {
     let r = run(&["run", b.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("different study"));
-    run_ok(&["run", b.to_str().unwrap(), "--out", out.to_str().unwrap(), "--fresh"]);
+    run_ok(&[
+        "run",
+        b.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--fresh",
+    ]);
 }

@@ -58,7 +58,10 @@ pub fn evaluate<'a>(
             skip,
             ..
         } => {
-            let dt = times.get(1).map(|t1| t1 - times[0]).ok_or("fewer than two samples")?;
+            let dt = times
+                .get(1)
+                .map(|t1| t1 - times[0])
+                .ok_or("fewer than two samples")?;
             let start = times.partition_point(|&t| t < times[0] + skip - 1e-9 * dt);
             let settings = SperlingSettings {
                 direction: if direction == "lateral" {
@@ -70,10 +73,16 @@ pub fn evaluate<'a>(
                 f_min: *f_min,
                 f_max: *f_max,
             };
-            let r = sperling_index(&signal(s)[start..], dt, &settings).map_err(|e| e.to_string())?;
+            let r =
+                sperling_index(&signal(s)[start..], dt, &settings).map_err(|e| e.to_string())?;
             Ok((r.w, Code::Ok))
         }
-        QoiSpec::MaxAbs { signal: s, from, to, .. } => {
+        QoiSpec::MaxAbs {
+            signal: s,
+            from,
+            to,
+            ..
+        } => {
             let x = signal(s);
             let to = to.unwrap_or(f64::INFINITY);
             let m = times
@@ -89,7 +98,9 @@ pub fn evaluate<'a>(
         }
         QoiSpec::Final { signal: s, .. } => {
             let x = signal(s);
-            x.last().map(|v| (*v, Code::Ok)).ok_or_else(|| format!("{s} is empty"))
+            x.last()
+                .map(|v| (*v, Code::Ok))
+                .ok_or_else(|| format!("{s} is empty"))
         }
     }
 }

@@ -12,6 +12,9 @@ use crate::qoi::{kde, moments};
 use crate::uq::pce::{MultiIndexSet, Pce};
 use crate::uq::rng;
 
+/// First-order and total Sobol' indices over time, each `[time][parameter]`.
+pub type SobolSeries = (Vec<Vec<f64>>, Vec<Vec<f64>>);
+
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
 pub struct OutputStats {
@@ -29,7 +32,7 @@ pub struct OutputStats {
     /// SCM: Std from the chaos coefficients (truncated at the study's order).
     pub std_pce: Option<Vec<f64>>,
     /// SCM/SGM: first-order and total Sobol' indices over time (`[time][parameter]`).
-    pub sobol: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>,
+    pub sobol: Option<SobolSeries>,
     /// PDF evolution: times of the columns.
     pub pdf_times: Vec<f64>,
     /// Grid of the densities.
@@ -175,7 +178,16 @@ fn finish(
 pub fn stats_from_pce(study: &Study, name: &str, pce: &Pce) -> OutputStats {
     let times = study.file.experiment.times();
     let samples = surrogate_basis(study, &pce.basis) * &pce.coeffs;
-    finish(study, name, &times, pce.mean(), pce.std(), None, Some(pce), &samples)
+    finish(
+        study,
+        name,
+        &times,
+        pce.mean(),
+        pce.std(),
+        None,
+        Some(pce),
+        &samples,
+    )
 }
 
 /// Indices of the successful runs.
@@ -187,13 +199,24 @@ fn ok_points(records: &[Option<Record>]) -> Vec<usize> {
 
 /// Analyses every output of a sampled or collocated study. `records` must hold a record for
 /// every point.
-pub fn analyse(study: &Study, design: &Design, records: &[Option<Record>]) -> Result<Vec<OutputStats>, String> {
+pub fn analyse(
+    study: &Study,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<Vec<OutputStats>, String> {
     let times = study.file.experiment.times();
     let nt = times.len();
     let ok = ok_points(records);
-    let needed = if design.method == MethodKind::Nominal { 1 } else { 2 };
+    let needed = if design.method == MethodKind::Nominal {
+        1
+    } else {
+        2
+    };
     if ok.len() < needed {
-        return Err(format!("only {} successful runs: nothing to analyse", ok.len()));
+        return Err(format!(
+            "only {} successful runs: nothing to analyse",
+            ok.len()
+        ));
     }
     let mut out = Vec::new();
     for (o, name) in study.file.outputs.variables.iter().enumerate() {
@@ -204,12 +227,23 @@ pub fn analyse(study: &Study, design: &Design, records: &[Option<Record>]) -> Re
         match (design.method, &design.weights) {
             (MethodKind::Scm, Some(w)) => {
                 if ok.len() != design.len() {
-                    return Err("a collocation node is missing: refusing to drop a weighted node".into());
+                    return Err(
+                        "a collocation node is missing: refusing to drop a weighted node".into(),
+                    );
                 }
                 let (mean, std) = moments::weighted_mean_std(&data, w);
                 let pce = project(study, design, w, &data)?;
                 let samples = surrogate_basis(study, &pce.basis) * &pce.coeffs;
-                out.push(finish(study, name, &times, mean, std, Some(pce.std()), Some(&pce), &samples));
+                out.push(finish(
+                    study,
+                    name,
+                    &times,
+                    mean,
+                    std,
+                    Some(pce.std()),
+                    Some(&pce),
+                    &samples,
+                ));
             }
             (MethodKind::Nominal, Some(w)) => {
                 let (mean, std) = moments::weighted_mean_std(&data, w);
@@ -251,14 +285,22 @@ pub fn analyse_scalars(
         }
         let n_never_hunts = codes.iter().filter(|c| **c == Code::NeverHunts).count();
         let n_never_stops = codes.iter().filter(|c| **c == Code::NeverStops).count();
-        let valid: Vec<f64> = values.iter().zip(&codes).filter(|(_, c)| **c == Code::Ok).map(|(v, _)| *v).collect();
+        let valid: Vec<f64> = values
+            .iter()
+            .zip(&codes)
+            .filter(|(_, c)| **c == Code::Ok)
+            .map(|(v, _)| *v)
+            .collect();
         if valid.is_empty() {
             return Err(format!(
                 "quantity '{}': no run gave a value ({n_never_hunts} never hunt, {n_never_stops} never stop)",
                 q.name()
             ));
         }
-        let (mean, std, sem, density_samples, sobol_first, sobol_total) = match (design.method, &design.weights) {
+        let (mean, std, sem, density_samples, sobol_first, sobol_total) = match (
+            design.method,
+            &design.weights,
+        ) {
             (MethodKind::Scm, Some(w)) => {
                 if valid.len() != design.len() {
                     return Err(format!(
@@ -273,18 +315,40 @@ pub fn analyse_scalars(
                 let data = DMatrix::from_column_slice(valid.len(), 1, &valid);
                 let (m, s) = moments::weighted_mean_std(&data, w);
                 let pce = project(study, design, w, &data)?;
-                let sur = (surrogate_basis(study, &pce.basis) * &pce.coeffs).column(0).iter().copied().collect();
-                (m[0], s[0], 0.0, sur, Some(pce.sobol_first(0)), Some(pce.sobol_total(0)))
+                let sur = (surrogate_basis(study, &pce.basis) * &pce.coeffs)
+                    .column(0)
+                    .iter()
+                    .copied()
+                    .collect();
+                (
+                    m[0],
+                    s[0],
+                    0.0,
+                    sur,
+                    Some(pce.sobol_first(0)),
+                    Some(pce.sobol_total(0)),
+                )
             }
             (MethodKind::Nominal, _) => (valid[0], 0.0, 0.0, valid.clone(), None, None),
             _ => {
                 let sum = moments::ScalarSummary::from_samples(&valid);
-                (sum.mean, sum.std, sum.std_error_mean, valid.clone(), None, None)
+                (
+                    sum.mean,
+                    sum.std,
+                    sum.std_error_mean,
+                    valid.clone(),
+                    None,
+                    None,
+                )
             }
         };
         let mut sorted = density_samples.clone();
         sorted.sort_by(f64::total_cmp);
-        let quantiles = a.quantiles.iter().map(|&p| (p, moments::quantile(&sorted, p))).collect();
+        let quantiles = a
+            .quantiles
+            .iter()
+            .map(|&p| (p, moments::quantile(&sorted, p)))
+            .collect();
         let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
         let bw = kde::silverman_bandwidth(&sorted);
         let grid = kde::auto_grid(lo - 3.0 * bw, hi + 3.0 * bw, a.pdf_grid);

@@ -28,21 +28,40 @@ fn method_label(s: &Study) -> String {
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Runs every variant and writes the comparison into `out_dir`.
-pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<StudyResult, StudyRunError> {
+pub fn run_suite(
+    suite: &Study,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
     let variants = suite.variants()?;
     let mut done: Vec<Done> = Vec::new();
     for v in variants {
         let dir = out_dir.join(&v.file.name);
-        eprintln!("{}: variant {} ({}) …", suite.file.name, v.file.name, method_label(&v));
+        eprintln!(
+            "{}: variant {} ({}) …",
+            suite.file.name,
+            v.file.name,
+            method_label(&v)
+        );
         let result = run_study(&v, &dir, opts)?;
         done.push(Done { study: v, result });
     }
-    let ref_name = suite.file.reference.clone().unwrap_or_else(|| done[0].study.file.name.clone());
-    let r = done.iter().position(|d| d.study.file.name == ref_name).expect("validated reference");
+    let ref_name = suite
+        .file
+        .reference
+        .clone()
+        .unwrap_or_else(|| done[0].study.file.name.clone());
+    let r = done
+        .iter()
+        .position(|d| d.study.file.name == ref_name)
+        .expect("validated reference");
     let mut sections = Vec::new();
     let mut summary_variants = Vec::new();
     // Per-variant table.
@@ -82,7 +101,12 @@ pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
             "quantities": d.result.scalars,
         }));
     }
-    let mut header = vec!["variant".to_string(), "method".into(), "model runs".into(), "wall time [s]".into()];
+    let mut header = vec![
+        "variant".to_string(),
+        "method".into(),
+        "model runs".into(),
+        "wall time [s]".into(),
+    ];
     for s in &done[r].result.stats {
         header.push(format!("max |Δmean {}| vs {ref_name}", s.name));
         header.push(format!("max |ΔStd {}| vs {ref_name}", s.name));
@@ -122,15 +146,22 @@ pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
                     s => s
                         .strip_prefix("p>")
                         .and_then(|l| l.parse::<f64>().ok())
-                        .and_then(|l| q.exceedance.iter().find(|e| (e.0 - l).abs() < 1e-12).map(|e| e.1)),
+                        .and_then(|l| {
+                            q.exceedance
+                                .iter()
+                                .find(|e| (e.0 - l).abs() < 1e-12)
+                                .map(|e| e.1)
+                        }),
                 });
             rows.push(vec![
                 pv.variant.clone(),
                 pv.quantity.clone(),
                 pv.statistic.clone(),
                 format!("{}", pv.value),
-                ours.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
-                ours.map(|v| format!("{:+.2} %", 100.0 * (v - pv.value) / pv.value)).unwrap_or_default(),
+                ours.map(|v| format!("{v:.5}"))
+                    .unwrap_or_else(|| "n/a".into()),
+                ours.map(|v| format!("{:+.2} %", 100.0 * (v - pv.value) / pv.value))
+                    .unwrap_or_default(),
                 pv.source.clone(),
             ]);
         }
@@ -139,10 +170,18 @@ pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
             text: "Published values beside ours.".into(),
             images: vec![],
             table: Some(Table {
-                header: ["variant", "quantity", "statistic", "paper", "railuq", "difference", "source"]
-                    .iter()
-                    .map(|s| s.to_string())
-                    .collect(),
+                header: [
+                    "variant",
+                    "quantity",
+                    "statistic",
+                    "paper",
+                    "railuq",
+                    "difference",
+                    "source",
+                ]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
                 rows,
             }),
         });
@@ -158,8 +197,14 @@ pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
         "wall_time_s": wall,
     });
     let spath = out_dir.join("summary.json");
-    std::fs::write(&spath, serde_json::to_string_pretty(&summary).expect("json"))
-        .map_err(|source| report::ReportError::Io { path: spath, source })?;
+    std::fs::write(
+        &spath,
+        serde_json::to_string_pretty(&summary).expect("json"),
+    )
+    .map_err(|source| report::ReportError::Io {
+        path: spath,
+        source,
+    })?;
     ReportPage {
         title: format!("railuq suite {}", suite.file.name),
         summary_json: serde_json::to_string_pretty(&summary).expect("json"),
@@ -174,14 +219,32 @@ pub fn run_suite(suite: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
     })
 }
 
-fn compare_output(dir: &Path, done: &[Done], r: usize, o: usize, rs: &OutputStats) -> Result<Section, StudyRunError> {
+fn compare_output(
+    dir: &Path,
+    done: &[Done],
+    r: usize,
+    o: usize,
+    rs: &OutputStats,
+) -> Result<Section, StudyRunError> {
     let v = &rs.name;
     let ref_name = &done[r].study.file.name;
     let mut header = vec!["time".to_string()];
     let mut cols: Vec<Vec<f64>> = Vec::new();
-    let mut mean_plot = LinePlot::new(format!("{v}: mean − mean({ref_name})"), "time [s]", format!("Δ mean {v}"));
-    let mut std_plot = LinePlot::new(format!("{v}: Std − Std({ref_name})"), "time [s]", format!("Δ Std {v}"));
-    let mut means = LinePlot::new(format!("{v}: mean ± 3σ of every variant"), "time [s]", v.clone());
+    let mut mean_plot = LinePlot::new(
+        format!("{v}: mean − mean({ref_name})"),
+        "time [s]",
+        format!("Δ mean {v}"),
+    );
+    let mut std_plot = LinePlot::new(
+        format!("{v}: Std − Std({ref_name})"),
+        "time [s]",
+        format!("Δ Std {v}"),
+    );
+    let mut means = LinePlot::new(
+        format!("{v}: mean ± 3σ of every variant"),
+        "time [s]",
+        v.clone(),
+    );
     for (i, d) in done.iter().enumerate() {
         let s = &d.result.stats[o];
         let name = &d.study.file.name;
@@ -189,11 +252,36 @@ fn compare_output(dir: &Path, done: &[Done], r: usize, o: usize, rs: &OutputStat
         cols.push(s.mean.clone());
         header.push(format!("std_{name}"));
         cols.push(s.std.clone());
-        let up: Vec<f64> = s.mean.iter().zip(&s.std).map(|(m, d)| m + 3.0 * d).collect();
-        let lo: Vec<f64> = s.mean.iter().zip(&s.std).map(|(m, d)| m - 3.0 * d).collect();
-        means.series.push(Series::new(format!("{name} mean"), s.times.clone(), s.mean.clone(), report::palette(i)));
-        means.series.push(Series::new(format!("{name} ±3σ"), s.times.clone(), up, report::palette(i)).dashed());
-        means.series.push(Series::new("", s.times.clone(), lo, report::palette(i)).dashed());
+        let up: Vec<f64> = s
+            .mean
+            .iter()
+            .zip(&s.std)
+            .map(|(m, d)| m + 3.0 * d)
+            .collect();
+        let lo: Vec<f64> = s
+            .mean
+            .iter()
+            .zip(&s.std)
+            .map(|(m, d)| m - 3.0 * d)
+            .collect();
+        means.series.push(Series::new(
+            format!("{name} mean"),
+            s.times.clone(),
+            s.mean.clone(),
+            report::palette(i),
+        ));
+        means.series.push(
+            Series::new(
+                format!("{name} ±3σ"),
+                s.times.clone(),
+                up,
+                report::palette(i),
+            )
+            .dashed(),
+        );
+        means
+            .series
+            .push(Series::new("", s.times.clone(), lo, report::palette(i)).dashed());
         if i != r {
             let dm: Vec<f64> = s.mean.iter().zip(&rs.mean).map(|(a, b)| a - b).collect();
             let ds: Vec<f64> = s.std.iter().zip(&rs.std).map(|(a, b)| a - b).collect();
@@ -201,8 +289,18 @@ fn compare_output(dir: &Path, done: &[Done], r: usize, o: usize, rs: &OutputStat
             cols.push(dm.clone());
             header.push(format!("dstd_{name}"));
             cols.push(ds.clone());
-            mean_plot.series.push(Series::new(name.clone(), s.times.clone(), dm, report::palette(i)));
-            std_plot.series.push(Series::new(name.clone(), s.times.clone(), ds, report::palette(i)));
+            mean_plot.series.push(Series::new(
+                name.clone(),
+                s.times.clone(),
+                dm,
+                report::palette(i),
+            ));
+            std_plot.series.push(Series::new(
+                name.clone(),
+                s.times.clone(),
+                ds,
+                report::palette(i),
+            ));
         }
     }
     let mut all: Vec<&[f64]> = vec![&rs.times];
@@ -228,7 +326,12 @@ fn compare_output(dir: &Path, done: &[Done], r: usize, o: usize, rs: &OutputStat
     })
 }
 
-fn compare_scalar(dir: &Path, done: &[Done], qi: usize, rq: &ScalarStats) -> Result<Section, StudyRunError> {
+fn compare_scalar(
+    dir: &Path,
+    done: &[Done],
+    qi: usize,
+    rq: &ScalarStats,
+) -> Result<Section, StudyRunError> {
     let q = &rq.name;
     let mut curves = Vec::new();
     let mut runs = Vec::new();
@@ -238,14 +341,23 @@ fn compare_scalar(dir: &Path, done: &[Done], qi: usize, rq: &ScalarStats) -> Res
     let mut labels = Vec::new();
     for (i, d) in done.iter().enumerate() {
         let s = &d.result.scalars[qi];
-        curves.push(Series::new(d.study.file.name.clone(), s.pdf_x.clone(), s.pdf.clone(), report::palette(i)));
+        curves.push(Series::new(
+            d.study.file.name.clone(),
+            s.pdf_x.clone(),
+            s.pdf.clone(),
+            report::palette(i),
+        ));
         runs.push(d.result.model_runs as f64);
         means.push(s.mean);
         stds.push(s.std);
         ses.push(s.std_error_mean);
         labels.push(d.study.file.name.clone());
     }
-    let markers = rq.exceedance.iter().map(|(l, _, _)| (*l, format!("limit {l}"))).collect();
+    let markers = rq
+        .exceedance
+        .iter()
+        .map(|(l, _, _)| (*l, format!("limit {l}")))
+        .collect();
     DensityPlot {
         title: format!("PDF of {q}, every variant"),
         x_label: q.clone(),
@@ -254,23 +366,52 @@ fn compare_scalar(dir: &Path, done: &[Done], qi: usize, rq: &ScalarStats) -> Res
         markers,
     }
     .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
-    let mut mplot = LinePlot::new(format!("mean of {q} against model runs"), "model runs", format!("mean {q}"));
-    let mut splot = LinePlot::new(format!("Std of {q} against model runs"), "model runs", format!("Std {q}"));
+    let mut mplot = LinePlot::new(
+        format!("mean of {q} against model runs"),
+        "model runs",
+        format!("mean {q}"),
+    );
+    let mut splot = LinePlot::new(
+        format!("Std of {q} against model runs"),
+        "model runs",
+        format!("Std {q}"),
+    );
     // Group by method kind so each method is one line (e.g. SCM 2,3,4,5 nodes; LHS 500, 20000).
-    let mut kinds: Vec<String> = done.iter().map(|d| d.study.file.method.kind.as_str().to_string()).collect();
+    let mut kinds: Vec<String> = done
+        .iter()
+        .map(|d| d.study.file.method.kind.as_str().to_string())
+        .collect();
     kinds.dedup();
     for (ki, kind) in kinds.iter().enumerate() {
-        let idx: Vec<usize> = (0..done.len()).filter(|&i| done[i].study.file.method.kind.as_str() == kind).collect();
+        let idx: Vec<usize> = (0..done.len())
+            .filter(|&i| done[i].study.file.method.kind.as_str() == kind)
+            .collect();
         let x: Vec<f64> = idx.iter().map(|&i| runs[i]).collect();
-        mplot.series.push(Series::new(kind.clone(), x.clone(), idx.iter().map(|&i| means[i]).collect(), report::palette(ki)));
-        splot.series.push(Series::new(kind.clone(), x, idx.iter().map(|&i| stds[i]).collect(), report::palette(ki)));
+        mplot.series.push(Series::new(
+            kind.clone(),
+            x.clone(),
+            idx.iter().map(|&i| means[i]).collect(),
+            report::palette(ki),
+        ));
+        splot.series.push(Series::new(
+            kind.clone(),
+            x,
+            idx.iter().map(|&i| stds[i]).collect(),
+            report::palette(ki),
+        ));
     }
     mplot.write(&dir.join(format!("{q}_mean_vs_runs.svg")))?;
     splot.write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
     let idx: Vec<f64> = (0..done.len()).map(|i| i as f64).collect();
     report::write_columns(
         &dir.join(format!("{q}_compare.csv")),
-        &["variant_index", "model_runs", "mean", "std", "std_error_mean"],
+        &[
+            "variant_index",
+            "model_runs",
+            "mean",
+            "std",
+            "std_error_mean",
+        ],
         &[&idx, &runs, &means, &stds, &ses],
     )?;
     Ok(Section {

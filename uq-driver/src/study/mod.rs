@@ -77,7 +77,11 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> crate::report::ReportEr
 
 /// Runs a study into `out_dir` (resuming what a previous run there finished). A suite runs
 /// every variant into `out_dir/<variant>/` and writes the comparison into `out_dir`.
-pub fn run_study(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<StudyResult, StudyRunError> {
+pub fn run_study(
+    study: &Study,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
     std::fs::create_dir_all(out_dir).map_err(io_err(out_dir))?;
     if study.is_suite() {
         return compare::run_suite(study, out_dir, opts);
@@ -97,8 +101,10 @@ pub fn run_study(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Stu
             total: design.len(),
         });
     }
-    let stats = analysis::analyse(study, &design, &outcome.records).map_err(StudyRunError::Analysis)?;
-    let scalars = analysis::analyse_scalars(study, &design, &outcome.records).map_err(StudyRunError::Analysis)?;
+    let stats =
+        analysis::analyse(study, &design, &outcome.records).map_err(StudyRunError::Analysis)?;
+    let scalars = analysis::analyse_scalars(study, &design, &outcome.records)
+        .map_err(StudyRunError::Analysis)?;
     let md = fmu.description();
     let m = &study.file.method;
     let ctx = output::RunContext {
@@ -170,7 +176,11 @@ fn points_csv(study: &Study, design: &Design, records: &[Option<Record>]) -> Str
     lines
 }
 
-fn run_sgm(study: &Study, out_dir: &Path, _opts: &RunOptions) -> Result<StudyResult, StudyRunError> {
+fn run_sgm(
+    study: &Study,
+    out_dir: &Path,
+    _opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
     let started = Instant::now();
     let (gs, coeffs) = sgm::solve(study).map_err(StudyRunError::Analysis)?;
     let wall_time = started.elapsed().as_secs_f64();

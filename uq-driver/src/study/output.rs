@@ -235,33 +235,62 @@ pub fn write_all(
         DensityPlot {
             title: format!("PDF of {name} ({})", study.file.name),
             x_label: name.clone(),
-            curves: vec![Series::new(format!("KDE ({})", ctx.density_source), q.pdf_x.clone(), q.pdf.clone(), report::palette(0))],
+            curves: vec![Series::new(
+                format!("KDE ({})", ctx.density_source),
+                q.pdf_x.clone(),
+                q.pdf.clone(),
+                report::palette(0),
+            )],
             histogram: (q.samples.len() > 10).then_some((edges, dens)),
             markers,
         }
         .write(&dir.join(format!("{name}_pdf.svg")))?;
-        report::write_columns(&dir.join(format!("{name}_pdf.csv")), &["x", "density"], &[&q.pdf_x, &q.pdf])?;
+        report::write_columns(
+            &dir.join(format!("{name}_pdf.csv")),
+            &["x", "density"],
+            &[&q.pdf_x, &q.pdf],
+        )?;
         let idx: Vec<f64> = (0..q.samples.len()).map(|i| i as f64).collect();
-        report::write_columns(&dir.join(format!("{name}_samples.csv")), &["run", name], &[&idx, &q.samples])?;
+        report::write_columns(
+            &dir.join(format!("{name}_samples.csv")),
+            &["run", name],
+            &[&idx, &q.samples],
+        )?;
         let mut rows = vec![
             vec!["mean".to_string(), format!("{:.6}", q.mean)],
             vec!["std".into(), format!("{:.6}", q.std)],
-            vec!["std error of the mean".into(), format!("{:.3e}", q.std_error_mean)],
+            vec![
+                "std error of the mean".into(),
+                format!("{:.3e}", q.std_error_mean),
+            ],
             vec!["valid runs".into(), q.n_valid.to_string()],
         ];
         if q.n_never_hunts + q.n_never_stops > 0 {
-            rows.push(vec!["never hunt / never stop".into(), format!("{} / {}", q.n_never_hunts, q.n_never_stops)]);
+            rows.push(vec![
+                "never hunt / never stop".into(),
+                format!("{} / {}", q.n_never_hunts, q.n_never_stops),
+            ]);
         }
         for (p, v) in &q.quantiles {
             rows.push(vec![format!("quantile {p}"), format!("{v:.6}")]);
         }
         for (l, p, se) in &q.exceedance {
-            rows.push(vec![format!("P({name} > {l})"), format!("{p:.5} ± {se:.1e}")]);
+            rows.push(vec![
+                format!("P({name} > {l})"),
+                format!("{p:.5} ± {se:.1e}"),
+            ]);
         }
         sections.push(Section {
             heading: format!("Quantity {name}"),
-            text: format!("Distribution of {name} over the runs ({}).", ctx.density_source),
-            images: vec![format!("{name}_pdf.svg"), format!("{name}_pdf.csv"), format!("{name}_samples.csv")],
+            text: format!(
+                "Distribution of {name} over the runs ({}).",
+                ctx.density_source
+            ),
+            images: vec![
+                format!("{name}_pdf.svg"),
+                format!("{name}_pdf.csv"),
+                format!("{name}_samples.csv"),
+            ],
             table: Some(Table {
                 header: vec!["statistic".into(), "value".into()],
                 rows,
@@ -272,7 +301,14 @@ pub fn write_all(
     // Signal against speed for the critical-speed quantities (the paper's Fig. 5a) when both
     // are recorded as outputs.
     for q in &study.file.qoi {
-        if let crate::study::spec::QoiSpec::CriticalSpeed { name, signal, speed, threshold, .. } = q {
+        if let crate::study::spec::QoiSpec::CriticalSpeed {
+            name,
+            signal,
+            speed,
+            threshold,
+            ..
+        } = q
+        {
             let find = |n: &str| stats.iter().find(|s| s.name == n);
             if let (Some(y), Some(v)) = (find(signal), find(speed)) {
                 let mut plot = LinePlot::new(
@@ -280,18 +316,51 @@ pub fn write_all(
                     speed.clone(),
                     signal.clone(),
                 );
-                let up: Vec<f64> = y.mean.iter().zip(&y.std).map(|(m, d)| m + 3.0 * d).collect();
-                let lo: Vec<f64> = y.mean.iter().zip(&y.std).map(|(m, d)| m - 3.0 * d).collect();
+                let up: Vec<f64> = y
+                    .mean
+                    .iter()
+                    .zip(&y.std)
+                    .map(|(m, d)| m + 3.0 * d)
+                    .collect();
+                let lo: Vec<f64> = y
+                    .mean
+                    .iter()
+                    .zip(&y.std)
+                    .map(|(m, d)| m - 3.0 * d)
+                    .collect();
                 if y.std.iter().any(|d| *d > 0.0) {
-                    plot.bands.push(Band::new("mean ± 3σ", v.mean.clone(), lo, up, report::palette(0)));
+                    plot.bands.push(Band::new(
+                        "mean ± 3σ",
+                        v.mean.clone(),
+                        lo,
+                        up,
+                        report::palette(0),
+                    ));
                 }
-                plot.series.push(Series::new(format!("{signal} (mean)"), v.mean.clone(), y.mean.clone(), report::palette(0)));
+                plot.series.push(Series::new(
+                    format!("{signal} (mean)"),
+                    v.mean.clone(),
+                    y.mean.clone(),
+                    report::palette(0),
+                ));
                 let ends = vec![v.mean[0], v.mean[v.mean.len() - 1]];
-                plot.series.push(Series::new(format!("threshold ±{threshold}"), ends.clone(), vec![*threshold; 2], report::palette(3)).dashed());
-                plot.series.push(Series::new("", ends, vec![-*threshold; 2], report::palette(3)).dashed());
+                plot.series.push(
+                    Series::new(
+                        format!("threshold ±{threshold}"),
+                        ends.clone(),
+                        vec![*threshold; 2],
+                        report::palette(3),
+                    )
+                    .dashed(),
+                );
+                plot.series
+                    .push(Series::new("", ends, vec![-*threshold; 2], report::palette(3)).dashed());
                 let file = format!("{signal}_vs_{speed}.svg");
                 plot.write(&dir.join(&file))?;
-                if let Some(sec) = sections.iter_mut().find(|s| s.heading == format!("Quantity {name}")) {
+                if let Some(sec) = sections
+                    .iter_mut()
+                    .find(|s| s.heading == format!("Quantity {name}"))
+                {
                     sec.images.insert(0, file);
                 }
             }
@@ -299,7 +368,10 @@ pub fn write_all(
     }
     if let Some(points) = &ctx.points_csv {
         let ppath = dir.join("points.csv");
-        std::fs::write(&ppath, points).map_err(|source| ReportError::Io { path: ppath, source })?;
+        std::fs::write(&ppath, points).map_err(|source| ReportError::Io {
+            path: ppath,
+            source,
+        })?;
     }
     let summary = json!({
         "study": study.file.name,

@@ -10,9 +10,9 @@ use sha2::{Digest, Sha256};
 
 use super::design::Design;
 use super::spec::{QoiSpec, Study};
-use crate::qoi::scalar;
 use super::store::{Manifest, Record, Store, StoreError};
 use crate::fmu::{Fmu, FmuError, Instance, ScalarVariable, VariableKind};
+use crate::qoi::scalar;
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -134,21 +134,27 @@ fn check_settable(fmu: &Fmu, var: &ScalarVariable) -> Result<(), RunError> {
     })
 }
 
+/// Deterministic settings: (value reference, value) for Reals and for Integers.
+type FixedValues = (Vec<(u32, f64)>, Vec<(u32, i32)>);
+
 /// Splits deterministic values into Real and Integer settings, checking each variable.
 fn fixed_values<'a>(
     fmu: &Fmu,
     values: impl Iterator<Item = (&'a str, f64)>,
-) -> Result<(Vec<(u32, f64)>, Vec<(u32, i32)>), RunError> {
+) -> Result<FixedValues, RunError> {
     let mut reals = Vec::new();
     let mut ints = Vec::new();
     for (name, v) in values {
-        let var = fmu.description().variable(name).ok_or_else(|| RunError::Interface {
-            fmu: fmu.path().display().to_string(),
-            message: format!(
-                "the study names variable '{name}', which the FMU ({}) does not have",
-                fmu.description().model_name
-            ),
-        })?;
+        let var = fmu
+            .description()
+            .variable(name)
+            .ok_or_else(|| RunError::Interface {
+                fmu: fmu.path().display().to_string(),
+                message: format!(
+                    "the study names variable '{name}', which the FMU ({}) does not have",
+                    fmu.description().model_name
+                ),
+            })?;
         check_settable(fmu, var)?;
         match var.kind {
             VariableKind::Real { .. } => reals.push((var.value_reference, v)),
@@ -164,7 +170,10 @@ fn fixed_values<'a>(
             _ => {
                 return Err(RunError::Interface {
                     fmu: fmu.path().display().to_string(),
-                    message: format!("'{name}' is a {}; only Real and Integer values can be set", var.kind.type_name()),
+                    message: format!(
+                        "'{name}' is a {}; only Real and Integer values can be set",
+                        var.kind.type_name()
+                    ),
                 })
             }
         }
@@ -184,7 +193,8 @@ pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError
         .iter()
         .map(|p| settable(&p.name))
         .collect::<Result<_, _>>()?;
-    let (fixed, fixed_int) = fixed_values(fmu, study.file.fixed.iter().map(|(n, v)| (n.as_str(), *v)))?;
+    let (fixed, fixed_int) =
+        fixed_values(fmu, study.file.fixed.iter().map(|(n, v)| (n.as_str(), *v)))?;
     let mut signal_names: Vec<String> = study.file.outputs.variables.clone();
     for q in &study.file.qoi {
         for s in q.signals() {
@@ -219,7 +229,11 @@ pub fn sha256_file(path: &Path) -> std::io::Result<String> {
             if e.file_type()?.is_dir() {
                 walk(&p, root, h)?;
             } else {
-                let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().into_owned();
+                let rel = p
+                    .strip_prefix(root)
+                    .unwrap_or(&p)
+                    .to_string_lossy()
+                    .into_owned();
                 h.update(rel.as_bytes());
                 h.update([0]);
                 h.update(std::fs::read(&p)?);
@@ -312,10 +326,15 @@ pub fn run_point(
     let mut out = traces[..iface.n_stored * nt].to_vec();
     for q in &iface.qois {
         let signal = |name: &str| -> &[f64] {
-            let i = iface.signal_names.iter().position(|n| n == name).expect("resolved");
+            let i = iface
+                .signal_names
+                .iter()
+                .position(|n| n == name)
+                .expect("resolved");
             &traces[i * nt..(i + 1) * nt]
         };
-        let (v, code) = scalar::evaluate(q, times, signal).map_err(|e| format!("quantity '{}': {e}", q.name()))?;
+        let (v, code) = scalar::evaluate(q, times, signal)
+            .map_err(|e| format!("quantity '{}': {e}", q.name()))?;
         out.push(v);
         out.push(code as u8 as f64);
     }
@@ -512,10 +531,11 @@ pub fn simulate(
         qois: Vec::new(),
     };
     let mut slot = None;
-    let flat = run_point(fmu, &mut slot, &iface, &[], times).map_err(|message| RunError::Interface {
-        fmu: fmu.path().display().to_string(),
-        message,
-    })?;
+    let flat =
+        run_point(fmu, &mut slot, &iface, &[], times).map_err(|message| RunError::Interface {
+            fmu: fmu.path().display().to_string(),
+            message,
+        })?;
     let nt = times.len();
     Ok((names, flat.chunks(nt).map(<[f64]>::to_vec).collect()))
 }

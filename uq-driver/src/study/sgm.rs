@@ -78,7 +78,12 @@ pub fn linear_system(sys: &SystemSpec, params: &[RandomParameter]) -> Result<Lin
             .iter()
             .enumerate()
             .find(|(_, p)| p.name == d.parameter)
-            .ok_or_else(|| format!("system.dependence names '{}', which is not a random parameter", d.parameter))?;
+            .ok_or_else(|| {
+                format!(
+                    "system.dependence names '{}', which is not a random parameter",
+                    d.parameter
+                )
+            })?;
         let Distribution::Normal { mean, std } = p.distribution else {
             return Err(format!("SGM needs '{}' to be normal", p.name));
         };
@@ -114,7 +119,11 @@ pub fn linear_system(sys: &SystemSpec, params: &[RandomParameter]) -> Result<Lin
 }
 
 /// Checks a `[system]` against the parameters and outputs of a study.
-pub fn validate(sys: &SystemSpec, params: &[RandomParameter], outputs: &[String]) -> Result<(), String> {
+pub fn validate(
+    sys: &SystemSpec,
+    params: &[RandomParameter],
+    outputs: &[String],
+) -> Result<(), String> {
     linear_system(sys, params)?;
     for o in outputs {
         if output_dof(sys, o).is_none() {
@@ -152,7 +161,9 @@ pub fn solve(study: &Study) -> Result<(GalerkinSystem, Vec<DMatrix<f64>>), Strin
         .map(|o| output_dof(sys, o).ok_or_else(|| format!("unknown output {o}")))
         .collect::<Result<_, _>>()?;
     let idx: Vec<usize> = dofs.iter().map(|d| d.0).collect();
-    let sol = gs.solve(&times, sys.step, &idx).map_err(|e| e.to_string())?;
+    let sol = gs
+        .solve(&times, sys.step, &idx)
+        .map_err(|e| e.to_string())?;
     let coeffs = dofs
         .iter()
         .zip(sol)

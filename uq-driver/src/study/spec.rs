@@ -448,7 +448,9 @@ impl QoiSpec {
     pub fn signals(&self) -> Vec<&str> {
         match self {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
-            QoiSpec::Sperling { signal, .. } | QoiSpec::MaxAbs { signal, .. } | QoiSpec::Final { signal, .. } => {
+            QoiSpec::Sperling { signal, .. }
+            | QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Final { signal, .. } => {
                 vec![signal]
             }
         }
@@ -513,18 +515,51 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ),
     ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
     ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
-    ("paper-wheel", include_str!("../../studies/paper-wheel.toml")),
-    ("bogie-nominal", include_str!("../../studies/bogie-nominal.toml")),
+    (
+        "paper-wheel",
+        include_str!("../../studies/paper-wheel.toml"),
+    ),
+    (
+        "bogie-nominal",
+        include_str!("../../studies/bogie-nominal.toml"),
+    ),
     ("bogie-scm", include_str!("../../studies/bogie-scm.toml")),
-    ("bogie-lhs-500", include_str!("../../studies/bogie-lhs-500.toml")),
-    ("bogie-lhs-20000", include_str!("../../studies/bogie-lhs-20000.toml")),
-    ("paper-bogie", include_str!("../../studies/paper-bogie.toml")),
-    ("vehicle-track-nominal", include_str!("../../studies/vehicle-track-nominal.toml")),
-    ("vehicle-track-scm-cov10", include_str!("../../studies/vehicle-track-scm-cov10.toml")),
-    ("vehicle-track-scm-cov20", include_str!("../../studies/vehicle-track-scm-cov20.toml")),
-    ("vehicle-track-scm-cov30", include_str!("../../studies/vehicle-track-scm-cov30.toml")),
-    ("vehicle-track-defect", include_str!("../../studies/vehicle-track-defect.toml")),
-    ("paper-vehicle-track", include_str!("../../studies/paper-vehicle-track.toml")),
+    (
+        "bogie-lhs-500",
+        include_str!("../../studies/bogie-lhs-500.toml"),
+    ),
+    (
+        "bogie-lhs-20000",
+        include_str!("../../studies/bogie-lhs-20000.toml"),
+    ),
+    (
+        "paper-bogie",
+        include_str!("../../studies/paper-bogie.toml"),
+    ),
+    (
+        "vehicle-track-nominal",
+        include_str!("../../studies/vehicle-track-nominal.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov10",
+        include_str!("../../studies/vehicle-track-scm-cov10.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov20",
+        include_str!("../../studies/vehicle-track-scm-cov20.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov30",
+        include_str!("../../studies/vehicle-track-scm-cov30.toml"),
+    ),
+    (
+        "vehicle-track-defect",
+        include_str!("../../studies/vehicle-track-defect.toml"),
+    ),
+    (
+        "paper-vehicle-track",
+        include_str!("../../studies/paper-vehicle-track.toml"),
+    ),
 ];
 
 /// Folders searched for an FMU named by a relative path that is not next to the study file:
@@ -603,13 +638,21 @@ impl Study {
             .collect()
     }
 
-    fn from_file(file: StudyFile, origin: &str, base: Option<&Path>, text: &str) -> Result<Study, StudyError> {
+    fn from_file(
+        file: StudyFile,
+        origin: &str,
+        base: Option<&Path>,
+        text: &str,
+    ) -> Result<Study, StudyError> {
         let invalid = |message: String| StudyError::Invalid {
             origin: origin.to_owned(),
             message,
         };
         let e = &file.experiment;
-        if !(e.start.is_finite() && e.stop.is_finite() && e.step.is_finite()) || e.step <= 0.0 || e.stop <= e.start {
+        if !(e.start.is_finite() && e.stop.is_finite() && e.step.is_finite())
+            || e.step <= 0.0
+            || e.stop <= e.start
+        {
             return Err(invalid(format!(
                 "experiment needs finite start < stop and step > 0 (got start {}, stop {}, step {})",
                 e.start, e.stop, e.step
@@ -627,15 +670,23 @@ impl Study {
             return Err(invalid("no random [[parameters]]".into()));
         }
         if file.outputs.variables.is_empty() && file.qoi.is_empty() {
-            return Err(invalid("nothing to analyse: give [outputs] variables and/or [[qoi]]".into()));
+            return Err(invalid(
+                "nothing to analyse: give [outputs] variables and/or [[qoi]]".into(),
+            ));
         }
         let mut parameters = Vec::new();
         for p in &file.parameters {
-            if parameters.iter().any(|q: &RandomParameter| q.name == p.name) {
+            if parameters
+                .iter()
+                .any(|q: &RandomParameter| q.name == p.name)
+            {
                 return Err(invalid(format!("parameter '{}' is listed twice", p.name)));
             }
             if file.fixed.contains_key(&p.name) {
-                return Err(invalid(format!("parameter '{}' is both random and fixed", p.name)));
+                return Err(invalid(format!(
+                    "parameter '{}' is both random and fixed",
+                    p.name
+                )));
             }
             let distribution = p
                 .to_distribution()
@@ -653,11 +704,16 @@ impl Study {
         let mut names: Vec<&str> = file.outputs.variables.iter().map(String::as_str).collect();
         for q in &file.qoi {
             if names.contains(&q.name()) {
-                return Err(invalid(format!("quantity name '{}' is used twice", q.name())));
+                return Err(invalid(format!(
+                    "quantity name '{}' is used twice",
+                    q.name()
+                )));
             }
             names.push(q.name());
             let bad = match q {
-                QoiSpec::CriticalSpeed { window, threshold, .. } => !(*window > 0.0 && *threshold > 0.0),
+                QoiSpec::CriticalSpeed {
+                    window, threshold, ..
+                } => !(*window > 0.0 && *threshold > 0.0),
                 QoiSpec::Sperling {
                     direction,
                     segment,
@@ -684,9 +740,9 @@ impl Study {
         let m = &file.method;
         match m.kind {
             MethodKind::Mc | MethodKind::Lhs => {
-                let n = m
-                    .samples
-                    .ok_or_else(|| invalid(format!("method {} needs `samples`", m.kind.as_str())))?;
+                let n = m.samples.ok_or_else(|| {
+                    invalid(format!("method {} needs `samples`", m.kind.as_str()))
+                })?;
                 if n < 2 {
                     return Err(invalid("`samples` must be at least 2".into()));
                 }
@@ -715,7 +771,9 @@ impl Study {
             }
             MethodKind::Nominal => {}
             MethodKind::Sgm => {
-                let order = m.order.ok_or_else(|| invalid("method sgm needs `order`".into()))?;
+                let order = m
+                    .order
+                    .ok_or_else(|| invalid("method sgm needs `order`".into()))?;
                 if order > 12 {
                     return Err(invalid(format!("SGM order {order} is above 12")));
                 }
@@ -725,13 +783,15 @@ impl Study {
                         p.name
                     )));
                 }
-                let sys = file
-                    .system
-                    .as_ref()
-                    .ok_or_else(|| invalid("method sgm needs a [system] (matrices M, C, K, q0)".into()))?;
+                let sys = file.system.as_ref().ok_or_else(|| {
+                    invalid("method sgm needs a [system] (matrices M, C, K, q0)".into())
+                })?;
                 super::sgm::validate(sys, &parameters, &file.outputs.variables).map_err(invalid)?;
                 if !file.qoi.is_empty() {
-                    return Err(invalid("[[qoi]] is not available with SGM (no time series of a model is run)".into()));
+                    return Err(invalid(
+                        "[[qoi]] is not available with SGM (no time series of a model is run)"
+                            .into(),
+                    ));
                 }
             }
         }
@@ -739,7 +799,8 @@ impl Study {
             return Err(invalid("`fmu` is required (the FMU to run)".into()));
         }
         let a = &file.analysis;
-        if a.pdf_grid < 2 || a.pdf_times < 1 || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q)) {
+        if a.pdf_grid < 2 || a.pdf_times < 1 || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q))
+        {
             return Err(invalid(
                 "analysis: pdf_grid >= 2, pdf_times >= 1, quantiles in [0, 1]".into(),
             ));
@@ -756,10 +817,16 @@ impl Study {
         }
         if let Some(r) = &file.reference {
             if !file.variants.iter().any(|v| &v.name == r) {
-                return Err(invalid(format!("reference '{r}' is not one of the variants")));
+                return Err(invalid(format!(
+                    "reference '{r}' is not one of the variants"
+                )));
             }
         }
-        let fmu_path = file.fmu.as_deref().map(|f| resolve_fmu(f, base)).unwrap_or_default();
+        let fmu_path = file
+            .fmu
+            .as_deref()
+            .map(|f| resolve_fmu(f, base))
+            .unwrap_or_default();
         let study = Study {
             file,
             fmu_path,
@@ -847,10 +914,7 @@ mod tests {
         let base = include_str!("../../studies/wheel-scm.toml");
         let cases = [
             (base.replace("stop = 5.0", "stop = -1.0"), "start < stop"),
-            (
-                base.replace("order = 5", "order = 6"),
-                "below the nodes",
-            ),
+            (base.replace("order = 5", "order = 6"), "below the nodes"),
             (base.replace("std = 10.0", "std = -10.0"), "parameter 'K'"),
             (
                 base.replace("kind = \"scm\"", "kind = \"magic\""),

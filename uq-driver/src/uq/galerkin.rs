@@ -143,16 +143,17 @@ pub struct Definiteness {
     pub warnings: Vec<String>,
 }
 
+/// Chaos coefficients of one DOF over time: (displacement, velocity), each terms × times.
+pub type Trajectory = (DMatrix<f64>, DMatrix<f64>);
+
 /// G_l[k, i] = E[ξ_l Ψ_k Ψ_i] (l = None: E[Ψ_k Ψ_i]).
 pub fn germ_matrix(basis: &MultiIndexSet, l: Option<usize>) -> DMatrix<f64> {
     let p = basis.len();
     let idx = basis.indices();
-    let dim = basis.dim();
     DMatrix::from_fn(p, p, |k, i| {
         let mut v = 1.0;
-        for d in 0..dim {
-            let c = usize::from(l == Some(d));
-            v *= hermite_triple(idx[k][d], idx[i][d], c);
+        for (d, (&a, &b)) in idx[k].iter().zip(&idx[i]).enumerate() {
+            v *= hermite_triple(a, b, usize::from(l == Some(d)));
             if v == 0.0 {
                 break;
             }
@@ -333,7 +334,7 @@ impl GalerkinSystem {
         times: &[f64],
         h: f64,
         dofs: &[usize],
-    ) -> Result<Vec<(DMatrix<f64>, DMatrix<f64>)>, GalerkinError> {
+    ) -> Result<Vec<Trajectory>, GalerkinError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(GalerkinError::Time(format!("step {h} must be > 0")));
         }
