@@ -461,3 +461,86 @@ fn a_folder_of_another_study_is_refused() {
         "--fresh",
     ]);
 }
+
+#[test]
+fn sgm_order_6_matches_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sgm");
+    run_ok(&["run", "builtin:wheel-sgm", "--out", out.to_str().unwrap()]);
+    let csv = read_csv(&out.join("q.csv"));
+    for t in TIMES {
+        let (m, s) = reference(t);
+        let (dm, ds) = (csv.at(t, "mean") - m, csv.at(t, "std") - s);
+        assert!(dm.abs() < 1e-9, "t = {t}: mean error {dm:e}");
+        assert!(ds.abs() < 1e-7, "t = {t}: std error {ds:e}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["method"]["terms"], 28, "C(6 + 2, 2)");
+    assert!(
+        summary["method"]["definiteness"]["min_eig_stiffness"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+}
+
+#[test]
+fn a_suite_compares_its_variants_against_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    // The paper-wheel suite with a small LHS, so the test stays fast.
+    let text = Command::new(DRIVER)
+        .args(["show", "paper-wheel"])
+        .output()
+        .unwrap()
+        .stdout;
+    let text = String::from_utf8(text).unwrap();
+    let cut = text.find("[[variants]]").unwrap();
+    let small = format!(
+        "{}{}",
+        &text[..cut].replace(
+            "fmu = \"Wheel.fmu\"",
+            &format!("fmu = \"{}\"", wheel_fmu().display())
+        ),
+        r#"[[variants]]
+name = "sgm"
+method = { kind = "sgm", order = 6 }
+
+[[variants]]
+name = "scm"
+method = { kind = "scm", nodes = 6, order = 5 }
+
+[[variants]]
+name = "lhs-200"
+method = { kind = "lhs", samples = 200 }
+"#
+    );
+    let study = dir.path().join("suite.toml");
+    std::fs::write(&study, small).unwrap();
+    let out = dir.path().join("o");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let cmp = read_csv(&out.join("q_compare.csv"));
+    for t in TIMES {
+        // SCM − SGM: both within 1e-9 (mean) / 1e-6 (Std) of the reference.
+        assert!(cmp.at(t, "dmean_scm").abs() < 2e-9);
+        assert!(cmp.at(t, "dstd_scm").abs() < 2e-6);
+        let (_, s) = reference(t);
+        assert!(cmp.at(t, "dmean_lhs-200").abs() < 4.0 * s / 200f64.sqrt());
+    }
+    for f in [
+        "index.html",
+        "summary.json",
+        "q_mean_diff.svg",
+        "q_std_diff.svg",
+        "sgm/q.csv",
+        "scm/q.csv",
+        "lhs-200/q.csv",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
