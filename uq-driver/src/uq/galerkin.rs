@@ -564,9 +564,9 @@ mod tests {
         let gs = GalerkinSystem::assemble(&sys, 0).unwrap();
         let sol = gs.solve(&times, 2.5e-4, &[0, 1]).unwrap();
         let r = realisation(&sys, &[], &times);
-        for k in 0..times.len() {
-            for dof in 0..2 {
-                assert!((sol[dof].0[(0, k)] - r[k][dof]).abs() < 1e-11);
+        for (k, rk) in r.iter().enumerate() {
+            for (dof, s) in sol.iter().enumerate() {
+                assert!((s.0[(0, k)] - rk[dof]).abs() < 1e-11);
             }
         }
     }
