@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
-use uq_driver::study::{run_study, RunOptions, Study, BUILTINS};
+use uq_driver::study::{run_study, shard, RunOptions, Study, BUILTINS};
 
 #[derive(Parser)]
 #[command(
@@ -42,6 +42,69 @@ enum Command {
         /// Stop after this many new points (the study can be resumed later).
         #[arg(long, hide = true)]
         max_points: Option<usize>,
+    },
+    /// Split a study into shards for a cluster: writes DIR/plan.json and DIR/design.csv.
+    Plan {
+        /// Study file, or builtin:NAME.
+        study: String,
+        /// Number of shards.
+        #[arg(long)]
+        shards: usize,
+        /// Plan folder.
+        #[arg(long, short)]
+        out: PathBuf,
+    },
+    /// Run one shard of a plan (resumable); K defaults to $SLURM_ARRAY_TASK_ID.
+    RunShard {
+        /// Plan folder.
+        dir: PathBuf,
+        /// Shard number (0-based).
+        #[arg(long)]
+        shard: Option<usize>,
+        /// Worker threads (default: all cores).
+        #[arg(long, short)]
+        threads: Option<usize>,
+        /// MC/LHS: continue past failed points.
+        #[arg(long)]
+        allow_failures: bool,
+    },
+    /// Check a plan's shards (every point exactly once, same study and FMU) and write the
+    /// study's outputs, as `run` would.
+    Merge {
+        /// Plan folder.
+        dir: PathBuf,
+        /// Output folder (default DIR/result).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// MC/LHS: accept failed points and report how many.
+        #[arg(long)]
+        allow_failures: bool,
+    },
+    /// Plan a study and submit it to Slurm: a job array of shards and a dependent merge job.
+    Slurm {
+        /// Study file, or builtin:NAME.
+        study: String,
+        /// Number of shards (array tasks).
+        #[arg(long)]
+        shards: usize,
+        /// Plan folder (on a filesystem every node sees).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Slurm partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// Time limit per task (e.g. 01:00:00).
+        #[arg(long)]
+        time: Option<String>,
+        /// CPUs per shard task (also its threads).
+        #[arg(long)]
+        cpus_per_task: Option<usize>,
+        /// Extra #SBATCH option (repeatable), e.g. --sbatch=--account=rail.
+        #[arg(long = "sbatch")]
+        sbatch: Vec<String>,
+        /// Write the scripts but do not submit.
+        #[arg(long)]
+        dry_run: bool,
     },
     /// List the built-in studies.
     List,
@@ -119,6 +182,7 @@ fn dispatch(cmd: Command) -> Result<()> {
                 allow_failures,
                 fresh,
                 max_new_points: max_points,
+                points: None,
             };
             let r = run_study(&s, &out, &opts).with_context(|| format!("study {}", s.origin))?;
             for w in &r.warnings {
@@ -148,6 +212,116 @@ fn dispatch(cmd: Command) -> Result<()> {
             if r.n_failed > 0 {
                 println!("{} points failed (see points.csv)", r.n_failed);
             }
+            Ok(())
+        }
+        Command::Plan { study, shards, out } => {
+            let s = Study::load(&study)?;
+            let p = shard::plan(&s, shards, &out)?;
+            println!(
+                "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
+                s.file.name,
+                p.manifest.n_points,
+                p.shards,
+                p.shards,
+                out.display(),
+                out.display()
+            );
+            Ok(())
+        }
+        Command::RunShard {
+            dir,
+            shard: k,
+            threads,
+            allow_failures,
+        } => {
+            let k = match k {
+                Some(k) => k,
+                None => std::env::var("SLURM_ARRAY_TASK_ID")
+                    .context("no --shard and no SLURM_ARRAY_TASK_ID")?
+                    .parse()
+                    .context("SLURM_ARRAY_TASK_ID is not a number")?,
+            };
+            let opts = RunOptions {
+                threads,
+                progress: std::io::stderr().is_terminal(),
+                allow_failures,
+                ..RunOptions::default()
+            };
+            let o = shard::run_shard(&dir, k, &opts)?;
+            println!(
+                "shard {k}: {} points run, {} resumed, wall time {:.2} s",
+                o.n_new, o.n_resumed, o.wall_time
+            );
+            Ok(())
+        }
+        Command::Merge {
+            dir,
+            out,
+            allow_failures,
+        } => {
+            let out = out.unwrap_or_else(|| dir.join("result"));
+            let opts = RunOptions {
+                allow_failures,
+                ..RunOptions::default()
+            };
+            let r = shard::merge(&dir, &out, &opts)?;
+            println!(
+                "merged {} points; report: {}",
+                r.model_runs,
+                out.join("index.html").display()
+            );
+            Ok(())
+        }
+        Command::Slurm {
+            study,
+            shards,
+            out,
+            partition,
+            time,
+            cpus_per_task,
+            sbatch,
+            dry_run,
+        } => {
+            let s = Study::load(&study)?;
+            shard::plan(&s, shards, &out)?;
+            let driver = std::env::current_exe().context("locating the uq-driver executable")?;
+            let o = shard::SlurmOptions {
+                partition,
+                time,
+                cpus_per_task,
+                extra: sbatch,
+            };
+            let (a, b) = shard::write_sbatch(&out, &driver, shards, &o)?;
+            if dry_run {
+                println!("wrote {} and {} (not submitted)", a.display(), b.display());
+                return Ok(());
+            }
+            let submit = |args: &[&str]| -> Result<String> {
+                let o = std::process::Command::new("sbatch")
+                    .arg("--parsable")
+                    .args(args)
+                    .output()
+                    .context("running sbatch (is Slurm installed and SLURM_CONF set?)")?;
+                anyhow::ensure!(
+                    o.status.success(),
+                    "sbatch failed: {}",
+                    String::from_utf8_lossy(&o.stderr).trim()
+                );
+                let id = String::from_utf8_lossy(&o.stdout)
+                    .trim()
+                    .split(';')
+                    .next()
+                    .unwrap_or("")
+                    .to_string();
+                anyhow::ensure!(!id.is_empty(), "sbatch printed no job id");
+                Ok(id)
+            };
+            let array = submit(&[a.to_str().context("path")?])?;
+            let dep = format!("--dependency=afterok:{array}");
+            let merge = submit(&[&dep, b.to_str().context("path")?])?;
+            println!("array job {array}");
+            println!("merge job {merge}");
+            println!("results will be in {}", out.join("result").display());
             Ok(())
         }
         Command::List => {

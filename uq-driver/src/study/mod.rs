@@ -11,6 +11,7 @@ pub mod design;
 pub mod output;
 pub mod runner;
 pub mod sgm;
+pub mod shard;
 pub mod spec;
 pub mod store;
 
@@ -92,6 +93,18 @@ pub fn run_study(
     let fmu = Fmu::open(&study.fmu_path).map_err(RunError::from)?;
     let design = Design::build(study).map_err(|e| RunError::Design(e.to_string()))?;
     let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
+    finish(study, &fmu, design, outcome, out_dir, opts)
+}
+
+/// Statistics and files of a study whose points have all been run (`outcome.records`).
+pub(crate) fn finish(
+    study: &Study,
+    fmu: &Fmu,
+    design: Design,
+    outcome: RunOutcome,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
     let done = outcome.records.iter().filter(|r| r.is_some()).count();
     let allow = opts.allow_failures || study.file.analysis.allow_failures;
     let n_failed = runner::check_failures(study, &design, &outcome.records, allow)?;

@@ -27,6 +27,8 @@ pub struct RunOptions {
     pub fresh: bool,
     /// Stop after this many newly finished points (for tests of interruption).
     pub max_new_points: Option<usize>,
+    /// Run only these points of the design (a shard); None: all.
+    pub points: Option<Vec<usize>>,
 }
 
 /// Runner failures.
@@ -380,10 +382,16 @@ pub fn run_points(
         n_values: iface.n_values(times.len()),
     };
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
-    let missing: Vec<usize> = (0..design.len())
+    let wanted: Vec<usize> = match &opts.points {
+        Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
+        None => (0..design.len()).collect(),
+    };
+    let missing: Vec<usize> = wanted
+        .iter()
+        .copied()
         .filter(|&i| records[i].is_none())
         .collect();
-    let n_resumed = design.len() - missing.len();
+    let n_resumed = wanted.len() - missing.len();
     let threads = opts
         .threads
         .unwrap_or_else(rayon::current_num_threads)

@@ -1,0 +1,388 @@
+//! Splitting a study over a cluster: `plan` writes the study, the FMU's hash and the shard
+//! assignment; `run-shard` runs one shard's points into its own folder (resumable, nothing
+//! shared with other shards); `merge` checks that every point is present exactly once and
+//! that every shard belongs to the plan, then writes the same outputs as `uq-driver run`.
+//!
+//! Layout of a plan folder `DIR`:
+//! ```text
+//! DIR/plan.json            study text, FMU path and SHA-256, driver version, shard count
+//! DIR/design.csv           index, shard, parameter values of every point
+//! DIR/shards/K/store/      shard K's results store (only shard K writes here)
+//! DIR/result/              merge output (summary.json, CSVs, plots, index.html)
+//! ```
+//! Point i belongs to shard i mod N (round robin, so every shard gets a share of the
+//! expensive and the cheap regions of the design).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::design::Design;
+use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::spec::Study;
+use super::store::{Manifest, Record, Store, StoreError};
+use super::{StudyResult, StudyRunError};
+use crate::fmu::Fmu;
+
+/// Version of the plan layout.
+pub const PLAN_VERSION: u32 = 1;
+
+/// `plan.json`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Plan {
+    /// Layout version.
+    pub version: u32,
+    /// uq-driver version that wrote the plan.
+    pub driver_version: String,
+    /// Where the study came from.
+    pub study_origin: String,
+    /// The study's TOML text.
+    pub study_source: String,
+    /// Folder relative paths of the study start from.
+    pub study_base: Option<PathBuf>,
+    /// Absolute path of the FMU.
+    pub fmu_path: PathBuf,
+    /// The results-store manifest every shard must have (study hash, FMU SHA-256, sizes).
+    pub manifest: Manifest,
+    /// Number of shards.
+    pub shards: usize,
+}
+
+/// Shard failures.
+#[derive(Debug, thiserror::Error)]
+pub enum ShardError {
+    /// File system error.
+    #[error("{path}: {source}")]
+    Io {
+        /// File.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// plan.json is unreadable or of another version.
+    #[error("{path}: {message}")]
+    BadPlan {
+        /// plan.json.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Wrong arguments.
+    #[error("{0}")]
+    Usage(String),
+    /// A shard does not belong to this plan, is missing, or overlaps another.
+    #[error("{0}")]
+    Shard(String),
+    /// Running or writing failed.
+    #[error(transparent)]
+    Run(#[from] StudyRunError),
+}
+
+impl From<RunError> for ShardError {
+    fn from(e: RunError) -> Self {
+        ShardError::Run(StudyRunError::Run(e))
+    }
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ShardError + '_ {
+    move |source| ShardError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// The points of shard `k` of `n` in a design of `len` points.
+pub fn shard_points(len: usize, n: usize, k: usize) -> Vec<usize> {
+    (k..len).step_by(n.max(1)).collect()
+}
+
+fn manifest_for(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, ShardError> {
+    let iface = runner::resolve_interface(study, fmu)?;
+    let fmu_sha256 = runner::sha256_file(fmu.path()).map_err(io(fmu.path()))?;
+    Ok(Manifest {
+        study_hash: runner::study_hash(study),
+        fmu_sha256,
+        n_points: design.len(),
+        n_values: iface.n_values(study.file.experiment.times().len()),
+    })
+}
+
+/// `uq-driver plan`: writes `DIR/plan.json` and `DIR/design.csv`.
+pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError> {
+    if shards == 0 {
+        return Err(ShardError::Usage("--shards must be at least 1".into()));
+    }
+    if study.is_suite() {
+        return Err(ShardError::Usage(
+            "a suite (a study with [[variants]]) cannot be planned as one; plan each variant's study".into(),
+        ));
+    }
+    if study.file.method.kind == super::MethodKind::Sgm {
+        return Err(ShardError::Usage(
+            "an SGM study is one Galerkin solve: nothing to shard".into(),
+        ));
+    }
+    let fmu_path = std::fs::canonicalize(&study.fmu_path).map_err(io(&study.fmu_path))?;
+    let fmu = Fmu::open(&fmu_path).map_err(RunError::from)?;
+    let design = Design::build(study).map_err(|e| RunError::Design(e.to_string()))?;
+    let manifest = manifest_for(study, &fmu, &design)?;
+    let p = Plan {
+        version: PLAN_VERSION,
+        driver_version: env!("CARGO_PKG_VERSION").into(),
+        study_origin: study.origin.clone(),
+        study_source: study.source.clone(),
+        study_base: study
+            .base
+            .as_ref()
+            .and_then(|b| std::fs::canonicalize(b).ok()),
+        fmu_path,
+        manifest,
+        shards,
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let path = dir.join("plan.json");
+    if path.exists() {
+        let old = load_plan(dir)?;
+        if old != p {
+            return Err(ShardError::Usage(format!(
+                "{} already holds another plan; use another folder",
+                dir.display()
+            )));
+        }
+    }
+    std::fs::write(&path, serde_json::to_string_pretty(&p).expect("json")).map_err(io(&path))?;
+    let mut csv = String::from("index,shard");
+    for par in &study.parameters {
+        csv.push(',');
+        csv.push_str(&par.name);
+    }
+    csv.push('\n');
+    for (i, vals) in design.values.iter().enumerate() {
+        csv.push_str(&format!("{i},{}", i % shards));
+        for v in vals {
+            csv.push_str(&format!(",{v}"));
+        }
+        csv.push('\n');
+    }
+    let dpath = dir.join("design.csv");
+    std::fs::write(&dpath, csv).map_err(io(&dpath))?;
+    Ok(p)
+}
+
+/// Reads `DIR/plan.json`.
+pub fn load_plan(dir: &Path) -> Result<Plan, ShardError> {
+    let path = dir.join("plan.json");
+    let text = std::fs::read_to_string(&path).map_err(io(&path))?;
+    let p: Plan = serde_json::from_str(&text).map_err(|e| ShardError::BadPlan {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    if p.version != PLAN_VERSION {
+        return Err(ShardError::BadPlan {
+            path,
+            message: format!(
+                "plan layout version {}, this uq-driver reads {PLAN_VERSION}",
+                p.version
+            ),
+        });
+    }
+    Ok(p)
+}
+
+fn plan_study(p: &Plan) -> Result<Study, ShardError> {
+    let mut study = Study::parse(&p.study_source, &p.study_origin, p.study_base.as_deref())
+        .map_err(|e| ShardError::Run(StudyRunError::Study(e)))?;
+    study.fmu_path = p.fmu_path.clone();
+    Ok(study)
+}
+
+/// `uq-driver run-shard`: runs shard `k` of the plan in `dir`.
+pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, ShardError> {
+    let p = load_plan(dir)?;
+    if k >= p.shards {
+        return Err(ShardError::Usage(format!(
+            "shard {k} does not exist: the plan has shards 0..{}",
+            p.shards
+        )));
+    }
+    let study = plan_study(&p)?;
+    let fmu = Fmu::open(&p.fmu_path).map_err(RunError::from)?;
+    let design = Design::build(&study).map_err(|e| RunError::Design(e.to_string()))?;
+    let now = manifest_for(&study, &fmu, &design)?;
+    if now != p.manifest {
+        return Err(ShardError::Shard(format!(
+            "{}: the FMU or the study changed since the plan was written (SHA-256 now {}, planned {})",
+            p.fmu_path.display(),
+            now.fmu_sha256,
+            p.manifest.fmu_sha256
+        )));
+    }
+    let opts = RunOptions {
+        points: Some(shard_points(design.len(), p.shards, k)),
+        ..opts.clone()
+    };
+    let sdir = dir.join("shards").join(k.to_string());
+    let outcome = runner::run_points(&study, &fmu, &design, &sdir, &opts)?;
+    let allow = opts.allow_failures || study.file.analysis.allow_failures;
+    let shard_records: Vec<Option<Record>> = outcome.records.clone();
+    runner::check_failures(&study, &design, &shard_records, allow)?;
+    Ok(outcome)
+}
+
+/// `uq-driver merge`: checks the shards and writes the study's outputs into `out`.
+pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, ShardError> {
+    let p = load_plan(dir)?;
+    let study = plan_study(&p)?;
+    let fmu = Fmu::open(&p.fmu_path).map_err(RunError::from)?;
+    let design = Design::build(&study).map_err(|e| RunError::Design(e.to_string()))?;
+    let n = design.len();
+    let mut records: Vec<Option<Record>> = vec![None; n];
+    let mut owner: Vec<Option<usize>> = vec![None; n];
+    let mut incomplete = Vec::new();
+    for k in 0..p.shards {
+        let sdir = dir.join("shards").join(k.to_string());
+        if !sdir.join("store").join("manifest.json").exists() {
+            incomplete.push(format!(
+                "shard {k}: missing ({} has no results)",
+                sdir.display()
+            ));
+            continue;
+        }
+        let (_, recs) = Store::open(&sdir, &p.manifest, false).map_err(|e| match e {
+            StoreError::Mismatch { what, .. } => ShardError::Shard(format!(
+                "shard {k} ({}) does not belong to this plan: {what}",
+                sdir.display()
+            )),
+            other => ShardError::Run(StudyRunError::Run(RunError::Store(other))),
+        })?;
+        let mut missing = 0;
+        for i in shard_points(n, p.shards, k) {
+            if recs[i].is_none() {
+                missing += 1;
+            }
+        }
+        for (i, r) in recs.into_iter().enumerate() {
+            let Some(r) = r else { continue };
+            if i % p.shards != k {
+                return Err(ShardError::Shard(format!(
+                    "point {i} appears in shard {k}, but belongs to shard {}",
+                    i % p.shards
+                )));
+            }
+            if let Some(other) = owner[i] {
+                return Err(ShardError::Shard(format!(
+                    "point {i} appears in shards {other} and {k}"
+                )));
+            }
+            owner[i] = Some(k);
+            records[i] = Some(r);
+        }
+        if missing > 0 {
+            incomplete.push(format!(
+                "shard {k}: {missing} points not finished (run it again: it resumes)"
+            ));
+        }
+    }
+    if !incomplete.is_empty() {
+        return Err(ShardError::Shard(format!(
+            "cannot merge {}: {}",
+            dir.display(),
+            incomplete.join("; ")
+        )));
+    }
+    // The merged store makes `out` look like (and resume like) a single-machine run.
+    let (store, _) = Store::open(out, &p.manifest, true).map_err(RunError::from)?;
+    for (i, r) in records.iter().enumerate() {
+        store
+            .append(i, r.as_ref().expect("checked complete"))
+            .map_err(RunError::from)?;
+    }
+    let outcome = RunOutcome {
+        records,
+        n_new: 0,
+        n_resumed: n,
+        wall_time: 0.0,
+        threads: 0,
+        fmu_sha256: p.manifest.fmu_sha256.clone(),
+    };
+    super::finish(&study, &fmu, design, outcome, out, opts).map_err(ShardError::Run)
+}
+
+/// Options of `uq-driver slurm`.
+#[derive(Clone, Debug, Default)]
+pub struct SlurmOptions {
+    /// Partition (`--partition`).
+    pub partition: Option<String>,
+    /// Time limit per task (`--time`).
+    pub time: Option<String>,
+    /// CPUs per shard task (`--cpus-per-task`), also the threads of each shard.
+    pub cpus_per_task: Option<usize>,
+    /// Extra `#SBATCH` lines.
+    pub extra: Vec<String>,
+}
+
+/// Writes `DIR/slurm/shard.sbatch` and `DIR/slurm/merge.sbatch`; returns their paths.
+pub fn write_sbatch(
+    dir: &Path,
+    driver: &Path,
+    shards: usize,
+    o: &SlurmOptions,
+) -> Result<(PathBuf, PathBuf), ShardError> {
+    let sdir = dir.join("slurm");
+    std::fs::create_dir_all(&sdir).map_err(io(&sdir))?;
+    let dir = std::fs::canonicalize(dir).map_err(io(dir))?;
+    if dir.to_string_lossy().contains(char::is_whitespace) {
+        // #SBATCH lines are not parsed by a shell: a path with blanks cannot be written there.
+        return Err(ShardError::Usage(format!(
+            "{}: the plan folder's path must not contain blanks for #SBATCH --output",
+            dir.display()
+        )));
+    }
+    let q = |p: &Path| format!("'{}'", p.display().to_string().replace('\'', "'\\''"));
+    let mut common = String::new();
+    if let Some(p) = &o.partition {
+        common.push_str(&format!("#SBATCH --partition={p}\n"));
+    }
+    if let Some(t) = &o.time {
+        common.push_str(&format!("#SBATCH --time={t}\n"));
+    }
+    for e in &o.extra {
+        common.push_str(&format!("#SBATCH {e}\n"));
+    }
+    let cpus = o.cpus_per_task.unwrap_or(1);
+    let shard = format!(
+        "#!/bin/bash\n#SBATCH --job-name=uq-shard\n#SBATCH --array=0-{last}\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --output={log}/shard-%a.out\n{common}\
+         # One array task per shard; a re-submitted task resumes from its own store.\n\
+         exec {driver} run-shard {dir} --shard \"$SLURM_ARRAY_TASK_ID\" --threads \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"\n",
+        last = shards - 1,
+        log = dir.join("slurm").display(),
+        driver = q(driver),
+        dir = q(&dir),
+    );
+    let merge = format!(
+        "#!/bin/bash\n#SBATCH --job-name=uq-merge\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --output={log}/merge.out\n{common}\
+         exec {driver} merge {dir} --out {out}\n",
+        log = dir.join("slurm").display(),
+        driver = q(driver),
+        dir = q(&dir),
+        out = q(&dir.join("result")),
+    );
+    let (a, b) = (sdir.join("shard.sbatch"), sdir.join("merge.sbatch"));
+    std::fs::write(&a, shard).map_err(io(&a))?;
+    std::fs::write(&b, merge).map_err(io(&b))?;
+    Ok((a, b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_partition_the_design() {
+        let mut all: Vec<usize> = (0..4).flat_map(|k| shard_points(10, 4, k)).collect();
+        all.sort_unstable();
+        assert_eq!(all, (0..10).collect::<Vec<_>>());
+        assert_eq!(shard_points(10, 4, 1), vec![1, 5, 9]);
+        assert!(shard_points(2, 4, 3).is_empty());
+    }
+}
