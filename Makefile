@@ -69,7 +69,7 @@ test-python: venv
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
 
 bench: build fmu venv
-	@echo "benchmarks not written yet"
+	CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
 # Every study of the paper (long: about half an hour on 2 cores, most of it the bogie's
 # 20 000-sample Latin hypercube). Re-running resumes what an interrupted run finished.
