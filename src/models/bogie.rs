@@ -49,9 +49,8 @@
 #![forbid(unsafe_code)]
 
 use super::{
-    require_finite, require_non_negative, require_positive, Causality, InitContext, Initial, Model,
-    ModelError, ModelInfo, SetResult, Start, StateReader, StateWriter, VarType, Variability,
-    Variable,
+    require_finite, require_non_negative, require_positive, InitContext, Model, ModelError,
+    ModelInfo, SetResult, StateReader, StateWriter, VarType, Variability, Variable,
 };
 use crate::solver::{rk4_step, substeps};
 use nalgebra::Matrix4;
@@ -100,7 +99,6 @@ const VR_V_CR_LINEAR: u32 = 120;
 /// Lowest speed (m/s) the model runs at: the creepages divide by V.
 pub const MIN_SPEED: f64 = 1.0;
 
-#[allow(clippy::too_many_arguments)]
 const fn param(
     name: &'static str,
     vr: u32,
@@ -110,17 +108,7 @@ const fn param(
     min: Option<f64>,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(Some(start)),
-        causality: Causality::Parameter,
-        variability,
-        initial: Some(Initial::Exact),
-        unit,
-        min,
-        description,
-    }
+    Variable::real_parameter(name, vr, start, variability, unit, description).with_min(min)
 }
 
 const fn output(
@@ -129,17 +117,7 @@ const fn output(
     unit: Option<&'static str>,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(None),
-        causality: Causality::Output,
-        variability: Variability::Continuous,
-        initial: None,
-        unit,
-        min: None,
-        description,
-    }
+    Variable::real_output(name, vr, unit, description)
 }
 
 use Variability::{Fixed, Tunable};
@@ -184,17 +162,12 @@ pub static VARIABLES: [Variable; 39] = [
     output("xi_y1", VR_XI_Y1, None, "Lateral creepage of the leading wheelset (dimensionless)"),
     output("xi_x2", VR_XI_X2, None, "Longitudinal creepage, left wheel of the trailing wheelset (dimensionless)"),
     output("xi_y2", VR_XI_Y2, None, "Lateral creepage of the trailing wheelset (dimensionless)"),
-    Variable {
-        name: "v_cr_linear",
-        vr: VR_V_CR_LINEAR,
-        start: Start::Real(None),
-        causality: Causality::CalculatedParameter,
-        variability: Fixed,
-        initial: Some(Initial::Calculated),
-        unit: Some("m/s"),
-        min: None,
-        description: "Linear (Hopf) critical speed of the linearised model at the parameters of the initialization (eigenvalues; clamped to the search range 2..1000 m/s)",
-    },
+    Variable::calculated_parameter(
+        "v_cr_linear",
+        VR_V_CR_LINEAR,
+        Some("m/s"),
+        "Linear (Hopf) critical speed of the linearised model at the parameters of the initialization (eigenvalues; clamped to the search range 2..1000 m/s)",
+    ),
 ];
 
 /// Static description of the bogie model.
@@ -1194,7 +1167,7 @@ mod tests {
         for v in &VARIABLES {
             let value = b.get_real(v.vr).unwrap();
             assert!(value.is_finite(), "{}", v.name);
-            if let Start::Real(Some(start)) = v.start {
+            if let crate::models::Start::Real(Some(start)) = v.start {
                 assert_eq!(value, start, "{}: start value vs Bogie::default()", v.name);
             }
             if let Some(u) = v.unit {

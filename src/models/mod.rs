@@ -101,6 +101,81 @@ pub struct Variable {
 }
 
 impl Variable {
+    /// A Real parameter with a start value (initial = exact).
+    pub const fn real_parameter(
+        name: &'static str,
+        vr: u32,
+        start: f64,
+        variability: Variability,
+        unit: Option<&'static str>,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr,
+            start: Start::Real(Some(start)),
+            causality: Causality::Parameter,
+            variability,
+            initial: Some(Initial::Exact),
+            unit,
+            min: None,
+            description,
+        }
+    }
+
+    /// A fixed Integer parameter with a start value.
+    pub const fn integer_parameter(
+        name: &'static str,
+        vr: u32,
+        start: i32,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            start: Start::Integer(Some(start)),
+            ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
+        }
+    }
+
+    /// A continuous Real output (initial calculated by default).
+    pub const fn real_output(
+        name: &'static str,
+        vr: u32,
+        unit: Option<&'static str>,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr,
+            start: Start::Real(None),
+            causality: Causality::Output,
+            variability: Variability::Continuous,
+            initial: None,
+            unit,
+            min: None,
+            description,
+        }
+    }
+
+    /// A Real calculated parameter (fixed, computed at initialization).
+    pub const fn calculated_parameter(
+        name: &'static str,
+        vr: u32,
+        unit: Option<&'static str>,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            causality: Causality::CalculatedParameter,
+            variability: Variability::Fixed,
+            initial: Some(Initial::Calculated),
+            ..Variable::real_output(name, vr, unit, description)
+        }
+    }
+
+    /// The same variable with a lower bound.
+    pub const fn with_min(self, min: Option<f64>) -> Variable {
+        Variable { min, ..self }
+    }
+
     /// The type of the variable.
     pub fn var_type(&self) -> VarType {
         match self.start {

@@ -24,8 +24,8 @@
 #![forbid(unsafe_code)]
 
 use super::{
-    require_finite, require_non_negative, require_positive, Causality, InitContext, Initial, Model,
-    ModelError, ModelInfo, SetResult, Start, StateReader, StateWriter, Variability, Variable,
+    require_finite, require_non_negative, require_positive, InitContext, Model, ModelError,
+    ModelInfo, SetResult, StateReader, StateWriter, Variability, Variable,
 };
 use crate::solver::{rk4_step, substeps};
 
@@ -47,17 +47,7 @@ const fn param(
     unit: &'static str,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(Some(start)),
-        causality: Causality::Parameter,
-        variability,
-        initial: Some(Initial::Exact),
-        unit: Some(unit),
-        min: None,
-        description,
-    }
+    Variable::real_parameter(name, vr, start, variability, Some(unit), description)
 }
 
 const fn output(
@@ -66,17 +56,7 @@ const fn output(
     unit: &'static str,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(None),
-        causality: Causality::Output,
-        variability: Variability::Continuous,
-        initial: None,
-        unit: Some(unit),
-        min: None,
-        description,
-    }
+    Variable::real_output(name, vr, Some(unit), description)
 }
 
 /// The wheel's variable table.

@@ -113,31 +113,11 @@ const fn real(
     unit: &'static str,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(Some(start)),
-        causality: Causality::Parameter,
-        variability,
-        initial: Some(Initial::Exact),
-        unit: Some(unit),
-        min: None,
-        description,
-    }
+    Variable::real_parameter(name, vr, start, variability, Some(unit), description)
 }
 
 const fn integer(name: &'static str, vr: u32, start: i32, description: &'static str) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Integer(Some(start)),
-        causality: Causality::Parameter,
-        variability: Fixed,
-        initial: Some(Initial::Exact),
-        unit: None,
-        min: None,
-        description,
-    }
+    Variable::integer_parameter(name, vr, start, description)
 }
 
 const fn calculated(
@@ -146,17 +126,7 @@ const fn calculated(
     unit: Option<&'static str>,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(None),
-        causality: Causality::CalculatedParameter,
-        variability: Fixed,
-        initial: Some(Initial::Calculated),
-        unit,
-        min: None,
-        description,
-    }
+    Variable::calculated_parameter(name, vr, unit, description)
 }
 
 const fn output(
@@ -165,17 +135,7 @@ const fn output(
     unit: &'static str,
     description: &'static str,
 ) -> Variable {
-    Variable {
-        name,
-        vr,
-        start: Start::Real(None),
-        causality: Causality::Output,
-        variability: Variability::Continuous,
-        initial: None,
-        unit: Some(unit),
-        min: None,
-        description,
-    }
+    Variable::real_output(name, vr, Some(unit), description)
 }
 
 /// Default speed: 300 km/h (m/s).
