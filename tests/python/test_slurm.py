@@ -60,7 +60,7 @@ class Cluster:
             jobs[jid] = (f.get("JobState", "?"), f.get("Reason", ""))
         return jobs
 
-    def wait(self, job_id, until=lambda jobs: False, timeout=JOB_TIMEOUT):
+    def wait(self, job_id, until=lambda jobs: False, timeout=JOB_TIMEOUT, plan_dir=None):
         """Waits until every job or task of job_id has ended (or `until(jobs)`); returns the
         states. A job whose dependency can never be met fails the test."""
         deadline = time.monotonic() + timeout
@@ -73,9 +73,9 @@ class Cluster:
             stuck = [j for j, (s, r) in jobs.items() if r == "DependencyNeverSatisfied"]
             if stuck:
                 pytest.fail(f"job {stuck} will never run (a job it depends on failed): {jobs}"
-                            f"{self.logs()}")
+                            f"{self.logs(plan_dir)}")
             if time.monotonic() > deadline:
-                pytest.fail(f"job {job_id} not done after {timeout} s: {jobs}{self.logs()}")
+                pytest.fail(f"job {job_id} not done after {timeout} s: {jobs}{self.logs(plan_dir)}")
             time.sleep(0.2)
 
     def logs(self, plan_dir=None):
@@ -138,9 +138,9 @@ def test_slurm_study_equals_local_run(cluster, tmp_path):
     array, merge = submit(cluster, study, out)
     assert (out / "plan.json").is_file()
     assert (out / "slurm" / "shard.sbatch").is_file() and (out / "slurm" / "merge.sbatch").is_file()
-    states = cluster.wait(merge)
+    states = cluster.wait(merge, plan_dir=out)
     assert states == {merge: ("COMPLETED", "None")}, f"{states}{cluster.logs(out)}"
-    tasks = cluster.wait(array)
+    tasks = cluster.wait(array, plan_dir=out)
     assert sorted(tasks) == [f"{array}_{k}" for k in range(4)], tasks
     assert all(s == "COMPLETED" for s, _ in tasks.values()), f"{tasks}{cluster.logs(out)}"
     for k in range(4):
@@ -160,18 +160,22 @@ def test_slurm_cancelled_task_resumes(cluster, tmp_path):
         assert time.monotonic() < deadline, f"shard 1 never started{cluster.logs(out)}"
         time.sleep(0.01)
     cluster.cmd("scancel", f"{array}_1")
-    tasks = cluster.wait(array)
+    tasks = cluster.wait(array, plan_dir=out)
     assert tasks[f"{array}_1"][0] == "CANCELLED", tasks
     done = records_in(shard1)
     assert 0 < done < 50, f"task 1 was to be cancelled part-way; it had {done} of 50 points"
     assert all(tasks[f"{array}_{k}"][0] == "COMPLETED" for k in (0, 2, 3)), tasks
-    # The merge waits on afterok of the whole array: it can never run now.
-    time.sleep(0.5)
-    cluster.cmd("scancel", merge)
+    # The merge depended on afterok of the whole array: it never runs now. It stays pending
+    # (DependencyNeverSatisfied) or, with --kill-on-invalid-dep, is cancelled; either way it goes.
+    states = cluster.wait(merge, until=lambda jobs: jobs.get(merge, ("", ""))[1]
+                          == "DependencyNeverSatisfied", timeout=30, plan_dir=out)
+    assert states[merge][0] in ("PENDING", "CANCELLED"), states
+    cluster.cmd("scancel", merge, check=False)
+    assert not (out / "result" / "summary.json").exists()
     # Re-submit task 1 alone and the merge after it, as a user would.
     again = cluster.sbatch("--array=1", out / "slurm" / "shard.sbatch")
     merge2 = cluster.sbatch(f"--dependency=afterok:{again}", out / "slurm" / "merge.sbatch")
-    states = cluster.wait(merge2)
+    states = cluster.wait(merge2, plan_dir=out)
     assert states == {merge2: ("COMPLETED", "None")}, f"{states}{cluster.logs(out)}"
     log = (out / "slurm" / "shard-1.out").read_text()
     assert resumed_count(log) == done, log

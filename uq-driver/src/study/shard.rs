@@ -360,7 +360,7 @@ pub fn write_sbatch(
         dir = q(&dir),
     );
     let merge = format!(
-        "#!/bin/bash\n#SBATCH --job-name=uq-merge\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --output={log}/merge.out\n{common}\
+        "#!/bin/bash\n#SBATCH --job-name=uq-merge\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --kill-on-invalid-dep=yes\n#SBATCH --output={log}/merge.out\n{common}\
          exec {driver} merge {dir} --out {out}\n",
         log = dir.join("slurm").display(),
         driver = q(driver),
