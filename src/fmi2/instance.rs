@@ -301,7 +301,8 @@ impl Instance {
         Ok(status)
     }
 
-    /// Gets values of one type into `out` (written only if every value could be read).
+    /// Gets values of one type into `out` (untouched if any reference is unknown or of
+    /// another type).
     pub fn get_values<T: Copy>(
         &mut self,
         vrs: &[u32],
@@ -312,12 +313,14 @@ impl Instance {
         if self.state == State::InitializationMode {
             self.initialize_if_dirty()?;
         }
-        let mut tmp = Vec::with_capacity(vrs.len());
+        // Check every reference first, so that a bad one leaves `out` untouched; a checked
+        // reference cannot fail to read. No allocation: this runs at every communication step.
         for &vr in vrs {
             self.lookup(vr, ty)?;
-            tmp.push(get(self.model.as_ref(), vr)?);
         }
-        out.copy_from_slice(&tmp);
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            *o = get(self.model.as_ref(), vr)?;
+        }
         Ok(FMI2_OK)
     }
 
