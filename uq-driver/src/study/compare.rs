@@ -341,12 +341,15 @@ fn compare_scalar(
     let mut labels = Vec::new();
     for (i, d) in done.iter().enumerate() {
         let s = &d.result.scalars[qi];
-        curves.push(Series::new(
-            d.study.file.name.clone(),
-            s.pdf_x.clone(),
-            s.pdf.clone(),
-            report::palette(i),
-        ));
+        // A single deterministic run has no distribution: it would be a spike in the plots.
+        if d.result.model_runs > 1 {
+            curves.push(Series::new(
+                d.study.file.name.clone(),
+                s.pdf_x.clone(),
+                s.pdf.clone(),
+                report::palette(i),
+            ));
+        }
         runs.push(d.result.model_runs as f64);
         means.push(s.mean);
         stds.push(s.std);
@@ -368,12 +371,12 @@ fn compare_scalar(
     .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
     let mut mplot = LinePlot::new(
         format!("mean of {q} against model runs"),
-        "model runs",
+        "log10(model runs)",
         format!("mean {q}"),
     );
     let mut splot = LinePlot::new(
         format!("Std of {q} against model runs"),
-        "model runs",
+        "log10(model runs)",
         format!("Std {q}"),
     );
     // Group by method kind so each method is one line (e.g. SCM 2,3,4,5 nodes; LHS 500, 20000).
@@ -384,9 +387,12 @@ fn compare_scalar(
     kinds.dedup();
     for (ki, kind) in kinds.iter().enumerate() {
         let idx: Vec<usize> = (0..done.len())
-            .filter(|&i| done[i].study.file.method.kind.as_str() == kind)
+            .filter(|&i| done[i].study.file.method.kind.as_str() == kind && runs[i] > 1.0)
             .collect();
-        let x: Vec<f64> = idx.iter().map(|&i| runs[i]).collect();
+        if idx.is_empty() {
+            continue;
+        }
+        let x: Vec<f64> = idx.iter().map(|&i| runs[i].log10()).collect();
         mplot.series.push(Series::new(
             kind.clone(),
             x.clone(),
