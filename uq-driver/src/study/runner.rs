@@ -97,9 +97,9 @@ impl Interface {
     }
 }
 
-fn real_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError> {
-    let var = fmu
-        .description()
+/// A variable of the FMU by name, or an error naming it.
+fn any_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError> {
+    fmu.description()
         .variable(name)
         .ok_or_else(|| RunError::Interface {
             fmu: fmu.path().display().to_string(),
@@ -107,7 +107,11 @@ fn real_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError
                 "the study names variable '{name}', which the FMU ({}) does not have",
                 fmu.description().model_name
             ),
-        })?;
+        })
+}
+
+fn real_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError> {
+    let var = any_var(fmu, name)?;
     if !matches!(var.kind, VariableKind::Real { .. }) {
         return Err(RunError::Interface {
             fmu: fmu.path().display().to_string(),
@@ -147,16 +151,7 @@ fn fixed_values<'a>(
     let mut reals = Vec::new();
     let mut ints = Vec::new();
     for (name, v) in values {
-        let var = fmu
-            .description()
-            .variable(name)
-            .ok_or_else(|| RunError::Interface {
-                fmu: fmu.path().display().to_string(),
-                message: format!(
-                    "the study names variable '{name}', which the FMU ({}) does not have",
-                    fmu.description().model_name
-                ),
-            })?;
+        let var = any_var(fmu, name)?;
         check_settable(fmu, var)?;
         match var.kind {
             VariableKind::Real { .. } => reals.push((var.value_reference, v)),
