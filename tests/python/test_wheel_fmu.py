@@ -51,9 +51,19 @@ def test_simulate_matches_closed_form(wheel_fmu, k):
     assert np.max(np.abs(resid)) < 1e-12
 
 
+def _start(fmu, instantiate=True):
+    """Instantiate (optionally), set up at t = 0 and leave initialization mode."""
+    if instantiate:
+        fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+
+
 def _slave(wheel_fmu, unzipdir):
+    """Value references by name, and an FMU2Slave on the extracted FMU."""
     md = read_model_description(wheel_fmu)
-    return md, FMU2Slave(
+    return {v.name: v.valueReference for v in md.modelVariables}, FMU2Slave(
         guid=md.guid,
         unzipDirectory=unzipdir,
         modelIdentifier=md.coSimulation.modelIdentifier,
@@ -64,20 +74,14 @@ def _slave(wheel_fmu, unzipdir):
 def test_fixed_parameter_after_initialization_is_rejected(wheel_fmu):
     unzipdir = extract(wheel_fmu)
     try:
-        md, fmu = _slave(wheel_fmu, unzipdir)
-        vr = {v.name: v.valueReference for v in md.modelVariables}
-        fmu.instantiate()
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        vr, fmu = _slave(wheel_fmu, unzipdir)
+        _start(fmu)
         with pytest.raises(FMICallException):
             fmu.setReal([vr["m"]], [5.0])
         fmu.reset()
         # After reset the fixed parameter may be set again, and it takes effect.
         fmu.setReal([vr["m"]], [40.0])
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        _start(fmu, instantiate=False)
         fmu.doStep(0.0, 0.01)
         a = fmu.getReal([vr["a"]])[0]
         q, v = fmu.getReal([vr["q"], vr["v"]])
@@ -91,12 +95,8 @@ def test_fixed_parameter_after_initialization_is_rejected(wheel_fmu):
 def test_tunable_parameter_between_steps(wheel_fmu):
     unzipdir = extract(wheel_fmu)
     try:
-        md, fmu = _slave(wheel_fmu, unzipdir)
-        vr = {v.name: v.valueReference for v in md.modelVariables}
-        fmu.instantiate()
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        vr, fmu = _slave(wheel_fmu, unzipdir)
+        _start(fmu)
         fmu.doStep(0.0, 0.5)
         fmu.setReal([vr["K"]], [200.0])
         assert fmu.getReal([vr["K"]])[0] == 200.0
@@ -125,10 +125,7 @@ def test_500_load_run_unload_cycles_keep_rss_flat(wheel_fmu):
     def cycle():
         fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                         modelIdentifier="Wheel", instanceName="w")
-        fmu.instantiate()
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        _start(fmu)
         t = 0.0
         for _ in range(50):
             fmu.doStep(t, 0.01)
