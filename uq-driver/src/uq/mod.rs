@@ -6,10 +6,12 @@
 //! - [`distributions`]: input distributions and their isoprobabilistic maps;
 //! - [`sampling`]: Monte Carlo and Latin hypercube designs on the open unit cube;
 //! - [`quadrature`]: Gauss–Hermite rules and tensor grids in standard-normal space;
-//! - [`pce`]: Hermite polynomial chaos (pseudo-spectral projection, moments, Sobol' indices).
+//! - [`pce`]: Hermite polynomial chaos (pseudo-spectral projection, moments, Sobol' indices);
+//! - [`hd`]: high-dimensional building blocks (sparse grids, Askey chaos, QMC, LARS, copula).
 
 pub mod distributions;
 pub mod galerkin;
+pub mod hd;
 pub mod pce;
 pub mod quadrature;
 pub mod rng;
