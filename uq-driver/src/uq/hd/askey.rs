@@ -131,6 +131,26 @@ impl Family {
         }
     }
 
+    /// Orthonormal values `vals[k] = p_k(t)` and derivatives `ders[k] = p_k'(t)` for
+    /// `k = 0..vals.len()` (`ders` as long as `vals`).
+    pub fn eval_all_with_derivative(&self, t: f64, vals: &mut [f64], ders: &mut [f64]) {
+        let (mut pm, mut p) = (0.0, 1.0);
+        let (mut dpm, mut dp) = (0.0, 0.0);
+        for k in 0..vals.len() {
+            vals[k] = p;
+            ders[k] = dp;
+            let (a, b) = self.recurrence(k);
+            let sb = if k == 0 { 0.0 } else { b.sqrt() };
+            let s1 = self.recurrence(k + 1).1.sqrt();
+            let next = ((t - a) * p - sb * pm) / s1;
+            let dnext = (p + (t - a) * dp - sb * dpm) / s1;
+            pm = p;
+            p = next;
+            dpm = dp;
+            dp = dnext;
+        }
+    }
+
     /// The orthonormal polynomial `p_n(t)`.
     pub fn eval(&self, n: usize, t: f64) -> f64 {
         let mut v = vec![0.0; n + 1];
