@@ -28,26 +28,26 @@ const MEHLER_TERMS: usize = 100;
 
 /// A marginal known through its isoprobabilistic map to the standard normal.
 pub trait NormalMapped: Send + Sync {
-    /// `x = F^-1(Phi(z))`.
-    fn from_standard_normal(&self, z: f64) -> f64;
-    /// `z = Phi^-1(F(x))`.
-    fn to_standard_normal(&self, x: f64) -> f64;
+    /// `x = F^-1(Phi(z))`: the physical value of standard-normal `z`.
+    fn physical(&self, z: f64) -> f64;
+    /// `z = Phi^-1(F(x))`: the standard-normal value of physical `x`.
+    fn normal(&self, x: f64) -> f64;
 }
 
 impl NormalMapped for Marginal {
-    fn from_standard_normal(&self, z: f64) -> f64 {
+    fn physical(&self, z: f64) -> f64 {
         Marginal::from_standard_normal(self, z)
     }
-    fn to_standard_normal(&self, x: f64) -> f64 {
+    fn normal(&self, x: f64) -> f64 {
         Marginal::to_standard_normal(self, x)
     }
 }
 
 impl NormalMapped for Distribution {
-    fn from_standard_normal(&self, z: f64) -> f64 {
+    fn physical(&self, z: f64) -> f64 {
         Distribution::from_standard_normal(self, z)
     }
-    fn to_standard_normal(&self, x: f64) -> f64 {
+    fn normal(&self, x: f64) -> f64 {
         let p = self.cdf(x);
         if p <= 0.5 {
             norm_ppf(p)
@@ -108,7 +108,7 @@ fn mehler(g: &dyn NormalMapped, nodes: &(Vec<f64>, Vec<f64>)) -> Mehler {
     let mut h = vec![0.0; MEHLER_TERMS + 1];
     let mut m2 = 0.0;
     for (&z, &w) in nodes.0.iter().zip(&nodes.1) {
-        let x = g.from_standard_normal(z);
+        let x = g.physical(z);
         Family::Hermite.eval_all(z, &mut h);
         for (ck, hk) in c.iter_mut().zip(&h) {
             *ck += w * x * hk;
@@ -302,7 +302,7 @@ impl GaussianCopula {
         let z = &self.chol * DVector::from_column_slice(u);
         z.iter()
             .zip(&self.marginals)
-            .map(|(&zi, m)| m.from_standard_normal(zi))
+            .map(|(&zi, m)| m.physical(zi))
             .collect()
     }
 
@@ -310,9 +310,7 @@ impl GaussianCopula {
     pub fn to_independent(&self, x: &[f64]) -> Vec<f64> {
         let z = DVector::from_iterator(
             x.len(),
-            x.iter()
-                .zip(&self.marginals)
-                .map(|(&xi, m)| m.to_standard_normal(xi)),
+            x.iter().zip(&self.marginals).map(|(&xi, m)| m.normal(xi)),
         );
         let u = self
             .chol
@@ -331,10 +329,10 @@ mod tests {
     /// Lognormal exp(mu + s z), written here.
     struct LogN(f64, f64);
     impl NormalMapped for LogN {
-        fn from_standard_normal(&self, z: f64) -> f64 {
+        fn physical(&self, z: f64) -> f64 {
             (self.0 + self.1 * z).exp()
         }
-        fn to_standard_normal(&self, x: f64) -> f64 {
+        fn normal(&self, x: f64) -> f64 {
             (x.ln() - self.0) / self.1
         }
     }
@@ -345,14 +343,14 @@ mod tests {
         let s = (1.0 - rz * rz).sqrt();
         let (mut ea, mut eb, mut ea2, mut eb2, mut eab) = (0.0, 0.0, 0.0, 0.0, 0.0);
         for (&u, &wu) in x.iter().zip(&w) {
-            let ga = a.from_standard_normal(u);
-            let gb = b.from_standard_normal(u);
+            let ga = a.physical(u);
+            let gb = b.physical(u);
             ea += wu * ga;
             eb += wu * gb;
             ea2 += wu * ga * ga;
             eb2 += wu * gb * gb;
             for (&v, &wv) in x.iter().zip(&w) {
-                eab += wu * wv * ga * b.from_standard_normal(rz * u + s * v);
+                eab += wu * wv * ga * b.physical(rz * u + s * v);
             }
         }
         (eab - ea * eb) / ((ea2 - ea * ea) * (eb2 - eb * eb)).sqrt()

@@ -344,7 +344,7 @@ mod tests {
             let k = big_l - s;
             let want: i64 = if k < d {
                 let b = (0..k).fold(1i64, |acc, i| acc * (d - 1 - i) as i64 / (i + 1) as i64);
-                if k % 2 == 0 {
+                if k & 1 == 0 {
                     b
                 } else {
                     -b
