@@ -14,6 +14,7 @@
 //! - [`sobol_seq`]: Sobol' points (Joe–Kuo direction numbers) with Owen scrambling;
 //! - [`regression`]: least squares with the closed-form leave-one-out error;
 //! - [`lars`]: least-angle regression with hybrid LOO basis selection, and OMP;
+//! - [`sparse_chaos`]: regression chaos (full or sparse) with degree adaptivity by LOO;
 //! - [`sensitivity`]: pick-freeze Sobol' estimators (Saltelli / Jansen) with bootstrap,
 //!   and replicated-design estimators.
 //!
@@ -33,4 +34,5 @@ pub mod regression;
 pub mod rules;
 pub mod sensitivity;
 pub mod smolyak;
+pub mod sparse_chaos;
 pub mod sobol_seq;

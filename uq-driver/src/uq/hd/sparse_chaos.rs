@@ -1,0 +1,187 @@
+//! Regression chaos with degree adaptivity: for each total degree `p` in a range, the
+//! hyperbolic (q-norm) basis of that degree is fitted by hybrid LARS / OMP (sparse) or
+//! by least squares (full), and the degree with the smallest corrected relative
+//! leave-one-out error is kept (as UQLab and OpenTURNS do). Scanning stops after two
+//! degrees in a row without improvement.
+//!
+//! Points are given in germ space (see [`super::askey`]): one coordinate per input, in
+//! the germ of that input's family.
+
+use std::ops::RangeInclusive;
+
+use nalgebra::DMatrix;
+
+use super::askey::Family;
+use super::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
+use super::lars::{sparse_regression, PathKind};
+use super::regression::{least_squares, RegressionError};
+
+/// Errors of the chaos fit.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ChaosFitError {
+    /// Basis construction failed.
+    #[error(transparent)]
+    Basis(#[from] BasisError),
+    /// Every degree failed; the error of the lowest degree.
+    #[error(transparent)]
+    Regression(#[from] RegressionError),
+    /// Empty degree range or no points.
+    #[error("a chaos fit needs points and a non-empty degree range")]
+    Empty,
+}
+
+/// How the coefficients are fitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitKind {
+    /// Ordinary least squares on the whole truncated basis.
+    Full,
+    /// Sparse: the path algorithm, then selection by corrected LOO.
+    Sparse(PathKind),
+}
+
+/// A fitted chaos.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChaosFit {
+    /// The selected basis (only the retained terms for a sparse fit).
+    pub basis: Basis,
+    /// Coefficients, one per basis term.
+    pub coeffs: Vec<f64>,
+    /// Corrected relative leave-one-out error of the selected model.
+    pub loo: f64,
+    /// Selected total degree.
+    pub degree: usize,
+    /// `(degree, corrected relative LOO)` for every degree tried.
+    pub tried: Vec<(usize, f64)>,
+}
+
+impl ChaosFit {
+    /// Mean, variance and Sobol' indices.
+    pub fn stats(&self) -> ChaosStats {
+        ChaosStats::new(self.basis.set(), &self.coeffs)
+    }
+
+    /// Evaluates the chaos at a germ point.
+    pub fn eval(&self, t: &[f64]) -> f64 {
+        let mut v = vec![0.0; self.basis.len()];
+        self.basis.eval(t, &mut v);
+        v.iter().zip(&self.coeffs).map(|(a, b)| a * b).sum()
+    }
+}
+
+/// Fits `y` at germ points `points` with degree adaptivity over `degrees`.
+pub fn fit_chaos(
+    families: &[Family],
+    points: &[Vec<f64>],
+    y: &[f64],
+    degrees: RangeInclusive<usize>,
+    q: f64,
+    kind: FitKind,
+) -> Result<ChaosFit, ChaosFitError> {
+    if points.is_empty() || degrees.is_empty() {
+        return Err(ChaosFitError::Empty);
+    }
+    let d = families.len();
+    let mut best: Option<ChaosFit> = None;
+    let mut tried = Vec::new();
+    let mut first_err = None;
+    let mut worse = 0;
+    for p in degrees {
+        let set = MultiIndexSet::hyperbolic(d, p, q)?;
+        let basis = Basis::new(families.to_vec(), set)?;
+        let psi: DMatrix<f64> = basis.design_matrix(points);
+        let result = match kind {
+            FitKind::Full => least_squares(&psi, y).map(|f| {
+                let loo = f.corrected_relative_loo();
+                (basis.clone(), f.coeffs, loo)
+            }),
+            FitKind::Sparse(path) => sparse_regression(&psi, y, Some(0), path).map(|f| {
+                let loo = f.fit.corrected_relative_loo();
+                let sub = basis.set().select(&f.columns).expect("distinct columns");
+                let b = Basis::new(families.to_vec(), sub).expect("same families");
+                (b, f.fit.coeffs, loo)
+            }),
+        };
+        let (b, coeffs, loo) = match result {
+            Ok(r) => r,
+            Err(e) => {
+                first_err.get_or_insert(e);
+                break;
+            }
+        };
+        tried.push((p, loo));
+        let improves = match &best {
+            None => true,
+            Some(b) => loo < b.loo,
+        };
+        if improves {
+            best = Some(ChaosFit {
+                basis: b,
+                coeffs,
+                loo,
+                degree: p,
+                tried: vec![],
+            });
+            worse = 0;
+        } else {
+            worse += 1;
+            if worse >= 2 {
+                break;
+            }
+        }
+    }
+    match best {
+        Some(mut b) => {
+            b.tried = tried;
+            Ok(b)
+        }
+        None => Err(first_err.map_or(ChaosFitError::Empty, ChaosFitError::Regression)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::hd::sobol_seq::Sobol;
+
+    #[test]
+    fn degree_adaptivity_finds_the_degree_of_a_polynomial() {
+        // f = t1^3 - 2 t1 t2 + 0.5 t2^2 on U(-1,1)^2: degree 3.
+        let pts: Vec<Vec<f64>> = Sobol::scrambled(2, 1, 0)
+            .unwrap()
+            .points(0, 64)
+            .unwrap()
+            .into_iter()
+            .map(|p| p.iter().map(|u| 2.0 * u - 1.0).collect())
+            .collect();
+        let y: Vec<f64> = pts
+            .iter()
+            .map(|t| t[0].powi(3) - 2.0 * t[0] * t[1] + 0.5 * t[1] * t[1])
+            .collect();
+        for kind in [FitKind::Full, FitKind::Sparse(PathKind::Lars)] {
+            let fit = fit_chaos(&[Family::Legendre; 2], &pts, &y, 1..=6, 1.0, kind).unwrap();
+            assert_eq!(fit.degree, 3, "{kind:?}: {:?}", fit.tried);
+            assert!(fit.loo < 1e-20);
+            // Mean: E[t1^3] - 2 E[t1 t2] + 0.5 E[t2^2] = 1/6.
+            assert!((fit.stats().mean - 1.0 / 6.0).abs() < 1e-13);
+            assert!((fit.eval(&[0.3, -0.4]) - (0.027 + 0.24 + 0.08)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn too_few_points_for_a_full_fit_is_an_error() {
+        let pts = vec![vec![0.1, 0.2], vec![0.3, -0.5], vec![-0.2, 0.9]];
+        let err = fit_chaos(
+            &[Family::Legendre; 2],
+            &pts,
+            &[1.0, 2.0, 3.0],
+            3..=3,
+            1.0,
+            FitKind::Full,
+        )
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            ChaosFitError::Regression(RegressionError::Underdetermined { .. })
+        ));
+    }
+}
