@@ -34,5 +34,5 @@ pub mod regression;
 pub mod rules;
 pub mod sensitivity;
 pub mod smolyak;
-pub mod sparse_chaos;
 pub mod sobol_seq;
+pub mod sparse_chaos;
