@@ -265,7 +265,7 @@ pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<
             }
         }
         let rkk = v.norm();
-        if !(rkk > 1e-10 * norm0.max(f64::MIN_POSITIVE)) {
+        if rkk.is_nan() || rkk <= 1e-10 * norm0.max(f64::MIN_POSITIVE) {
             out.resize(order.len(), f64::INFINITY);
             return out;
         }
