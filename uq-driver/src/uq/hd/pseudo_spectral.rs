@@ -265,6 +265,34 @@ mod tests {
     }
 
     #[test]
+    fn mixed_rules_project_onto_mixed_families() {
+        // t1 ~ N(0,1) (Genz–Keister), t2 ~ U(-1,1) (Gauss–Patterson):
+        // f = 1 + 2 t1 + t1^2 t2 + 0.5 t2^3: mean 1 + 0 = 1,
+        // Var = 4 + E[t1^4 t2^2] + 0.25 E[t2^6] + 2 * 0.5 E[t1^2] E[t2^4]
+        //     = 4 + 3/3 + 0.25/7 + 1/5.
+        let grid = SparseGrid::new(
+            &[RuleKind::GenzKeister, RuleKind::GaussPatterson],
+            &LevelSet::total(2, 3).unwrap(),
+        )
+        .unwrap();
+        let values = DMatrix::from_fn(grid.len(), 1, |j, _| {
+            let (a, b) = (grid.points[j][0], grid.points[j][1]);
+            1.0 + 2.0 * a + a * a * b + 0.5 * b.powi(3)
+        });
+        let pce = sparse_pseudo_spectral(&grid, &values).unwrap();
+        assert_eq!(pce.basis.families(), &[Family::Hermite, Family::Legendre]);
+        let st =
+            crate::uq::hd::basis::ChaosStats::new(pce.basis.set(), pce.coeffs.column(0).as_slice());
+        let var = 4.0 + 1.0 + 0.25 / 7.0 + 0.2;
+        assert!((st.mean - 1.0).abs() < 1e-13);
+        assert!(
+            (st.variance - var).abs() < 1e-12,
+            "{} vs {var}",
+            st.variance
+        );
+    }
+
+    #[test]
     fn wrong_value_count_is_refused() {
         let grid = SparseGrid::new(
             &[RuleKind::ClenshawCurtis; 2],

@@ -332,6 +332,42 @@ mod tests {
     }
 
     #[test]
+    fn replicated_lhs_gives_an_honest_error_where_the_mc_formula_overstates_it() {
+        use crate::uq::sampling::latin_hypercube;
+        use rand::RngCore;
+        // Nearly additive f on U(0,1)^4: LHS removes the additive variance, so the plain
+        // MC formula sigma / sqrt(n) overstates the error of the LHS mean.
+        let f = |x: &[f64]| -> f64 {
+            x.iter().map(|v| (3.0 * v).sin()).sum::<f64>() + 0.1 * x[0] * x[1]
+        };
+        let n = 50;
+        let lhs_mean = |r: u64| -> (f64, f64) {
+            let seed = stream(99, r).next_u64();
+            let y: Vec<f64> = latin_hypercube(n, 4, seed).iter().map(|x| f(x)).collect();
+            let m = y.iter().sum::<f64>() / n as f64;
+            let sd = (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+            (m, sd / (n as f64).sqrt())
+        };
+        // R = 10 replicates: the replicated standard error of one replicate's mean is
+        // se * sqrt(R).
+        let reps: Vec<(f64, f64)> = (0..10).map(lhs_mean).collect();
+        let summary = replicate_summary(&reps.iter().map(|r| r.0).collect::<Vec<_>>());
+        let per_replicate = summary.std_error * (summary.replicates as f64).sqrt();
+        // The true spread of one LHS mean, from 300 further replicates.
+        let many: Vec<f64> = (100..400).map(|r| lhs_mean(r).0).collect();
+        let truth = replicate_summary(&many).std_error * (many.len() as f64).sqrt();
+        let mc_formula = reps[0].1;
+        assert!(
+            mc_formula > 5.0 * truth,
+            "MC formula {mc_formula} vs true {truth}"
+        );
+        assert!(
+            per_replicate > 0.4 * truth && per_replicate < 2.0 * truth,
+            "replicated {per_replicate} vs true {truth}"
+        );
+    }
+
+    #[test]
     fn replicate_summary_is_the_standard_error_of_the_mean() {
         let s = replicate_summary(&[1.0, 2.0, 3.0, 4.0]);
         assert_eq!(s.mean, 2.5);
