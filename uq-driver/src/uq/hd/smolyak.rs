@@ -139,39 +139,41 @@ impl LevelSet {
     }
 
     /// The non-zero combination coefficients `(l, c_l)`, in the set's order.
+    ///
+    /// The subsets `e` with `l + e` in the set are enumerated depth first, pruned at the
+    /// first `l + e` outside the set (downward closedness: no superset can be inside),
+    /// so the cost is the number of such subsets, not `2^d`.
     pub fn combination(&self) -> Vec<(Vec<usize>, i64)> {
         let members: std::collections::HashSet<&Vec<usize>> = self.levels.iter().collect();
-        let d = self.dim;
         let mut out = Vec::new();
-        let mut probe = vec![0usize; d];
         for l in &self.levels {
-            let mut c = 0i64;
-            // Subsets e of {0,1}^d; only dimensions where l + e_i can stay in the set
-            // matter, but checking membership is enough (d <= 63 assumed by the mask).
-            let active: Vec<usize> = (0..d)
-                .filter(|&i| {
-                    probe.copy_from_slice(l);
-                    probe[i] += 1;
-                    members.contains(&probe)
-                })
-                .collect();
-            for mask in 0u64..(1u64 << active.len()) {
-                probe.copy_from_slice(l);
-                for (b, &i) in active.iter().enumerate() {
-                    if mask >> b & 1 == 1 {
-                        probe[i] += 1;
-                    }
-                }
-                if members.contains(&probe) {
-                    c += if mask.count_ones() % 2 == 0 { 1 } else { -1 };
-                }
-            }
+            let mut probe = l.clone();
+            let c = signed_subsets(&members, &mut probe, 0, 0);
             if c != 0 {
                 out.push((l.clone(), c));
             }
         }
         out
     }
+}
+
+/// `sum (-1)^|e|` over the subsets `e` of the dimensions `from..` (added to `probe`, which
+/// already carries `depth` unit increments) with `probe + e` in `members`.
+fn signed_subsets(
+    members: &std::collections::HashSet<&Vec<usize>>,
+    probe: &mut Vec<usize>,
+    from: usize,
+    depth: usize,
+) -> i64 {
+    let mut c = if depth & 1 == 0 { 1 } else { -1 };
+    for i in from..probe.len() {
+        probe[i] += 1;
+        if members.contains(probe) {
+            c += signed_subsets(members, probe, i + 1, depth + 1);
+        }
+        probe[i] -= 1;
+    }
+    c
 }
 
 /// One full-tensor term of the combination.
@@ -467,6 +469,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn combination_is_cheap_in_high_dimension() {
+        // d = 40, L = 2: the classical coefficients, without visiting 2^40 subsets.
+        let set = LevelSet::total(40, 2).unwrap();
+        let comb = set.combination();
+        for (l, c) in &comb {
+            let s: usize = l.iter().sum();
+            let want = match 2 - s {
+                0 => 1,
+                1 => -39,
+                _ => 39 * 38 / 2,
+            };
+            assert_eq!(*c, want, "{l:?}");
+        }
+        assert_eq!(comb.len(), set.levels().len());
+        let grid = SparseGrid::new(&[RuleKind::ClenshawCurtis; 40], &set).unwrap();
+        // 1 + 2 d (level 1) + 2 d (level 2 new nodes) + 4 C(d, 2) (pairs).
+        assert_eq!(grid.len(), 1 + 4 * 40 + 4 * 40 * 39 / 2);
+        assert!((grid.weights.iter().sum::<f64>() - 1.0).abs() < 1e-10);
     }
 
     #[test]
