@@ -146,8 +146,7 @@ impl<'e> Attrs<'e> {
                 .map_err(|err| malformed(format!("in <{element}> attribute {key}: {err}")))?;
             list.push((key, value));
         }
-        let mut seen = HashSet::with_capacity(list.len());
-        if let Some((key, _)) = list.iter().find(|(k, _)| !seen.insert(k.as_ref())) {
+        if let Some(key) = first_duplicate(&list) {
             return Err(malformed(format!(
                 "<{element}> has the attribute {key} twice"
             )));
@@ -569,6 +568,22 @@ fn variable_kind(a: &Attrs) -> Result<VariableKind, DescriptionError> {
             declared_type: a.required("declaredType")?,
         },
     })
+}
+
+/// The first attribute name that appears twice: pairwise for a few attributes (no allocation),
+/// with a hash set for many (linear).
+fn first_duplicate<'a>(list: &'a [(Cow<'_, str>, Cow<'_, str>)]) -> Option<&'a str> {
+    if list.len() <= 16 {
+        return list
+            .iter()
+            .enumerate()
+            .find(|(i, (k, _))| list[..*i].iter().any(|(j, _)| j == k))
+            .map(|(_, (k, _))| k.as_ref());
+    }
+    let mut seen = HashSet::with_capacity(list.len());
+    list.iter()
+        .map(|(k, _)| k.as_ref())
+        .find(|k| !seen.insert(*k))
 }
 
 /// `value`, cut to [`QUOTE_MAX`] characters for an error message.

@@ -34,7 +34,12 @@ pub(super) fn check<'x>(xml: &'x [u8], limits: &ParseLimits) -> Result<&'x [u8],
             ),
         });
     }
-    if let Some(at) = xml.iter().position(|&b| b == 0) {
+    // `contains` is a word-at-a-time memchr; the position is only needed for the message.
+    if let Some(at) = xml
+        .contains(&0)
+        .then(|| xml.iter().position(|&b| b == 0))
+        .flatten()
+    {
         let (line, column) = line_col(xml, at);
         return Err(DescriptionError::Malformed {
             line,
@@ -46,7 +51,8 @@ pub(super) fn check<'x>(xml: &'x [u8], limits: &ParseLimits) -> Result<&'x [u8],
     }
     if let Some(declared) = declared_encoding(xml) {
         let utf8 = declared.eq_ignore_ascii_case("utf-8") || declared.eq_ignore_ascii_case("utf8");
-        if let (false, Some(at)) = (utf8, xml.iter().position(|b| !b.is_ascii())) {
+        let non_ascii = || xml.iter().position(|b| !b.is_ascii());
+        if let (false, Some(at)) = (utf8, (!utf8 && !xml.is_ascii()).then(non_ascii).flatten()) {
             // ASCII reads the same in every encoding that could be declared here; anything
             // else would be read differently from what the declaration says.
             let (line, column) = line_col(xml, at);
