@@ -231,52 +231,18 @@ impl Store {
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes).map_err(io_err(&path))?;
 
-        let (fmt, mut decoded) = decode(&bytes, manifest.n_values);
-        let mut done: Vec<Option<Record>> = vec![None; manifest.n_points];
-        let mut kept_ranges = Vec::with_capacity(decoded.records.len());
-        let mut skipped = std::mem::take(&mut decoded.skipped);
-        for (i, rec, range) in decoded.records {
-            if i >= manifest.n_points {
-                skipped.push(Skipped {
-                    bytes: range.start as u64..range.end as u64,
-                    point: None,
-                    reason: format!(
-                        "record of point {i}, but the design has {} points",
-                        manifest.n_points
-                    ),
-                });
-                continue;
-            }
-            if done[i].is_none() {
-                done[i] = Some(rec.clone());
-            }
-            kept_ranges.push((i, rec, range));
-        }
-        skipped.sort_by_key(|s| s.bytes.start);
-
+        let fmt = format::detect_format(&bytes);
+        let (done, kept, skipped) = read_records(&bytes, fmt, manifest);
         let mut recovery = Recovery {
             path: path.clone(),
-            kept: kept_ranges.len(),
+            kept: kept.len(),
             converted_from_v1: fmt == Format::V1,
             ..Recovery::default()
         };
-        let valid_end = kept_ranges.last().map_or(0, |(_, _, r)| r.end);
+        let valid_end = kept.last().map_or(0, |(_, _, r)| r.end);
         let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
         if fmt == Format::V1 || damage_inside {
-            let (label, new_bytes): (String, Vec<u8>) = if fmt == Format::V1 {
-                let mut out = Vec::new();
-                for (i, rec, _) in &kept_ranges {
-                    out.extend_from_slice(&encode(*i, rec));
-                }
-                ("v1".into(), out)
-            } else {
-                let mut out = Vec::with_capacity(bytes.len());
-                for (_, _, r) in &kept_ranges {
-                    out.extend_from_slice(&bytes[r.clone()]);
-                }
-                (format!("damaged-{}", unix_seconds()), out)
-            };
-            let (new_file, backup) = rewrite(&path, &label, &new_bytes)?;
+            let (new_file, backup) = rewrite_kept(&path, &bytes, fmt, &kept)?;
             file = new_file;
             recovery.backup = Some(backup);
         } else if valid_end < bytes.len() {
@@ -321,6 +287,69 @@ impl Store {
         let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
         f.write_all(&bytes).map_err(io_err(&self.path))
     }
+}
+
+/// A valid record and its bytes in the file.
+type Kept = (usize, Record, std::ops::Range<usize>);
+
+/// Decodes `bytes` for `manifest`: the first record of each point, every valid record of the
+/// design (in file order), and the skipped stretches (in file order; a valid record of a point
+/// beyond the design counts as skipped).
+fn read_records(
+    bytes: &[u8],
+    fmt: Format,
+    manifest: &Manifest,
+) -> (Vec<Option<Record>>, Vec<Kept>, Vec<Skipped>) {
+    let decoded = format::decode_format(bytes, manifest.n_values, fmt);
+    let mut done: Vec<Option<Record>> = vec![None; manifest.n_points];
+    let mut kept = Vec::with_capacity(decoded.records.len());
+    let mut skipped = decoded.skipped;
+    for (i, rec, range) in decoded.records {
+        if i >= manifest.n_points {
+            skipped.push(Skipped {
+                bytes: range.start as u64..range.end as u64,
+                point: None,
+                reason: format!(
+                    "record of point {i}, but the design has {} points",
+                    manifest.n_points
+                ),
+            });
+            continue;
+        }
+        if done[i].is_none() {
+            done[i] = Some(rec.clone());
+        }
+        kept.push((i, rec, range));
+    }
+    skipped.sort_by_key(|s| s.bytes.start);
+    (done, kept, skipped)
+}
+
+/// Rewrites `records.bin` with the `kept` records only, in format 2: a format-1 store is
+/// re-encoded (and kept as `records.v1.bin`), a damaged one keeps the valid records' bytes (and
+/// the file as found as `records.damaged-<unix seconds>.bin`).
+fn rewrite_kept(
+    path: &Path,
+    bytes: &[u8],
+    fmt: Format,
+    kept: &[Kept],
+) -> Result<(File, PathBuf), StoreError> {
+    let mut out = Vec::with_capacity(bytes.len());
+    let label = match fmt {
+        Format::V1 => {
+            for (i, rec, _) in kept {
+                out.extend_from_slice(&encode(*i, rec));
+            }
+            "v1".to_string()
+        }
+        Format::V2 => {
+            for (_, _, r) in kept {
+                out.extend_from_slice(&bytes[r.clone()]);
+            }
+            format!("damaged-{}", unix_seconds())
+        }
+    };
+    rewrite(path, &label, &out)
 }
 
 /// Writes the manifest of a new store, or checks that an existing one is `manifest`.

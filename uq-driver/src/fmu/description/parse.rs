@@ -603,6 +603,7 @@ fn malformed(xml: &[u8], pos: usize, reason: String) -> DescriptionError {
     DescriptionError::Malformed {
         line,
         column,
-        reason,
+        // quick-xml quotes names from the document, which may be huge.
+        reason: quote(&reason),
     }
 }
