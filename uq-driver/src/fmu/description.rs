@@ -159,8 +159,9 @@ impl ParseLimits {
     /// Default [`ParseLimits::max_bytes`]: 256 MiB, far above the tens of MB of FMUs with
     /// 10^5 variables.
     pub const DEFAULT_MAX_BYTES: usize = 256 << 20;
-    /// Default [`ParseLimits::max_depth`]: 256, the default of libxml2 (and so of fmpy); FMI 2.0
-    /// itself nests 5 levels, tool annotations a few more.
+    /// Default [`ParseLimits::max_depth`]: 256, as libxml2 without `XML_PARSE_HUGE` (fmpy,
+    /// through lxml, also accepts 256 levels and refuses 257); FMI 2.0 itself nests 5 levels,
+    /// tool annotations a few more.
     pub const DEFAULT_MAX_DEPTH: usize = 256;
 }
 

@@ -239,10 +239,10 @@ impl Store {
             converted_from_v1: fmt == Format::V1,
             ..Recovery::default()
         };
-        let valid_end = kept.last().map_or(0, |(_, _, r)| r.end);
+        let valid_end = kept.last().map_or(0, |(_, r)| r.end);
         let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
         if fmt == Format::V1 || damage_inside {
-            let (new_file, backup) = rewrite_kept(&path, &bytes, fmt, &kept)?;
+            let (new_file, backup) = rewrite_kept(&path, &bytes, fmt, &kept, &done)?;
             file = new_file;
             recovery.backup = Some(backup);
         } else if valid_end < bytes.len() {
@@ -289,8 +289,8 @@ impl Store {
     }
 }
 
-/// A valid record and its bytes in the file.
-type Kept = (usize, Record, std::ops::Range<usize>);
+/// A valid record's point and its bytes in the file.
+type Kept = (usize, std::ops::Range<usize>);
 
 /// Decodes `bytes` for `manifest`: the first record of each point, every valid record of the
 /// design (in file order), and the skipped stretches (in file order; a valid record of a point
@@ -317,9 +317,9 @@ fn read_records(
             continue;
         }
         if done[i].is_none() {
-            done[i] = Some(rec.clone());
+            done[i] = Some(rec);
         }
-        kept.push((i, rec, range));
+        kept.push((i, range));
     }
     skipped.sort_by_key(|s| s.bytes.start);
     (done, kept, skipped)
@@ -333,17 +333,23 @@ fn rewrite_kept(
     bytes: &[u8],
     fmt: Format,
     kept: &[Kept],
+    done: &[Option<Record>],
 ) -> Result<(File, PathBuf), StoreError> {
     let mut out = Vec::with_capacity(bytes.len());
     let label = match fmt {
         Format::V1 => {
-            for (i, rec, _) in kept {
-                out.extend_from_slice(&encode(*i, rec));
+            // The first record of each point (later ones are never read).
+            let mut written = vec![false; done.len()];
+            for &(i, _) in kept {
+                if let (Some(rec), false) = (&done[i], written[i]) {
+                    out.extend_from_slice(&encode(i, rec));
+                    written[i] = true;
+                }
             }
             "v1".to_string()
         }
         Format::V2 => {
-            for (_, _, r) in kept {
+            for (_, r) in kept {
                 out.extend_from_slice(&bytes[r.clone()]);
             }
             format!("damaged-{}", unix_seconds())
