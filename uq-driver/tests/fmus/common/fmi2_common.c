@@ -87,7 +87,7 @@ static void emit(const fmi2CallbackFunctions *cb, const char *name, fmi2Status s
 void fmu_log(Instance *inst, fmi2Status status, const char *category, const char *format, ...) {
     va_list args;
     if (inst == NULL) return;
-    if (!inst->logging_on && status != fmi2Error && status != fmi2Fatal) return;
+    if (!inst->logging_on && status == fmi2OK) return;
     va_start(args, format);
     emit(&inst->cb, inst->name, status, category, format, args);
     va_end(args);

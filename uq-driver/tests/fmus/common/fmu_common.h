@@ -9,7 +9,7 @@
  *     outputs never);
  *   - FMU state get/set/serialize (a copy of time + the model's data);
  *   - the resource folder: the fmuResourceLocation URI decoded to a file system path;
- *   - logging: errors always, the rest when logging is on.
+ *   - logging: warnings and errors always, the rest when logging is on.
  *
  * Written for the test suite, never shipped. C99 + POSIX.
  */
@@ -103,7 +103,7 @@ struct Instance {
 };
 
 /* Logs through the importer's logger as logger(env, name, status, category, "%s", message).
- * fmi2Error/fmi2Fatal messages always, others only when logging is on. */
+ * Messages with a status other than fmi2OK always, the others only when logging is on. */
 void fmu_log(Instance *inst, fmi2Status status, const char *category, const char *format, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 4, 5)))
