@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave, fmi2LastSuccessfulTime, fmi2Terminated
+from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2LastSuccessfulTime, fmi2Terminated
 from fmpy.validation import validate_fmu
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -560,8 +560,14 @@ def test_misbehave_2_to_5_crash_exit_or_hang_the_importer_process(features_fmu, 
 def test_setting_rules(features_fmu, capsys):
     with slave(features_fmu) as s:
         s.start()
+        s.fmu.doStep(0.0, 0.1)
         s.set(u=3.0, k=4, flag=True)  # inputs may change between steps
         assert (s.get("u_echo"), s.get("k_echo"), s.get("flag_echo")) == (3.0, 4, True)
+        assert s.get("u_gain") == 3.0
+        s.set(gain=-0.5)  # and tunable parameters
+        assert s.get("u_gain") == -1.5
+        s.fmu.doStep(0.1, 0.1)
+        assert s.get("u_gain") == -1.5
         with pytest.raises(FMICallException):
             s.set(int_param=1)
         assert "fixed parameter" in capsys.readouterr().out
@@ -580,3 +586,25 @@ def test_setting_rules(features_fmu, capsys):
             with pytest.raises(FMICallException):
                 s.set(**{var: value})
             assert "is outside" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_instantiate_refuses_a_wrong_guid_and_model_exchange(built, name, capsys):
+    path = str(built[name][0])
+    md = read_model_description(path)
+    unzipdir = extract(path)
+    try:
+        wrong = FMU2Slave(guid="{not-the-guid}", unzipDirectory=unzipdir,
+                          modelIdentifier=md.coSimulation.modelIdentifier, instanceName="w")
+        with pytest.raises(Exception, match="instantiate"):
+            wrong.instantiate()
+        assert "wrong GUID {not-the-guid}" in capsys.readouterr().out
+        lib = ctypes.CDLL(os.path.join(unzipdir, "binaries", "linux64",
+                                       md.coSimulation.modelIdentifier + ".so"))
+        lib.fmi2Instantiate.restype = ctypes.c_void_p
+        model_exchange = 0
+        assert lib.fmi2Instantiate(b"x", model_exchange, md.guid.encode(), b"file:///tmp",
+                                   ctypes.byref(defaultCallbacks), 0, 0) is None
+        assert "only Co-Simulation is supported (fmuType = 0)" in capsys.readouterr().out
+    finally:
+        shutil.rmtree(unzipdir, ignore_errors=True)

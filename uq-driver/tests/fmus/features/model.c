@@ -6,7 +6,7 @@
  *
  *   int_out = int_param, bool_out = bool_param, enum_out = enum_param (Enumeration Colour),
  *   string_out = string_param, string_len = strlen(string_param)
- *   u_echo = u (direct feedthrough), u_integral = integral of u dt with u held over each step
+ *   u_echo = u and u_gain = gain u (direct feedthrough; gain is a tunable parameter), u_integral = integral of u dt with u held over each step
  *   (the left Riemann sum over the communication steps), k_echo = k, flag_echo = flag
  *   file_value = the first number in the file read_file (resolved in resources/ when
  *   relative; read at the end of initialization; 0 when read_file is empty)
@@ -47,6 +47,7 @@ typedef struct {
     double stop_at;
     fmi2Integer misbehave;
     double misbehave_at;
+    double gain; /* tunable */
     /* inputs */
     double u;
     fmi2Integer k;
@@ -58,6 +59,7 @@ typedef struct {
     char string_out[STRING_CAPACITY];
     fmi2Integer string_len;
     double u_echo;
+    double u_gain;
     double u_integral;
     fmi2Integer k_echo;
     fmi2Boolean flag_echo;
@@ -77,6 +79,8 @@ static const Variable VARIABLES[] = {
     VAR("file_value", TYPE_REAL, 4, KIND_OUTPUT, file_value),
     VAR("stop_at", TYPE_REAL, 5, KIND_FIXED_PARAMETER, stop_at),
     VAR("misbehave_at", TYPE_REAL, 6, KIND_FIXED_PARAMETER, misbehave_at),
+    VAR("gain", TYPE_REAL, 7, KIND_TUNABLE_PARAMETER, gain),
+    VAR("u_gain", TYPE_REAL, 8, KIND_OUTPUT, u_gain),
     VAR("int_param", TYPE_INTEGER, 0, KIND_FIXED_PARAMETER, int_param),
     {"enum_param", TYPE_INTEGER, 1, KIND_FIXED_PARAMETER, offsetof(Data, enum_param), 1, 1, 3},
     {"misbehave", TYPE_INTEGER, 2, KIND_FIXED_PARAMETER, offsetof(Data, misbehave), 1, 0,
@@ -106,6 +110,7 @@ static void set_defaults(void *data) {
     d->stop_at = 0.0;
     d->misbehave = MISBEHAVE_NONE;
     d->misbehave_at = 0.5;
+    d->gain = 1.0;
 }
 
 static void calculate(Instance *inst) {
@@ -117,7 +122,13 @@ static void calculate(Instance *inst) {
     d->string_len = (fmi2Integer)strlen(d->string_param);
     d->k_echo = d->k;
     d->flag_echo = d->flag;
-    d->u_echo = (d->misbehave == MISBEHAVE_NAN && d->misbehaved) ? NAN : d->u;
+    if (d->misbehave == MISBEHAVE_NAN && d->misbehaved) {
+        d->u_echo = NAN;
+        d->u_gain = NAN;
+    } else {
+        d->u_echo = d->u;
+        d->u_gain = d->gain * d->u;
+    }
 }
 
 /* The first decimal number in `text` (as strtod reads it from a sign, digit or point), skipping
@@ -223,6 +234,7 @@ static fmi2Status step(Instance *inst, double h) {
     inst->time = end;
     if (d->misbehave == MISBEHAVE_NAN && d->misbehaved) {
         d->u_echo = NAN;
+        d->u_gain = NAN;
         d->u_integral = NAN;
         d->file_value = NAN;
     }
