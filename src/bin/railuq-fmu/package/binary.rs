@@ -113,9 +113,14 @@ fn strip_tools(platform: Platform) -> Vec<String> {
 /// --strip-all`: a shared library keeps its dynamic symbols / export table). The error names
 /// each program tried and what it said.
 pub fn strip(input: &Path, output: &Path, platform: Platform) -> Result<(), String> {
+    strip_with(&strip_tools(platform), input, output)
+}
+
+/// [`strip`] with the first of `tools` that succeeds.
+fn strip_with(tools: &[String], input: &Path, output: &Path) -> Result<(), String> {
     let mut tried = Vec::new();
-    for tool in strip_tools(platform) {
-        let result = Command::new(&tool)
+    for tool in tools {
+        let result = Command::new(tool)
             .arg("--strip-all")
             .arg("-o")
             .arg(output)
@@ -194,6 +199,61 @@ mod tests {
         assert!(err(b"MZ").contains("truncated"));
         assert!(err(b"<?xml").contains("no ELF, PE or Mach-O"));
         assert!(err(b"").contains("no ELF, PE or Mach-O"));
+    }
+
+    /// Section names of a little-endian ELF64 file (section headers and .shstrtab).
+    fn elf64_section_names(b: &[u8]) -> Vec<String> {
+        let u16_at = |at: usize| usize::from(u16::from_le_bytes([b[at], b[at + 1]]));
+        let u32_at = |at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap()) as usize;
+        let u64_at = |at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap()) as usize;
+        let (shoff, shentsize, shnum, shstrndx) =
+            (u64_at(0x28), u16_at(0x3a), u16_at(0x3c), u16_at(0x3e));
+        let strtab = u64_at(shoff + shstrndx * shentsize + 0x18);
+        (0..shnum)
+            .map(|i| {
+                let start = strtab + u32_at(shoff + i * shentsize);
+                let len = b[start..].iter().position(|&c| c == 0).unwrap();
+                String::from_utf8_lossy(&b[start..start + len]).into_owned()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn strip_removes_the_symbol_table_and_debug_info() {
+        // This test program is an ELF file with symbols and (in a debug build) debug info.
+        let exe = std::env::current_exe().unwrap();
+        let dir = std::env::temp_dir().join(format!("railuq-strip-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("stripped");
+        strip_with(&["strip".to_owned()], &exe, &out).unwrap();
+        let before = std::fs::read(&exe).unwrap();
+        let after = std::fs::read(&out).unwrap();
+        assert!(
+            after.len() < before.len(),
+            "{} -> {}",
+            before.len(),
+            after.len()
+        );
+        let debug = |b: &[u8]| {
+            let names = elf64_section_names(b);
+            assert!(names.iter().any(|n| n == ".text"), "{names:?}");
+            names
+                .into_iter()
+                // .debug_gdb_scripts is loaded data (a pointer to pretty-printers), not debug info.
+                .filter(|n| n == ".symtab" || n.starts_with(".debug") && n != ".debug_gdb_scripts")
+                .count()
+        };
+        assert!(debug(&before) > 0);
+        assert_eq!(debug(&after), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_missing_strip_program_is_named_in_the_error() {
+        let dir = std::env::temp_dir();
+        let tools = ["no-such-strip-program".to_owned()];
+        let err = strip_with(&tools, &dir.join("in"), &dir.join("out")).unwrap_err();
+        assert!(err.contains("no-such-strip-program"), "{err}");
     }
 
     #[test]
