@@ -1,7 +1,8 @@
 """The win64 DLL of the FMUs, run for real: a small FMI importer in C (tests/wine/importer.c),
 built with mingw-w64, loads it under Wine (Debian's wine64), steps the Wheel and is compared
-with the closed form and with the linux64 binary run by fmpy; calls in the wrong state must
-return fmi2Error.
+with the closed form and with the linux64 binary run by fmpy (Bogie and VehicleTrack too, and
+VehicleTrack reading a measured profile from its resources folder, given as a file:///Z:/...
+URI); calls in the wrong state must return fmi2Error.
 
 Debian 12's Wine 8.0 lacks bcryptprimitives.dll, which Rust's standard library imports on
 Windows (every Windows 10 or later has it): a stand-in built from tests/wine/bcryptprimitives.c
@@ -157,7 +158,9 @@ def run_under_wine(wine, fmu, sets, outputs, stop, dt):
     """[t, outputs...] at t_i = i dt from the win64 binary, run by the importer under Wine."""
     folder, md = fmu
     vr = refs(md)
-    set_arg = ",".join(f"{vr[n]}={x!r}" for n, x in sets.items()) or "-"
+    kinds = {v.name: v.type for v in md.modelVariables}
+    prefix = {"Real": "", "Integer": "i:", "String": "s:"}
+    set_arg = ",".join(f"{prefix[kinds[n]]}{vr[n]}={x}" for n, x in sets.items()) or "-"
     get_arg = ",".join(str(vr[n]) for n in outputs)
     out = wine.importer(folder, md, "run", stop, dt, set_arg, get_arg)
     lines = out.splitlines()
@@ -168,18 +171,22 @@ def run_under_wine(wine, fmu, sets, outputs, stop, dt):
     return rows
 
 
-def run_linux_so(name, sets, outputs, stop, dt):
-    """The same calls on the linux64 binary through fmpy, at the same communication points."""
+def run_linux_so(name, sets, outputs, stop, dt, resources=None):
+    """The same calls on the linux64 binary through fmpy, at the same communication points;
+    `resources` ({file name: text}) are written to the FMU's resources folder first."""
     path = fmu_path(name)
     md = read_model_description(path)
     vr = refs(md)
+    kinds = {v.name: v.type for v in md.modelVariables}
     folder = extract(path)
     try:
+        write_resources(folder, resources or {})
         fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder,
                         modelIdentifier=md.coSimulation.modelIdentifier, instanceName="linux")
         fmu.instantiate()
-        if sets:
-            fmu.setReal([vr[n] for n in sets], list(sets.values()))
+        setters = {"Real": fmu.setReal, "Integer": fmu.setInteger, "String": fmu.setString}
+        for n, x in sets.items():
+            setters[kinds[n]]([vr[n]], [x])
         fmu.setupExperiment(startTime=0.0, stopTime=stop)
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
@@ -195,6 +202,13 @@ def run_linux_so(name, sets, outputs, stop, dt):
         return np.array(rows)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def write_resources(folder, files):
+    res = pathlib.Path(folder) / "resources"
+    res.mkdir(exist_ok=True)
+    for name, text in files.items():
+        (res / name).write_text(text)
 
 
 WHEEL_OUTPUTS = ["q", "v", "a"]
@@ -253,6 +267,27 @@ def test_other_models_dll_under_wine_follow_the_linux_binary(wine, name, stop):
     print(f"{name}: {len(outputs)} outputs, {len(win)} points, largest difference "
           f"{rel:.3g} of each output's range")
     assert rel < 1e-12, rel
+
+
+def test_relative_profile_file_resolves_in_the_resources_folder_under_wine(wine):
+    """VehicleTrack with a measured profile (irregularity = 10) named relative to the resources
+    folder: the DLL gets that folder as file:///Z:/... and must open Z:/.../track.csv."""
+    x = np.arange(0.0, 3001.0)
+    z = 2e-3 * np.sin(2 * np.pi * x / 25.0)
+    profile = {"track.csv": "x,z\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z))}
+    sets = {"irregularity": 10, "profile_file": "track.csv"}
+    outputs = ["Z0_1"]
+    fmu = extracted("VehicleTrack")
+    try:
+        write_resources(fmu[0], profile)
+        win = run_under_wine(wine, fmu, sets, outputs, stop=0.2, dt=0.002)
+    finally:
+        shutil.rmtree(fmu[0], ignore_errors=True)
+    linux = run_linux_so("VehicleTrack", sets, outputs, stop=0.2, dt=0.002, resources=profile)
+    # The profile is what the wheels run on: within its range, and not flat.
+    assert np.all(np.abs(win[:, 1:]) <= 2e-3 + 1e-12)
+    assert np.ptp(win[:, 1]) > 1e-3, np.ptp(win[:, 1])
+    assert np.max(np.abs(win - linux)) <= 1e-12 * 2e-3, np.max(np.abs(win - linux))
 
 
 def test_wrong_state_calls_return_fmi2error_under_wine(wheel, wine):

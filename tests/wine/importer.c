@@ -2,8 +2,9 @@
  * Wine by tests/python/test_win64_wine.py against the win64 DLL of a railuq FMU.
  *
  *   importer.exe DLL GUID RESOURCE_URI run STOP DT SETS GETS
- *       SETS: "vr=value,..." (fmi2SetReal before initialization, may be "-"),
- *       GETS: "vr,..." (fmi2GetReal after initialization and after every step).
+ *       SETS: "vr=value,..." set before initialization ("-": none); a Real by default,
+ *             "i:vr=value" an Integer, "s:vr=text" a String (text without commas);
+ *       GETS: "vr,..." Reals read after initialization and after every step.
  *       Prints one CSV line per communication point t_i = i * DT: t_i, then each GETS value,
  *       all with 17 significant digits.
  *   importer.exe DLL GUID RESOURCE_URI wrong-state FIXED_VR
@@ -71,27 +72,63 @@ static int load(const char *dll) {
     return missing == 0;
 }
 
-/* Parses "a,b,c" (unsigned ints) or "vr=value,..." pairs; returns the count, or -1. */
-static int parse_list(const char *s, fmi2ValueReference vr[], fmi2Real val[]) {
+/* One value to set before initialization. */
+typedef struct {
+    char type; /* 'r', 'i' or 's' */
+    fmi2ValueReference vr;
+    fmi2Real real;
+    fmi2Integer integer;
+    const char *string;
+} Setting;
+
+/* Parses SETS (see above) in place; returns the count, or -1. */
+static int parse_sets(char *s, Setting out[]) {
     int n = 0;
+    char *item;
     if (strcmp(s, "-") == 0) return 0;
+    for (item = strtok(s, ","); item; item = strtok(NULL, ",")) {
+        Setting *x = &out[n];
+        char *end, *value;
+        if (n == MAX_VARS) return -1;
+        x->type = 'r';
+        if ((item[0] == 'i' || item[0] == 's') && item[1] == ':') {
+            x->type = item[0];
+            item += 2;
+        }
+        x->vr = (fmi2ValueReference)strtoul(item, &end, 10);
+        if (end == item || *end != '=') return -1;
+        value = end + 1;
+        if (x->type == 'r') x->real = strtod(value, &end);
+        if (x->type == 'i') x->integer = (fmi2Integer)strtol(value, &end, 10);
+        if (x->type == 's') x->string = value;
+        else if (end == value || *end) return -1;
+        n++;
+    }
+    return n;
+}
+
+/* Parses "a,b,c" (value references); returns the count, or -1. */
+static int parse_refs(const char *s, fmi2ValueReference vr[]) {
+    int n = 0;
     while (*s) {
         char *end;
         if (n == MAX_VARS) return -1;
         vr[n] = (fmi2ValueReference)strtoul(s, &end, 10);
         if (end == s) return -1;
         s = end;
-        if (val) {
-            if (*s++ != '=') return -1;
-            val[n] = strtod(s, &end);
-            if (end == s) return -1;
-            s = end;
-        }
         n++;
         if (*s == ',') s++;
         else if (*s) return -1;
     }
     return n;
+}
+
+static fmi2Status apply(fmi2Component c, const Setting *x) {
+    switch (x->type) {
+    case 'i': return fmi2SetInteger(c, &x->vr, 1, &x->integer);
+    case 's': return fmi2SetString(c, &x->vr, 1, &x->string);
+    default: return fmi2SetReal(c, &x->vr, 1, &x->real);
+    }
 }
 
 #define CHECK(call)                                                                           \
@@ -104,8 +141,9 @@ static int parse_list(const char *s, fmi2ValueReference vr[], fmi2Real val[]) {
     } while (0)
 
 static int run(const char *guid, const char *uri, int argc, char **argv) {
-    fmi2ValueReference set_vr[MAX_VARS], get_vr[MAX_VARS];
-    fmi2Real set_val[MAX_VARS], got[MAX_VARS];
+    Setting sets[MAX_VARS];
+    fmi2ValueReference get_vr[MAX_VARS];
+    fmi2Real got[MAX_VARS];
     double stop, dt;
     long n, i;
     int nset, nget, k;
@@ -113,8 +151,8 @@ static int run(const char *guid, const char *uri, int argc, char **argv) {
     if (argc != 4) return 2;
     stop = strtod(argv[0], NULL);
     dt = strtod(argv[1], NULL);
-    nset = parse_list(argv[2], set_vr, set_val);
-    nget = parse_list(argv[3], get_vr, NULL);
+    nset = parse_sets(argv[2], sets);
+    nget = parse_refs(argv[3], get_vr);
     if (!(dt > 0) || !(stop > 0) || nset < 0 || nget <= 0) return 2;
     n = lround(stop / dt);
 
@@ -123,7 +161,7 @@ static int run(const char *guid, const char *uri, int argc, char **argv) {
         fprintf(stderr, "fmi2Instantiate returned NULL\n");
         return 1;
     }
-    if (nset) CHECK(fmi2SetReal(c, set_vr, (size_t)nset, set_val));
+    for (k = 0; k < nset; k++) CHECK(apply(c, &sets[k]));
     CHECK(fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2True, stop));
     CHECK(fmi2EnterInitializationMode(c));
     CHECK(fmi2ExitInitializationMode(c));
