@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bogie;
+pub mod table;
 pub mod vehicle_track;
 pub mod wheel;
 
@@ -132,6 +133,19 @@ impl Variable {
     ) -> Variable {
         Variable {
             start: Start::Integer(Some(start)),
+            ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
+        }
+    }
+
+    /// A fixed String parameter with a start value.
+    pub const fn string_parameter(
+        name: &'static str,
+        vr: u32,
+        start: &'static str,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            start: Start::String(Some(start)),
             ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
         }
     }
