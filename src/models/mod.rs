@@ -259,6 +259,9 @@ pub enum ModelError {
     /// The value reference is not one the model handles for this type.
     #[error("no {0:?} variable with value reference {1}")]
     NoSuchVariable(VarType, u32),
+    /// A step that needs too many internal substeps (refused before any work).
+    #[error("{0}")]
+    StepTooLong(#[from] crate::solver::TooManySubsteps),
     /// A serialized state could not be read.
     #[error("corrupt model state: {0}")]
     CorruptState(String),

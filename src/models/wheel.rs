@@ -54,7 +54,8 @@ pub static INFO: ModelInfo = ModelInfo {
 &zeta; = C / (2&radic;(K m)) = 0.316, &omega;<sub>d</sub> = 3 rad/s and
 q(t) = 0.1 e<sup>&minus;t</sup>(cos 3t + sin(3t)/3).</p>
 <p>Integration: classical Runge&ndash;Kutta (RK4) with equal substeps no longer than the
-parameter <code>h</code> (default 1 ms; error below 1e-9 q0 over 0&ndash;5 s).
+parameter <code>h</code> (default 1 ms; error below 1e-9 q0 over 0&ndash;5 s). A communication
+step that would need more than 10<sup>7</sup> substeps is refused with an error.
 K and C are tunable: a change between communication steps acts from the next step on.
 K &le; 0 is accepted with a warning; m &le; 0, C &lt; 0 and non-finite values are refused.</p>"#,
 };
@@ -126,7 +127,7 @@ impl Model for Wheel {
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
-        let n = substeps(h, self.h);
+        let n = substeps(h, self.h)?;
         let dt = h / n as f64;
         let (m, k, c) = (self.m, self.k, self.c);
         for i in 0..n {
@@ -271,6 +272,19 @@ mod tests {
             t += 0.01;
         }
         assert!(failed);
+    }
+
+    #[test]
+    fn an_absurd_step_is_refused_with_an_error_not_a_hang() {
+        // fmi2DoStep with h = 1e300 (or 1e6) used to overflow the substep count and never return.
+        let mut w = Wheel::default();
+        w.initialize(&InitContext::default()).unwrap();
+        for h in [1e300, 1e6, f64::MAX] {
+            let e = w.do_step(0.0, h).unwrap_err();
+            assert!(matches!(e, ModelError::StepTooLong(_)), "{e}");
+        }
+        assert_eq!(w.y, [0.1, 0.0], "a refused step leaves the state");
+        w.do_step(0.0, 0.01).unwrap();
     }
 
     #[test]

@@ -177,7 +177,7 @@ impl Model for Bogie {
             return Err(self.speed_error(tt, vv));
         }
         let h_max = self.dt.min(1.0 / self.fastest_rate(v_min));
-        let n = substeps(h, h_max);
+        let n = substeps(h, h_max)?;
         let dt = h / n as f64;
         let p = self.p;
         let (v0, ramp, t_start) = (self.v0, self.ramp, self.t_start);

@@ -227,6 +227,29 @@ fn full_ramp_reaches_55_m_per_s_and_stops_before_1_m_per_s() {
 }
 
 #[test]
+fn an_absurd_step_is_refused_with_an_error_not_a_hang() {
+    // At constant speed nothing else stops a step of 1e300 s: the substep count overflowed.
+    let mut b = Bogie {
+        ramp: 0.0,
+        ..Bogie::default()
+    };
+    b.initialize(&InitContext::default()).unwrap();
+    for h in [1e300, 1e6] {
+        let e = b.do_step(0.0, h).unwrap_err();
+        assert!(matches!(e, ModelError::StepTooLong(_)), "{e}");
+    }
+    b.do_step(0.0, 0.01).unwrap();
+    // On the ramp the speed guard refuses it first.
+    let mut b = Bogie::default();
+    b.initialize(&InitContext::default()).unwrap();
+    assert!(b
+        .do_step(0.0, 1e300)
+        .unwrap_err()
+        .to_string()
+        .contains("1 m/s"));
+}
+
+#[test]
 fn refuses_bad_parameters() {
     let mut b = Bogie::default();
     for vr in [VR_K_SY, VR_C_SY, VR_K_PHI, VR_K0] {

@@ -271,7 +271,7 @@ impl VehicleTrack {
 
     /// Advances by `h` (s) in equal substeps no longer than `dt`.
     pub(super) fn advance(&self, sim: &mut Sim, h: f64) -> Result<(), ModelError> {
-        let n = substeps(h, self.p.r(VR_DT));
+        let n = substeps(h, self.p.r(VR_DT))?;
         let hs = h / n as f64;
         let v = self.p.r(VR_V);
         self.check_reach(sim, sim.run.xc + v * h)?;

@@ -272,6 +272,24 @@ fn refuses_bad_parameters_with_clear_messages() {
 }
 
 #[test]
+fn an_absurd_step_is_refused_with_an_error_not_a_hang() {
+    // fmi2DoStep with h = 1e300 (or 1e6) used to overflow the substep count and never return.
+    let mut m = small(63, 32);
+    m.initialize(&InitContext::default()).unwrap();
+    let zc = out(&m, VR_ZC);
+    for h in [1e300, 1e6, 2e3] {
+        let e = m.do_step(0.0, h).unwrap_err();
+        assert!(matches!(e, ModelError::StepTooLong(_)), "h = {h}: {e}");
+        assert!(
+            e.to_string().contains("use shorter communication steps"),
+            "{e}"
+        );
+    }
+    assert_eq!(out(&m, VR_ZC), zc, "a refused step leaves the state");
+    m.do_step(0.0, 0.01).unwrap();
+}
+
+#[test]
 fn tunable_suspension_is_read_at_every_step() {
     let mut m = small(127, 64);
     m.initialize(&InitContext::default()).unwrap();
