@@ -24,6 +24,26 @@ pub(super) struct Diag {
     pub(super) z0: [f64; 4],
 }
 
+/// The rail profile the wheels see: the irregularity times `irregularity_scale`, plus the dip.
+#[derive(Clone, Debug)]
+pub(super) struct Profile {
+    exc: Excitation,
+    /// Factor on the irregularity amplitude (1).
+    scale: f64,
+}
+
+impl Profile {
+    /// Z0(x) (m, positive down).
+    #[inline]
+    fn z0(&self, x: f64) -> f64 {
+        self.scale * self.exc.irregularity_at(x) + self.exc.dip.eval(x)
+    }
+
+    fn check_range(&self, x_lo: f64, x_hi: f64) -> Result<(), String> {
+        self.exc.check_range(x_lo, x_hi)
+    }
+}
+
 /// Geometry of the running vehicle on the window.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Run {
@@ -40,7 +60,7 @@ pub(super) struct Run {
 pub(super) struct Sim {
     pub(super) track: Track,
     pub(super) contact: Contact,
-    pub(super) exc: Excitation,
+    pub(super) exc: Profile,
     pub(super) zhai: Zhai,
     pub(super) time: f64,
     pub(super) run: Run,
@@ -51,13 +71,22 @@ pub(super) struct Sim {
     pub(super) diag: Diag,
 }
 
+impl Sim {
+    /// Vertical acceleration (m/s², Z down) of the carbody point at x = ∓`lc` (m) from its
+    /// centre, `sign` = −1 above the front bogie (x = +Lc, attached at Zc − Lc βc), +1 above
+    /// the rear one: Zc'' + sign · Lc βc''.
+    pub(super) fn carbody_acc_at(&self, sign: f64, lc: f64) -> f64 {
+        self.zhai.a[super::vehicle::ZC] + sign * lc * self.zhai.a[super::vehicle::BC]
+    }
+}
+
 /// Accelerations of the whole system `a = M⁻¹F(x, v)` with the vehicle at `run`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn accelerations(
     hv: &HalfVehicle,
     track: &mut Track,
     contact: &Contact,
-    exc: &Excitation,
+    exc: &Profile,
     run: &Run,
     x: &[f64],
     v: &[f64],
@@ -117,15 +146,18 @@ impl VehicleTrack {
             )),
         };
         let offsets = hv.wheel_offsets();
-        let exc = Excitation {
-            irregularity,
-            dip: Dip {
-                x0: p.r(VR_DIP_X0),
-                length: p.r(VR_DIP_LENGTH),
-                depth: p.r(VR_DIP_DEPTH),
+        let exc = Profile {
+            exc: Excitation {
+                irregularity,
+                dip: Dip {
+                    x0: p.r(VR_DIP_X0),
+                    length: p.r(VR_DIP_LENGTH),
+                    depth: p.r(VR_DIP_DEPTH),
+                },
+                ramp_start: p.r(VR_X_START) + offsets[0],
+                ramp_length: p.r(VR_RAMP_LENGTH),
             },
-            ramp_start: p.r(VR_X_START) + offsets[0],
-            ramp_length: p.r(VR_RAMP_LENGTH),
+            scale: p.r(VR_IRREGULARITY_SCALE),
         };
         let (ls, l) = (p.r(VR_LS), track.length);
         let span = offsets[0].max(-offsets[3]);

@@ -388,3 +388,66 @@ fn speed() {
         1.0 / wall
     );
 }
+
+/// Outputs `vrs` after each of `n` steps of `h` (s) from a fresh initialization.
+fn trace(m: &mut VehicleTrack, n: usize, h: f64, vrs: &[u32]) -> Vec<Vec<f64>> {
+    m.initialize(&InitContext::default()).unwrap();
+    (0..n)
+        .map(|i| {
+            m.do_step(i as f64 * h, h).unwrap();
+            vrs.iter().map(|&vr| out(m, vr)).collect()
+        })
+        .collect()
+}
+
+#[test]
+fn irregularity_scale_zero_is_a_perfect_track_and_two_doubles_the_profile() {
+    let rough = |scale: f64| {
+        let mut m = small(127, 64);
+        m.set_integer(VR_IRREGULARITY, 3).unwrap();
+        m.set_real(VR_RAMP_LENGTH, 0.0).unwrap();
+        m.set_real(VR_IRREGULARITY_SCALE, scale).unwrap();
+        m
+    };
+    let vrs = [VR_Z0_1, VR_ZC_ACC, VR_P1, VR_P4, VR_ZR1];
+    let zero = trace(&mut rough(0.0), 40, 0.005, &vrs);
+    let none = trace(&mut small(127, 64), 40, 0.005, &vrs);
+    assert_eq!(zero, none, "scale 0 must be the perfect track");
+    let (one, two) = (
+        trace(&mut rough(1.0), 40, 0.005, &vrs),
+        trace(&mut rough(2.0), 40, 0.005, &vrs),
+    );
+    let peak = one.iter().fold(0.0f64, |m, r| m.max(r[0].abs()));
+    assert!(peak > 1e-4, "the profile is not trivial: {peak}");
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!(b[0], 2.0 * a[0], "scale 2 doubles the profile");
+    }
+    assert!(rough(1.0).set_real(VR_IRREGULARITY_SCALE, -1.0).is_err());
+}
+
+#[test]
+fn carbody_acceleration_above_the_bogies_from_centre_and_pitch() {
+    // Z is positive down and the front bogie is attached at Zc − Lc βc: above the front
+    // bogie centre (x = +Lc) the acceleration is Zc'' − Lc βc'', above the rear Zc'' + Lc βc''.
+    let mut m = small(127, 64);
+    m.set_integer(VR_IRREGULARITY, 3).unwrap();
+    let rows = trace(
+        &mut m,
+        200,
+        0.002,
+        &[VR_ZC_ACC, VR_BETA_C_ACC, VR_ZC_ACC_FRONT, VR_ZC_ACC_REAR],
+    );
+    let lc = 8.6875;
+    let scale = rows.iter().fold(0.0f64, |m, r| m.max(r[0].abs()));
+    let mut pitch = 0.0f64;
+    for r in &rows {
+        let (front, rear) = (r[0] - lc * r[1], r[0] + lc * r[1]);
+        assert!((r[2] - front).abs() <= 1e-12 * scale, "{r:?}");
+        assert!((r[3] - rear).abs() <= 1e-12 * scale, "{r:?}");
+        pitch = pitch.max((lc * r[1]).abs());
+    }
+    assert!(
+        pitch > 1e-3 * scale,
+        "the pitch contributes: {pitch:e} of {scale:e}"
+    );
+}

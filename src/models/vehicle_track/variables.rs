@@ -103,6 +103,7 @@ variables! {
     real_parameter("lambda_max", VR_LAMBDA_MAX = 33, Some("m"), m.p.reals[33], 200.0, Fixed, positive, "Longest wavelength of the random irregularity [lit: TB/T 3352 range]"),
     real_parameter("irregularity_length", VR_IRR_LENGTH = 34, Some("m"), m.p.reals[34], 4096.0, Fixed, positive, "Length of the random irregularity sample; it repeats beyond [assumed]"),
     real_parameter("ramp_length", VR_RAMP_LENGTH = 35, Some("m"), m.p.reals[35], 20.0, Fixed, non_negative, "Irregularity fades in over this length ahead of the leading wheel's start position; 0 = none [assumed]"),
+    real_parameter("irregularity_scale", VR_IRREGULARITY_SCALE = 36, None, m.p.reals[36], 1.0, Fixed, non_negative, "Factor on the amplitude of the irregularity (random or measured; not the dip): 0 = perfect track, 2 = twice as rough [assumed]"),
     integer_parameter("n_sleepers", VR_N_SLEEPERS = 40, m.p.n_sleepers, 255, sleeper_count, "Sleepers in the computing window N (N + 1 a power of two: 63, 127, 255, 511, ...) [assumed]"),
     integer_parameter("n_modes", VR_N_MODES = 41, m.p.n_modes, 255, mode_count, "Rail modes NM, 1..2N+1; default N: shortest modal wavelength 2 l/NM = 2 ls [assumed]"),
     integer_parameter("contact_law", VR_CONTACT_LAW = 42, m.p.contact_law, 0, contact_law, "0 = nonlinear Hertz, 1 = Hertz linearised at the static load"),
@@ -135,6 +136,8 @@ variables! {
     output("Zr4", VR_ZR4 = 119, Some("m"), m.state(|s| s.diag.zr[3]), "Rail displacement under wheel 4"),
     output("Z0_1", VR_Z0_1 = 120, Some("m"), m.state(|s| s.diag.z0[0]), "Rail profile under wheel 1: irregularity plus dip (down)"),
     output("x", VR_X = 121, Some("m"), m.state(|s| s.run.xc), "Track position of the carbody centre"),
+    output("Zc_acc_front", VR_ZC_ACC_FRONT = 122, Some("m/s2"), m.state(|s| s.carbody_acc_at(-1.0, m.p.r(VR_LC))), "Carbody vertical acceleration above the front bogie centre (x = +Lc): Zc_acc - Lc beta_c_acc (Z down)"),
+    output("Zc_acc_rear", VR_ZC_ACC_REAR = 123, Some("m/s2"), m.state(|s| s.carbody_acc_at(1.0, m.p.r(VR_LC))), "Carbody vertical acceleration above the rear bogie centre (x = -Lc): Zc_acc + Lc beta_c_acc (Z down)"),
 }
 
 /// Static description of the vehicle–track model.
