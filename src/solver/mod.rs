@@ -1,6 +1,7 @@
 //! Fixed-step integrators shared by the models.
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
+pub mod simd;
 pub mod zhai;
 
 /// Largest number of internal substeps one communication step may take. A step that would

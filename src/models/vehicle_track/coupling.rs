@@ -12,6 +12,7 @@ use super::variables::*;
 use super::vehicle::{HalfVehicle, NV, ZW1};
 use super::{VehicleTrack, MIN_END_MARGIN};
 use crate::models::ModelError;
+use crate::solver::simd::Job;
 use crate::solver::substeps;
 use crate::solver::zhai::Zhai;
 use std::sync::Arc;
@@ -34,7 +35,7 @@ pub(super) struct Profile {
 
 impl Profile {
     /// Z0(x) (m, positive down).
-    #[inline]
+    #[inline(always)]
     fn z0(&self, x: f64) -> f64 {
         self.scale * self.exc.irregularity_at(x) + self.exc.dip.eval(x)
     }
@@ -71,6 +72,48 @@ pub(super) struct Sim {
     pub(super) diag: Diag,
 }
 
+/// The substeps of one communication step, as a [`Job`] compiled for each instruction set.
+struct Stepping<'a> {
+    model: &'a VehicleTrack,
+    sim: &'a mut Sim,
+    hv: HalfVehicle,
+    /// Number of substeps, their length (s), the speed (m/s).
+    n: usize,
+    hs: f64,
+    v: f64,
+    moving: bool,
+}
+
+impl Job for Stepping<'_> {
+    #[inline(always)]
+    fn run(&mut self) {
+        let sim = &mut *self.sim;
+        for _ in 0..self.n {
+            if self.moving {
+                self.model.follow(sim);
+            }
+            let mut run = sim.run;
+            run.xc += self.v * self.hs;
+            let Sim {
+                track,
+                contact,
+                exc,
+                zhai,
+                diag,
+                ..
+            } = sim;
+            zhai.predict(self.hs);
+            let a = &mut zhai.a;
+            accelerations(
+                &self.hv, track, contact, exc, &run, &zhai.x, &zhai.v, a, diag,
+            );
+            zhai.commit(self.hs);
+            sim.run = run;
+            sim.time += self.hs;
+        }
+    }
+}
+
 impl Sim {
     /// Vertical acceleration (m/s², Z down) of the carbody point at x = ∓`lc` (m) from its
     /// centre, `sign` = −1 above the front bogie (x = +Lc, attached at Zc − Lc βc), +1 above
@@ -82,6 +125,7 @@ impl Sim {
 
 /// Accelerations of the whole system `a = M⁻¹F(x, v)` with the vehicle at `run`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(super) fn accelerations(
     hv: &HalfVehicle,
     track: &mut Track,
@@ -113,8 +157,8 @@ impl VehicleTrack {
     pub(super) fn build(&mut self, start_time: f64) -> Result<Sim, ModelError> {
         let p = &self.p;
         let hv = p.half_vehicle();
-        let track =
-            Track::new(p.track()).map_err(|e| Self::invalid(VR_N_SLEEPERS, p.n_sleepers, e))?;
+        let track = Track::with_kernel(p.track(), self.kernel)
+            .map_err(|e| Self::invalid(VR_N_SLEEPERS, p.n_sleepers, e))?;
         let law = ContactLaw::from_code(p.contact_law)
             .ok_or_else(|| Self::invalid(VR_CONTACT_LAW, p.contact_law, "must be 0 or 1"))?;
         let contact = Contact::new(law, hertz_constant(p.r(VR_R)), p.static_load());
@@ -247,12 +291,18 @@ impl VehicleTrack {
     }
 
     /// Moves the window forward by whole sleepers if the carbody has drifted far enough.
+    #[inline(always)]
     fn follow(&self, sim: &mut Sim) {
-        let ls = self.p.r(VR_LS);
         let drift = sim.run.xc - sim.run.x_win - 0.5 * sim.track.length;
-        if drift < sim.shift_trigger {
-            return;
+        if drift >= sim.shift_trigger {
+            self.shift_window(sim, drift);
         }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn shift_window(&self, sim: &mut Sim, drift: f64) {
+        let ls = self.p.r(VR_LS);
         let m = (drift / ls).round() as usize;
         for arr in [&mut sim.zhai.x, &mut sim.zhai.v, &mut sim.zhai.a_prev] {
             sim.track.shift(m, &mut arr[NV..]);
@@ -301,35 +351,24 @@ impl VehicleTrack {
         Ok(())
     }
 
-    /// Advances by `h` (s) in equal substeps no longer than `dt`.
+    /// Advances by `h` (s) in equal substeps no longer than `dt`, on the instruction set the
+    /// track's kernel chose.
     pub(super) fn advance(&self, sim: &mut Sim, h: f64) -> Result<(), ModelError> {
         let n = substeps(h, self.p.r(VR_DT))?;
         let hs = h / n as f64;
         let v = self.p.r(VR_V);
         self.check_reach(sim, sim.run.xc + v * h)?;
-        let hv = self.p.half_vehicle();
-        let moving = self.p.moving_window == 1;
-        for _ in 0..n {
-            if moving {
-                self.follow(sim);
-            }
-            let mut run = sim.run;
-            run.xc += v * hs;
-            let Sim {
-                track,
-                contact,
-                exc,
-                zhai,
-                diag,
-                ..
-            } = sim;
-            zhai.step(hs, |x, v, a| -> Result<(), ModelError> {
-                accelerations(&hv, track, contact, exc, &run, x, v, a, diag);
-                Ok(())
-            })?;
-            sim.run = run;
-            sim.time += hs;
-        }
+        let simd = sim.track.simd();
+        let mut job = Stepping {
+            model: self,
+            hv: self.p.half_vehicle(),
+            sim: &mut *sim,
+            n,
+            hs,
+            v,
+            moving: self.p.moving_window == 1,
+        };
+        simd.dispatch(&mut job);
         let ok = sim.zhai.x[..NV].iter().all(|x| x.is_finite())
             && sim.zhai.a.iter().all(|a| a.is_finite())
             && sim.diag.p.iter().all(|p| p.is_finite());

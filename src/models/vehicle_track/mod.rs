@@ -19,6 +19,7 @@ pub mod contact;
 mod coupling;
 pub mod fft;
 pub mod irregularity;
+pub mod plain;
 pub mod track;
 pub mod variables;
 pub mod vehicle;
@@ -32,6 +33,7 @@ use coupling::{accelerations, Sim};
 use irregularity::{IrregularityKind, RandomProfile};
 use std::path::PathBuf;
 use std::sync::Arc;
+pub use track::Kernel;
 
 /// Closest a wheel may come to an end of the computing window (m).
 pub const MIN_END_MARGIN: f64 = 5.0;
@@ -45,6 +47,8 @@ pub struct VehicleTrack {
     resource_dir: Option<PathBuf>,
     /// Last random sample, reused while its key does not change.
     sample_cache: Option<Arc<RandomProfile>>,
+    /// Implementation of the track's equations (not an FMI variable).
+    kernel: Kernel,
 }
 
 impl VehicleTrack {
@@ -60,7 +64,14 @@ impl VehicleTrack {
             sim: None,
             resource_dir: None,
             sample_cache: None,
+            kernel: Kernel::Fast,
         }
+    }
+
+    /// Selects the implementation of the track's equations for the next initialization: the
+    /// fast kernel (default) or the plain reference (tests and benchmarks compare them).
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        self.kernel = kernel;
     }
 
     fn invalid(vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
@@ -186,6 +197,7 @@ impl Model for VehicleTrack {
         }
         let mut model = VehicleTrack {
             sample_cache: self.sample_cache.clone(),
+            kernel: self.kernel,
             ..VehicleTrack::default()
         };
         TABLE.restore_parameters(&mut model, input)?;

@@ -451,3 +451,66 @@ fn carbody_acceleration_above_the_bogies_from_centre_and_pitch() {
         "the pitch contributes: {pitch:e} of {scale:e}"
     );
 }
+
+/// Largest difference between two runs relative to the largest magnitude of the reference,
+/// per output column.
+fn relative_differences(fast: &[Vec<f64>], plain: &[Vec<f64>]) -> Vec<f64> {
+    (0..plain[0].len())
+        .map(|c| {
+            let scale = plain.iter().fold(0.0f64, |m, r| m.max(r[c].abs()));
+            let diff = fast
+                .iter()
+                .zip(plain)
+                .fold(0.0f64, |m, (a, b)| m.max((a[c] - b[c]).abs()));
+            diff / scale
+        })
+        .collect()
+}
+
+#[test]
+fn every_fast_kernel_path_matches_the_plain_kernel_to_1e_12() {
+    // The default track (random irregularity) and a dip on a perfect track, 0.3 s each (the
+    // leading wheel crosses the dip at 0.18 s): contact forces and carbody accelerations.
+    let vrs = [
+        VR_ZC_ACC,
+        VR_ZC_ACC_FRONT,
+        VR_ZC_ACC_REAR,
+        VR_P1,
+        VR_P2,
+        VR_P3,
+        VR_P4,
+    ];
+    type Setup = fn(&mut VehicleTrack);
+    let scenarios: [(&str, Setup); 2] = [
+        ("default irregularity", |_| {}),
+        ("dip", |m| {
+            m.set_integer(VR_IRREGULARITY, 0).unwrap();
+            m.set_real(VR_DIP_DEPTH, 0.3e-3).unwrap();
+        }),
+    ];
+    let kernels = Kernel::available();
+    assert!(kernels.len() >= 3, "{kernels:?}");
+    for (name, setup) in scenarios {
+        let run_with = |kernel: Kernel| {
+            let mut m = VehicleTrack::default();
+            setup(&mut m);
+            m.set_kernel(kernel);
+            trace(&mut m, 60, 0.005, &vrs)
+        };
+        let plain = run_with(Kernel::Plain);
+        let peak = plain.iter().fold(0.0f64, |m, r| m.max(r[3]));
+        assert!(peak > 7e4, "{name}: the wheel force varies: {peak}");
+        for kernel in kernels.iter().filter(|k| **k != Kernel::Plain) {
+            let rel = relative_differences(&run_with(*kernel), &plain);
+            let text: Vec<String> = rel.iter().map(|r| format!("{r:.1e}")).collect();
+            eprintln!(
+                "{name}, {kernel:?}: relative differences {}",
+                text.join(" ")
+            );
+            assert!(
+                rel.iter().all(|&r| r <= 1e-12),
+                "{name}, {kernel:?}: {text:?}"
+            );
+        }
+    }
+}

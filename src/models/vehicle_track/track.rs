@@ -22,7 +22,9 @@
 //! Displacements are measured from the unloaded track (self-weight not modelled).
 #![forbid(unsafe_code)]
 
-use super::fft::DstI;
+use super::fft::{DstI, FftPath};
+use super::plain::{self, Plain};
+use crate::solver::simd::{Isa, Simd};
 use std::f64::consts::PI;
 
 /// Track data (SI units).
@@ -60,6 +62,46 @@ pub struct TrackParams {
     pub n_modes: usize,
 }
 
+/// Which implementation computes the track's accelerations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Kernel {
+    /// The fast kernel (the default) on the widest instruction set of this CPU and
+    /// rustfft's own choice of FFT.
+    #[default]
+    Fast,
+    /// The fast kernel on a given instruction set and FFT path (tests, benchmarks); refused
+    /// at initialization if this CPU lacks them.
+    Custom {
+        /// Instruction set of the kernel's loops.
+        isa: Isa,
+        /// Instruction set of the FFT.
+        fft: FftPath,
+    },
+    /// The plain reference implementation ([`super::plain`]).
+    Plain,
+}
+
+impl Kernel {
+    /// Every kernel this machine can run: each instruction set of the loops with each FFT
+    /// path, and the plain one.
+    pub fn available() -> Vec<Kernel> {
+        let mut v = Vec::new();
+        for simd in Simd::available() {
+            for fft in FftPath::available() {
+                v.push(Kernel::Custom {
+                    isa: simd.isa(),
+                    fft,
+                });
+            }
+        }
+        v.push(Kernel::Plain);
+        v
+    }
+}
+
+/// Modes per block of the wheels' mode shapes (see [`Track::set_wheels`]).
+const BLOCK: usize = 16;
+
 /// The track: parameters, transforms and scratch (allocated once).
 #[derive(Clone, Debug)]
 pub struct Track {
@@ -74,36 +116,58 @@ pub struct Track {
     /// √(2/(m_r l)) (1/√kg): amplitude of the mass-normalised modes.
     pub scale: f64,
     /// ω_k² = (EI/m_r)(kπ/l)⁴ (1/s²).
-    omega2: Vec<f64>,
+    pub(super) omega2: Vec<f64>,
     /// Sleeper-grid bin (0-based) of mode k, or `usize::MAX` when it vanishes at every sleeper.
-    fold_bin: Vec<usize>,
+    pub(super) fold_bin: Vec<usize>,
     /// Sign of the fold.
-    fold_sign: Vec<f64>,
+    pub(super) fold_sign: Vec<f64>,
     dst: DstI,
     dst_fine: DstI,
     bins: Vec<f64>,
     r: Vec<f64>,
     modal: Vec<f64>,
     frs: Vec<f64>,
+    /// Ballast shear forces per unit mass between blocks i−1 and i, i = 0..=N (ends 0).
+    shear: Vec<f64>,
     fine: Vec<f64>,
     fine_out: Vec<f64>,
-    /// sin(kπ x_wj / l) for the four wheels, row-major 4 × NM.
+    /// sin(kπ x_wj / l), k = 0..stride, wheel-major: wheel j at `j * stride`.
     wheel_sin: Vec<f64>,
+    /// Length of one wheel's row of `wheel_sin`: NM + 1 rounded up to whole blocks.
+    stride: usize,
+    kernel: Kernel,
+    simd: Simd,
+    /// The plain kernel's scratch, when it is selected.
+    pub(super) plain: Option<Plain>,
 }
 
 impl Track {
-    /// Builds the track (validates N and NM).
+    /// Builds the track (validates N and NM) with the fast kernel.
     pub fn new(p: TrackParams) -> Result<Self, String> {
+        Self::with_kernel(p, Kernel::Fast)
+    }
+
+    /// Builds the track with the given kernel.
+    pub fn with_kernel(p: TrackParams, kernel: Kernel) -> Result<Self, String> {
         let (n, nm) = (p.n_sleepers, p.n_modes);
-        let dst = DstI::new(n).map_err(|e| format!("n_sleepers = {n}: {e}"))?;
+        let (simd, path) = match kernel {
+            Kernel::Fast => (Simd::best(), FftPath::Auto),
+            Kernel::Custom { isa, fft } => (
+                Simd::new(isa).ok_or_else(|| format!("this CPU does not run {isa:?}"))?,
+                fft,
+            ),
+            Kernel::Plain => (Simd::baseline(), FftPath::Auto),
+        };
+        let dst = DstI::with_path(n, path).map_err(|e| format!("n_sleepers = {n}: {e}"))?;
         if nm == 0 || nm > 2 * n + 1 {
             return Err(format!(
                 "n_modes = {nm} must be between 1 and 2 n_sleepers + 1 = {}",
                 2 * n + 1
             ));
         }
-        let dst_fine = DstI::new(2 * n + 1)?;
+        let dst_fine = DstI::with_path(2 * n + 1, path)?;
         let length = (n + 1) as f64 * p.ls;
+        let stride = (nm + 1).div_ceil(BLOCK) * BLOCK;
         let period = 2 * (n + 1);
         let (mut fold_bin, mut fold_sign) = (Vec::with_capacity(nm), Vec::with_capacity(nm));
         for k in 1..=nm {
@@ -136,10 +200,28 @@ impl Track {
             r: vec![0.0; n],
             modal: vec![0.0; nm],
             frs: vec![0.0; n],
+            shear: vec![0.0; n + 1],
             fine: vec![0.0; 2 * n + 1],
             fine_out: vec![0.0; 2 * n + 1],
-            wheel_sin: vec![0.0; 4 * nm],
+            wheel_sin: vec![0.0; 4 * stride],
+            stride,
+            kernel,
+            simd,
+            plain: match kernel {
+                Kernel::Plain => Some(Plain::new(n, nm)?),
+                _ => None,
+            },
         })
+    }
+
+    /// The kernel in use.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    /// The instruction set the stepping loop runs on.
+    pub fn simd(&self) -> Simd {
+        self.simd
     }
 
     /// Length of the track part of the state: NM + 2N.
@@ -195,101 +277,175 @@ impl Track {
         }
     }
 
-    /// Stores sin(kπx/l), k = 1..NM, for the wheels at local positions `x` (m, 0 < x < l),
-    /// by the three-term recurrence (the four wheels interleaved), re-seeded from `sin_cos`
-    /// every 128 modes to bound round-off growth.
+    /// Stores sin(kπx/l), k = 0..NM, for the wheels at local positions `x` (m, 0 < x < l).
+    ///
+    /// With a = πx/l, the modes come in blocks of [`BLOCK`]: sin((bB + i)a) =
+    /// Im(e^{ibBa}) cos(ia) + Re(e^{ibBa}) sin(ia), from a table e^{ia}, i < B, and the block
+    /// rotations e^{ibBa}, each by repeated complex multiplication from `sin_cos(a)` and
+    /// `sin_cos(Ba)`. Rotations keep the error at a few tens of ulps without the 1/sin(a)
+    /// growth of a three-term recurrence, the four wheels' chains run side by side, and the
+    /// fill of each block is a vector loop.
+    #[inline(always)]
     pub fn set_wheels(&mut self, x: &[f64; 4]) {
-        let nm = self.nm;
+        if let Some(pl) = self.plain.as_mut() {
+            pl.set_wheels(self.length, x);
+            return;
+        }
         let a: [f64; 4] = std::array::from_fn(|j| PI * x[j] / self.length);
-        let sc: [(f64, f64); 4] = std::array::from_fn(|j| a[j].sin_cos());
-        let c2: [f64; 4] = std::array::from_fn(|j| 2.0 * sc[j].1);
-        const CHUNK: usize = 128;
-        for (chunk_no, chunk) in self.wheel_sin.chunks_mut(4 * CHUNK).enumerate() {
-            let k0 = chunk_no * CHUNK; // first mode of the chunk is k0 + 1
-            let mut prev = [0.0; 4];
-            let mut cur = [0.0; 4];
+        let one: [(f64, f64); 4] = std::array::from_fn(|j| a[j].sin_cos());
+        let big: [(f64, f64); 4] = std::array::from_fn(|j| (BLOCK as f64 * a[j]).sin_cos());
+        // cos(ia), sin(ia) for i < B, per wheel.
+        let mut t_re = [[1.0; BLOCK]; 4];
+        let mut t_im = [[0.0; BLOCK]; 4];
+        for i in 1..BLOCK {
             for j in 0..4 {
-                // sin(k0 a) and sin((k0 + 1) a) = sin(k0 a) cos a + cos(k0 a) sin a.
-                let (s0, c0) = if k0 == 0 {
-                    (0.0, 1.0)
-                } else {
-                    (k0 as f64 * a[j]).sin_cos()
-                };
-                prev[j] = s0;
-                cur[j] = s0 * sc[j].1 + c0 * sc[j].0;
-            }
-            for row in chunk.chunks_exact_mut(4) {
-                for j in 0..4 {
-                    row[j] = cur[j];
-                    let next = c2[j] * cur[j] - prev[j];
-                    prev[j] = cur[j];
-                    cur[j] = next;
-                }
+                let (s, c) = one[j];
+                let (pr, pi) = (t_re[j][i - 1], t_im[j][i - 1]);
+                t_re[j][i] = pr * c - pi * s;
+                t_im[j][i] = pi * c + pr * s;
             }
         }
-        debug_assert_eq!(self.wheel_sin.len(), 4 * nm);
+        let stride = self.stride;
+        let mut u_re = [1.0; 4];
+        let mut u_im = [0.0; 4];
+        for b in 0..stride / BLOCK {
+            for j in 0..4 {
+                let row = &mut self.wheel_sin[j * stride + b * BLOCK..j * stride + (b + 1) * BLOCK];
+                let (ur, ui) = (u_re[j], u_im[j]);
+                for ((o, &tr), &ti) in row.iter_mut().zip(&t_re[j]).zip(&t_im[j]) {
+                    *o = ui * tr + ur * ti;
+                }
+                let (s, c) = big[j];
+                u_re[j] = ur * c - ui * s;
+                u_im[j] = ui * c + ur * s;
+            }
+        }
     }
 
     /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`.
+    #[inline(always)]
     pub fn rail_at_wheels(&self, q: &[f64]) -> [f64; 4] {
-        let mut out = [0.0; 4];
-        for (row, &qk) in self.wheel_sin.chunks_exact(4).zip(q) {
-            for j in 0..4 {
-                out[j] += row[j] * qk;
-            }
+        if let Some(pl) = &self.plain {
+            return pl.rail_at_wheels(self.scale, q);
         }
-        out.map(|v| v * self.scale)
+        let nm = self.nm;
+        std::array::from_fn(|j| {
+            let s = &self.wheel_sin[j * self.stride + 1..j * self.stride + 1 + nm];
+            // Four partial sums: independent chains the compiler keeps in one vector.
+            let mut acc = [0.0; 4];
+            let (s4, q4) = (s.chunks_exact(4), q[..nm].chunks_exact(4));
+            let (s_rest, q_rest) = (s4.remainder(), q4.remainder());
+            for (sc, qc) in s4.zip(q4) {
+                for l in 0..4 {
+                    acc[l] += sc[l] * qc[l];
+                }
+            }
+            let tail: f64 = s_rest.iter().zip(q_rest).map(|(a, b)| a * b).sum();
+            ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail) * self.scale
+        })
     }
 
     /// Value of mode shape sin(kπx_j/l) at wheel j (after [`Track::set_wheels`]), k ≥ 1.
     pub fn wheel_sine(&self, j: usize, k: usize) -> f64 {
-        self.wheel_sin[4 * (k - 1) + j]
+        match &self.plain {
+            Some(pl) => pl.wheel_sine(j, k),
+            None => self.wheel_sin[j * self.stride + k],
+        }
     }
 
     /// Track accelerations `acc` from positions `y`, velocities `yd` (track layout) and the
     /// wheel–rail forces `p` (N) at the wheels set by [`Track::set_wheels`]. No allocation.
+    ///
+    /// The fast kernel: two sine transforms ([`DstI`]) and straight loops over zipped slices
+    /// (no bounds checks, vectorized); the modal forces of pads, stiffness and wheels in one
+    /// pass; the ballast shear through a scratch array instead of a loop-carried update.
+    #[inline(always)]
     pub fn accelerations(&mut self, y: &[f64], yd: &[f64], p: &[f64; 4], acc: &mut [f64]) {
-        let (n, nm) = (self.n, self.nm);
-        let (q, zs, zb) = (&y[..nm], &y[nm..nm + n], &y[nm + n..nm + 2 * n]);
-        let (qd, zsd, zbd) = (&yd[..nm], &yd[nm..nm + n], &yd[nm + n..nm + 2 * n]);
-        let t = self.p;
-        // The pads only see Kp Zr + Cp Zr' at the sleepers: one transform of Kp q + Cp q'.
-        for ((w, &a), &b) in self.modal.iter_mut().zip(q).zip(qd) {
-            *w = t.kp * a + t.cp * b;
+        if self.plain.is_some() {
+            plain::accelerations(self, y, yd, p, acc);
+            return;
         }
-        Self::synthesize(
-            &mut self.dst,
-            &self.fold_bin,
-            &self.fold_sign,
-            self.scale,
-            &self.modal,
-            &mut self.bins,
-            &mut self.r,
-        );
-        let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
-        let (acc_q, rest) = acc.split_at_mut(nm);
+        let (n, nm, scale) = (self.n, self.nm, self.scale);
+        let t = self.p;
+        let (q, rest) = y[..nm + 2 * n].split_at(nm);
+        let (zs, zb) = rest.split_at(n);
+        let (qd, rest) = yd[..nm + 2 * n].split_at(nm);
+        let (zsd, zbd) = rest.split_at(n);
+        let (acc_q, rest) = acc[..nm + 2 * n].split_at_mut(nm);
         let (acc_s, acc_b) = rest.split_at_mut(n);
-        for i in 0..n {
-            let frs = self.r[i] - t.kp * zs[i] - t.cp * zsd[i];
-            let fb = t.kb * (zs[i] - zb[i]) + t.cb * (zsd[i] - zbd[i]);
-            self.frs[i] = frs;
-            acc_s[i] = (frs - fb) * inv_ms;
-            acc_b[i] = (fb - t.kf * zb[i] - t.cf * zbd[i]) * inv_mb;
+        // The pads only see Kp Zr + Cp Zr' at the sleepers: one transform of Kp q + Cp q'.
+        if nm <= n {
+            for ((b, &a), &ad) in self.bins.iter_mut().zip(q).zip(qd) {
+                *b = t.kp * a + t.cp * ad;
+            }
+            self.bins[nm..].fill(0.0);
+        } else {
+            for ((w, &a), &ad) in self.modal.iter_mut().zip(q).zip(qd) {
+                *w = t.kp * a + t.cp * ad;
+            }
+            self.bins.fill(0.0);
+            for ((&b, &s), &w) in self.fold_bin.iter().zip(&self.fold_sign).zip(&self.modal) {
+                if b != usize::MAX {
+                    self.bins[b] += s * w;
+                }
+            }
+        }
+        self.dst.transform(&self.bins, &mut self.r);
+        let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
+        let sleepers = self
+            .r
+            .iter()
+            .zip(&mut self.frs)
+            .zip(zs.iter().zip(zsd))
+            .zip(zb.iter().zip(zbd))
+            .zip(acc_s.iter_mut().zip(acc_b.iter_mut()));
+        for ((((&r, f), (&s, &sd)), (&b, &bd)), (a_s, a_b)) in sleepers {
+            let frs = r * scale - t.kp * s - t.cp * sd;
+            let fb = t.kb * (s - b) + t.cb * (sd - bd);
+            *f = frs;
+            *a_s = (frs - fb) * inv_ms;
+            *a_b = (fb - t.kf * b - t.cf * bd) * inv_mb;
         }
         // Ballast shear: Kw, Cw between neighbouring blocks (end blocks have one neighbour).
         let (kw, cw) = (t.kw * inv_mb, t.cw * inv_mb);
-        for i in 0..n - 1 {
-            let f = kw * (zb[i] - zb[i + 1]) + cw * (zbd[i] - zbd[i + 1]);
-            acc_b[i] -= f;
-            acc_b[i + 1] += f;
+        let pairs = zb.windows(2).zip(zbd.windows(2));
+        for (sh, (b, bd)) in self.shear[1..n].iter_mut().zip(pairs) {
+            *sh = kw * (b[0] - b[1]) + cw * (bd[0] - bd[1]);
         }
-        for ((a, &w2), &qk) in acc_q.iter_mut().zip(&self.omega2).zip(q) {
-            *a = -w2 * qk;
+        self.shear[0] = 0.0;
+        self.shear[n] = 0.0;
+        for (a, sh) in acc_b.iter_mut().zip(self.shear.windows(2)) {
+            *a = (*a + sh[0]) - sh[1];
         }
-        self.analyze_add(-1.0, acc_q);
-        let c: [f64; 4] = std::array::from_fn(|j| self.scale * p[j]);
-        for (a, row) in acc_q.iter_mut().zip(self.wheel_sin.chunks_exact(4)) {
-            *a += c[0] * row[0] + c[1] * row[1] + c[2] * row[2] + c[3] * row[3];
+        // Modal forces: stiffness, pads (the transposed map), wheels.
+        self.dst.transform(&self.frs, &mut self.bins);
+        let c = -scale;
+        let cw: [f64; 4] = std::array::from_fn(|j| scale * p[j]);
+        let st = self.stride;
+        let s = &self.wheel_sin;
+        let (s0, s1, s2, s3) = (
+            &s[1..nm + 1],
+            &s[st + 1..st + nm + 1],
+            &s[2 * st + 1..2 * st + nm + 1],
+            &s[3 * st + 1..3 * st + nm + 1],
+        );
+        let wheels = s0.iter().zip(s1).zip(s2.iter().zip(s3));
+        if nm <= n {
+            let modes = acc_q.iter_mut().zip(&self.omega2).zip(q).zip(&self.bins);
+            for ((((a, &w2), &qk), &b), ((&r0, &r1), (&r2, &r3))) in modes.zip(wheels) {
+                *a = (-w2 * qk + c * b) + (cw[0] * r0 + cw[1] * r1 + cw[2] * r2 + cw[3] * r3);
+            }
+        } else {
+            let folds = self.fold_bin.iter().zip(&self.fold_sign);
+            let modes = acc_q.iter_mut().zip(&self.omega2).zip(q).zip(folds);
+            for ((((a, &w2), &qk), (&b, &sg)), ((&r0, &r1), (&r2, &r3))) in modes.zip(wheels) {
+                let pad = if b == usize::MAX {
+                    -w2 * qk
+                } else {
+                    -w2 * qk + c * sg * self.bins[b]
+                };
+                *a = pad + (cw[0] * r0 + cw[1] * r1 + cw[2] * r2 + cw[3] * r3);
+            }
         }
     }
 
@@ -337,8 +493,11 @@ impl Track {
         let (n, nm, dim) = (self.n, self.nm, self.dim());
         let t = self.p;
         let mut b = vec![0.0; dim];
-        for (k, row) in self.wheel_sin.chunks_exact(4).enumerate() {
-            b[k] = self.scale * (0..4).map(|j| p[j] * row[j]).sum::<f64>();
+        for (k, bk) in b[..nm].iter_mut().enumerate() {
+            *bk = self.scale
+                * (0..4)
+                    .map(|j| p[j] * self.wheel_sine(j, k + 1))
+                    .sum::<f64>();
         }
         let half = (n + 1) as f64 / 2.0;
         let mut diag = vec![0.0; dim];
