@@ -15,8 +15,13 @@
 //! maps modes → sleepers and sleeper forces → modal forces are DST-I's of size N
 //! ([`super::fft::DstI`], N + 1 a power of two), O(N log N) per step. Modes k > N alias onto
 //! the sleeper grid (sin(kπi/n) = ± sin(k'πi/n)), which a fold of the modal vector handles,
-//! so any NM ≤ 2N + 1 works. The wheels sit anywhere: their mode values come from the
-//! recurrence sin((k+1)a) = 2 cos a sin(ka) − sin((k−1)a), 4 × NM operations.
+//! so any NM ≤ 2N + 1 works. The wheels sit anywhere: their mode values come from blocked
+//! complex rotations ([`Track::set_wheels`]), never stored: the two passes that use them run
+//! over the blocks.
+//!
+//! Two kernels compute the same equations ([`Kernel`]): the fast one (default) and the plain
+//! reference ([`super::plain`]) it is tested against; the fast one's stepping loop runs
+//! compiled for AVX2 where the CPU has it ([`crate::solver::simd`]).
 //!
 //! Track state layout (one slice): `[q_1..q_NM | Z_s1..Z_sN | Z_b1..Z_bN]`.
 //! Displacements are measured from the unloaded track (self-weight not modelled).
@@ -131,10 +136,16 @@ pub struct Track {
     shear: Vec<f64>,
     fine: Vec<f64>,
     fine_out: Vec<f64>,
-    /// sin(kπ x_wj / l), k = 0..stride, wheel-major: wheel j at `j * stride`.
-    wheel_sin: Vec<f64>,
-    /// Length of one wheel's row of `wheel_sin`: NM + 1 rounded up to whole blocks.
-    stride: usize,
+    /// The wheels' mode shapes, in blocks of [`BLOCK`] modes (see [`Track::set_wheels`]):
+    /// `t_re[j][i] + i t_im[j][i]` = e^{i(i+1)a_j}, a_j = πx_j/l.
+    t_re: [[f64; BLOCK]; 4],
+    t_im: [[f64; BLOCK]; 4],
+    /// Block rotations e^{ibBa_j}, one per block b, the four wheels side by side.
+    u_re: Vec<[f64; 4]>,
+    u_im: Vec<[f64; 4]>,
+    /// Per wheel j: the position difference x_0 − x_j (m) the next two rotations belong to,
+    /// and e^{−iδ_j}, e^{−iBδ_j}, δ_j = π(x_0 − x_j)/l (cos, sin, cos, sin).
+    offsets: [(f64, [f64; 4]); 4],
     kernel: Kernel,
     simd: Simd,
     /// The plain kernel's scratch, when it is selected.
@@ -167,7 +178,7 @@ impl Track {
         }
         let dst_fine = DstI::with_path(2 * n + 1, path)?;
         let length = (n + 1) as f64 * p.ls;
-        let stride = (nm + 1).div_ceil(BLOCK) * BLOCK;
+        let blocks = nm.div_ceil(BLOCK);
         let period = 2 * (n + 1);
         let (mut fold_bin, mut fold_sign) = (Vec::with_capacity(nm), Vec::with_capacity(nm));
         for k in 1..=nm {
@@ -203,8 +214,11 @@ impl Track {
             shear: vec![0.0; n + 1],
             fine: vec![0.0; 2 * n + 1],
             fine_out: vec![0.0; 2 * n + 1],
-            wheel_sin: vec![0.0; 4 * stride],
-            stride,
+            t_re: [[0.0; BLOCK]; 4],
+            t_im: [[0.0; BLOCK]; 4],
+            u_re: vec![[0.0; 4]; blocks],
+            u_im: vec![[0.0; 4]; blocks],
+            offsets: [(0.0, [1.0, 0.0, 1.0, 0.0]); 4],
             kernel,
             simd,
             plain: match kernel {
@@ -277,79 +291,120 @@ impl Track {
         }
     }
 
-    /// Stores sin(kπx/l), k = 0..NM, for the wheels at local positions `x` (m, 0 < x < l).
+    /// Sets the wheels at local positions `x` (m, 0 < x < l) for the mode shapes
+    /// sin(kπx_j/l), k = 1..NM, which the fast kernel never stores: with a = πx/l and the
+    /// modes in blocks of B = [`BLOCK`], mode k = bB + i + 1 is
     ///
-    /// With a = πx/l, the modes come in blocks of [`BLOCK`]: sin((bB + i)a) =
-    /// Im(e^{ibBa}) cos(ia) + Re(e^{ibBa}) sin(ia), from a table e^{ia}, i < B, and the block
-    /// rotations e^{ibBa}, each by repeated complex multiplication from `sin_cos(a)` and
-    /// `sin_cos(Ba)`. Rotations keep the error at a few tens of ulps without the 1/sin(a)
-    /// growth of a three-term recurrence, the four wheels' chains run side by side, and the
-    /// fill of each block is a vector loop.
+    /// ```text
+    /// sin(kπx/l) = Im(e^{ibBa} e^{i(i+1)a}) = Im(U_b) Re(T_i) + Re(U_b) Im(T_i)
+    /// ```
+    ///
+    /// from a table T_i = e^{i(i+1)a}, i < B, and block rotations U_b = e^{ibBa}, each by
+    /// repeated complex multiplication. Only wheel 0 calls `sin_cos` (of a and Ba): the others
+    /// are rotated from it by their fixed distances to wheel 0, whose rotations are kept.
+    /// Rotations keep the error at a few tens of ulps, without the 1/sin(a) growth of a
+    /// three-term recurrence; the consumers ([`Track::rail_at_wheels`], the modal wheel forces)
+    /// run over the blocks as vector loops.
     #[inline(always)]
     pub fn set_wheels(&mut self, x: &[f64; 4]) {
         if let Some(pl) = self.plain.as_mut() {
             pl.set_wheels(self.length, x);
             return;
         }
-        let a: [f64; 4] = std::array::from_fn(|j| PI * x[j] / self.length);
-        let one: [(f64, f64); 4] = std::array::from_fn(|j| a[j].sin_cos());
-        let big: [(f64, f64); 4] = std::array::from_fn(|j| (BLOCK as f64 * a[j]).sin_cos());
-        // cos(ia), sin(ia) for i < B, per wheel.
-        let mut t_re = [[1.0; BLOCK]; 4];
-        let mut t_im = [[0.0; BLOCK]; 4];
-        for i in 1..BLOCK {
+        let a0 = PI * x[0] / self.length;
+        let (s1, c1) = a0.sin_cos();
+        let (sb, cb) = (BLOCK as f64 * a0).sin_cos();
+        let mut one = [(0.0, 0.0); 4];
+        let mut big = [(0.0, 0.0); 4];
+        for j in 0..4 {
+            let d = x[0] - x[j];
+            if (d - self.offsets[j].0).abs() > 1e-12 * d.abs().max(1.0) {
+                self.offsets[j] = Self::offset_rotations(d, self.length);
+            }
+            let r = self.offsets[j].1;
+            // e^{ia_j} = e^{ia_0} e^{−iδ_j}, likewise for Ba.
+            one[j] = (c1 * r[0] + s1 * r[1], s1 * r[0] - c1 * r[1]);
+            big[j] = (cb * r[2] + sb * r[3], sb * r[2] - cb * r[3]);
+        }
+        let (mut pr, mut pi) = ([0.0; 4], [0.0; 4]);
+        for j in 0..4 {
+            (pr[j], pi[j]) = one[j];
+        }
+        for i in 0..BLOCK {
             for j in 0..4 {
-                let (s, c) = one[j];
-                let (pr, pi) = (t_re[j][i - 1], t_im[j][i - 1]);
-                t_re[j][i] = pr * c - pi * s;
-                t_im[j][i] = pi * c + pr * s;
+                self.t_re[j][i] = pr[j];
+                self.t_im[j][i] = pi[j];
+                let (c, s) = one[j];
+                (pr[j], pi[j]) = (pr[j] * c - pi[j] * s, pi[j] * c + pr[j] * s);
             }
         }
-        let stride = self.stride;
-        let mut u_re = [1.0; 4];
-        let mut u_im = [0.0; 4];
-        for b in 0..stride / BLOCK {
+        let (mut ur, mut ui) = ([1.0; 4], [0.0; 4]);
+        for (re, im) in self.u_re.iter_mut().zip(self.u_im.iter_mut()) {
+            *re = ur;
+            *im = ui;
             for j in 0..4 {
-                let row = &mut self.wheel_sin[j * stride + b * BLOCK..j * stride + (b + 1) * BLOCK];
-                let (ur, ui) = (u_re[j], u_im[j]);
-                for ((o, &tr), &ti) in row.iter_mut().zip(&t_re[j]).zip(&t_im[j]) {
-                    *o = ui * tr + ur * ti;
-                }
-                let (s, c) = big[j];
-                u_re[j] = ur * c - ui * s;
-                u_im[j] = ui * c + ur * s;
+                let (c, s) = big[j];
+                (ur[j], ui[j]) = (ur[j] * c - ui[j] * s, ui[j] * c + ur[j] * s);
             }
         }
     }
 
-    /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`.
+    /// e^{−iδ}, e^{−iBδ} of δ = πd/l for wheels a distance `d` (m) behind wheel 0.
+    #[cold]
+    fn offset_rotations(d: f64, length: f64) -> (f64, [f64; 4]) {
+        let delta = PI * d / length;
+        let (s, c) = delta.sin_cos();
+        let (sb, cb) = (BLOCK as f64 * delta).sin_cos();
+        (d, [c, s, cb, sb])
+    }
+
+    /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`:
+    /// Σ_k sin(kπx_j/l) q_k = Σ_i [Re T_i Σ_b Im U_b q_{bB+i} + Im T_i Σ_b Re U_b q_{bB+i}].
     #[inline(always)]
     pub fn rail_at_wheels(&self, q: &[f64]) -> [f64; 4] {
         if let Some(pl) = &self.plain {
             return pl.rail_at_wheels(self.scale, q);
         }
-        let nm = self.nm;
-        std::array::from_fn(|j| {
-            let s = &self.wheel_sin[j * self.stride + 1..j * self.stride + 1 + nm];
-            // Four partial sums: independent chains the compiler keeps in one vector.
-            let mut acc = [0.0; 4];
-            let (s4, q4) = (s.chunks_exact(4), q[..nm].chunks_exact(4));
-            let (s_rest, q_rest) = (s4.remainder(), q4.remainder());
-            for (sc, qc) in s4.zip(q4) {
-                for l in 0..4 {
-                    acc[l] += sc[l] * qc[l];
+        let q = &q[..self.nm];
+        let blocks = q.chunks_exact(BLOCK);
+        let tail = blocks.remainder();
+        let mut out = [0.0; 4];
+        for j in 0..4 {
+            let (mut vr, mut vi) = ([0.0; BLOCK], [0.0; BLOCK]);
+            for ((qb, ur), ui) in blocks.clone().zip(&self.u_re).zip(&self.u_im) {
+                let (ur, ui) = (ur[j], ui[j]);
+                for ((r, i), &qk) in vr.iter_mut().zip(vi.iter_mut()).zip(qb) {
+                    *r += ui * qk;
+                    *i += ur * qk;
                 }
             }
-            let tail: f64 = s_rest.iter().zip(q_rest).map(|(a, b)| a * b).sum();
-            ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail) * self.scale
-        })
+            let last = q.len() / BLOCK;
+            for ((r, i), &qk) in vr.iter_mut().zip(vi.iter_mut()).zip(tail) {
+                *r += self.u_im[last][j] * qk;
+                *i += self.u_re[last][j] * qk;
+            }
+            let mut sum = [0.0; 4];
+            for (l, ((&tr, &ti), (&r, &i))) in self.t_re[j]
+                .iter()
+                .zip(&self.t_im[j])
+                .zip(vr.iter().zip(&vi))
+                .enumerate()
+            {
+                sum[l % 4] += tr * r + ti * i;
+            }
+            out[j] = ((sum[0] + sum[1]) + (sum[2] + sum[3])) * self.scale;
+        }
+        out
     }
 
     /// Value of mode shape sin(kπx_j/l) at wheel j (after [`Track::set_wheels`]), k ≥ 1.
     pub fn wheel_sine(&self, j: usize, k: usize) -> f64 {
         match &self.plain {
             Some(pl) => pl.wheel_sine(j, k),
-            None => self.wheel_sin[j * self.stride + k],
+            None => {
+                let (b, i) = ((k - 1) / BLOCK, (k - 1) % BLOCK);
+                self.u_im[b][j] * self.t_re[j][i] + self.u_re[b][j] * self.t_im[j][i]
+            }
         }
     }
 
@@ -420,31 +475,59 @@ impl Track {
         // Modal forces: stiffness, pads (the transposed map), wheels.
         self.dst.transform(&self.frs, &mut self.bins);
         let c = -scale;
-        let cw: [f64; 4] = std::array::from_fn(|j| scale * p[j]);
-        let st = self.stride;
-        let s = &self.wheel_sin;
-        let (s0, s1, s2, s3) = (
-            &s[1..nm + 1],
-            &s[st + 1..st + nm + 1],
-            &s[2 * st + 1..2 * st + nm + 1],
-            &s[3 * st + 1..3 * st + nm + 1],
-        );
-        let wheels = s0.iter().zip(s1).zip(s2.iter().zip(s3));
         if nm <= n {
-            let modes = acc_q.iter_mut().zip(&self.omega2).zip(q).zip(&self.bins);
-            for ((((a, &w2), &qk), &b), ((&r0, &r1), (&r2, &r3))) in modes.zip(wheels) {
-                *a = (-w2 * qk + c * b) + (cw[0] * r0 + cw[1] * r1 + cw[2] * r2 + cw[3] * r3);
+            let modes = acc_q
+                .iter_mut()
+                .zip(q)
+                .zip(&self.omega2)
+                .zip(&self.bins[..nm]);
+            for (((a, &qk), &w2), &b) in modes {
+                *a = -w2 * qk + c * b;
             }
         } else {
             let folds = self.fold_bin.iter().zip(&self.fold_sign);
-            let modes = acc_q.iter_mut().zip(&self.omega2).zip(q).zip(folds);
-            for ((((a, &w2), &qk), (&b, &sg)), ((&r0, &r1), (&r2, &r3))) in modes.zip(wheels) {
-                let pad = if b == usize::MAX {
+            let modes = acc_q.iter_mut().zip(q).zip(&self.omega2).zip(folds);
+            for (((a, &qk), &w2), (&b, &sg)) in modes {
+                *a = if b == usize::MAX {
                     -w2 * qk
                 } else {
                     -w2 * qk + c * sg * self.bins[b]
                 };
-                *a = pad + (cw[0] * r0 + cw[1] * r1 + cw[2] * r2 + cw[3] * r3);
+            }
+        }
+        let cw: [f64; 4] = std::array::from_fn(|j| scale * p[j]);
+        self.add_wheel_forces(&cw, acc_q);
+    }
+
+    /// `acc_q[k] += Σ_j cw_j sin((k+1)πx_j/l)`, block by block: within block b the wheel
+    /// term is Σ_j (cw_j Im U_b) Re T_i + (cw_j Re U_b) Im T_i.
+    #[inline(always)]
+    fn add_wheel_forces(&self, cw: &[f64; 4], acc_q: &mut [f64]) {
+        let (tr, ti) = (&self.t_re, &self.t_im);
+        let term = |a: &[f64; 4], b: &[f64; 4], i: usize| {
+            ((a[0] * tr[0][i] + b[0] * ti[0][i]) + (a[1] * tr[1][i] + b[1] * ti[1][i]))
+                + ((a[2] * tr[2][i] + b[2] * ti[2][i]) + (a[3] * tr[3][i] + b[3] * ti[3][i]))
+        };
+        let coefficients = |blk: usize| -> ([f64; 4], [f64; 4]) {
+            let (ur, ui) = (&self.u_re[blk], &self.u_im[blk]);
+            (
+                std::array::from_fn(|j| cw[j] * ui[j]),
+                std::array::from_fn(|j| cw[j] * ur[j]),
+            )
+        };
+        let mut blocks = acc_q.chunks_exact_mut(BLOCK);
+        for (blk, out) in (&mut blocks).enumerate() {
+            let (a, b) = coefficients(blk);
+            let out: &mut [f64; BLOCK] = out.try_into().expect("a whole block");
+            for (i, o) in out.iter_mut().enumerate() {
+                *o += term(&a, &b, i);
+            }
+        }
+        let tail = blocks.into_remainder();
+        if !tail.is_empty() {
+            let (a, b) = coefficients(self.nm / BLOCK);
+            for (i, o) in tail.iter_mut().enumerate() {
+                *o += term(&a, &b, i);
             }
         }
     }
