@@ -293,7 +293,7 @@ impl Track {
 
     /// Sets the wheels at local positions `x` (m, 0 < x < l) for the mode shapes
     /// sin(kπx_j/l), k = 1..NM, which the fast kernel never stores: with a = πx/l and the
-    /// modes in blocks of B = [`BLOCK`], mode k = bB + i + 1 is
+    /// modes in blocks of B = 16, mode k = bB + i + 1 is
     ///
     /// ```text
     /// sin(kπx/l) = Im(e^{ibBa} e^{i(i+1)a}) = Im(U_b) Re(T_i) + Re(U_b) Im(T_i)
