@@ -25,7 +25,8 @@
 //!
 //! Then the VehicleTrack stepping in detail ([`vt_kernels`], through the Rust API of the same
 //! library, `--vt-json FILE` for its JSON): µs per substep at the default resolution (N = 255,
-//! NM = 255, dt = 1e-4 s) and at the sleeper-passing one (N = 511, NM = 511, dt = 2e-5 s), for
+//! NM = 255, dt = 1e-4 s), a fine one (N = 511, NM = 511, dt = 2e-5 s) and the one that
+//! resolves the sleeper-passing force (N = 255, NM = 511, dt = 2e-5 s), for
 //! the plain kernel and the fast one on each instruction set, measured interleaved; the
 //! real-time factors; the arithmetic bound (a flop count per substep over a measured loop
 //! throughput) and the fraction of it reached; and the largest relative difference of the

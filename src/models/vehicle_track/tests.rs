@@ -480,22 +480,40 @@ fn every_fast_kernel_path_matches_the_plain_kernel_to_1e_12() {
         VR_P3,
         VR_P4,
     ];
+    // Then the modes beyond the sleeper grid (NM = 2N + 1, the folded transform) at a short
+    // step, over a dip met at 0.025 s, 0.1 s.
     type Setup = fn(&mut VehicleTrack);
-    let scenarios: [(&str, Setup); 2] = [
-        ("default irregularity", |_| {}),
-        ("dip", |m| {
-            m.set_integer(VR_IRREGULARITY, 0).unwrap();
-            m.set_real(VR_DIP_DEPTH, 0.3e-3).unwrap();
-        }),
+    let scenarios: [(&str, Setup, usize); 3] = [
+        ("default irregularity", |_| {}, 60),
+        (
+            "dip",
+            |m| {
+                m.set_integer(VR_IRREGULARITY, 0).unwrap();
+                m.set_real(VR_DIP_DEPTH, 0.3e-3).unwrap();
+            },
+            60,
+        ),
+        (
+            "NM = 2N + 1, dip",
+            |m| {
+                m.set_integer(VR_IRREGULARITY, 0).unwrap();
+                m.set_integer(VR_N_SLEEPERS, 127).unwrap();
+                m.set_integer(VR_N_MODES, 255).unwrap();
+                m.set_real(VR_DT, 2e-5).unwrap();
+                m.set_real(VR_DIP_DEPTH, 0.3e-3).unwrap();
+                m.set_real(VR_DIP_X0, 12.0).unwrap();
+            },
+            20,
+        ),
     ];
     let kernels = Kernel::available();
     assert!(kernels.len() >= 3, "{kernels:?}");
-    for (name, setup) in scenarios {
+    for (name, setup, steps) in scenarios {
         let run_with = |kernel: Kernel| {
             let mut m = VehicleTrack::default();
             setup(&mut m);
             m.set_kernel(kernel);
-            trace(&mut m, 60, 0.005, &vrs)
+            trace(&mut m, steps, 0.005, &vrs)
         };
         let plain = run_with(Kernel::Plain);
         let peak = plain.iter().fold(0.0f64, |m, r| m.max(r[3]));
