@@ -72,6 +72,20 @@ pub(super) struct Sim {
     pub(super) diag: Diag,
 }
 
+/// Whether every value is finite: x · 0 is 0 for a finite x and NaN otherwise, summed in four
+/// lanes (a vector loop without early exit).
+fn all_finite(v: &[f64]) -> bool {
+    let mut acc = [0.0; 4];
+    let chunks = v.chunks_exact(4);
+    let tail = chunks.remainder().iter().fold(0.0, |s, x| s + x * 0.0);
+    for c in chunks {
+        for l in 0..4 {
+            acc[l] += c[l] * 0.0;
+        }
+    }
+    (acc[0] + acc[1] + acc[2] + acc[3] + tail) == 0.0
+}
+
 /// The substeps of one communication step, as a [`Job`] compiled for each instruction set.
 struct Stepping<'a> {
     model: &'a VehicleTrack,
@@ -92,29 +106,33 @@ impl Job for Stepping<'_> {
             if self.moving {
                 self.model.follow(sim);
             }
-            let mut run = sim.run;
-            run.xc += self.v * self.hs;
-            let Sim {
-                track,
-                contact,
-                exc,
-                zhai,
-                diag,
-                ..
-            } = sim;
-            zhai.predict(self.hs);
-            let a = &mut zhai.a;
-            accelerations(
-                &self.hv, track, contact, exc, &run, &zhai.x, &zhai.v, a, diag,
-            );
-            zhai.commit(self.hs);
-            sim.run = run;
+            sim.zhai.predict(self.hs);
+            sim.run.xc += self.v * self.hs;
+            sim.update_accelerations(&self.hv);
+            sim.zhai.commit(self.hs);
             sim.time += self.hs;
         }
     }
 }
 
 impl Sim {
+    /// a = M⁻¹F(x, v) of the current state, with the vehicle at `self.run`; refreshes the
+    /// reported forces.
+    #[inline(always)]
+    pub(super) fn update_accelerations(&mut self, hv: &HalfVehicle) {
+        let Sim {
+            track,
+            contact,
+            exc,
+            zhai,
+            diag,
+            run,
+            ..
+        } = self;
+        let a = &mut zhai.a;
+        accelerations(hv, track, contact, exc, run, &zhai.x, &zhai.v, a, diag);
+    }
+
     /// Vertical acceleration (m/s², Z down) of the carbody point at x = ∓`lc` (m) from its
     /// centre, `sign` = −1 above the front bogie (x = +Lc, attached at Zc − Lc βc), +1 above
     /// the rear one: Zc'' + sign · Lc βc''.
@@ -263,18 +281,8 @@ impl VehicleTrack {
         }
         xs.copy_from_slice(&hv.static_displacements(&zw));
         sim.zhai.v.iter_mut().for_each(|v| *v = 0.0);
-        let Sim {
-            track,
-            contact,
-            exc,
-            zhai,
-            diag,
-            ..
-        } = sim;
-        zhai.init_accel(|x, v, a| -> Result<(), ModelError> {
-            accelerations(&hv, track, contact, exc, &run, x, v, a, diag);
-            Ok(())
-        })?;
+        sim.update_accelerations(&hv);
+        let zhai = &mut sim.zhai;
         zhai.a_prev.copy_from_slice(&zhai.a);
         zhai.restart();
         let veh = zhai.a[..NV].iter().fold(0.0f64, |m, a| m.max(a.abs()));
@@ -308,21 +316,7 @@ impl VehicleTrack {
             sim.track.shift(m, &mut arr[NV..]);
         }
         sim.run.x_win += m as f64 * ls;
-        let hv = self.p.half_vehicle();
-        let Sim {
-            track,
-            contact,
-            exc,
-            zhai,
-            diag,
-            run,
-            ..
-        } = sim;
-        let run = *run;
-        let _ = zhai.init_accel(|x, v, a| -> Result<(), ModelError> {
-            accelerations(&hv, track, contact, exc, &run, x, v, a, diag);
-            Ok(())
-        });
+        sim.update_accelerations(&self.p.half_vehicle());
     }
 
     /// The wheels' track positions over [xc, xc_end] must stay on the window and the profile.
@@ -369,9 +363,8 @@ impl VehicleTrack {
             moving: self.p.moving_window == 1,
         };
         simd.dispatch(&mut job);
-        let ok = sim.zhai.x[..NV].iter().all(|x| x.is_finite())
-            && sim.zhai.a.iter().all(|a| a.is_finite())
-            && sim.diag.p.iter().all(|p| p.is_finite());
+        let ok =
+            all_finite(&sim.zhai.x[..NV]) && all_finite(&sim.zhai.a) && all_finite(&sim.diag.p);
         if ok {
             Ok(())
         } else {
@@ -380,6 +373,25 @@ impl VehicleTrack {
                 reason: "the state became non-finite (integration unstable: reduce dt or n_modes)"
                     .into(),
             })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    #[test]
+    fn all_finite_finds_any_nan_or_infinity() {
+        let mut v: Vec<f64> = (0..23).map(|i| i as f64 * 1e300).collect();
+        assert!(all_finite(&v) && all_finite(&[]));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for i in [0, 5, 21, 22] {
+                let keep = v[i];
+                v[i] = bad;
+                assert!(!all_finite(&v), "{bad} at {i}");
+                v[i] = keep;
+            }
         }
     }
 }
