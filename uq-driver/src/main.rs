@@ -429,7 +429,8 @@ fn simulate(
 
 fn inspect(path: &std::path::Path) -> Result<()> {
     let fmu = Fmu::open(path)?;
-    let mut o = std::io::stdout().lock();
+    // Buffered: one write per line would cost a system call per variable.
+    let mut o = std::io::BufWriter::new(std::io::stdout().lock());
     let md = fmu.description();
     let cs = &md.co_simulation;
     writeln!(
@@ -488,5 +489,6 @@ fn inspect(path: &std::path::Path) -> Result<()> {
             v.description.as_deref().unwrap_or("")
         )?;
     }
+    o.flush()?;
     Ok(())
 }

@@ -377,6 +377,9 @@ pub fn run_points(
         n_values: iface.n_values(times.len()),
     };
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
+    if let Some(note) = store.recovery().summary() {
+        eprintln!("warning: {note}");
+    }
     let wanted: Vec<usize> = match &opts.points {
         Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
         None => (0..design.len()).collect(),
