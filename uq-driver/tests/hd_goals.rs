@@ -38,7 +38,7 @@ fn ishigami(x: &[f64]) -> f64 {
 }
 
 #[test]
-fn ishigami_all_indices_within_0_01_with_150_runs() {
+fn ishigami_all_indices_within_0_01_with_100_runs() {
     // Closed forms, a = 7, b = 0.1, x_i ~ U(-pi, pi).
     let (a, b) = (7.0f64, 0.1f64);
     let v1 = 0.5 * (1.0 + b * PI.powi(4) / 5.0).powi(2);
@@ -47,7 +47,7 @@ fn ishigami_all_indices_within_0_01_with_150_runs() {
     let v = a * a / 8.0 + b * PI.powi(4) / 5.0 + b * b * PI.powi(8) / 18.0 + 0.5;
     let s = [v1 / v, v2 / v, 0.0];
     let st = [(v1 + v13) / v, v2 / v, v13 / v];
-    let n = 150;
+    let n = 100;
     let fams = [Family::Legendre; 3];
     for rep in 0..3 {
         let pts = germ_points(&fams, n, rep);
