@@ -52,6 +52,27 @@ pub struct SparseChaos {
     pub coeffs: DMatrix<f64>,
 }
 
+impl SparseChaos {
+    /// Mean, variance and Sobol' indices of output column `output`.
+    pub fn stats(&self, output: usize) -> super::basis::ChaosStats {
+        super::basis::ChaosStats::new(self.basis.set(), self.coeffs.column(output).as_slice())
+    }
+
+    /// All outputs of the chaos at germ point `t`.
+    pub fn eval(&self, t: &[f64]) -> Vec<f64> {
+        let mut v = vec![0.0; self.basis.len()];
+        self.basis.eval(t, &mut v);
+        (0..self.coeffs.ncols())
+            .map(|o| {
+                v.iter()
+                    .enumerate()
+                    .map(|(k, vk)| vk * self.coeffs[(k, o)])
+                    .sum()
+            })
+            .collect()
+    }
+}
+
 /// Per-dimension maximal degree of the tensor projection of a term.
 fn term_degrees(term: &TensorTerm) -> Vec<usize> {
     term.exactness.iter().map(|&e| e / 2).collect()
