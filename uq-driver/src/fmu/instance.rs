@@ -6,9 +6,10 @@ use std::ptr::{self, NonNull};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
-use super::binary::{c_string, Component, Functions, RawStatus, StatePtr, FMI2_CO_SIMULATION};
+use super::binary::{Component, Functions, RawStatus, StatePtr, FMI2_CO_SIMULATION};
 use super::description::{ModelDescription, ScalarVariable};
 use super::error::{FmuError, LogMessage, Status};
+use super::ffi::c_string;
 use super::logger::{CallbackFunctions, LogSink};
 use super::FmuInner;
 
