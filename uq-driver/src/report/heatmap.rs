@@ -21,7 +21,7 @@ pub struct Heatmap {
     pub x_label: String,
     /// Label of the vertical axis, with unit.
     pub y_label: String,
-    /// Horizontal cell centres (length nx), e.g. times [s].
+    /// Horizontal cell centres (length nx), e.g. times (s).
     pub x: Vec<f64>,
     /// Vertical cell centres (length ny), e.g. the grid of q.
     pub y: Vec<f64>,

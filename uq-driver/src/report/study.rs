@@ -11,6 +11,7 @@ use super::{
 };
 use crate::qoi::QoiSpec;
 use crate::results::{self, OutputStats, PointStatus, PointTable, ScalarStats, Summary};
+use crate::uq::method::Sobol;
 
 /// Everything a study's report shows.
 #[derive(Clone, Copy, Debug)]
@@ -50,9 +51,9 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<(), ReportError> {
             format!("{}_band.svg", s.name),
             format!("{}_pdf.svg", s.name),
         ];
-        if let Some(sobol) = &s.sobol {
-            write_sobol_csv(dir, s, &sobol.first, &sobol.total, &names)?;
-            write_sobol_plot(dir, s, &sobol.first, &sobol.total, &names)?;
+        if s.sobol.is_some() {
+            write_sobol_csv(dir, s, &names)?;
+            write_sobol_plot(dir, s, &names)?;
             images.push(format!("{}_sobol.svg", s.name));
         }
         images.push(format!("{}.csv", s.name));
@@ -131,13 +132,10 @@ fn column(rows: &[Vec<f64>], j: usize) -> Vec<f64> {
 }
 
 /// `<V>_sobol.csv`: `time,S_<p>...,ST_<p>...`.
-fn write_sobol_csv(
-    dir: &Path,
-    s: &OutputStats,
-    first: &[Vec<f64>],
-    total: &[Vec<f64>],
-    names: &[&str],
-) -> Result<(), ReportError> {
+fn write_sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), ReportError> {
+    let Some(Sobol { first, total }) = &s.sobol else {
+        return Ok(());
+    };
     let mut header = vec!["time".to_string()];
     header.extend(names.iter().map(|n| format!("S_{n}")));
     header.extend(names.iter().map(|n| format!("ST_{n}")));
@@ -152,13 +150,10 @@ fn write_sobol_csv(
 }
 
 /// `<V>_sobol.svg`: first-order (solid) and total (dashed) indices over time.
-fn write_sobol_plot(
-    dir: &Path,
-    s: &OutputStats,
-    first: &[Vec<f64>],
-    total: &[Vec<f64>],
-    names: &[&str],
-) -> Result<(), ReportError> {
+fn write_sobol_plot(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), ReportError> {
+    let Some(Sobol { first, total }) = &s.sobol else {
+        return Ok(());
+    };
     let v = &s.name;
     let mut plot = LinePlot::new(format!("Sobol' indices of {v}"), "time [s]", "index [-]");
     for (j, name) in names.iter().enumerate() {

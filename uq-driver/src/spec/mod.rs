@@ -25,7 +25,7 @@
 //!
 //! [`Study::parse`] reads the file into [`StudyFile`] (serde: tagged enums for the method,
 //! the distributions and the quantities of interest, unknown keys refused) and validates it
-//! in one place ([`validate`]) into a [`Study`]. Errors carry the origin and, where the
+//! in one place (`validate.rs`) into a [`Study`]. Errors carry the origin and, where the
 //! file has them, the line and column.
 
 mod builtins;

@@ -134,9 +134,7 @@ fn positive(name: &'static str, value: f64) -> Result<f64, DistributionError> {
 impl Distribution {
     /// Normal distribution; `std` must be finite and positive, `mean` finite.
     pub fn normal(mean: f64, std: f64) -> Result<Self, DistributionError> {
-        let d = Distribution::Normal { mean, std };
-        d.validate()?;
-        Ok(d)
+        Distribution::Normal { mean, std }.checked()
     }
 
     /// Normal distribution from its mean and coefficient of variation
@@ -152,9 +150,7 @@ impl Distribution {
 
     /// Log-normal distribution from the parameters of the underlying normal.
     pub fn lognormal(mu: f64, sigma: f64) -> Result<Self, DistributionError> {
-        let d = Distribution::LogNormal { mu, sigma };
-        d.validate()?;
-        Ok(d)
+        Distribution::LogNormal { mu, sigma }.checked()
     }
 
     /// Log-normal distribution with the given mean and standard deviation
@@ -170,9 +166,7 @@ impl Distribution {
 
     /// Uniform distribution on `[low, high]` (finite, `low < high`).
     pub fn uniform(low: f64, high: f64) -> Result<Self, DistributionError> {
-        let d = Distribution::Uniform { low, high };
-        d.validate()?;
-        Ok(d)
+        Distribution::Uniform { low, high }.checked()
     }
 
     /// Normal `N(mean, std^2)` truncated to `[low, high]`; the bounds may be
@@ -184,14 +178,19 @@ impl Distribution {
         low: f64,
         high: f64,
     ) -> Result<Self, DistributionError> {
-        let d = Distribution::TruncatedNormal {
+        Distribution::TruncatedNormal {
             mean,
             std,
             low,
             high,
-        };
-        d.validate()?;
-        Ok(d)
+        }
+        .checked()
+    }
+
+    /// `self` if its parameters are valid.
+    fn checked(self) -> Result<Self, DistributionError> {
+        self.validate()?;
+        Ok(self)
     }
 
     /// Checks the parameters (used by the constructors; call it on

@@ -1,5 +1,5 @@
 //! Latin hypercube sampling: one point in each of `samples` equal-probability strata of every
-//! input; estimated like Monte Carlo ([`super::sample`]; the MC standard error is valid, if
+//! input; estimated like Monte Carlo (`sample.rs`; the MC standard error is valid, if
 //! pessimistic).
 
 use serde::{Deserialize, Serialize};

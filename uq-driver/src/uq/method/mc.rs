@@ -1,5 +1,5 @@
 //! Monte Carlo: independent uniform draws mapped through each input's quantile function;
-//! sample mean, unbiased Std and the standard error of the mean ([`super::sample`]).
+//! sample mean, unbiased Std and the standard error of the mean (`sample.rs`).
 
 use serde::{Deserialize, Serialize};
 

@@ -252,4 +252,96 @@ mod tests {
             assert!(r.is_err(), "{text}");
         }
     }
+
+    /// The analytic fixture every sampling method is checked against, through the trait
+    /// only: f = K + K C + C² with K ~ N(a, s²), C ~ N(b, t²), independent. With K = a + sξ,
+    /// C = b + tη: mean a + ab + b² + t², variance s²(1+b)² + t²(a+2b)² + s²t² + 2t⁴.
+    #[test]
+    fn every_sampling_method_estimates_the_analytic_fixture() {
+        let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
+        let params = [
+            RandomParameter {
+                name: "K".into(),
+                distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
+            },
+            RandomParameter {
+                name: "C".into(),
+                distribution: crate::uq::Distribution::normal(b, t).unwrap(),
+            },
+        ];
+        let f = |v: &[f64]| v[0] + v[0] * v[1] + v[1] * v[1];
+        let mean = a + a * b + b * b + t * t;
+        let parts = [
+            s_k * s_k * (1.0 + b) * (1.0 + b),
+            t * t * (a + 2.0 * b) * (a + 2.0 * b) + 2.0 * t.powi(4),
+            s_k * s_k * t * t,
+        ];
+        let var: f64 = parts.iter().sum();
+        for text in [
+            "kind = \"mc\"\nsamples = 20000",
+            "kind = \"lhs\"\nsamples = 20000",
+            "kind = \"scm\"\nnodes = 3",
+            "kind = \"nominal\"",
+        ] {
+            let spec: MethodSpec = toml::from_str(text).unwrap();
+            let Evaluation::Sampling(m) = spec.method().evaluation() else {
+                panic!("{text} runs a design");
+            };
+            let design = m.design(&params, 7).unwrap();
+            let values: Vec<f64> = design.values.iter().map(|v| f(v)).collect();
+            let data = DMatrix::from_column_slice(values.len(), 1, &values);
+            let rows: Vec<usize> = (0..design.len()).collect();
+            let e = m.estimate(&design, &rows, &data).unwrap();
+            match spec.method().kind() {
+                "nominal" => {
+                    assert_eq!(e.mean[0], f(&[a, b]));
+                    assert_eq!(e.std[0], 0.0);
+                }
+                "scm" => {
+                    // Degree 4 in each germ: the 3-node rule is exact, and so is the order-2 chaos.
+                    assert!((e.mean[0] - mean).abs() < 1e-12, "{}", e.mean[0]);
+                    assert!((e.std[0] - var.sqrt()).abs() < 1e-12, "{}", e.std[0]);
+                    assert!((e.std_chaos.as_ref().unwrap()[0] - var.sqrt()).abs() < 1e-12);
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][0] - parts[0] / var).abs() < 1e-12);
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 1e-12);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-12);
+                    assert_eq!(e.draws, Draws::Chaos);
+                }
+                kind => {
+                    let se = e.std_error_mean.as_ref().unwrap()[0];
+                    assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    assert!((e.mean[0] - mean).abs() < 4.0 * se, "{kind}: {}", e.mean[0]);
+                    assert!(
+                        (e.std[0] / var.sqrt() - 1.0).abs() < 0.03,
+                        "{kind}: {}",
+                        e.std[0]
+                    );
+                    assert_eq!(e.draws, Draws::Runs);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_weighted_design_refuses_a_missing_point() {
+        let spec: MethodSpec = toml::from_str("kind = \"scm\"\nnodes = 2").unwrap();
+        let Evaluation::Sampling(m) = spec.method().evaluation() else {
+            panic!("scm runs a design");
+        };
+        let params = [RandomParameter {
+            name: "K".into(),
+            distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+        }];
+        let design = m.design(&params, 0).unwrap();
+        let data = DMatrix::from_element(1, 3, 1.0);
+        let e = m.estimate(&design, &[1], &data).unwrap_err();
+        assert!(matches!(
+            e,
+            MethodError::MissingPoints {
+                missing: 1,
+                total: 2
+            }
+        ));
+    }
 }
