@@ -1,5 +1,7 @@
 //! The built-in studies, embedded in the binary (`uq-driver list`, `run builtin:NAME`).
 
+use super::error::StudyError;
+
 /// The built-in studies, embedded in the binary: (name, TOML).
 pub const BUILTINS: &[(&str, &str)] = &[
     ("wheel-scm", include_str!("../../studies/wheel-scm.toml")),
@@ -63,3 +65,12 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/paper-vehicle-track.toml"),
     ),
 ];
+
+/// The text of a built-in study.
+pub fn builtin(name: &str) -> Result<&'static str, StudyError> {
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| StudyError::UnknownBuiltin(name.to_owned()))
+}

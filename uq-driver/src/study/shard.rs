@@ -17,9 +17,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::single::{finish, open_fmu};
 use super::store::{Manifest, Record, Store, StoreError};
-use super::{open_fmu, StudyResult, StudyRunError};
 use crate::spec::Study;
 use crate::uq::method::{Design, Evaluation, Sampling};
 
@@ -314,7 +315,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         threads: 0,
         fmu_sha256: p.manifest.fmu_sha256.clone(),
     };
-    super::finish(&study, method, &fmu, &design, outcome, out, opts).map_err(ShardError::Run)
+    finish(&study, method, &fmu, &design, outcome, out, opts).map_err(ShardError::Run)
 }
 
 /// Options of `uq-driver slurm`.

@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use super::{run_single, RunOptions, StudyResult, StudyRunError, SuiteResult};
+use super::outcome::{StudyResult, StudyRunError, SuiteResult};
+use super::runner::RunOptions;
+use super::single::run_single;
 use crate::report::{self, suite::VariantResults};
 use crate::results::{SuiteSummary, VariantOutput, VariantSummary};
 use crate::spec::{Study, Suite};

@@ -24,6 +24,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::pce::{hermite_triple, MultiIndexSet, Pce};
 
+pub mod system;
+
 /// A matrix (or vector, as an n×1 matrix) depending affinely on standard Gaussian germs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Affine {

@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use super::MethodError;
+use super::error::MethodError;
 use crate::uq::distributions::{Germ, RandomParameter};
 
 /// Where a [`Sampling`](super::Sampling) method runs the model.

@@ -19,19 +19,19 @@
 //! `[method] kind = "<type in snake_case>"` with the struct's fields as keys.
 
 mod design;
+mod error;
 mod estimate;
 mod sample;
+mod traits;
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 pub use design::Design;
+pub use error::{InvalidSettings, MethodError};
 pub use estimate::{Draws, Estimate, Sobol};
-
-use crate::uq::distributions::RandomParameter;
-use crate::uq::galerkin::GalerkinError;
-use crate::uq::pce::PceError;
-use crate::uq::quadrature::QuadratureError;
+pub use traits::{
+    details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
+};
 
 /// Declares the method modules and the `[method]` table: one line per method.
 macro_rules! methods {
@@ -68,159 +68,12 @@ methods! {
     nominal::Nominal,
 }
 
-/// Settings that make no sense for the study they are in (reported as a study-file error).
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct InvalidSettings(pub String);
-
-/// Failures of designs and estimators.
-#[derive(Debug, thiserror::Error)]
-pub enum MethodError {
-    /// A quadrature rule could not be built.
-    #[error(transparent)]
-    Quadrature(#[from] QuadratureError),
-    /// A chaos could not be projected.
-    #[error(transparent)]
-    Chaos(#[from] PceError),
-    /// The Galerkin system could not be assembled or solved.
-    #[error(transparent)]
-    Galerkin(#[from] GalerkinError),
-    /// The settings do not fit the study.
-    #[error(transparent)]
-    Invalid(#[from] InvalidSettings),
-    /// A weighted design lacks results at some of its points.
-    #[error(
-        "{missing} of {total} weighted points have no value; a weighted design cannot drop a point"
-    )]
-    MissingPoints {
-        /// Points without a value.
-        missing: usize,
-        /// Points of the design.
-        total: usize,
-    },
-}
-
-/// What a method knows of the study it belongs to.
-#[derive(Clone, Copy, Debug)]
-pub struct Problem<'a> {
-    /// The random parameters, in study order.
-    pub parameters: &'a [RandomParameter],
-    /// The output variables analysed over time.
-    pub outputs: &'a [String],
-    /// Number of scalar quantities of interest.
-    pub quantities: usize,
-    /// Communication points (s).
-    pub times: &'a [f64],
-    /// The study's `[system]` (the equations of an intrusive method), if any.
-    pub system: Option<&'a sgm::SystemSpec>,
-}
-
-/// The `method` entry of `summary.json`: the kind and the method's settings and diagnostics.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MethodSummary {
-    /// `kind` of the study file.
-    pub kind: String,
-    /// Per method (e.g. `samples`, `nodes_per_dimension`, `order`, `terms`, `definiteness`).
-    #[serde(flatten)]
-    pub details: serde_json::Map<String, serde_json::Value>,
-}
-
-impl MethodSummary {
-    /// A summary of `kind` with the fields of `settings` (a struct or map).
-    pub fn new(kind: &str, settings: &impl Serialize) -> MethodSummary {
-        MethodSummary {
-            kind: kind.to_owned(),
-            details: details(settings),
-        }
-    }
-}
-
-/// The fields of a struct (or map) as the entries of a JSON object; empty for anything else.
-pub fn details(value: &impl Serialize) -> serde_json::Map<String, serde_json::Value> {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::Object(map)) => map,
-        _ => serde_json::Map::new(),
-    }
-}
-
-/// The size of a design as summary.json has always reported it (`null` where it does not apply).
-#[derive(Clone, Copy, Debug, Serialize)]
-pub(crate) struct DesignSize {
-    /// Samples (MC, LHS).
-    pub samples: Option<usize>,
-    /// Nodes per dimension (tensor grids).
-    pub nodes_per_dimension: Option<usize>,
-    /// Chaos order.
-    pub order: Option<usize>,
-}
-
-/// How a method obtains its results.
-pub enum Evaluation<'a> {
-    /// The model is run at the points of a design.
-    Sampling(&'a dyn Sampling),
-    /// The method solves its own projected system; the model is not run.
-    Intrusive(&'a dyn Intrusive),
-}
-
-/// A UQ method as the study runner and the report see it.
-pub trait Method: std::fmt::Debug + Send + Sync {
-    /// The `kind` in study files and summaries.
-    fn kind(&self) -> &'static str;
-
-    /// A short label for tables and logs, e.g. `lhs 1000`, `scm 6^2`, `sgm order 6`
-    /// (`dim`: number of random parameters).
-    fn label(&self, dim: usize) -> String;
-
-    /// Checks the settings against the study; called once, when the study is loaded.
-    fn validate(&self, problem: &Problem) -> Result<(), InvalidSettings>;
-
-    /// The settings written under `method` in `summary.json`.
-    fn summary(&self, dim: usize) -> MethodSummary;
-
-    /// Whether the method runs the model at a design or solves its own system.
-    fn evaluation(&self) -> Evaluation<'_>;
-}
-
-/// A method that runs the model at the points of a design.
-pub trait Sampling {
-    /// The design for `parameters` (deterministic in `seed`).
-    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError>;
-
-    /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
-    /// the points that gave a value; one column per time step or quantity).
-    fn estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError>;
-
-    /// The fewest successful runs the estimator can work with.
-    fn min_runs(&self) -> usize {
-        2
-    }
-}
-
-/// A method that solves a projected (intrusive) system instead of running the model.
-pub trait Intrusive {
-    /// One estimate per output of `problem`, over its times.
-    fn solve(&self, problem: &Problem) -> Result<Solution, MethodError>;
-}
-
-/// What an intrusive method returns.
-#[derive(Clone, Debug)]
-pub struct Solution {
-    /// One estimate per output.
-    pub outputs: Vec<Estimate>,
-    /// Diagnostics for the method's entry in `summary.json`.
-    pub details: serde_json::Map<String, serde_json::Value>,
-    /// Warnings for the user.
-    pub warnings: Vec<String>,
-}
-
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use super::*;
+    use crate::uq::distributions::RandomParameter;
 
     #[test]
     fn kinds_are_the_snake_case_variant_names() {

@@ -3,10 +3,10 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::{
-    Design, DesignSize, Estimate, Evaluation, InvalidSettings, Method, MethodError,
-    MethodSummary, Problem, Sampling,
-};
+use super::design::Design;
+use super::error::{InvalidSettings, MethodError};
+use super::estimate::Estimate;
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::{Germ, RandomParameter};
 
 /// `kind = "nominal"` (no settings).

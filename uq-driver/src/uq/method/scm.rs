@@ -6,12 +6,11 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::{
-    Design, DesignSize, Estimate, Evaluation, InvalidSettings, Method, MethodError,
-    MethodSummary, Problem, Sampling, Sobol,
-};
+use super::design::Design;
+use super::error::{InvalidSettings, MethodError};
+use super::estimate::{Draws, Estimate, Sobol};
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::{Germ, RandomParameter};
-use crate::uq::method::Draws;
 use crate::uq::pce::{MultiIndexSet, Pce};
 use crate::uq::quadrature;
 

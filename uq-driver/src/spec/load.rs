@@ -1,18 +1,61 @@
-//! Validation of a study file, in one place: from a parsed [`StudyFile`] to a [`Study`]
-//! whose parameters, quantities, method and variants all make sense together.
+//! Loading a study: the file parsed into a [`StudyFile`], then validated in one place into a
+//! [`Study`] whose parameters, quantities, method and variants all make sense together.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use toml::Spanned;
 
-use super::{
-    fmu_search_path, location, Analysis, ParameterSpec, Study, StudyError, StudyFile, Suite,
-    Variant,
-};
+use super::builtins::builtin;
+use super::error::{location, Location, StudyError};
+use super::file::{Analysis, StudyFile, Variant};
+use super::parameter::ParameterSpec;
+use super::study::{Study, Suite};
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::Evaluation;
+
+impl Study {
+    /// Loads `builtin:NAME` or a TOML file.
+    pub fn load(spec: &str) -> Result<Study, StudyError> {
+        if let Some(name) = spec.strip_prefix("builtin:") {
+            return Study::parse(builtin(name)?, spec, None);
+        }
+        let path = Path::new(spec);
+        let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Study::parse(&text, spec, path.parent())
+    }
+
+    /// Parses and validates a study; `base` is the folder relative FMU paths start from.
+    pub fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Study, StudyError> {
+        let file: StudyFile = toml::from_str(text).map_err(|e| StudyError::Parse {
+            origin: origin.to_owned(),
+            at: Location::of(text, e.span().map_or(0, |s| s.start)),
+            message: e.message().to_owned(),
+        })?;
+        study(file, origin, base, text)
+    }
+}
+
+/// Folders searched for an FMU named by a relative path that is not next to the study file:
+/// `$RAILUQ_FMU_DIR`, `<folder of the executable>/../fmu` (i.e. `target/fmu` for a cargo
+/// build), `./target/fmu`.
+pub fn fmu_search_path() -> Vec<PathBuf> {
+    let mut dirs = Vec::new();
+    if let Some(d) = std::env::var_os("RAILUQ_FMU_DIR") {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        if let Some(parent) = exe.parent().and_then(Path::parent) {
+            dirs.push(parent.join("fmu"));
+        }
+    }
+    dirs.push(PathBuf::from("target/fmu"));
+    dirs
+}
 
 /// Where errors point: the origin and the text the spans refer to.
 struct Context<'a> {
@@ -32,7 +75,7 @@ impl Context<'_> {
 }
 
 /// Validates `file` (parsed from `text`) into a study.
-pub(super) fn study(
+fn study(
     file: StudyFile,
     origin: &str,
     base: Option<&Path>,
