@@ -17,6 +17,19 @@
 //! `deny_unknown_fields`) that implements [`Method`] and [`Sampling`] or [`Intrusive`], and
 //! add one line `<name>::<Type>,` to the `methods!` list below. The study file then accepts
 //! `[method] kind = "<type in snake_case>"` with the struct's fields as keys.
+//!
+//! How the methods to come fit (settings and structure are the method's own; the estimator
+//! receives its settings as `&self`, so it can rebuild any structure of its design):
+//! - a sparse grid: a [`Design`] with (possibly negative) weights; the estimator combines
+//!   full-tensor projections over the grid's index sets into [`Estimate::chaos`];
+//! - regression chaos: the design of another sampling method, the chaos fitted to the rows
+//!   that succeeded (`rows`), its leave-one-out error as a new field of [`Estimate`];
+//! - quasi-Monte Carlo and replicated Latin hypercubes: point `i` belongs to replicate
+//!   `i / samples`; the standard error of the mean comes from the replicates;
+//! - pick-freeze Sobol' sampling: the blocks A, B and A_B^(j) by point index; [`Sobol`] from
+//!   the blocks;
+//! - a nested study: the product of an outer and an inner design, and for every outer sample
+//!   the inner method's own [`Sampling::estimate`] on that sample's rows.
 
 mod design;
 mod error;
