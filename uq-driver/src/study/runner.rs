@@ -150,9 +150,11 @@ pub fn sha256_file(path: &Path) -> std::io::Result<String> {
     Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
 
-/// Hash of everything in a study that changes its numbers (not its name or description).
+/// Hash of everything in a study that changes the stored records (not its name, description
+/// or analysis settings). The quantities of interest are stored with every run, so their
+/// settings are part of it (a study without any keeps the hash it always had).
 pub fn study_hash(study: &Study) -> String {
-    let key = serde_json::json!({
+    let mut key = serde_json::json!({
         "seed": study.seed,
         "experiment": study.experiment,
         "method": study.method,
@@ -160,6 +162,9 @@ pub fn study_hash(study: &Study) -> String {
         "fixed": study.fixed,
         "outputs": { "variables": study.outputs },
     });
+    if !study.qoi.is_empty() {
+        key["qoi"] = serde_json::json!(study.qoi);
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }
 
@@ -458,4 +463,33 @@ pub fn simulate(
     let flat = run_point(fmu, &mut None, &iface, &[], times)?;
     let series = flat.chunks(times.len()).map(<[f64]>::to_vec).collect();
     Ok((iface.signal_names, series))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn changed_quantity_settings_do_not_resume_stale_records() {
+        let base = crate::spec::builtin("bogie-lhs-500").unwrap();
+        let study = |text: &str| Study::parse(text, "t.toml", None).unwrap();
+        let a = study_hash(&study(base));
+        let b = study_hash(&study(
+            &base.replace("threshold = 1e-4", "threshold = 2e-4"),
+        ));
+        assert_ne!(a, b, "a record holds v_cr for one threshold only");
+        // Name, description and analysis settings do not change the records.
+        let renamed = base.replace("name = \"bogie-lhs-500\"", "name = \"renamed\"");
+        let c = study_hash(&study(&format!("{renamed}\n[analysis]\npdf_grid = 50\n")));
+        assert_eq!(a, c);
+    }
+
+    #[test]
+    fn studies_without_quantities_keep_their_hash() {
+        // The hash of wheel-scm in the store/manifest.json that uq-driver wrote before the
+        // restructuring (commit 7b51554): old result folders still resume.
+        let s = Study::load("builtin:wheel-scm").unwrap();
+        let expected = "9c4270a27263cfdb71ef7669728eefc88c107f891685caf239948c85fa49637a";
+        assert_eq!(study_hash(&s), expected);
+    }
 }
