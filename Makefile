@@ -12,19 +12,56 @@ FMU_DIR := target/fmu
 LIB := target/release/librailuq.so
 DRIVER := target/release/uq-driver
 FMUS := $(FMU_DIR)/Wheel.fmu
+# The Windows binary of the FMUs, cross-compiled with mingw-w64.
+WIN_TARGET := x86_64-pc-windows-gnu
+DLL := target/$(WIN_TARGET)/release/railuq.dll
+# WIN64=auto (default): the FMUs carry a win64 DLL beside the linux64 .so when the Windows
+# toolchain is installed (`make win64-toolchain` installs it, `make test` does), else they are
+# written without it and a note says why; WIN64=yes: the DLL is required; WIN64=no: linux64 only.
+WIN64 ?= auto
+# Non-empty under CI (env CI set to anything but 0/false/no): what is skipped elsewhere fails.
+IN_CI := $(filter-out 0 false no False FALSE No NO,$(strip $(CI)))
 # Headers of the FMI 2.0 standard as fmpy ships them (for the C test FMU).
 FMI2_HEADERS = $(shell $(VPY) -c 'import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), "c-code"))')
 
-.PHONY: all build fmu xml run test test-rust test-python lint fmt bench paper clean venv
+.PHONY: all build fmu xml run test test-rust test-python lint fmt bench paper clean venv \
+	win64-toolchain
 
 all: build fmu
 
 build:
 	$(CARGO) build --release --workspace
 
+# The packaged binaries are stripped of symbols and debug info (the ones under target/ keep
+# theirs for profiling).
 fmu:
 	$(CARGO) build --release -p railuq --lib --bin railuq-fmu
-	target/release/railuq-fmu package $(LIB) $(FMU_DIR)
+	@extra=; \
+	if [ "$(WIN64)" != no ]; then \
+	  if why=$$(bash tests/wine/toolchain.sh check-build 2>&1); then \
+	    echo "$(CARGO) build --release -p railuq --lib --target $(WIN_TARGET)"; \
+	    $(CARGO) build --release -p railuq --lib --target $(WIN_TARGET); \
+	    extra="--library $(DLL)"; \
+	  elif [ "$(WIN64)" = yes ] || [ -n "$(IN_CI)" ]; then \
+	    echo "make fmu: cannot build the win64 binary: $$why" >&2; exit 1; \
+	  else \
+	    echo "make fmu: note: the FMUs carry no win64 binary: $$why ('make win64-toolchain' installs it)" >&2; \
+	  fi; \
+	fi; \
+	echo "target/release/railuq-fmu package $(LIB) $(FMU_DIR) $$extra"; \
+	target/release/railuq-fmu package $(LIB) $(FMU_DIR) $$extra
+
+# rustup's Windows target, Debian's mingw-w64 and wine64, installed if missing (apt-get as
+# root). Where they cannot be had the FMUs go without win64 and the Wine test skips, except
+# under CI, where that is a failure.
+win64-toolchain:
+	@rc=0; bash tests/wine/toolchain.sh install || rc=$$?; \
+	if [ $$rc -eq 77 ] && [ -z "$(IN_CI)" ]; then \
+	  echo "make: continuing without the Windows toolchain (no win64 binary, Wine test skipped)" >&2; \
+	elif [ $$rc -ne 0 ]; then \
+	  [ $$rc -ne 77 ] || echo "make: the Windows toolchain is required under CI" >&2; \
+	  exit $$rc; \
+	fi
 
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
@@ -52,7 +89,7 @@ lint:
 fmt:
 	$(CARGO) fmt --all
 
-test: lint venv build fmu
+test: lint venv win64-toolchain build fmu
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
@@ -79,6 +116,12 @@ paper: build fmu
 	$(DRIVER) run builtin:vehicle-track-defect --out out/vehicle-track-defect
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
 	@echo "reports: out/paper-*/index.html"
+
+# Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser and the
+# results store reader, FUZZ_SECONDS per target (default 60); not part of make test.
+.PHONY: fuzz
+fuzz:
+	uq-driver/fuzz/run.sh
 
 clean:
 	$(CARGO) clean

@@ -22,6 +22,15 @@
 //! budget per model is spent (at least 5 rounds); the median and the best round are printed,
 //! as ns per call. Options: `--budget SECONDS` per model (default 1.5), `--json FILE` (the
 //! results as JSON, for `bench/run.py`). Any other argument (cargo passes `--bench`) is ignored.
+//!
+//! Then the VehicleTrack stepping in detail ([`vt_kernels`], through the Rust API of the same
+//! library, `--vt-json FILE` for its JSON): µs per substep at the default resolution (N = 255,
+//! NM = 255, dt = 1e-4 s), a fine one (N = 511, NM = 511, dt = 2e-5 s) and the one that
+//! resolves the sleeper-passing force (N = 255, NM = 511, dt = 2e-5 s), for
+//! the plain kernel and the fast one on each instruction set, measured interleaved; the
+//! real-time factors; the arithmetic bound (a flop count per substep over a measured loop
+//! throughput) and the fraction of it reached; and the largest relative difference of the
+//! fast kernel from the plain one over 6 s runs.
 
 use std::ffi::{c_char, c_int, c_uint, c_void, CString};
 use std::hint::black_box;
@@ -352,11 +361,13 @@ fn json_row(case: &Case, call: &str, s: &Stat) -> String {
 
 fn main() {
     let mut json: Option<PathBuf> = None;
+    let mut vt_json: Option<PathBuf> = None;
     let mut budget = Duration::from_secs_f64(1.5);
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--json" => json = args.next().map(PathBuf::from),
+            "--vt-json" => vt_json = args.next().map(PathBuf::from),
             "--budget" => {
                 let v = args.next().and_then(|v| v.parse::<f64>().ok());
                 match v {
@@ -411,4 +422,13 @@ fn main() {
             fail(&format!("cannot write {}: {e}", p.display()));
         }
     }
+    let vt = vt_kernels::run(budget);
+    if let Some(p) = vt_json {
+        if let Err(e) = std::fs::write(&p, vt) {
+            fail(&format!("cannot write {}: {e}", p.display()));
+        }
+    }
 }
+
+#[path = "fmi_step/vt_kernels.rs"]
+mod vt_kernels;

@@ -2,10 +2,11 @@
 //!
 //! - [`models`]: the physics (pure Rust, no FMI types);
 //! - [`solver`]: fixed-step integrators;
-//! - [`fmi2`]: the FMI 2.0 Co-Simulation export layer (the `fmi2*` C functions);
-//! - [`package`]: writes `.fmu` archives and model descriptions.
+//! - [`fmi2`]: the FMI 2.0 Co-Simulation export layer (the `fmi2*` C functions).
+//!
+//! Packaging (`.fmu` archives, model descriptions, icons) lives in the `railuq-fmu` binary
+//! (`src/bin/railuq-fmu/`), so that the FMU's own shared library carries none of it.
 
 pub mod fmi2;
 pub mod models;
-pub mod package;
 pub mod solver;

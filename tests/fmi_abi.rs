@@ -1471,6 +1471,39 @@ fn a_communication_point_off_the_fmu_time_is_an_error() {
 }
 
 #[test]
+fn an_absurd_step_is_an_error_not_a_hang() {
+    // fmi2DoStep with h = 1e300 (or 1e6) never returned: the substep count overflowed.
+    let inst = Inst::new("absurd");
+    inst.init(0.0, None);
+    for h in [1e300, 1e6] {
+        assert_eq!(inst.step(0.0, h), ERROR, "h = {h}");
+        inst.assert_logged(
+            ERROR,
+            &["fmi2DoStep", "substeps", "use shorter communication steps"],
+        );
+        assert_eq!(inst.reset(), OK);
+        inst.init(0.0, None);
+    }
+    assert_eq!(inst.step(0.0, 0.01), OK, "normal steps after a reset");
+
+    // VehicleTrack (no irregularity, a short window: quick to initialise in a debug build).
+    let guid = railuq::fmi2::xml::guid(&railuq::models::vehicle_track::INFO);
+    let vt = Spec::new("absurd-vt")
+        .guid(Some(&guid))
+        .instantiate()
+        .unwrap_or_else(|log| panic!("VehicleTrack: {log:#?}"));
+    use railuq::models::vehicle_track::{VR_IRREGULARITY, VR_N_MODES, VR_N_SLEEPERS};
+    for (vr, v) in [(VR_N_SLEEPERS, 63), (VR_N_MODES, 32), (VR_IRREGULARITY, 0)] {
+        // SAFETY: live instance; one value reference and one value.
+        let s = unsafe { (fmu().set_integer)(vt.c, &vr, 1, &v) };
+        assert_eq!(s, OK);
+    }
+    vt.init(0.0, None);
+    assert_eq!(vt.step(0.0, 1e300), ERROR);
+    vt.assert_logged(ERROR, &["fmi2DoStep", "substeps"]);
+}
+
+#[test]
 fn a_step_past_the_stop_time_is_an_error() {
     let inst = Inst::new("stop");
     inst.init(0.0, Some(1.0));

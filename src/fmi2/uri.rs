@@ -3,8 +3,14 @@
 use std::path::PathBuf;
 
 /// Converts a `file:` URI to a path. Accepts `file:///p`, `file:/p` and `file://localhost/p`,
-/// with percent-encoding; returns None for other schemes or malformed escapes.
+/// with percent-encoding; returns None for other schemes or malformed escapes. On Windows a
+/// drive letter loses the slash before it (`file:///C:/x` is `C:/x`).
 pub fn file_uri_to_path(uri: &str) -> Option<PathBuf> {
+    uri_path(uri, cfg!(windows)).map(PathBuf::from)
+}
+
+/// The decoded path of a `file:` URI; `windows` drops the `/` before a drive letter.
+fn uri_path(uri: &str, windows: bool) -> Option<String> {
     let rest = uri
         .strip_prefix("file://localhost/")
         .map(|r| format!("/{r}"))
@@ -28,7 +34,16 @@ pub fn file_uri_to_path(uri: &str) -> Option<PathBuf> {
         }
     }
     let s = String::from_utf8(out).ok()?;
-    Some(PathBuf::from(s))
+    let b = s.as_bytes();
+    let drive = b.len() >= 3
+        && b[1].is_ascii_alphabetic()
+        && b[2] == b':'
+        && (b.len() == 3 || b[3] == b'/' || b[3] == b'\\');
+    Some(if windows && drive {
+        s[1..].to_owned()
+    } else {
+        s
+    })
 }
 
 #[cfg(test)]
@@ -47,5 +62,20 @@ mod tests {
         assert_eq!(file_uri_to_path("http://x/y"), None);
         assert_eq!(file_uri_to_path("file:///bad%2"), None);
         assert_eq!(file_uri_to_path("file:///bad%zz"), None);
+    }
+
+    #[test]
+    fn windows_drive_letter_uris_lose_the_leading_slash() {
+        let p = Some("C:/Users/a b/resources".to_owned());
+        assert_eq!(uri_path("file:///C:/Users/a%20b/resources", true), p);
+        assert_eq!(uri_path("file:/C:/Users/a%20b/resources", true), p);
+        assert_eq!(
+            uri_path("file://localhost/C:/Users/a%20b/resources", true),
+            p
+        );
+        assert_eq!(uri_path("file:///Z:", true), Some("Z:".to_owned()));
+        // Not a drive: kept as it is; on other systems the slash stays.
+        assert_eq!(uri_path("file:///CD:/x", true), Some("/CD:/x".to_owned()));
+        assert_eq!(uri_path("file:///C:/x", false), Some("/C:/x".to_owned()));
     }
 }

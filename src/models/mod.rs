@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bogie;
+pub mod table;
 pub mod vehicle_track;
 pub mod wheel;
 
@@ -136,6 +137,19 @@ impl Variable {
         }
     }
 
+    /// A fixed String parameter with a start value.
+    pub const fn string_parameter(
+        name: &'static str,
+        vr: u32,
+        start: &'static str,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            start: Start::String(Some(start)),
+            ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
+        }
+    }
+
     /// A continuous Real output (initial calculated by default).
     pub const fn real_output(
         name: &'static str,
@@ -245,6 +259,9 @@ pub enum ModelError {
     /// The value reference is not one the model handles for this type.
     #[error("no {0:?} variable with value reference {1}")]
     NoSuchVariable(VarType, u32),
+    /// A step that needs too many internal substeps (refused before any work).
+    #[error("{0}")]
+    StepTooLong(#[from] crate::solver::TooManySubsteps),
     /// A serialized state could not be read.
     #[error("corrupt model state: {0}")]
     CorruptState(String),

@@ -5,17 +5,8 @@
 //! m q'' + C q' + K q = 0,   q(0) = q0,   q'(0) = v0
 //! ```
 //!
-//! | variable | vr | unit  | default | kind                 |
-//! |----------|----|-------|---------|----------------------|
-//! | m        | 0  | kg    | 10      | fixed parameter      |
-//! | K        | 1  | N/m   | 100     | tunable parameter    |
-//! | C        | 2  | N.s/m | 20      | tunable parameter    |
-//! | q0       | 3  | m     | 0.1     | fixed parameter      |
-//! | v0       | 4  | m/s   | 0       | fixed parameter      |
-//! | h        | 5  | s     | 1e-3    | fixed parameter: internal RK4 step (max) |
-//! | q        | 10 | m     |         | output: displacement |
-//! | v        | 11 | m/s   |         | output: velocity q'  |
-//! | a        | 12 | m/s2  |         | output: acceleration q'' |
+//! The variables (parameters m, K, C, q0, v0, h; outputs q, v, a), their value references,
+//! units and defaults are declared once, in the `variables!` table below ([`TABLE`]).
 //!
 //! K and C are tunable: a change between communication steps acts from the next step on.
 //! K <= 0 (an unstable or neutral spring, which a Gaussian stiffness reaches far in its tail) is
@@ -23,54 +14,30 @@
 //! refused.
 #![forbid(unsafe_code)]
 
-use super::{
-    require_finite, require_non_negative, require_positive, InitContext, Model, ModelError,
-    ModelInfo, SetResult, StateReader, StateWriter, Variability, Variable,
-};
+use super::table::{finite, non_negative, positive, variables};
+use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
 use crate::solver::{rk4_step, substeps};
 
-const VR_M: u32 = 0;
-const VR_K: u32 = 1;
-const VR_C: u32 = 2;
-const VR_Q0: u32 = 3;
-const VR_V0: u32 = 4;
-const VR_H: u32 = 5;
-const VR_Q: u32 = 10;
-const VR_V: u32 = 11;
-const VR_A: u32 = 12;
-
-const fn param(
-    name: &'static str,
-    vr: u32,
-    start: f64,
-    variability: Variability,
-    unit: &'static str,
-    description: &'static str,
-) -> Variable {
-    Variable::real_parameter(name, vr, start, variability, Some(unit), description)
+/// K may be zero or negative (a Gaussian stiffness reaches it far in its tail): accepted with
+/// a warning, the integrator handles it.
+fn stiffness(name: &'static str, value: f64) -> SetResult {
+    finite(name, value)?;
+    Ok((value <= 0.0)
+        .then(|| format!("K = {value} N/m is not positive: the wheel is unstable or neutral")))
 }
 
-const fn output(
-    name: &'static str,
-    vr: u32,
-    unit: &'static str,
-    description: &'static str,
-) -> Variable {
-    Variable::real_output(name, vr, Some(unit), description)
+variables! {
+    static TABLE: [Wheel as w];
+    real_parameter("m", VR_M = 0, Some("kg"), w.m, 10.0, Fixed, positive, "Mass"),
+    real_parameter("K", VR_K = 1, Some("N/m"), w.k, 100.0, Tunable, stiffness, "Stiffness"),
+    real_parameter("C", VR_C = 2, Some("N.s/m"), w.c, 20.0, Tunable, non_negative, "Damping coefficient"),
+    real_parameter("q0", VR_Q0 = 3, Some("m"), w.q0, 0.1, Fixed, finite, "Initial displacement q(0)"),
+    real_parameter("v0", VR_V0 = 4, Some("m/s"), w.v0, 0.0, Fixed, finite, "Initial velocity q'(0)"),
+    real_parameter("h", VR_H = 5, Some("s"), w.h, 1e-3, Fixed, positive, "Largest internal RK4 step; each communication step is split into equal substeps no longer than h"),
+    output("q", VR_Q = 10, Some("m"), w.y[0], "Displacement q"),
+    output("v", VR_V = 11, Some("m/s"), w.y[1], "Velocity q'"),
+    output("a", VR_A = 12, Some("m/s2"), w.acceleration(w.y[0], w.y[1]), "Acceleration q''"),
 }
-
-/// The wheel's variable table.
-pub static VARIABLES: [Variable; 9] = [
-    param("m", VR_M, 10.0, Variability::Fixed, "kg", "Mass"),
-    param("K", VR_K, 100.0, Variability::Tunable, "N/m", "Stiffness"),
-    param("C", VR_C, 20.0, Variability::Tunable, "N.s/m", "Damping coefficient"),
-    param("q0", VR_Q0, 0.1, Variability::Fixed, "m", "Initial displacement q(0)"),
-    param("v0", VR_V0, 0.0, Variability::Fixed, "m/s", "Initial velocity q'(0)"),
-    param("h", VR_H, 1e-3, Variability::Fixed, "s", "Largest internal RK4 step; each communication step is split into equal substeps no longer than h"),
-    output("q", VR_Q, "m", "Displacement q"),
-    output("v", VR_V, "m/s", "Velocity q'"),
-    output("a", VR_A, "m/s2", "Acceleration q''"),
-];
 
 /// Static description of the wheel model.
 pub static INFO: ModelInfo = ModelInfo {
@@ -87,7 +54,8 @@ pub static INFO: ModelInfo = ModelInfo {
 &zeta; = C / (2&radic;(K m)) = 0.316, &omega;<sub>d</sub> = 3 rad/s and
 q(t) = 0.1 e<sup>&minus;t</sup>(cos 3t + sin(3t)/3).</p>
 <p>Integration: classical Runge&ndash;Kutta (RK4) with equal substeps no longer than the
-parameter <code>h</code> (default 1 ms; error below 1e-9 q0 over 0&ndash;5 s).
+parameter <code>h</code> (default 1 ms; error below 1e-9 q0 over 0&ndash;5 s). A communication
+step that would need more than 10<sup>7</sup> substeps is refused with an error.
 K and C are tunable: a change between communication steps acts from the next step on.
 K &le; 0 is accepted with a warning; m &le; 0, C &lt; 0 and non-finite values are refused.</p>"#,
 };
@@ -114,14 +82,15 @@ pub struct Wheel {
 impl Default for Wheel {
     fn default() -> Self {
         let mut w = Wheel {
-            m: 10.0,
-            k: 100.0,
-            c: 20.0,
-            q0: 0.1,
+            m: 0.0,
+            k: 0.0,
+            c: 0.0,
+            q0: 0.0,
             v0: 0.0,
-            h: 1e-3,
+            h: 0.0,
             y: [0.0; 2],
         };
+        TABLE.apply_defaults(&mut w);
         w.y = [w.q0, w.v0];
         w
     }
@@ -145,54 +114,11 @@ impl Model for Wheel {
     }
 
     fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
-        Ok(match vr {
-            VR_M => self.m,
-            VR_K => self.k,
-            VR_C => self.c,
-            VR_Q0 => self.q0,
-            VR_V0 => self.v0,
-            VR_H => self.h,
-            VR_Q => self.y[0],
-            VR_V => self.y[1],
-            VR_A => self.acceleration(self.y[0], self.y[1]),
-            _ => return Err(ModelError::NoSuchVariable(super::VarType::Real, vr)),
-        })
+        TABLE.get_real(self, vr)
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
-        match vr {
-            VR_M => {
-                require_positive("m", value)?;
-                self.m = value;
-            }
-            VR_K => {
-                require_finite("K", value)?;
-                self.k = value;
-                if value <= 0.0 {
-                    return Ok(Some(format!(
-                        "K = {value} N/m is not positive: the wheel is unstable or neutral"
-                    )));
-                }
-            }
-            VR_C => {
-                require_non_negative("C", value)?;
-                self.c = value;
-            }
-            VR_Q0 => {
-                require_finite("q0", value)?;
-                self.q0 = value;
-            }
-            VR_V0 => {
-                require_finite("v0", value)?;
-                self.v0 = value;
-            }
-            VR_H => {
-                require_positive("h", value)?;
-                self.h = value;
-            }
-            _ => return Err(ModelError::NoSuchVariable(super::VarType::Real, vr)),
-        }
-        Ok(None)
+        TABLE.set_real(self, vr, value)
     }
 
     fn initialize(&mut self, _ctx: &InitContext) -> Result<(), ModelError> {
@@ -201,7 +127,7 @@ impl Model for Wheel {
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
-        let n = substeps(h, self.h);
+        let n = substeps(h, self.h)?;
         let dt = h / n as f64;
         let (m, k, c) = (self.m, self.k, self.c);
         for i in 0..n {
@@ -230,22 +156,16 @@ impl Model for Wheel {
     }
 
     fn save(&self, out: &mut StateWriter) {
-        out.f64s(&[
-            self.m, self.k, self.c, self.q0, self.v0, self.h, self.y[0], self.y[1],
-        ]);
+        TABLE.save_parameters(self, out);
+        out.f64s(&self.y);
     }
 
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError> {
-        let v = input.f64s(Some(8))?;
-        *self = Wheel {
-            m: v[0],
-            k: v[1],
-            c: v[2],
-            q0: v[3],
-            v0: v[4],
-            h: v[5],
-            y: [v[6], v[7]],
-        };
+        let mut w = Wheel::default();
+        TABLE.restore_parameters(&mut w, input)?;
+        let y = input.f64s(Some(2))?;
+        w.y = [y[0], y[1]];
+        *self = w;
         Ok(())
     }
 }
@@ -352,6 +272,19 @@ mod tests {
             t += 0.01;
         }
         assert!(failed);
+    }
+
+    #[test]
+    fn an_absurd_step_is_refused_with_an_error_not_a_hang() {
+        // fmi2DoStep with h = 1e300 (or 1e6) used to overflow the substep count and never return.
+        let mut w = Wheel::default();
+        w.initialize(&InitContext::default()).unwrap();
+        for h in [1e300, 1e6, f64::MAX] {
+            let e = w.do_step(0.0, h).unwrap_err();
+            assert!(matches!(e, ModelError::StepTooLong(_)), "{e}");
+        }
+        assert_eq!(w.y, [0.1, 0.0], "a refused step leaves the state");
+        w.do_step(0.0, 0.01).unwrap();
     }
 
     #[test]

@@ -1,20 +1,47 @@
 //! Fixed-step integrators shared by the models.
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
+pub mod simd;
 pub mod zhai;
 
-/// Number of equal substeps of length <= `h_max` that cover `span` (at least 1).
+/// Largest number of internal substeps one communication step may take. A step that would
+/// need more is refused before any work is done (an absurd step such as 1e300 s would
+/// otherwise run for ever): split it into shorter communication steps. 10⁷ substeps take
+/// about 0.2 s for the Wheel (h = 1 ms: steps up to 10⁴ s) and about a minute for
+/// VehicleTrack (dt = 0.1 ms: steps up to 1 000 s).
+pub const MAX_SUBSTEPS: usize = 10_000_000;
+
+/// A step that needs more than [`MAX_SUBSTEPS`] substeps (or a step that is not a number).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "a step of {span} s needs {needed:.3e} internal substeps of at most {h_max} s, more than the \
+     {MAX_SUBSTEPS} allowed per step: use shorter communication steps"
+)]
+pub struct TooManySubsteps {
+    /// The step (s).
+    pub span: f64,
+    /// The largest substep (s).
+    pub h_max: f64,
+    /// Substeps it would need.
+    pub needed: f64,
+}
+
+/// Number of equal substeps of length <= `h_max` that cover `span` (at least 1), or an error
+/// when that number exceeds [`MAX_SUBSTEPS`] or is not a number.
 ///
 /// A communication step of 0.010000000000000009 s with `h_max` = 1e-3 s gives 10 substeps,
 /// not 11: the ratio is rounded up only beyond a relative tolerance of 1e-9.
-pub fn substeps(span: f64, h_max: f64) -> usize {
+pub fn substeps(span: f64, h_max: f64) -> Result<usize, TooManySubsteps> {
     let r = span / h_max;
     let n = (r - 1e-9 * r.max(1.0)).ceil();
-    if n.is_finite() && n >= 1.0 {
-        n as usize
-    } else {
-        1
+    if n.is_nan() || n > MAX_SUBSTEPS as f64 {
+        return Err(TooManySubsteps {
+            span,
+            h_max,
+            needed: n,
+        });
     }
+    Ok(if n >= 1.0 { n as usize } else { 1 })
 }
 
 /// One classical Runge–Kutta (RK4) step of y' = f(t, y) from `t` with step `h`, in place.
@@ -50,11 +77,26 @@ mod tests {
 
     #[test]
     fn substeps_tolerates_importer_rounding() {
-        assert_eq!(substeps(0.010000000000000009, 1e-3), 10);
-        assert_eq!(substeps(0.01, 1e-3), 10);
-        assert_eq!(substeps(0.0105, 1e-3), 11);
-        assert_eq!(substeps(1e-4, 1e-3), 1);
-        assert_eq!(substeps(0.0, 1e-3), 1);
+        assert_eq!(substeps(0.010000000000000009, 1e-3), Ok(10));
+        assert_eq!(substeps(0.01, 1e-3), Ok(10));
+        assert_eq!(substeps(0.0105, 1e-3), Ok(11));
+        assert_eq!(substeps(1e-4, 1e-3), Ok(1));
+        assert_eq!(substeps(0.0, 1e-3), Ok(1));
+    }
+
+    #[test]
+    fn an_absurd_step_is_refused_not_counted_into_an_overflow() {
+        // h = 1e300 (and 1e6) used to give usize::MAX substeps: a loop that never ended.
+        for span in [1e300, 1e6, f64::MAX, f64::INFINITY, f64::NAN] {
+            let e = substeps(span, 1e-4).unwrap_err();
+            assert!(
+                e.to_string().contains("use shorter communication steps"),
+                "{e}"
+            );
+        }
+        let limit = MAX_SUBSTEPS as f64 * 1e-4;
+        assert_eq!(substeps(limit, 1e-4), Ok(MAX_SUBSTEPS));
+        assert!(substeps(limit * (1.0 + 1e-6), 1e-4).is_err());
     }
 
     #[test]

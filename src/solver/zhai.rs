@@ -66,24 +66,38 @@ impl Zhai {
     }
 
     /// One step of length `h` (s). `accel(x, v, a)` writes `M⁻¹F(x, v)` into `a`.
+    #[inline(always)]
     pub fn step<E>(
         &mut self,
         h: f64,
         mut accel: impl FnMut(&[f64], &[f64], &mut [f64]) -> Result<(), E>,
     ) -> Result<(), E> {
+        self.predict(h);
+        accel(&self.x, &self.v, &mut self.a)?;
+        self.commit(h);
+        Ok(())
+    }
+
+    /// First half of [`Zhai::step`]: advances x and v by `h` (s) and moves a to a_prev; the
+    /// caller then writes `M⁻¹F(x, v)` into `a` and calls [`Zhai::commit`].
+    #[inline(always)]
+    pub fn predict(&mut self, h: f64) {
         let same_h = self.started && (h - self.last_h).abs() <= 1e-12 * h.abs();
         let (psi, phi) = if same_h { (PSI, PSI) } else { (0.0, 0.0) };
         let h2 = h * h;
-        for i in 0..self.x.len() {
-            let (a, ap) = (self.a[i], self.a_prev[i]);
-            self.x[i] += self.v[i] * h + (0.5 + psi) * a * h2 - psi * ap * h2;
-            self.v[i] += (1.0 + phi) * a * h - phi * ap * h;
+        let state = self.x.iter_mut().zip(self.v.iter_mut());
+        for ((x, v), (&a, &ap)) in state.zip(self.a.iter().zip(&self.a_prev)) {
+            *x += *v * h + (0.5 + psi) * a * h2 - psi * ap * h2;
+            *v += (1.0 + phi) * a * h - phi * ap * h;
         }
         std::mem::swap(&mut self.a, &mut self.a_prev);
-        accel(&self.x, &self.v, &mut self.a)?;
+    }
+
+    /// Second half of [`Zhai::step`], after the new accelerations are in `a`.
+    #[inline(always)]
+    pub fn commit(&mut self, h: f64) {
         self.started = true;
         self.last_h = h;
-        Ok(())
     }
 }
 

@@ -449,7 +449,8 @@ fn simulate(a: SimulateArgs) -> Result<()> {
 
 fn inspect(path: &Path) -> Result<()> {
     let fmu = Fmu::open(path)?;
-    let mut o = std::io::stdout().lock();
+    // Buffered: one write per line would cost a system call per variable.
+    let mut o = std::io::BufWriter::new(std::io::stdout().lock());
     let md = fmu.description();
     let cs = &md.co_simulation;
     writeln!(
@@ -508,5 +509,6 @@ fn inspect(path: &Path) -> Result<()> {
             v.description.as_deref().unwrap_or("")
         )?;
     }
+    o.flush()?;
     Ok(())
 }

@@ -71,7 +71,7 @@ impl Contact {
     }
 
     /// Contact force P (N) at compression `delta` (m); 0 when the wheel is off the rail.
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, delta: f64) -> f64 {
         match self.law {
             ContactLaw::Hertz => {

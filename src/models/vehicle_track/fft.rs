@@ -15,11 +15,13 @@
 //! symmetric and `D·D = (n/2) I`, so the same routine maps modes to sleepers and sleeper
 //! forces back to modal forces, and `(2/n) D` inverts it.
 //!
-//! Everything is planned once (twiddles, bit reversal, scratch); [`DstI::transform`] and
-//! [`Fft::forward`] never allocate.
+//! [`DstI`] runs the complex FFT of the rustfft crate (planned once, with its scratch); the
+//! own radix-2 [`Fft`] serves the irregularity generator and [`PlainDstI`], the plain
+//! reference the fast transform is tested against. Nothing here allocates per transform.
 #![forbid(unsafe_code)]
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// A complex number (no arithmetic traits: the few operations needed are written out).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -150,9 +152,226 @@ impl Fft {
     }
 }
 
-/// DST-I plan of size `N` (with `N + 1` a power of two), see the module documentation.
-#[derive(Clone, Debug)]
+/// Which complex FFT of rustfft a [`DstI`] runs on. rustfft selects its instruction set at
+/// run time ([`FftPath::Auto`]: AVX, else SSE4.1, else scalar); the others force one path,
+/// so that tests can check every path the machine has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FftPath {
+    /// rustfft's own choice for this CPU.
+    #[default]
+    Auto,
+    /// Portable scalar code.
+    Scalar,
+    /// SSE4.1 (x86_64 only).
+    Sse,
+    /// AVX and FMA (x86_64 only).
+    Avx,
+}
+
+impl FftPath {
+    /// The paths this machine can run (always `Auto` and `Scalar`).
+    pub fn available() -> Vec<FftPath> {
+        let mut v = vec![FftPath::Auto, FftPath::Scalar];
+        if rustfft::FftPlannerSse::<f64>::new().is_ok() {
+            v.push(FftPath::Sse);
+        }
+        if rustfft::FftPlannerAvx::<f64>::new().is_ok() {
+            v.push(FftPath::Avx);
+        }
+        v
+    }
+
+    fn plan(self, len: usize) -> Result<Arc<dyn rustfft::Fft<f64>>, String> {
+        let dir = rustfft::FftDirection::Forward;
+        let unsupported = || format!("FFT path {self:?} is not supported by this CPU");
+        Ok(match self {
+            FftPath::Auto => rustfft::FftPlanner::new().plan_fft(len, dir),
+            FftPath::Scalar => rustfft::FftPlannerScalar::new().plan_fft(len, dir),
+            FftPath::Sse => rustfft::FftPlannerSse::new()
+                .map_err(|()| unsupported())?
+                .plan_fft(len, dir),
+            FftPath::Avx => rustfft::FftPlannerAvx::new()
+                .map_err(|()| unsupported())?
+                .plan_fft(len, dir),
+        })
+    }
+}
+
+type C64 = rustfft::num_complex::Complex<f64>;
+
+/// DST-I plan of size `N` (with `N + 1` a power of two), see the module documentation: the
+/// same algorithm as [`PlainDstI`], on rustfft's complex FFT, with the passes before and
+/// after it written as straight loops the compiler vectorizes.
+#[derive(Clone)]
 pub struct DstI {
+    size: usize,
+    n: usize,
+    fft: Arc<dyn rustfft::Fft<f64>>,
+    path: FftPath,
+    /// `sin(jπ/n)`, j = 0..n.
+    sin_j: Vec<f64>,
+    /// Re and Im of `e^{−2πik/n}`, k = 0..n/2.
+    w_re: Vec<f64>,
+    w_im: Vec<f64>,
+    /// Scratch: I_k, k = 0..n/2.
+    y: Vec<f64>,
+    /// Scratch: the packed sequence, and rustfft's scratch.
+    z: Vec<C64>,
+    scratch: Vec<C64>,
+    /// Scratch: R_k, k = 0..n/2.
+    r: Vec<f64>,
+}
+
+impl std::fmt::Debug for DstI {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DstI")
+            .field("size", &self.size)
+            .field("path", &self.path)
+            .finish_non_exhaustive()
+    }
+}
+
+impl DstI {
+    /// Plans a DST-I of `size` points on rustfft's choice of instruction set; `size + 1`
+    /// must be a power of two ≥ 2.
+    pub fn new(size: usize) -> Result<Self, String> {
+        Self::with_path(size, FftPath::Auto)
+    }
+
+    /// Plans a DST-I of `size` points on the FFT path `path`.
+    pub fn with_path(size: usize, path: FftPath) -> Result<Self, String> {
+        let n = size + 1;
+        if size == 0 || !n.is_power_of_two() {
+            return Err(format!(
+                "DST-I size {size}: size + 1 must be a power of two (e.g. 63, 127, 255, 511)"
+            ));
+        }
+        let m = n / 2;
+        let fft = path.plan(m)?;
+        let scratch = vec![C64::default(); fft.get_inplace_scratch_len()];
+        let w = |k: usize| -2.0 * PI * k as f64 / n as f64;
+        Ok(Self {
+            size,
+            n,
+            fft,
+            path,
+            sin_j: (0..n).map(|j| (PI * j as f64 / n as f64).sin()).collect(),
+            w_re: (0..m).map(|k| w(k).cos()).collect(),
+            w_im: (0..m).map(|k| w(k).sin()).collect(),
+            y: vec![0.0; m],
+            z: vec![C64::default(); m],
+            scratch,
+            r: vec![0.0; m],
+        })
+    }
+
+    /// The FFT path this plan runs on.
+    pub fn path(&self) -> FftPath {
+        self.path
+    }
+
+    /// The number of points N.
+    pub fn len(&self) -> usize {
+        self.size
+    }
+
+    /// Whether N is zero (never).
+    pub fn is_empty(&self) -> bool {
+        self.size == 0
+    }
+
+    /// `out[i−1] = Σ_{k=1}^{N} input[k−1] sin(π k i/(N+1))`, i = 1..N. No allocation.
+    #[inline(always)]
+    pub fn transform(&mut self, input: &[f64], out: &mut [f64]) {
+        let (n, size) = (self.n, self.size);
+        assert!(
+            input.len() == size && out.len() == size,
+            "DST-I buffer length"
+        );
+        let m = n / 2;
+        if m == 1 {
+            out[0] = input[0];
+            return;
+        }
+        // y_j = sin(jπ/n)(b_j + b_{n−j}) + ½(b_j − b_{n−j}), j = 1..n−1, y_0 = 0, b_j = input[j − 1],
+        // written straight into the FFT buffer: z_p = y_{2p} + i y_{2p+1} is y in memory.
+        let y: &mut [f64] = bytemuck::cast_slice_mut(&mut self.z[..m]);
+        let (inp, sin_j) = (&input[..n - 1], &self.sin_j[..n]);
+        y[0] = 0.0;
+        for (((y, &s), &bj), &bc) in y[1..]
+            .iter_mut()
+            .zip(&sin_j[1..])
+            .zip(inp)
+            .zip(inp.iter().rev())
+        {
+            *y = s * (bj + bc) + 0.5 * (bj - bc);
+        }
+        self.fft
+            .process_with_scratch(&mut self.z, &mut self.scratch);
+        // Real DFT Y_k = R_k − i I_k = E_k + w_k O_k of y, with E_k = (Z_k + conj Z_{m−k})/2 and
+        // O_k = (Z_k − conj Z_{m−k})/(2i), k = 1..m−1: I_k and R_k into two arrays.
+        let z = &self.z[..m];
+        let (odd, r) = (&mut self.y[..m], &mut self.r[..m]);
+        let terms = z[1..]
+            .iter()
+            .zip(z[1..].iter().rev())
+            .zip(self.w_re[1..m].iter().zip(&self.w_im[1..m]));
+        for ((o, r), ((zk, zc), (&wr, &wi))) in odd[1..].iter_mut().zip(&mut r[1..]).zip(terms) {
+            let (er, ei) = (0.5 * (zk.re + zc.re), 0.5 * (zk.im - zc.im));
+            let (or, oi) = (0.5 * (zk.im + zc.im), -0.5 * (zk.re - zc.re));
+            *r = er + wr * or - wi * oi;
+            *o = -(ei + wr * oi + wi * or);
+        }
+        // S_1 = R_0/2, S_{2k+1} = S_{2k−1} + R_k: a prefix sum in place, in four blocks run
+        // side by side (independent chains), then each block offset by the sums before it.
+        r[0] = 0.5 * (z[0].re + z[0].im);
+        if m < 8 {
+            for k in 1..m {
+                r[k] += r[k - 1];
+            }
+        } else {
+            let q = m / 4;
+            let (b0, rest) = r.split_at_mut(q);
+            let (b1, rest) = rest.split_at_mut(q);
+            let (b2, b3) = rest.split_at_mut(q);
+            let mut acc = [0.0; 4];
+            for (((v0, v1), v2), v3) in b0
+                .iter_mut()
+                .zip(b1.iter_mut())
+                .zip(b2.iter_mut())
+                .zip(b3.iter_mut())
+            {
+                acc[0] += *v0;
+                *v0 = acc[0];
+                acc[1] += *v1;
+                *v1 = acc[1];
+                acc[2] += *v2;
+                *v2 = acc[2];
+                acc[3] += *v3;
+                *v3 = acc[3];
+            }
+            let (o1, o2) = (acc[0], acc[0] + acc[1]);
+            let o3 = o2 + acc[2];
+            for (blk, off) in [(b1, o1), (b2, o2), (b3, o3)] {
+                blk.iter_mut().for_each(|v| *v += off);
+            }
+        }
+        // S_{2k} = I_k, S_{2k+1} = prefix_k.
+        out[0] = r[0];
+        for (o, (&i, &s)) in out[1..]
+            .chunks_exact_mut(2)
+            .zip(odd[1..].iter().zip(&r[1..]))
+        {
+            o[0] = i;
+            o[1] = s;
+        }
+    }
+}
+
+/// The plain DST-I on the own radix-2 [`Fft`]: the reference implementation the fast
+/// [`DstI`] is tested against (and what the plain kernel of the track uses).
+#[derive(Clone, Debug)]
+pub struct PlainDstI {
     /// N, the number of interior points.
     size: usize,
     /// n = N + 1.
@@ -167,7 +386,7 @@ pub struct DstI {
     z: Vec<Complex>,
 }
 
-impl DstI {
+impl PlainDstI {
     /// Plans a DST-I of `size` points; `size + 1` must be a power of two ≥ 2.
     pub fn new(size: usize) -> Result<Self, String> {
         let n = size + 1;

@@ -15,14 +15,21 @@
 //! maps modes → sleepers and sleeper forces → modal forces are DST-I's of size N
 //! ([`super::fft::DstI`], N + 1 a power of two), O(N log N) per step. Modes k > N alias onto
 //! the sleeper grid (sin(kπi/n) = ± sin(k'πi/n)), which a fold of the modal vector handles,
-//! so any NM ≤ 2N + 1 works. The wheels sit anywhere: their mode values come from the
-//! recurrence sin((k+1)a) = 2 cos a sin(ka) − sin((k−1)a), 4 × NM operations.
+//! so any NM ≤ 2N + 1 works. The wheels sit anywhere: their mode values come from blocked
+//! complex rotations ([`Track::set_wheels`]), never stored: the two passes that use them run
+//! over the blocks.
+//!
+//! Two kernels compute the same equations ([`Kernel`]): the fast one (default) and the plain
+//! reference ([`super::plain`]) it is tested against; the fast one's stepping loop runs
+//! compiled for AVX2 where the CPU has it ([`crate::solver::simd`]).
 //!
 //! Track state layout (one slice): `[q_1..q_NM | Z_s1..Z_sN | Z_b1..Z_bN]`.
 //! Displacements are measured from the unloaded track (self-weight not modelled).
 #![forbid(unsafe_code)]
 
-use super::fft::DstI;
+use super::fft::{DstI, FftPath};
+use super::plain::{self, Plain};
+use crate::solver::simd::{Isa, Simd};
 use std::f64::consts::PI;
 
 /// Track data (SI units).
@@ -60,6 +67,46 @@ pub struct TrackParams {
     pub n_modes: usize,
 }
 
+/// Which implementation computes the track's accelerations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Kernel {
+    /// The fast kernel (the default) on the widest instruction set of this CPU and
+    /// rustfft's own choice of FFT.
+    #[default]
+    Fast,
+    /// The fast kernel on a given instruction set and FFT path (tests, benchmarks); refused
+    /// at initialization if this CPU lacks them.
+    Custom {
+        /// Instruction set of the kernel's loops.
+        isa: Isa,
+        /// Instruction set of the FFT.
+        fft: FftPath,
+    },
+    /// The plain reference implementation ([`super::plain`]).
+    Plain,
+}
+
+impl Kernel {
+    /// Every kernel this machine can run: each instruction set of the loops with each FFT
+    /// path, and the plain one.
+    pub fn available() -> Vec<Kernel> {
+        let mut v = Vec::new();
+        for simd in Simd::available() {
+            for fft in FftPath::available() {
+                v.push(Kernel::Custom {
+                    isa: simd.isa(),
+                    fft,
+                });
+            }
+        }
+        v.push(Kernel::Plain);
+        v
+    }
+}
+
+/// Modes per block of the wheels' mode shapes (see [`Track::set_wheels`]).
+const BLOCK: usize = 16;
+
 /// The track: parameters, transforms and scratch (allocated once).
 #[derive(Clone, Debug)]
 pub struct Track {
@@ -74,36 +121,64 @@ pub struct Track {
     /// √(2/(m_r l)) (1/√kg): amplitude of the mass-normalised modes.
     pub scale: f64,
     /// ω_k² = (EI/m_r)(kπ/l)⁴ (1/s²).
-    omega2: Vec<f64>,
+    pub(super) omega2: Vec<f64>,
     /// Sleeper-grid bin (0-based) of mode k, or `usize::MAX` when it vanishes at every sleeper.
-    fold_bin: Vec<usize>,
+    pub(super) fold_bin: Vec<usize>,
     /// Sign of the fold.
-    fold_sign: Vec<f64>,
+    pub(super) fold_sign: Vec<f64>,
     dst: DstI,
     dst_fine: DstI,
     bins: Vec<f64>,
     r: Vec<f64>,
     modal: Vec<f64>,
     frs: Vec<f64>,
+    /// Ballast shear forces per unit mass between blocks i−1 and i, i = 0..=N (ends 0).
+    shear: Vec<f64>,
     fine: Vec<f64>,
     fine_out: Vec<f64>,
-    /// sin(kπ x_wj / l) for the four wheels, row-major 4 × NM.
-    wheel_sin: Vec<f64>,
+    /// The wheels' mode shapes, in blocks of [`BLOCK`] modes (see [`Track::set_wheels`]):
+    /// `t_re[j][i] + i t_im[j][i]` = e^{i(i+1)a_j}, a_j = πx_j/l.
+    t_re: [[f64; BLOCK]; 4],
+    t_im: [[f64; BLOCK]; 4],
+    /// Block rotations e^{ibBa_j}, one per block b, the four wheels side by side.
+    u_re: Vec<[f64; 4]>,
+    u_im: Vec<[f64; 4]>,
+    /// Per wheel j: the position difference x_0 − x_j (m) the next two rotations belong to,
+    /// and e^{−iδ_j}, e^{−iBδ_j}, δ_j = π(x_0 − x_j)/l (cos, sin, cos, sin).
+    offsets: [(f64, [f64; 4]); 4],
+    kernel: Kernel,
+    simd: Simd,
+    /// The plain kernel's scratch, when it is selected.
+    pub(super) plain: Option<Plain>,
 }
 
 impl Track {
-    /// Builds the track (validates N and NM).
+    /// Builds the track (validates N and NM) with the fast kernel.
     pub fn new(p: TrackParams) -> Result<Self, String> {
+        Self::with_kernel(p, Kernel::Fast)
+    }
+
+    /// Builds the track with the given kernel.
+    pub fn with_kernel(p: TrackParams, kernel: Kernel) -> Result<Self, String> {
         let (n, nm) = (p.n_sleepers, p.n_modes);
-        let dst = DstI::new(n).map_err(|e| format!("n_sleepers = {n}: {e}"))?;
+        let (simd, path) = match kernel {
+            Kernel::Fast => (Simd::best(), FftPath::Auto),
+            Kernel::Custom { isa, fft } => (
+                Simd::new(isa).ok_or_else(|| format!("this CPU does not run {isa:?}"))?,
+                fft,
+            ),
+            Kernel::Plain => (Simd::baseline(), FftPath::Auto),
+        };
+        let dst = DstI::with_path(n, path).map_err(|e| format!("n_sleepers = {n}: {e}"))?;
         if nm == 0 || nm > 2 * n + 1 {
             return Err(format!(
                 "n_modes = {nm} must be between 1 and 2 n_sleepers + 1 = {}",
                 2 * n + 1
             ));
         }
-        let dst_fine = DstI::new(2 * n + 1)?;
+        let dst_fine = DstI::with_path(2 * n + 1, path)?;
         let length = (n + 1) as f64 * p.ls;
+        let blocks = nm.div_ceil(BLOCK);
         let period = 2 * (n + 1);
         let (mut fold_bin, mut fold_sign) = (Vec::with_capacity(nm), Vec::with_capacity(nm));
         for k in 1..=nm {
@@ -136,10 +211,31 @@ impl Track {
             r: vec![0.0; n],
             modal: vec![0.0; nm],
             frs: vec![0.0; n],
+            shear: vec![0.0; n + 1],
             fine: vec![0.0; 2 * n + 1],
             fine_out: vec![0.0; 2 * n + 1],
-            wheel_sin: vec![0.0; 4 * nm],
+            t_re: [[0.0; BLOCK]; 4],
+            t_im: [[0.0; BLOCK]; 4],
+            u_re: vec![[0.0; 4]; blocks],
+            u_im: vec![[0.0; 4]; blocks],
+            offsets: [(0.0, [1.0, 0.0, 1.0, 0.0]); 4],
+            kernel,
+            simd,
+            plain: match kernel {
+                Kernel::Plain => Some(Plain::new(n, nm)?),
+                _ => None,
+            },
         })
+    }
+
+    /// The kernel in use.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    /// The instruction set the stepping loop runs on.
+    pub fn simd(&self) -> Simd {
+        self.simd
     }
 
     /// Length of the track part of the state: NM + 2N.
@@ -195,101 +291,244 @@ impl Track {
         }
     }
 
-    /// Stores sin(kπx/l), k = 1..NM, for the wheels at local positions `x` (m, 0 < x < l),
-    /// by the three-term recurrence (the four wheels interleaved), re-seeded from `sin_cos`
-    /// every 128 modes to bound round-off growth.
+    /// Sets the wheels at local positions `x` (m, 0 < x < l) for the mode shapes
+    /// sin(kπx_j/l), k = 1..NM, which the fast kernel never stores: with a = πx/l and the
+    /// modes in blocks of B = 16, mode k = bB + i + 1 is
+    ///
+    /// ```text
+    /// sin(kπx/l) = Im(e^{ibBa} e^{i(i+1)a}) = Im(U_b) Re(T_i) + Re(U_b) Im(T_i)
+    /// ```
+    ///
+    /// from a table T_i = e^{i(i+1)a}, i < B, and block rotations U_b = e^{ibBa}, each by
+    /// repeated complex multiplication. Only wheel 0 calls `sin_cos` (of a and Ba): the others
+    /// are rotated from it by their fixed distances to wheel 0, whose rotations are kept.
+    /// Rotations keep the error at a few tens of ulps, without the 1/sin(a) growth of a
+    /// three-term recurrence; the consumers ([`Track::rail_at_wheels`], the modal wheel forces)
+    /// run over the blocks as vector loops.
+    #[inline(always)]
     pub fn set_wheels(&mut self, x: &[f64; 4]) {
-        let nm = self.nm;
-        let a: [f64; 4] = std::array::from_fn(|j| PI * x[j] / self.length);
-        let sc: [(f64, f64); 4] = std::array::from_fn(|j| a[j].sin_cos());
-        let c2: [f64; 4] = std::array::from_fn(|j| 2.0 * sc[j].1);
-        const CHUNK: usize = 128;
-        for (chunk_no, chunk) in self.wheel_sin.chunks_mut(4 * CHUNK).enumerate() {
-            let k0 = chunk_no * CHUNK; // first mode of the chunk is k0 + 1
-            let mut prev = [0.0; 4];
-            let mut cur = [0.0; 4];
-            for j in 0..4 {
-                // sin(k0 a) and sin((k0 + 1) a) = sin(k0 a) cos a + cos(k0 a) sin a.
-                let (s0, c0) = if k0 == 0 {
-                    (0.0, 1.0)
-                } else {
-                    (k0 as f64 * a[j]).sin_cos()
-                };
-                prev[j] = s0;
-                cur[j] = s0 * sc[j].1 + c0 * sc[j].0;
+        if let Some(pl) = self.plain.as_mut() {
+            pl.set_wheels(self.length, x);
+            return;
+        }
+        let a0 = PI * x[0] / self.length;
+        let (s1, c1) = a0.sin_cos();
+        let (sb, cb) = (BLOCK as f64 * a0).sin_cos();
+        let mut one = [(0.0, 0.0); 4];
+        let mut big = [(0.0, 0.0); 4];
+        for j in 0..4 {
+            let d = x[0] - x[j];
+            if (d - self.offsets[j].0).abs() > 1e-12 * d.abs().max(1.0) {
+                self.offsets[j] = Self::offset_rotations(d, self.length);
             }
-            for row in chunk.chunks_exact_mut(4) {
-                for j in 0..4 {
-                    row[j] = cur[j];
-                    let next = c2[j] * cur[j] - prev[j];
-                    prev[j] = cur[j];
-                    cur[j] = next;
-                }
+            let r = self.offsets[j].1;
+            // e^{ia_j} = e^{ia_0} e^{−iδ_j}, likewise for Ba.
+            one[j] = (c1 * r[0] + s1 * r[1], s1 * r[0] - c1 * r[1]);
+            big[j] = (cb * r[2] + sb * r[3], sb * r[2] - cb * r[3]);
+        }
+        let (mut pr, mut pi) = ([0.0; 4], [0.0; 4]);
+        for j in 0..4 {
+            (pr[j], pi[j]) = one[j];
+        }
+        for i in 0..BLOCK {
+            for j in 0..4 {
+                self.t_re[j][i] = pr[j];
+                self.t_im[j][i] = pi[j];
+                let (c, s) = one[j];
+                (pr[j], pi[j]) = (pr[j] * c - pi[j] * s, pi[j] * c + pr[j] * s);
             }
         }
-        debug_assert_eq!(self.wheel_sin.len(), 4 * nm);
+        let (mut ur, mut ui) = ([1.0; 4], [0.0; 4]);
+        for (re, im) in self.u_re.iter_mut().zip(self.u_im.iter_mut()) {
+            *re = ur;
+            *im = ui;
+            for j in 0..4 {
+                let (c, s) = big[j];
+                (ur[j], ui[j]) = (ur[j] * c - ui[j] * s, ui[j] * c + ur[j] * s);
+            }
+        }
     }
 
-    /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`.
+    /// e^{−iδ}, e^{−iBδ} of δ = πd/l for wheels a distance `d` (m) behind wheel 0.
+    #[cold]
+    fn offset_rotations(d: f64, length: f64) -> (f64, [f64; 4]) {
+        let delta = PI * d / length;
+        let (s, c) = delta.sin_cos();
+        let (sb, cb) = (BLOCK as f64 * delta).sin_cos();
+        (d, [c, s, cb, sb])
+    }
+
+    /// Rail displacement Zr (m) under each wheel (after [`Track::set_wheels`]) from modal `q`:
+    /// Σ_k sin(kπx_j/l) q_k = Σ_i [Re T_i Σ_b Im U_b q_{bB+i} + Im T_i Σ_b Re U_b q_{bB+i}].
+    #[inline(always)]
     pub fn rail_at_wheels(&self, q: &[f64]) -> [f64; 4] {
-        let mut out = [0.0; 4];
-        for (row, &qk) in self.wheel_sin.chunks_exact(4).zip(q) {
-            for j in 0..4 {
-                out[j] += row[j] * qk;
-            }
+        if let Some(pl) = &self.plain {
+            return pl.rail_at_wheels(self.scale, q);
         }
-        out.map(|v| v * self.scale)
+        let q = &q[..self.nm];
+        let blocks = q.chunks_exact(BLOCK);
+        let tail = blocks.remainder();
+        let mut out = [0.0; 4];
+        for j in 0..4 {
+            let (mut vr, mut vi) = ([0.0; BLOCK], [0.0; BLOCK]);
+            for ((qb, ur), ui) in blocks.clone().zip(&self.u_re).zip(&self.u_im) {
+                let (ur, ui) = (ur[j], ui[j]);
+                for ((r, i), &qk) in vr.iter_mut().zip(vi.iter_mut()).zip(qb) {
+                    *r += ui * qk;
+                    *i += ur * qk;
+                }
+            }
+            let last = q.len() / BLOCK;
+            for ((r, i), &qk) in vr.iter_mut().zip(vi.iter_mut()).zip(tail) {
+                *r += self.u_im[last][j] * qk;
+                *i += self.u_re[last][j] * qk;
+            }
+            let mut sum = [0.0; 4];
+            for (l, ((&tr, &ti), (&r, &i))) in self.t_re[j]
+                .iter()
+                .zip(&self.t_im[j])
+                .zip(vr.iter().zip(&vi))
+                .enumerate()
+            {
+                sum[l % 4] += tr * r + ti * i;
+            }
+            out[j] = ((sum[0] + sum[1]) + (sum[2] + sum[3])) * self.scale;
+        }
+        out
     }
 
     /// Value of mode shape sin(kπx_j/l) at wheel j (after [`Track::set_wheels`]), k ≥ 1.
     pub fn wheel_sine(&self, j: usize, k: usize) -> f64 {
-        self.wheel_sin[4 * (k - 1) + j]
+        match &self.plain {
+            Some(pl) => pl.wheel_sine(j, k),
+            None => {
+                let (b, i) = ((k - 1) / BLOCK, (k - 1) % BLOCK);
+                self.u_im[b][j] * self.t_re[j][i] + self.u_re[b][j] * self.t_im[j][i]
+            }
+        }
     }
 
     /// Track accelerations `acc` from positions `y`, velocities `yd` (track layout) and the
     /// wheel–rail forces `p` (N) at the wheels set by [`Track::set_wheels`]. No allocation.
+    ///
+    /// The fast kernel: two sine transforms ([`DstI`]) and straight loops over zipped slices
+    /// (no bounds checks, vectorized); the modal forces of pads, stiffness and wheels in one
+    /// pass; the ballast shear through a scratch array instead of a loop-carried update.
+    #[inline(always)]
     pub fn accelerations(&mut self, y: &[f64], yd: &[f64], p: &[f64; 4], acc: &mut [f64]) {
-        let (n, nm) = (self.n, self.nm);
-        let (q, zs, zb) = (&y[..nm], &y[nm..nm + n], &y[nm + n..nm + 2 * n]);
-        let (qd, zsd, zbd) = (&yd[..nm], &yd[nm..nm + n], &yd[nm + n..nm + 2 * n]);
-        let t = self.p;
-        // The pads only see Kp Zr + Cp Zr' at the sleepers: one transform of Kp q + Cp q'.
-        for ((w, &a), &b) in self.modal.iter_mut().zip(q).zip(qd) {
-            *w = t.kp * a + t.cp * b;
+        if self.plain.is_some() {
+            plain::accelerations(self, y, yd, p, acc);
+            return;
         }
-        Self::synthesize(
-            &mut self.dst,
-            &self.fold_bin,
-            &self.fold_sign,
-            self.scale,
-            &self.modal,
-            &mut self.bins,
-            &mut self.r,
-        );
-        let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
-        let (acc_q, rest) = acc.split_at_mut(nm);
+        let (n, nm, scale) = (self.n, self.nm, self.scale);
+        let t = self.p;
+        let (q, rest) = y[..nm + 2 * n].split_at(nm);
+        let (zs, zb) = rest.split_at(n);
+        let (qd, rest) = yd[..nm + 2 * n].split_at(nm);
+        let (zsd, zbd) = rest.split_at(n);
+        let (acc_q, rest) = acc[..nm + 2 * n].split_at_mut(nm);
         let (acc_s, acc_b) = rest.split_at_mut(n);
-        for i in 0..n {
-            let frs = self.r[i] - t.kp * zs[i] - t.cp * zsd[i];
-            let fb = t.kb * (zs[i] - zb[i]) + t.cb * (zsd[i] - zbd[i]);
-            self.frs[i] = frs;
-            acc_s[i] = (frs - fb) * inv_ms;
-            acc_b[i] = (fb - t.kf * zb[i] - t.cf * zbd[i]) * inv_mb;
+        // The pads only see Kp Zr + Cp Zr' at the sleepers: one transform of Kp q + Cp q'.
+        if nm <= n {
+            for ((b, &a), &ad) in self.bins.iter_mut().zip(q).zip(qd) {
+                *b = t.kp * a + t.cp * ad;
+            }
+            self.bins[nm..].fill(0.0);
+        } else {
+            for ((w, &a), &ad) in self.modal.iter_mut().zip(q).zip(qd) {
+                *w = t.kp * a + t.cp * ad;
+            }
+            self.bins.fill(0.0);
+            for ((&b, &s), &w) in self.fold_bin.iter().zip(&self.fold_sign).zip(&self.modal) {
+                if b != usize::MAX {
+                    self.bins[b] += s * w;
+                }
+            }
+        }
+        self.dst.transform(&self.bins, &mut self.r);
+        let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
+        let sleepers = self
+            .r
+            .iter()
+            .zip(&mut self.frs)
+            .zip(zs.iter().zip(zsd))
+            .zip(zb.iter().zip(zbd))
+            .zip(acc_s.iter_mut().zip(acc_b.iter_mut()));
+        for ((((&r, f), (&s, &sd)), (&b, &bd)), (a_s, a_b)) in sleepers {
+            let frs = r * scale - t.kp * s - t.cp * sd;
+            let fb = t.kb * (s - b) + t.cb * (sd - bd);
+            *f = frs;
+            *a_s = (frs - fb) * inv_ms;
+            *a_b = (fb - t.kf * b - t.cf * bd) * inv_mb;
         }
         // Ballast shear: Kw, Cw between neighbouring blocks (end blocks have one neighbour).
         let (kw, cw) = (t.kw * inv_mb, t.cw * inv_mb);
-        for i in 0..n - 1 {
-            let f = kw * (zb[i] - zb[i + 1]) + cw * (zbd[i] - zbd[i + 1]);
-            acc_b[i] -= f;
-            acc_b[i + 1] += f;
+        let pairs = zb.windows(2).zip(zbd.windows(2));
+        for (sh, (b, bd)) in self.shear[1..n].iter_mut().zip(pairs) {
+            *sh = kw * (b[0] - b[1]) + cw * (bd[0] - bd[1]);
         }
-        for ((a, &w2), &qk) in acc_q.iter_mut().zip(&self.omega2).zip(q) {
-            *a = -w2 * qk;
+        self.shear[0] = 0.0;
+        self.shear[n] = 0.0;
+        for (a, sh) in acc_b.iter_mut().zip(self.shear.windows(2)) {
+            *a = (*a + sh[0]) - sh[1];
         }
-        self.analyze_add(-1.0, acc_q);
-        let c: [f64; 4] = std::array::from_fn(|j| self.scale * p[j]);
-        for (a, row) in acc_q.iter_mut().zip(self.wheel_sin.chunks_exact(4)) {
-            *a += c[0] * row[0] + c[1] * row[1] + c[2] * row[2] + c[3] * row[3];
+        // Modal forces: stiffness, pads (the transposed map), wheels.
+        self.dst.transform(&self.frs, &mut self.bins);
+        let c = -scale;
+        if nm <= n {
+            let modes = acc_q
+                .iter_mut()
+                .zip(q)
+                .zip(&self.omega2)
+                .zip(&self.bins[..nm]);
+            for (((a, &qk), &w2), &b) in modes {
+                *a = -w2 * qk + c * b;
+            }
+        } else {
+            let folds = self.fold_bin.iter().zip(&self.fold_sign);
+            let modes = acc_q.iter_mut().zip(q).zip(&self.omega2).zip(folds);
+            for (((a, &qk), &w2), (&b, &sg)) in modes {
+                *a = if b == usize::MAX {
+                    -w2 * qk
+                } else {
+                    -w2 * qk + c * sg * self.bins[b]
+                };
+            }
+        }
+        let cw: [f64; 4] = std::array::from_fn(|j| scale * p[j]);
+        self.add_wheel_forces(&cw, acc_q);
+    }
+
+    /// `acc_q[k] += Σ_j cw_j sin((k+1)πx_j/l)`, block by block: within block b the wheel
+    /// term is Σ_j (cw_j Im U_b) Re T_i + (cw_j Re U_b) Im T_i.
+    #[inline(always)]
+    fn add_wheel_forces(&self, cw: &[f64; 4], acc_q: &mut [f64]) {
+        let (tr, ti) = (&self.t_re, &self.t_im);
+        let term = |a: &[f64; 4], b: &[f64; 4], i: usize| {
+            ((a[0] * tr[0][i] + b[0] * ti[0][i]) + (a[1] * tr[1][i] + b[1] * ti[1][i]))
+                + ((a[2] * tr[2][i] + b[2] * ti[2][i]) + (a[3] * tr[3][i] + b[3] * ti[3][i]))
+        };
+        let coefficients = |blk: usize| -> ([f64; 4], [f64; 4]) {
+            let (ur, ui) = (&self.u_re[blk], &self.u_im[blk]);
+            (
+                std::array::from_fn(|j| cw[j] * ui[j]),
+                std::array::from_fn(|j| cw[j] * ur[j]),
+            )
+        };
+        let mut blocks = acc_q.chunks_exact_mut(BLOCK);
+        for (blk, out) in (&mut blocks).enumerate() {
+            let (a, b) = coefficients(blk);
+            let out: &mut [f64; BLOCK] = out.try_into().expect("a whole block");
+            for (i, o) in out.iter_mut().enumerate() {
+                *o += term(&a, &b, i);
+            }
+        }
+        let tail = blocks.into_remainder();
+        if !tail.is_empty() {
+            let (a, b) = coefficients(self.nm / BLOCK);
+            for (i, o) in tail.iter_mut().enumerate() {
+                *o += term(&a, &b, i);
+            }
         }
     }
 
@@ -337,8 +576,11 @@ impl Track {
         let (n, nm, dim) = (self.n, self.nm, self.dim());
         let t = self.p;
         let mut b = vec![0.0; dim];
-        for (k, row) in self.wheel_sin.chunks_exact(4).enumerate() {
-            b[k] = self.scale * (0..4).map(|j| p[j] * row[j]).sum::<f64>();
+        for (k, bk) in b[..nm].iter_mut().enumerate() {
+            *bk = self.scale
+                * (0..4)
+                    .map(|j| p[j] * self.wheel_sine(j, k + 1))
+                    .sum::<f64>();
         }
         let half = (n + 1) as f64 / 2.0;
         let mut diag = vec![0.0; dim];

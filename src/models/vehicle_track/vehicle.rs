@@ -81,7 +81,7 @@ impl HalfVehicle {
 
     /// Accelerations `a` (m/s², rad/s²) of the ten DOFs at displacements `x`, velocities `v`
     /// and wheel–rail forces `p` (N).
-    #[inline]
+    #[inline(always)]
     pub fn accelerations(&self, x: &[f64], v: &[f64], p: &[f64; 4], a: &mut [f64]) {
         let s = self;
         let fs1 = s.ksz * (x[ZC] - s.lc * x[BC] - x[ZT1]) + s.csz * (v[ZC] - s.lc * v[BC] - v[ZT1]);

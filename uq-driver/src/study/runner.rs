@@ -308,6 +308,9 @@ pub fn run_points(
     let started = Instant::now();
     let manifest = manifest(study, fmu, design)?;
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
+    if let Some(note) = store.recovery().summary() {
+        eprintln!("warning: {note}");
+    }
     let wanted: Vec<usize> = match &opts.points {
         Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
         None => (0..design.len()).collect(),

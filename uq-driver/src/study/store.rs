@@ -2,12 +2,20 @@
 //! interrupted study resumes where it stopped.
 //!
 //! Layout of `DIR/store/`: `manifest.json` (fingerprint of the study and the FMU, number of
-//! points and values per point) and `records.bin`, a sequence of records
-//! `"REC1" | index u64 | kind u8 (0 ok, 1 failed) | length u64 | payload | checksum u64`
-//! (little endian; payload: f64 values, or a UTF-8 failure message; FNV-1a checksum over
-//! index, kind and payload). A torn record at the end (a kill during a write) is cut off on
-//! the next open.
+//! points and values per point) and `records.bin`, a sequence of CRC-32-framed records (see
+//! [`format`] for the bytes).
+//!
+//! Opening never panics and never gives up on good records: a damaged record is skipped and
+//! reading resumes at the next valid one. What was skipped, and which points therefore have no
+//! result and run again, is returned as a [`Recovery`] ([`Store::recovery`]). A damaged tail (a
+//! kill during a write) is cut off; damage before the last valid record makes the store
+//! rewrite `records.bin` with its valid records only, keeping the damaged file beside it as
+//! `records.damaged-<unix seconds>.bin`. A store of the previous format (format 1, before
+//! issue 12) is read and converted, the old file kept as `records.v1.bin`.
 
+pub mod format;
+
+use std::fmt;
 use std::fs::{self, File, OpenOptions};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -15,7 +23,7 @@ use std::sync::Mutex;
 
 use serde::{Deserialize, Serialize};
 
-const MAGIC: &[u8; 4] = b"REC1";
+pub use format::{decode, encode, Decoded, Format, Skipped};
 
 /// What the store is for; a store written for another study is refused.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -68,12 +76,119 @@ pub enum StoreError {
     },
 }
 
+/// What opening the store skipped or repaired. Empty ([`Recovery::is_clean`]) for an intact
+/// store.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Recovery {
+    /// `records.bin`.
+    pub path: PathBuf,
+    /// Damaged stretches skipped, in file order (byte offsets into the file as it was found).
+    pub skipped: Vec<Skipped>,
+    /// Points named by a damaged record (or a record that did not fit the design) that have
+    /// no valid record: they have no result now and run again. Sorted.
+    pub rerun: Vec<usize>,
+    /// Points of the design without a result after opening (including never-run ones).
+    pub missing: usize,
+    /// Valid records kept.
+    pub kept: usize,
+    /// Bytes cut off the end of the file (a torn or damaged tail), if any.
+    pub truncated: Option<u64>,
+    /// Where the file as found was kept, when the store rewrote `records.bin`.
+    pub backup: Option<PathBuf>,
+    /// Whether the store was converted from format 1.
+    pub converted_from_v1: bool,
+}
+
+impl Recovery {
+    /// Whether the store was intact (nothing skipped, cut or converted).
+    pub fn is_clean(&self) -> bool {
+        self.skipped.is_empty() && self.truncated.is_none() && !self.converted_from_v1
+    }
+
+    /// A message for the user, or `None` when the store was intact.
+    pub fn summary(&self) -> Option<String> {
+        (!self.is_clean()).then(|| self.to_string())
+    }
+}
+
+impl fmt::Display for Recovery {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "results store {}: ", self.path.display())?;
+        if self.converted_from_v1 {
+            write!(f, "converted from the format before issue 12; ")?;
+        }
+        if !self.skipped.is_empty() {
+            let n = self.skipped.len();
+            write!(
+                f,
+                "skipped {n} damaged stretch{} (",
+                if n == 1 { "" } else { "es" }
+            )?;
+            for (k, s) in self.skipped.iter().take(5).enumerate() {
+                let sep = if k == 0 { "" } else { "; " };
+                write!(
+                    f,
+                    "{sep}bytes {}..{}: {}",
+                    s.bytes.start, s.bytes.end, s.reason
+                )?;
+                if let Some(p) = s.point {
+                    write!(f, ", point {p}")?;
+                }
+            }
+            if n > 5 {
+                write!(f, "; and {} more", n - 5)?;
+            }
+            write!(f, "); ")?;
+        }
+        if let Some(t) = self.truncated {
+            write!(f, "cut {t} bytes of a torn or damaged end; ")?;
+        }
+        write!(f, "kept {} valid records", self.kept)?;
+        if !self.rerun.is_empty() {
+            let shown: Vec<String> = self.rerun.iter().take(20).map(usize::to_string).collect();
+            let more = self.rerun.len().saturating_sub(20);
+            let more = if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            };
+            write!(
+                f,
+                "; point{} {}{more} lost {} record and will be run again",
+                if self.rerun.len() == 1 { "" } else { "s" },
+                shown.join(", "),
+                if self.rerun.len() == 1 {
+                    "its"
+                } else {
+                    "their"
+                }
+            )?;
+        }
+        let unnamed = self.skipped.iter().filter(|s| s.point.is_none()).count();
+        if unnamed > 0 {
+            write!(
+                f,
+                "; {unnamed} damaged stretch{} named no point: any point {} held is among the \
+                 {} points without a result, which a resumed run computes",
+                if unnamed == 1 { "" } else { "es" },
+                if unnamed == 1 { "it" } else { "they" },
+                self.missing
+            )?;
+        }
+        if let Some(b) = &self.backup {
+            write!(f, "; the file as found is kept as {}", b.display())?;
+        }
+        Ok(())
+    }
+}
+
 /// An open store, safe to append to from many threads.
 #[derive(Debug)]
 pub struct Store {
     path: PathBuf,
     file: Mutex<File>,
     n_values: usize,
+    recovery: Recovery,
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> StoreError + '_ {
@@ -83,75 +198,18 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> StoreError + '_ {
     }
 }
 
-fn checksum(index: u64, kind: u8, payload: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in index
-        .to_le_bytes()
-        .iter()
-        .chain(std::iter::once(&kind))
-        .chain(payload)
-    {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
-/// Encodes one record.
-pub fn encode(index: usize, rec: &Record) -> Vec<u8> {
-    let (kind, payload): (u8, Vec<u8>) = match rec {
-        Record::Ok(v) => (0, v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        Record::Failed(m) => (1, m.as_bytes().to_vec()),
-    };
-    let mut out = Vec::with_capacity(payload.len() + 29);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&(index as u64).to_le_bytes());
-    out.push(kind);
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&payload);
-    out.extend_from_slice(&checksum(index as u64, kind, &payload).to_le_bytes());
-    out
-}
-
-/// Decodes records from `bytes`; returns them and the length of the valid prefix.
+/// Decodes format-2 records from `bytes`, skipping damaged stretches; returns the records and
+/// the end of the last valid one.
 pub fn decode_all(bytes: &[u8], n_values: usize) -> (Vec<(usize, Record)>, usize) {
-    let mut out = Vec::new();
-    let mut pos = 0;
-    loop {
-        let rest = &bytes[pos..];
-        if rest.len() < 21 || &rest[..4] != MAGIC {
-            break;
-        }
-        let index = u64::from_le_bytes(rest[4..12].try_into().expect("8"));
-        let kind = rest[12];
-        let len = u64::from_le_bytes(rest[13..21].try_into().expect("8")) as usize;
-        if rest.len() < 21 + len + 8 {
-            break;
-        }
-        let payload = &rest[21..21 + len];
-        let sum = u64::from_le_bytes(rest[21 + len..29 + len].try_into().expect("8"));
-        if sum != checksum(index, kind, payload) {
-            break;
-        }
-        let rec = match kind {
-            0 if len == 8 * n_values => Record::Ok(
-                payload
-                    .chunks_exact(8)
-                    .map(|c| f64::from_le_bytes(c.try_into().expect("8")))
-                    .collect(),
-            ),
-            1 => Record::Failed(String::from_utf8_lossy(payload).into_owned()),
-            _ => break,
-        };
-        out.push((index as usize, rec));
-        pos += 29 + len;
-    }
-    (out, pos)
+    let d = format::decode_format(bytes, n_values, Format::V2);
+    let end = d.valid_end();
+    (d.records.into_iter().map(|(i, r, _)| (i, r)).collect(), end)
 }
 
 impl Store {
     /// Opens (or creates) the store in `dir/store` for `manifest`. Returns the store and the
-    /// records already finished, by point index (first record wins).
+    /// records already finished, by point index (first record wins). What was skipped or
+    /// repaired on the way is in [`Store::recovery`].
     pub fn open(
         dir: &Path,
         manifest: &Manifest,
@@ -162,28 +220,7 @@ impl Store {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
         }
         fs::create_dir_all(&sdir).map_err(io_err(&sdir))?;
-        let mpath = sdir.join("manifest.json");
-        if mpath.exists() {
-            let text = fs::read_to_string(&mpath).map_err(io_err(&mpath))?;
-            let old: Manifest = serde_json::from_str(&text).map_err(|e| StoreError::Corrupt {
-                path: mpath.clone(),
-                message: e.to_string(),
-            })?;
-            if &old != manifest {
-                let what = if old.fmu_sha256 != manifest.fmu_sha256 {
-                    "the FMU differs"
-                } else {
-                    "the study definition differs"
-                };
-                return Err(StoreError::Mismatch {
-                    dir: dir.to_path_buf(),
-                    what: what.into(),
-                });
-            }
-        } else {
-            let text = serde_json::to_string_pretty(manifest).expect("serializable");
-            fs::write(&mpath, text).map_err(io_err(&mpath))?;
-        }
+        check_manifest(dir, &sdir.join("manifest.json"), manifest)?;
         let path = sdir.join("records.bin");
         let mut file = OpenOptions::new()
             .create(true)
@@ -193,35 +230,52 @@ impl Store {
             .map_err(io_err(&path))?;
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes).map_err(io_err(&path))?;
-        let (records, valid) = decode_all(&bytes, manifest.n_values);
-        if valid < bytes.len() {
-            // A torn tail from an interrupted write: cut it off.
-            file.set_len(valid as u64).map_err(io_err(&path))?;
+
+        let fmt = format::detect_format(&bytes);
+        let (done, kept, skipped) = read_records(&bytes, fmt, manifest);
+        let mut recovery = Recovery {
+            path: path.clone(),
+            kept: kept.len(),
+            converted_from_v1: fmt == Format::V1,
+            ..Recovery::default()
+        };
+        let valid_end = kept.last().map_or(0, |(_, r)| r.end);
+        let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
+        if fmt == Format::V1 || damage_inside {
+            let (new_file, backup) = rewrite_kept(&path, &bytes, fmt, &kept, &done)?;
+            file = new_file;
+            recovery.backup = Some(backup);
+        } else if valid_end < bytes.len() {
+            // A torn tail from an interrupted write (or a damaged last record): cut it off.
+            file.set_len(valid_end as u64).map_err(io_err(&path))?;
             file.seek(SeekFrom::End(0)).map_err(io_err(&path))?;
+            recovery.truncated = Some((bytes.len() - valid_end) as u64);
         }
-        let mut done: Vec<Option<Record>> = vec![None; manifest.n_points];
-        for (i, r) in records {
-            if i >= manifest.n_points {
-                return Err(StoreError::Corrupt {
-                    path: path.clone(),
-                    message: format!(
-                        "record for point {i}, but the design has {}",
-                        manifest.n_points
-                    ),
-                });
-            }
-            if done[i].is_none() {
-                done[i] = Some(r);
-            }
-        }
+
+        let mut rerun: Vec<usize> = skipped
+            .iter()
+            .filter_map(|s| s.point)
+            .filter(|&p| p < manifest.n_points && done[p].is_none())
+            .collect();
+        rerun.sort_unstable();
+        rerun.dedup();
+        recovery.rerun = rerun;
+        recovery.skipped = skipped;
+        recovery.missing = done.iter().filter(|r| r.is_none()).count();
         Ok((
             Store {
                 path,
                 file: Mutex::new(file),
                 n_values: manifest.n_values,
+                recovery,
             },
             done,
         ))
+    }
+
+    /// What opening skipped or repaired (empty for an intact store).
+    pub fn recovery(&self) -> &Recovery {
+        &self.recovery
     }
 
     /// Appends one record (one write call per record, under a lock).
@@ -233,6 +287,145 @@ impl Store {
         let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
         f.write_all(&bytes).map_err(io_err(&self.path))
     }
+}
+
+/// A valid record's point and its bytes in the file.
+type Kept = (usize, std::ops::Range<usize>);
+
+/// Decodes `bytes` for `manifest`: the first record of each point, every valid record of the
+/// design (in file order), and the skipped stretches (in file order; a valid record of a point
+/// beyond the design counts as skipped).
+fn read_records(
+    bytes: &[u8],
+    fmt: Format,
+    manifest: &Manifest,
+) -> (Vec<Option<Record>>, Vec<Kept>, Vec<Skipped>) {
+    let decoded = format::decode_format(bytes, manifest.n_values, fmt);
+    let mut done: Vec<Option<Record>> = vec![None; manifest.n_points];
+    let mut kept = Vec::with_capacity(decoded.records.len());
+    let mut skipped = decoded.skipped;
+    for (i, rec, range) in decoded.records {
+        if i >= manifest.n_points {
+            skipped.push(Skipped {
+                bytes: range.start as u64..range.end as u64,
+                point: None,
+                reason: format!(
+                    "record of point {i}, but the design has {} points",
+                    manifest.n_points
+                ),
+            });
+            continue;
+        }
+        if done[i].is_none() {
+            done[i] = Some(rec);
+        }
+        kept.push((i, range));
+    }
+    skipped.sort_by_key(|s| s.bytes.start);
+    (done, kept, skipped)
+}
+
+/// Rewrites `records.bin` with the `kept` records only, in format 2: a format-1 store is
+/// re-encoded (and kept as `records.v1.bin`), a damaged one keeps the valid records' bytes (and
+/// the file as found as `records.damaged-<unix seconds>.bin`).
+fn rewrite_kept(
+    path: &Path,
+    bytes: &[u8],
+    fmt: Format,
+    kept: &[Kept],
+    done: &[Option<Record>],
+) -> Result<(File, PathBuf), StoreError> {
+    let mut out = Vec::with_capacity(bytes.len());
+    let label = match fmt {
+        Format::V1 => {
+            // The first record of each point (later ones are never read).
+            let mut written = vec![false; done.len()];
+            for &(i, _) in kept {
+                if let (Some(rec), false) = (&done[i], written[i]) {
+                    out.extend_from_slice(&encode(i, rec));
+                    written[i] = true;
+                }
+            }
+            "v1".to_string()
+        }
+        Format::V2 => {
+            for (_, r) in kept {
+                out.extend_from_slice(&bytes[r.clone()]);
+            }
+            format!("damaged-{}", unix_seconds())
+        }
+    };
+    rewrite(path, &label, &out)
+}
+
+/// Writes the manifest of a new store, or checks that an existing one is `manifest`.
+fn check_manifest(dir: &Path, mpath: &Path, manifest: &Manifest) -> Result<(), StoreError> {
+    if !mpath.exists() {
+        let text = serde_json::to_string_pretty(manifest).expect("serializable");
+        return fs::write(mpath, text).map_err(io_err(mpath));
+    }
+    let text = fs::read_to_string(mpath).map_err(io_err(mpath))?;
+    let old: Manifest = serde_json::from_str(&text).map_err(|e| StoreError::Corrupt {
+        path: mpath.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    if &old != manifest {
+        let what = if old.fmu_sha256 != manifest.fmu_sha256 {
+            "the FMU differs"
+        } else {
+            "the study definition differs"
+        };
+        return Err(StoreError::Mismatch {
+            dir: dir.to_path_buf(),
+            what: what.into(),
+        });
+    }
+    Ok(())
+}
+
+fn unix_seconds() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs())
+}
+
+/// Replaces `path` by `bytes` atomically (a new file renamed over it), after keeping the old
+/// file as `records.<label>.bin` beside it (a hard link, or a copy where links are not
+/// supported; `-2`, `-3`, ... appended if taken). Returns the new file opened for appending and
+/// the backup's path. At every moment `path` is either the old or the new file.
+fn rewrite(path: &Path, label: &str, bytes: &[u8]) -> Result<(File, PathBuf), StoreError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut backup = dir.join(format!("records.{label}.bin"));
+    let mut n = 1;
+    while backup.exists() {
+        n += 1;
+        backup = dir.join(format!("records.{label}-{n}.bin"));
+    }
+    if fs::hard_link(path, &backup).is_err() {
+        fs::copy(path, &backup).map_err(io_err(&backup))?;
+    }
+    let tmp = path.with_extension("bin.tmp");
+    let written = (|| {
+        let mut f = File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    if let Err(e) = written {
+        let _ = fs::remove_file(&tmp);
+        return Err(StoreError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        });
+    }
+    // Make the rename durable; not every platform can sync a folder.
+    let _ = File::open(dir).and_then(|d| d.sync_all());
+    let file = OpenOptions::new()
+        .read(true)
+        .append(true)
+        .open(path)
+        .map_err(io_err(path))?;
+    Ok((file, backup))
 }
 
 #[cfg(test)]
@@ -289,13 +482,34 @@ mod tests {
     }
 
     #[test]
-    fn corrupted_byte_stops_reading_there() {
+    fn corrupted_byte_skips_only_its_record() {
         let a = encode(0, &Record::Ok(vec![1.0, 2.0]));
         let mut b = encode(1, &Record::Ok(vec![3.0, 4.0]));
-        b[25] ^= 1;
-        let all = [a.clone(), b].concat();
-        let (recs, valid) = decode_all(&all, 2);
-        assert_eq!(recs.len(), 1);
-        assert_eq!(valid, a.len());
+        b[30] ^= 1;
+        let c = encode(2, &Record::Ok(vec![5.0, 6.0]));
+        let all = [a.clone(), b.clone(), c.clone()].concat();
+        let (recs, end) = decode_all(&all, 2);
+        assert_eq!(
+            recs,
+            vec![
+                (0, Record::Ok(vec![1.0, 2.0])),
+                (2, Record::Ok(vec![5.0, 6.0]))
+            ]
+        );
+        assert_eq!(end, all.len());
+    }
+
+    #[test]
+    fn intact_store_reports_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let (s, _) = Store::open(dir.path(), &manifest(), false).unwrap();
+        s.append(1, &Record::Ok(vec![1.0, 2.0])).unwrap();
+        drop(s);
+        let (s, done) = Store::open(dir.path(), &manifest(), false).unwrap();
+        assert!(s.recovery().is_clean(), "{}", s.recovery());
+        assert_eq!(s.recovery().summary(), None);
+        assert_eq!(s.recovery().kept, 1);
+        assert_eq!(s.recovery().missing, 3);
+        assert_eq!(done.iter().flatten().count(), 1);
     }
 }
