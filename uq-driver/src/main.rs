@@ -1,14 +1,15 @@
 //! `uq-driver`: the command line over the uq_driver library.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
-use uq_driver::study::{run_study, shard, RunOptions, Study, BUILTINS};
+use uq_driver::spec::{builtin, Experiment, Study, BUILTINS};
+use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
 
 #[derive(Parser)]
 #[command(
@@ -24,25 +25,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a study (a TOML file or builtin:NAME) and write its results to --out.
-    Run {
-        /// Study file, or builtin:NAME (see `uq-driver list`).
-        study: String,
-        /// Output folder (re-running into the same folder resumes an interrupted study).
-        #[arg(long, short)]
-        out: PathBuf,
-        /// Worker threads (default: all cores).
-        #[arg(long, short)]
-        threads: Option<usize>,
-        /// MC/LHS: continue past failed points and report how many failed.
-        #[arg(long)]
-        allow_failures: bool,
-        /// Discard earlier results in --out instead of resuming.
-        #[arg(long)]
-        fresh: bool,
-        /// Stop after this many new points (the study can be resumed later).
-        #[arg(long, hide = true)]
-        max_points: Option<usize>,
-    },
+    Run(RunArgs),
     /// Split a study into shards for a cluster: writes DIR/plan.json and DIR/design.csv.
     Plan {
         /// Study file, or builtin:NAME.
@@ -81,31 +64,7 @@ enum Command {
         allow_failures: bool,
     },
     /// Plan a study and submit it to Slurm: a job array of shards and a dependent merge job.
-    Slurm {
-        /// Study file, or builtin:NAME.
-        study: String,
-        /// Number of shards (array tasks).
-        #[arg(long)]
-        shards: usize,
-        /// Plan folder (on a filesystem every node sees).
-        #[arg(long, short)]
-        out: PathBuf,
-        /// Slurm partition.
-        #[arg(long)]
-        partition: Option<String>,
-        /// Time limit per task (e.g. 01:00:00).
-        #[arg(long)]
-        time: Option<String>,
-        /// CPUs per shard task (also its threads).
-        #[arg(long)]
-        cpus_per_task: Option<usize>,
-        /// Extra #SBATCH option (repeatable), e.g. --sbatch=--account=rail.
-        #[arg(long = "sbatch")]
-        sbatch: Vec<String>,
-        /// Write the scripts but do not submit.
-        #[arg(long)]
-        dry_run: bool,
-    },
+    Slurm(SlurmArgs),
     /// List the built-in studies.
     List,
     /// Print a built-in study's TOML (a starting point for your own).
@@ -119,28 +78,79 @@ enum Command {
         fmu: PathBuf,
     },
     /// Run an FMU once at given parameter values and write its outputs as CSV.
-    Simulate {
-        /// The .fmu file.
-        fmu: PathBuf,
-        /// Parameter values, NAME=VALUE (repeatable).
-        #[arg(long = "set", value_parser = parse_assignment)]
-        set: Vec<(String, f64)>,
-        /// Outputs to record (repeatable; default: every Real output).
-        #[arg(long = "output")]
-        outputs: Vec<String>,
-        /// Start time (s; default: the FMU's default experiment, else 0).
-        #[arg(long)]
-        start: Option<f64>,
-        /// Stop time (s; default: the FMU's default experiment).
-        #[arg(long)]
-        stop: Option<f64>,
-        /// Communication step (s; default: the FMU's default experiment).
-        #[arg(long)]
-        step: Option<f64>,
-        /// CSV file to write (default: standard output).
-        #[arg(long, short)]
-        out: Option<PathBuf>,
-    },
+    Simulate(SimulateArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// Study file, or builtin:NAME (see `uq-driver list`).
+    study: String,
+    /// Output folder (re-running into the same folder resumes an interrupted study).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long, short)]
+    threads: Option<usize>,
+    /// MC/LHS: continue past failed points and report how many failed.
+    #[arg(long)]
+    allow_failures: bool,
+    /// Discard earlier results in --out instead of resuming.
+    #[arg(long)]
+    fresh: bool,
+    /// Stop after this many new points (the study can be resumed later).
+    #[arg(long, hide = true)]
+    max_points: Option<usize>,
+}
+
+#[derive(Args)]
+struct SlurmArgs {
+    /// Study file, or builtin:NAME.
+    study: String,
+    /// Number of shards (array tasks).
+    #[arg(long)]
+    shards: usize,
+    /// Plan folder (on a filesystem every node sees).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Slurm partition.
+    #[arg(long)]
+    partition: Option<String>,
+    /// Time limit per task (e.g. 01:00:00).
+    #[arg(long)]
+    time: Option<String>,
+    /// CPUs per shard task (also its threads).
+    #[arg(long)]
+    cpus_per_task: Option<usize>,
+    /// Extra #SBATCH option (repeatable), e.g. --sbatch=--account=rail.
+    #[arg(long = "sbatch")]
+    sbatch: Vec<String>,
+    /// Write the scripts but do not submit.
+    #[arg(long)]
+    dry_run: bool,
+}
+
+#[derive(Args)]
+struct SimulateArgs {
+    /// The .fmu file.
+    fmu: PathBuf,
+    /// Parameter values, NAME=VALUE (repeatable).
+    #[arg(long = "set", value_parser = parse_assignment)]
+    set: Vec<(String, f64)>,
+    /// Outputs to record (repeatable; default: every Real output).
+    #[arg(long = "output")]
+    outputs: Vec<String>,
+    /// Start time (s; default: the FMU's default experiment, else 0).
+    #[arg(long)]
+    start: Option<f64>,
+    /// Stop time (s; default: the FMU's default experiment).
+    #[arg(long)]
+    stop: Option<f64>,
+    /// Communication step (s; default: the FMU's default experiment).
+    #[arg(long)]
+    step: Option<f64>,
+    /// CSV file to write (default: standard output).
+    #[arg(long, short)]
+    out: Option<PathBuf>,
 }
 
 fn parse_assignment(s: &str) -> Result<(String, f64), String> {
@@ -166,84 +176,38 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("uq-driver: error: {e:#}");
+            eprintln!("uq-driver: error: {}", causes(&e));
             ExitCode::FAILURE
         }
     }
 }
 
+/// The error and its causes, each once: a cause whose text an outer message already
+/// contains (libraries that print their source in their own message) is not repeated.
+fn causes(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let msg = cause.to_string();
+        if text.contains(&msg) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&msg);
+    }
+    text
+}
+
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
-        Command::Run {
-            study,
-            out,
-            threads,
-            allow_failures,
-            fresh,
-            max_points,
-        } => {
-            let s = Study::load(&study)?;
-            let opts = RunOptions {
-                threads,
-                progress: std::io::stderr().is_terminal(),
-                allow_failures,
-                fresh,
-                max_new_points: max_points,
-                points: None,
-            };
-            let r = run_study(&s, &out, &opts).with_context(|| format!("study {}", s.origin))?;
-            for w in &r.warnings {
-                eprintln!("uq-driver: warning: {w}");
-            }
-            if s.is_suite() {
-                println!(
-                    "{}: report {}",
-                    s.file.name,
-                    out.join("index.html").display()
-                );
-                for v in r.summary["variants"].as_array().into_iter().flatten() {
-                    println!(
-                        "  {:<12} {:<16} {:>7} model runs, wall time {:.2} s",
-                        v["name"].as_str().unwrap_or("?"),
-                        v["method"].as_str().unwrap_or("?"),
-                        v["model_runs"],
-                        v["wall_time_s"].as_f64().unwrap_or(0.0)
-                    );
-                }
-                return Ok(());
-            }
-            println!(
-                "{}: {} model runs ({} resumed), wall time {:.2} s; report: {}",
-                s.file.name,
-                r.model_runs,
-                r.summary["runs_resumed"],
-                r.summary["wall_time_s"].as_f64().unwrap_or(0.0),
-                out.join("index.html").display()
-            );
-            for q in &r.scalars {
-                if r.model_runs == 1 {
-                    println!("  {} = {:.6}", q.name, q.mean);
-                } else {
-                    println!(
-                        "  {}: mean {:.6}, std {:.6} ({} valid runs)",
-                        q.name, q.mean, q.std, q.n_valid
-                    );
-                }
-                for (l, p, se) in &q.exceedance {
-                    println!("  P({} > {l}) = {p:.5} (standard error {se:.1e})", q.name);
-                }
-            }
-            if r.n_failed > 0 {
-                println!("{} points failed (see points.csv)", r.n_failed);
-            }
-            Ok(())
-        }
+        Command::Run(args) => run(args),
         Command::Plan { study, shards, out } => {
             let s = Study::load(&study)?;
             let p = shard::plan(&s, shards, &out)?;
             println!(
                 "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
-                s.file.name,
+                s.name,
                 p.manifest.n_points,
                 p.shards,
                 p.shards,
@@ -254,30 +218,10 @@ fn dispatch(cmd: Command) -> Result<()> {
         }
         Command::RunShard {
             dir,
-            shard: k,
+            shard,
             threads,
             allow_failures,
-        } => {
-            let k = match k {
-                Some(k) => k,
-                None => std::env::var("SLURM_ARRAY_TASK_ID")
-                    .context("no --shard and no SLURM_ARRAY_TASK_ID")?
-                    .parse()
-                    .context("SLURM_ARRAY_TASK_ID is not a number")?,
-            };
-            let opts = RunOptions {
-                threads,
-                progress: std::io::stderr().is_terminal(),
-                allow_failures,
-                ..RunOptions::default()
-            };
-            let o = shard::run_shard(&dir, k, &opts)?;
-            println!(
-                "shard {k}: {} points run, {} resumed, wall time {:.2} s",
-                o.n_new, o.n_resumed, o.wall_time
-            );
-            Ok(())
-        }
+        } => run_shard(&dir, shard, threads, allow_failures),
         Command::Merge {
             dir,
             out,
@@ -291,121 +235,197 @@ fn dispatch(cmd: Command) -> Result<()> {
             let r = shard::merge(&dir, &out, &opts)?;
             println!(
                 "merged {} points; report: {}",
-                r.model_runs,
+                r.summary.model_runs,
                 out.join("index.html").display()
             );
             Ok(())
         }
-        Command::Slurm {
-            study,
-            shards,
-            out,
-            partition,
-            time,
-            cpus_per_task,
-            sbatch,
-            dry_run,
-        } => {
-            let s = Study::load(&study)?;
-            shard::plan(&s, shards, &out)?;
-            let driver = std::env::current_exe().context("locating the uq-driver executable")?;
-            let o = shard::SlurmOptions {
-                partition,
-                time,
-                cpus_per_task,
-                extra: sbatch,
-            };
-            let (a, b) = shard::write_sbatch(&out, &driver, shards, &o)?;
-            if dry_run {
-                println!("wrote {} and {} (not submitted)", a.display(), b.display());
-                return Ok(());
-            }
-            let submit = |args: &[&str]| -> Result<String> {
-                let o = std::process::Command::new("sbatch")
-                    .arg("--parsable")
-                    .args(args)
-                    .output()
-                    .context("running sbatch (is Slurm installed and SLURM_CONF set?)")?;
-                anyhow::ensure!(
-                    o.status.success(),
-                    "sbatch failed: {}",
-                    String::from_utf8_lossy(&o.stderr).trim()
-                );
-                let id = String::from_utf8_lossy(&o.stdout)
-                    .trim()
-                    .split(';')
-                    .next()
-                    .unwrap_or("")
-                    .to_string();
-                anyhow::ensure!(!id.is_empty(), "sbatch printed no job id");
-                Ok(id)
-            };
-            let array = submit(&[a.to_str().context("path")?])?;
-            let dep = format!("--dependency=afterok:{array}");
-            let merge = submit(&[&dep, b.to_str().context("path")?])?;
-            println!("array job {array}");
-            println!("merge job {merge}");
-            println!("results will be in {}", out.join("result").display());
-            Ok(())
-        }
+        Command::Slurm(args) => slurm(args),
         Command::List => {
             let mut o = std::io::stdout().lock();
             for (name, text) in BUILTINS {
                 let s = Study::parse(text, name, None)?;
-                writeln!(o, "builtin:{name:<24} {}", s.file.description)?;
+                writeln!(o, "builtin:{name:<24} {}", s.description)?;
             }
             Ok(())
         }
         Command::Show { name } => {
-            let key = name.strip_prefix("builtin:").unwrap_or(&name);
-            let (_, text) = BUILTINS
-                .iter()
-                .find(|(n, _)| *n == key)
-                .with_context(|| format!("no built-in study '{key}' (see `uq-driver list`)"))?;
+            let text = builtin(name.strip_prefix("builtin:").unwrap_or(&name))?;
             std::io::stdout().lock().write_all(text.as_bytes())?;
             Ok(())
         }
         Command::Inspect { fmu } => inspect(&fmu),
-        Command::Simulate {
-            fmu,
-            set,
-            outputs,
-            start,
-            stop,
-            step,
-            out,
-        } => simulate(&fmu, &set, &outputs, start, stop, step, out.as_deref()),
+        Command::Simulate(args) => simulate(args),
     }
 }
 
-fn simulate(
-    path: &std::path::Path,
-    set: &[(String, f64)],
-    outputs: &[String],
-    start: Option<f64>,
-    stop: Option<f64>,
-    step: Option<f64>,
-    out: Option<&std::path::Path>,
+/// `uq-driver run`.
+fn run(a: RunArgs) -> Result<()> {
+    let s = Study::load(&a.study)?;
+    let opts = RunOptions {
+        threads: a.threads,
+        progress: std::io::stderr().is_terminal(),
+        allow_failures: a.allow_failures,
+        fresh: a.fresh,
+        max_new_points: a.max_points,
+        points: None,
+    };
+    let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
+    match outcome {
+        Outcome::Study(r) => print_study(&r, &a.out),
+        Outcome::Suite(r) => print_suite(&r, &a.out),
+    }
+    Ok(())
+}
+
+/// `uq-driver run-shard`.
+fn run_shard(
+    dir: &Path,
+    shard: Option<usize>,
+    threads: Option<usize>,
+    allow_failures: bool,
 ) -> Result<()> {
-    let fmu = Fmu::open(path)?;
+    let k = match shard {
+        Some(k) => k,
+        None => std::env::var("SLURM_ARRAY_TASK_ID")
+            .context("no --shard and no SLURM_ARRAY_TASK_ID")?
+            .parse()
+            .context("SLURM_ARRAY_TASK_ID is not a number")?,
+    };
+    let opts = RunOptions {
+        threads,
+        progress: std::io::stderr().is_terminal(),
+        allow_failures,
+        ..RunOptions::default()
+    };
+    let o = shard::run_shard(dir, k, &opts)?;
+    println!(
+        "shard {k}: {} points run, {} resumed, wall time {:.2} s",
+        o.n_new, o.n_resumed, o.wall_time
+    );
+    Ok(())
+}
+
+/// `uq-driver slurm`: plan, write the batch scripts and (unless --dry-run) submit them.
+fn slurm(a: SlurmArgs) -> Result<()> {
+    let s = Study::load(&a.study)?;
+    shard::plan(&s, a.shards, &a.out)?;
+    let driver = std::env::current_exe().context("locating the uq-driver executable")?;
+    let o = shard::SlurmOptions {
+        partition: a.partition,
+        time: a.time,
+        cpus_per_task: a.cpus_per_task,
+        extra: a.sbatch,
+    };
+    let (array_script, merge_script) = shard::write_sbatch(&a.out, &driver, a.shards, &o)?;
+    if a.dry_run {
+        println!(
+            "wrote {} and {} (not submitted)",
+            array_script.display(),
+            merge_script.display()
+        );
+        return Ok(());
+    }
+    let array = sbatch(&[array_script.to_str().context("path")?])?;
+    let dep = format!("--dependency=afterok:{array}");
+    let merge = sbatch(&[&dep, merge_script.to_str().context("path")?])?;
+    println!("array job {array}");
+    println!("merge job {merge}");
+    println!("results will be in {}", a.out.join("result").display());
+    Ok(())
+}
+
+/// Submits with `sbatch --parsable ARGS`; returns the job id.
+fn sbatch(args: &[&str]) -> Result<String> {
+    let o = std::process::Command::new("sbatch")
+        .arg("--parsable")
+        .args(args)
+        .output()
+        .context("running sbatch (is Slurm installed and SLURM_CONF set?)")?;
+    anyhow::ensure!(
+        o.status.success(),
+        "sbatch failed: {}",
+        String::from_utf8_lossy(&o.stderr).trim()
+    );
+    let id = String::from_utf8_lossy(&o.stdout)
+        .trim()
+        .split(';')
+        .next()
+        .unwrap_or("")
+        .to_string();
+    anyhow::ensure!(!id.is_empty(), "sbatch printed no job id");
+    Ok(id)
+}
+
+/// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings.
+fn print_study(r: &StudyResult, out: &Path) {
+    let s = &r.summary;
+    for w in &s.warnings {
+        eprintln!("uq-driver: warning: {w}");
+    }
+    println!(
+        "{}: {} model runs ({} resumed), wall time {:.2} s; report: {}",
+        s.study,
+        s.model_runs,
+        s.runs_resumed,
+        s.wall_time_s,
+        out.join("index.html").display()
+    );
+    for q in &r.quantities {
+        if s.model_runs == 1 {
+            println!("  {} = {:.6}", q.name, q.mean);
+        } else {
+            println!(
+                "  {}: mean {:.6}, std {:.6} ({} valid runs)",
+                q.name, q.mean, q.std, q.n_valid
+            );
+        }
+        for (l, p, se) in &q.exceedance {
+            println!("  P({} > {l}) = {p:.5} (standard error {se:.1e})", q.name);
+        }
+    }
+    if s.failed_runs > 0 {
+        println!("{} points failed (see points.csv)", s.failed_runs);
+    }
+}
+
+/// The result of `run` for a suite: one line per variant.
+fn print_suite(r: &SuiteResult, out: &Path) {
+    for v in &r.variants {
+        for w in &v.summary.warnings {
+            eprintln!("uq-driver: warning: {}: {w}", v.summary.study);
+        }
+    }
+    println!(
+        "{}: report {}",
+        r.summary.suite,
+        out.join("index.html").display()
+    );
+    for v in &r.summary.variants {
+        println!(
+            "  {:<12} {:<16} {:>7} model runs, wall time {:.2} s",
+            v.name, v.method, v.model_runs, v.wall_time_s
+        );
+    }
+}
+
+/// `uq-driver simulate`: one run as CSV.
+fn simulate(a: SimulateArgs) -> Result<()> {
+    let fmu = Fmu::open(&a.fmu)?;
     let de = fmu.description().default_experiment.unwrap_or_default();
-    let start = start.or(de.start_time).unwrap_or(0.0);
-    let stop = stop
+    let start = a.start.or(de.start_time).unwrap_or(0.0);
+    let stop = a
+        .stop
         .or(de.stop_time)
         .context("no --stop and no default stop time in the FMU")?;
-    let step = step
+    let step = a
+        .step
         .or(de.step_size)
         .context("no --step and no default step size in the FMU")?;
-    let experiment = uq_driver::study::spec::Experiment { start, stop, step };
-    anyhow::ensure!(
-        step > 0.0 && stop > start && {
-            let r = (stop - start) / step;
-            (r - r.round()).abs() < 1e-6 * r.max(1.0)
-        },
-        "stop − start must be a positive whole number of steps"
-    );
+    let experiment = Experiment { start, stop, step };
+    experiment.check()?;
     let times = experiment.times();
-    let (names, series) = uq_driver::study::runner::simulate(&fmu, set, outputs, &times)?;
+    let (names, series) = runner::simulate(&fmu, &a.set, &a.outputs, &times)?;
     let mut text = String::from("time");
     for n in &names {
         text.push(',');
@@ -420,14 +440,14 @@ fn simulate(
         }
         text.push('\n');
     }
-    match out {
+    match a.out.as_deref() {
         Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?,
         None => std::io::stdout().lock().write_all(text.as_bytes())?,
     }
     Ok(())
 }
 
-fn inspect(path: &std::path::Path) -> Result<()> {
+fn inspect(path: &Path) -> Result<()> {
     let fmu = Fmu::open(path)?;
     // Buffered: one write per line would cost a system call per variable.
     let mut o = std::io::BufWriter::new(std::io::stdout().lock());

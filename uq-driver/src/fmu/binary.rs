@@ -5,12 +5,13 @@
 //! The pointers stay valid as long as the [`FmuLibrary`] (which owns the `Library`) is alive;
 //! instances hold it in an `Arc`, so the library is unloaded after the last instance is freed.
 
-use std::ffi::{c_char, c_int, c_uint, c_void, CStr};
+use std::ffi::{c_char, c_int, c_uint, c_void};
 use std::path::{Path, PathBuf};
 
 use libloading::Library;
 
 use super::error::FmuError;
+use super::ffi::c_string;
 use super::logger::CallbackFunctions;
 
 /// `fmi2Component`.
@@ -217,28 +218,13 @@ impl FmuLibrary {
         let version = unsafe { c_string((api.get_version)()) };
         // SAFETY: as above, for fmi2GetTypesPlatform.
         let types_platform = unsafe { c_string((api.get_types_platform)()) };
-        let incompatible = |reason: String| FmuError::IncompatibleBinary {
-            path: path.to_path_buf(),
-            reason,
-        };
-        match version.as_deref() {
-            Some("2.0") => {}
-            Some(v) => {
-                return Err(incompatible(format!(
-                    "fmi2GetVersion() returned \"{v}\", expected \"2.0\""
-                )))
-            }
-            None => return Err(incompatible("fmi2GetVersion() returned null".into())),
-        }
-        match types_platform.as_deref() {
-            Some("default") => {}
-            Some(v) => {
-                return Err(incompatible(format!(
-                    "fmi2GetTypesPlatform() returned \"{v}\", expected \"default\""
-                )))
-            }
-            None => return Err(incompatible("fmi2GetTypesPlatform() returned null".into())),
-        }
+        expect_string(path, "fmi2GetVersion", version.as_deref(), "2.0")?;
+        expect_string(
+            path,
+            "fmi2GetTypesPlatform",
+            types_platform.as_deref(),
+            "default",
+        )?;
         Ok(FmuLibrary {
             path: path.to_path_buf(),
             version: version.unwrap_or_default(),
@@ -264,17 +250,22 @@ impl FmuLibrary {
     }
 }
 
-/// Copies a C string returned by the FMU, `None` if null.
-///
-/// # Safety
-/// `ptr` must be null or point to a NUL-terminated string valid for the duration of the call.
-pub(crate) unsafe fn c_string(ptr: *const c_char) -> Option<String> {
-    if ptr.is_null() {
-        return None;
-    }
-    // SAFETY: non-null, and NUL-terminated and valid per this function's contract.
-    let s = unsafe { CStr::from_ptr(ptr) };
-    Some(s.to_string_lossy().into_owned())
+/// Refuses a binary whose `function()` did not return `expected`.
+fn expect_string(
+    path: &Path,
+    function: &str,
+    got: Option<&str>,
+    expected: &str,
+) -> Result<(), FmuError> {
+    let reason = match got {
+        Some(v) if v == expected => return Ok(()),
+        Some(v) => format!("{function}() returned \"{v}\", expected \"{expected}\""),
+        None => format!("{function}() returned null"),
+    };
+    Err(FmuError::IncompatibleBinary {
+        path: path.to_path_buf(),
+        reason,
+    })
 }
 
 #[cfg(unix)]

@@ -11,8 +11,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
-use super::binary::c_string;
 use super::error::{LogMessage, Status};
+use super::ffi::c_string;
 
 /// How many messages an instance keeps.
 const CAPACITY: usize = 256;

@@ -27,6 +27,7 @@ pub mod archive;
 mod binary;
 pub mod description;
 mod error;
+mod ffi;
 mod instance;
 mod logger;
 

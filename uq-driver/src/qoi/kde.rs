@@ -40,7 +40,8 @@ pub fn silverman_bandwidth(samples: &[f64]) -> f64 {
     } else {
         0.0
     };
-    let iqr = (super::moments::quantile(&s, 0.75) - super::moments::quantile(&s, 0.25)) / 1.34;
+    let iqr =
+        (crate::uq::moments::quantile(&s, 0.75) - crate::uq::moments::quantile(&s, 0.25)) / 1.34;
     let spread = match (std > 0.0, iqr > 0.0) {
         (true, true) => std.min(iqr),
         (true, false) => std,

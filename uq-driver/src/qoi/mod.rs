@@ -1,16 +1,14 @@
-//! Statistics and quantities of interest computed from ensembles of runs.
+//! Quantities of interest computed from runs and ensembles of runs.
 //!
-//! - [`moments`]: sample and quadrature moments, quantiles, summaries, exceedance probabilities;
+//! - [`scalar`]: the `[[qoi]]` of a study file, evaluated on one run's time series;
+//! - [`critical_speed`]: the speed at which a hunting oscillation dies out on a speed ramp;
+//! - [`sperling`]: the Sperling ride index of an acceleration record;
 //! - [`kde`]: Gaussian kernel density estimates.
 
 pub mod critical_speed;
 pub mod kde;
-pub mod moments;
 pub mod scalar;
 pub mod sperling;
 
 pub use kde::{auto_grid, gaussian_kde, silverman_bandwidth};
-pub use moments::{
-    column_quantiles, exceedance_probability, quantile, sample_mean_std, weighted_mean_std,
-    ScalarSummary,
-};
+pub use scalar::{QoiError, QoiSpec};

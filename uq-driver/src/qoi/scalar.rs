@@ -1,12 +1,217 @@
 //! Scalar quantities of interest evaluated on one run's time series, as the study file
 //! declares them (`[[qoi]]`): critical speed, Sperling index, peak |signal|, final value.
 
-use crate::qoi::critical_speed::{critical_speed, CriticalSpeed};
-use crate::qoi::sperling::{sperling_index, Direction, SperlingSettings};
-use crate::study::spec::QoiSpec;
+use serde::{Deserialize, Serialize};
+
+use crate::qoi::critical_speed::{critical_speed, CriticalSpeed, CriticalSpeedError};
+use crate::qoi::sperling::{sperling_index, Direction, SperlingError, SperlingSettings};
+
+/// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
+/// `kind`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum QoiSpec {
+    /// Speed at which an oscillation dies out on a speed ramp (see [`critical_speed`]).
+    CriticalSpeed {
+        /// Name in reports.
+        name: String,
+        /// Oscillating signal (e.g. "Y").
+        signal: String,
+        /// Speed signal (e.g. "V").
+        speed: String,
+        /// Sliding window (s).
+        #[serde(default = "default_window")]
+        window: f64,
+        /// Amplitude threshold (units of the signal).
+        #[serde(default = "default_threshold")]
+        threshold: f64,
+        /// Exceedance limits: P(q > limit) is reported.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+    /// Sperling ride index of an acceleration signal (see [`sperling_index`]).
+    Sperling {
+        /// Name in reports.
+        name: String,
+        /// Acceleration signal (m/s²).
+        signal: String,
+        /// Weighting direction.
+        #[serde(default)]
+        direction: Direction,
+        /// FFT segment length (s).
+        #[serde(default = "default_segment")]
+        segment: f64,
+        /// Lowest frequency (Hz).
+        #[serde(default = "default_fmin")]
+        f_min: f64,
+        /// Highest frequency (Hz).
+        #[serde(default = "default_fmax")]
+        f_max: f64,
+        /// Initial transient left out (s).
+        #[serde(default)]
+        skip: f64,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+    /// Largest |signal| over [from, to] (s).
+    MaxAbs {
+        /// Name in reports.
+        name: String,
+        /// Signal.
+        signal: String,
+        /// Start of the interval (s).
+        #[serde(default)]
+        from: f64,
+        /// End of the interval (s; default the stop time).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<f64>,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+    /// Value of a signal at the stop time.
+    Final {
+        /// Name in reports.
+        name: String,
+        /// Signal.
+        signal: String,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+}
+
+fn default_window() -> f64 {
+    1.0
+}
+fn default_threshold() -> f64 {
+    1e-4
+}
+fn default_segment() -> f64 {
+    5.0
+}
+fn default_fmin() -> f64 {
+    0.5
+}
+fn default_fmax() -> f64 {
+    40.0
+}
+
+/// Settings of a quantity that make no sense.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("quantity '{name}': {problem}")]
+pub struct InvalidQuantity {
+    /// The quantity.
+    pub name: String,
+    /// What is wrong.
+    pub problem: String,
+}
+
+/// Why a quantity could not be evaluated on a run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum QoiError {
+    /// The critical-speed detection refused the series.
+    #[error(transparent)]
+    CriticalSpeed(#[from] CriticalSpeedError),
+    /// The Sperling index could not be computed.
+    #[error(transparent)]
+    Sperling(#[from] SperlingError),
+    /// Fewer than two samples (no time step).
+    #[error("fewer than two samples")]
+    TooShort,
+    /// No sample in the interval of a `max_abs`.
+    #[error("no sample of {signal} in [{from}, {to}] s")]
+    EmptyInterval {
+        /// The signal.
+        signal: String,
+        /// Start (s).
+        from: f64,
+        /// End (s).
+        to: f64,
+    },
+    /// The signal has no sample.
+    #[error("{0} is empty")]
+    EmptySignal(String),
+}
+
+impl QoiSpec {
+    /// The quantity's name.
+    pub fn name(&self) -> &str {
+        match self {
+            QoiSpec::CriticalSpeed { name, .. }
+            | QoiSpec::Sperling { name, .. }
+            | QoiSpec::MaxAbs { name, .. }
+            | QoiSpec::Final { name, .. } => name,
+        }
+    }
+
+    /// The FMU signals it reads.
+    pub fn signals(&self) -> Vec<&str> {
+        match self {
+            QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
+            QoiSpec::Sperling { signal, .. }
+            | QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Final { signal, .. } => vec![signal],
+        }
+    }
+
+    /// Exceedance limits.
+    pub fn limits(&self) -> &[f64] {
+        match self {
+            QoiSpec::CriticalSpeed { limits, .. }
+            | QoiSpec::Sperling { limits, .. }
+            | QoiSpec::MaxAbs { limits, .. }
+            | QoiSpec::Final { limits, .. } => limits,
+        }
+    }
+
+    /// Checks the settings for a run of `duration` seconds.
+    pub fn validate(&self, duration: f64) -> Result<(), InvalidQuantity> {
+        let problem = match self {
+            QoiSpec::CriticalSpeed {
+                window, threshold, ..
+            } => {
+                (!(*window > 0.0 && *threshold > 0.0)).then_some("window and threshold must be > 0")
+            }
+            QoiSpec::Sperling {
+                segment,
+                f_min,
+                f_max,
+                skip,
+                ..
+            } => {
+                if !(*segment > 0.0 && *f_min > 0.0 && f_max > f_min && *skip >= 0.0) {
+                    Some("segment > 0, 0 < f_min < f_max and skip >= 0 are needed")
+                } else if *skip + *segment > duration + 1e-9 {
+                    Some("skip + segment must fit within the run")
+                } else {
+                    None
+                }
+            }
+            QoiSpec::MaxAbs { from, to, .. } => to
+                .is_some_and(|t| t <= *from)
+                .then_some("`to` must be after `from`"),
+            QoiSpec::Final { .. } => None,
+        };
+        let problem = problem.or_else(|| {
+            self.limits()
+                .iter()
+                .any(|l| !l.is_finite())
+                .then_some("limits must be finite")
+        });
+        match problem {
+            Some(p) => Err(InvalidQuantity {
+                name: self.name().to_owned(),
+                problem: p.to_owned(),
+            }),
+            None => Ok(()),
+        }
+    }
+}
 
 /// Outcome code stored beside a scalar value.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[repr(u8)]
 pub enum Code {
     /// The value is valid.
@@ -34,7 +239,7 @@ pub fn evaluate<'a>(
     q: &QoiSpec,
     times: &[f64],
     signal: impl Fn(&str) -> &'a [f64],
-) -> Result<(f64, Code), String> {
+) -> Result<(f64, Code), QoiError> {
     match q {
         QoiSpec::CriticalSpeed {
             signal: s,
@@ -42,13 +247,13 @@ pub fn evaluate<'a>(
             window,
             threshold,
             ..
-        } => match critical_speed(times, signal(s), signal(speed), *window, *threshold)
-            .map_err(|e| e.to_string())?
-        {
-            CriticalSpeed::Found { speed, .. } => Ok((speed, Code::Ok)),
-            CriticalSpeed::NeverHunts => Ok((f64::NAN, Code::NeverHunts)),
-            CriticalSpeed::NeverStops => Ok((f64::NAN, Code::NeverStops)),
-        },
+        } => Ok(
+            match critical_speed(times, signal(s), signal(speed), *window, *threshold)? {
+                CriticalSpeed::Found { speed, .. } => (speed, Code::Ok),
+                CriticalSpeed::NeverHunts => (f64::NAN, Code::NeverHunts),
+                CriticalSpeed::NeverStops => (f64::NAN, Code::NeverStops),
+            },
+        ),
         QoiSpec::Sperling {
             signal: s,
             direction,
@@ -61,21 +266,18 @@ pub fn evaluate<'a>(
             let dt = times
                 .get(1)
                 .map(|t1| t1 - times[0])
-                .ok_or("fewer than two samples")?;
+                .ok_or(QoiError::TooShort)?;
             let start = times.partition_point(|&t| t < times[0] + skip - 1e-9 * dt);
             let settings = SperlingSettings {
-                direction: if direction == "lateral" {
-                    Direction::Lateral
-                } else {
-                    Direction::Vertical
-                },
+                direction: *direction,
                 segment_length_s: *segment,
                 f_min: *f_min,
                 f_max: *f_max,
             };
-            let r =
-                sperling_index(&signal(s)[start..], dt, &settings).map_err(|e| e.to_string())?;
-            Ok((r.w, Code::Ok))
+            Ok((
+                sperling_index(&signal(s)[start..], dt, &settings)?.w,
+                Code::Ok,
+            ))
         }
         QoiSpec::MaxAbs {
             signal: s,
@@ -83,24 +285,98 @@ pub fn evaluate<'a>(
             to,
             ..
         } => {
-            let x = signal(s);
             let to = to.unwrap_or(f64::INFINITY);
             let m = times
                 .iter()
-                .zip(x)
+                .zip(signal(s))
                 .filter(|(t, _)| **t >= *from && **t <= to)
                 .map(|(_, v)| v.abs())
                 .fold(f64::NAN, f64::max);
             if m.is_nan() {
-                return Err(format!("no sample of {s} in [{from}, {to}] s"));
+                return Err(QoiError::EmptyInterval {
+                    signal: s.clone(),
+                    from: *from,
+                    to,
+                });
             }
             Ok((m, Code::Ok))
         }
-        QoiSpec::Final { signal: s, .. } => {
-            let x = signal(s);
-            x.last()
-                .map(|v| (*v, Code::Ok))
-                .ok_or_else(|| format!("{s} is empty"))
-        }
+        QoiSpec::Final { signal: s, .. } => signal(s)
+            .last()
+            .map(|v| (*v, Code::Ok))
+            .ok_or_else(|| QoiError::EmptySignal(s.clone())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn direction_is_typed_with_vertical_default() {
+        let q: QoiSpec =
+            toml::from_str("kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"").unwrap();
+        assert!(matches!(
+            q,
+            QoiSpec::Sperling {
+                direction: Direction::Vertical,
+                ..
+            }
+        ));
+        let q: QoiSpec = toml::from_str(
+            "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"\ndirection = \"lateral\"",
+        )
+        .unwrap();
+        assert!(matches!(
+            q,
+            QoiSpec::Sperling {
+                direction: Direction::Lateral,
+                ..
+            }
+        ));
+        let r: Result<QoiSpec, _> = toml::from_str(
+            "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"\ndirection = \"sideways\"",
+        );
+        assert!(r.unwrap_err().to_string().contains("unknown variant"));
+    }
+
+    #[test]
+    fn invalid_settings_name_the_quantity() {
+        let q: QoiSpec = toml::from_str(
+            "kind = \"max_abs\"\nname = \"P\"\nsignal = \"a\"\nfrom = 2.0\nto = 1.0",
+        )
+        .unwrap();
+        let e = q.validate(10.0).unwrap_err();
+        assert!(e.to_string().starts_with("quantity 'P': "), "{e}");
+        let q: QoiSpec =
+            toml::from_str("kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"\nskip = 6.0")
+                .unwrap();
+        assert!(q.validate(10.0).is_err());
+        assert!(q.validate(11.0).is_ok());
+    }
+
+    #[test]
+    fn max_abs_and_final() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        let x = [1.0, -4.0, 2.0, 0.5];
+        let q = QoiSpec::MaxAbs {
+            name: "m".into(),
+            signal: "x".into(),
+            from: 1.5,
+            to: None,
+            limits: vec![],
+        };
+        assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (2.0, Code::Ok));
+        let q = QoiSpec::Final {
+            name: "f".into(),
+            signal: "x".into(),
+            limits: vec![],
+        };
+        assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (0.5, Code::Ok));
+        let empty: [f64; 0] = [];
+        assert_eq!(
+            evaluate(&q, &empty, |_| &empty[..]).unwrap_err(),
+            QoiError::EmptySignal("x".into())
+        );
     }
 }

@@ -22,10 +22,12 @@
 //!
 //! Check: a 1 Hz sinusoid of amplitude 0.1 m/s² gives W = 0.896 (10³ · 0.325)^0.1 = 1.60.
 
-/// Direction of the acceleration (selects the weighting F).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Direction of the acceleration (selects the weighting F); `"vertical"` or `"lateral"` in files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Direction {
     /// Vertical weighting.
+    #[default]
     Vertical,
     /// Lateral weighting.
     Lateral,
@@ -135,16 +137,15 @@ pub fn weighting(direction: Direction, f: f64) -> f64 {
     }
 }
 
-/// Sperling index of the acceleration record `accel` (m/s²) sampled every `dt` (s).
-pub fn sperling_index(
+/// Checks the record and the settings; returns the samples per segment.
+fn samples_per_segment(
     accel: &[f64],
     dt: f64,
-    settings: &SperlingSettings,
-) -> Result<SperlingResult, SperlingError> {
+    s: &SperlingSettings,
+) -> Result<usize, SperlingError> {
     if !(dt.is_finite() && dt > 0.0) {
         return Err(SperlingError::InvalidStep(dt));
     }
-    let s = settings;
     if !(s.segment_length_s.is_finite() && s.segment_length_s > 0.0) {
         return Err(SperlingError::InvalidSettings(format!(
             "segment_length_s = {} must be finite and > 0",
@@ -175,41 +176,73 @@ pub fn sperling_index(
             segment_s: s.segment_length_s,
         });
     }
-    let df = 1.0 / (ns as f64 * dt);
-    let tol = 1e-9 * df;
-    let i_lo = ((s.f_min - tol) / df).ceil().max(1.0) as usize;
-    let i_hi = (((s.f_max + tol) / df).floor() as usize).min(ns / 2);
-    // cos and sin of 2π m / N_s, m = 0..N_s.
-    let table: Vec<(f64, f64)> = (0..ns)
-        .map(|m| {
-            let a = 2.0 * std::f64::consts::PI * m as f64 / ns as f64;
-            (a.cos(), a.sin())
-        })
-        .collect();
+    Ok(ns)
+}
+
+/// The DFT lines `i_lo..=i_hi` of one segment and their spacing `df` (Hz).
+struct Lines {
+    i_lo: usize,
+    i_hi: usize,
+    df: f64,
+    /// cos and sin of 2π m / N_s, m = 0..N_s.
+    table: Vec<(f64, f64)>,
+}
+
+impl Lines {
+    fn new(ns: usize, dt: f64, s: &SperlingSettings) -> Lines {
+        let df = 1.0 / (ns as f64 * dt);
+        let tol = 1e-9 * df;
+        let table = (0..ns)
+            .map(|m| {
+                let a = 2.0 * std::f64::consts::PI * m as f64 / ns as f64;
+                (a.cos(), a.sin())
+            })
+            .collect();
+        Lines {
+            i_lo: ((s.f_min - tol) / df).ceil().max(1.0) as usize,
+            i_hi: (((s.f_max + tol) / df).floor() as usize).min(ns / 2),
+            df,
+            table,
+        }
+    }
+
+    /// W of one segment of `table.len()` samples.
+    fn segment_w(&self, seg: &[f64], direction: Direction) -> f64 {
+        let ns = self.table.len();
+        let mut sum = 0.0;
+        for i in self.i_lo..=self.i_hi {
+            let (mut re, mut im) = (0.0, 0.0);
+            let mut idx = 0usize;
+            for &a in seg {
+                let (c, sn) = self.table[idx];
+                re += a * c;
+                im -= a * sn;
+                idx += i;
+                if idx >= ns {
+                    idx -= ns;
+                }
+            }
+            let scale = if 2 * i == ns { 1.0 } else { 2.0 };
+            let amp_cm = 100.0 * scale * (re * re + im * im).sqrt() / ns as f64;
+            let f = i as f64 * self.df;
+            sum += amp_cm.powi(3) * weighting(direction, f) / f;
+        }
+        0.896 * sum.powf(0.1)
+    }
+}
+
+/// Sperling index of the acceleration record `accel` (m/s²) sampled every `dt` (s).
+pub fn sperling_index(
+    accel: &[f64],
+    dt: f64,
+    settings: &SperlingSettings,
+) -> Result<SperlingResult, SperlingError> {
+    let ns = samples_per_segment(accel, dt, settings)?;
+    let lines = Lines::new(ns, dt, settings);
     let n_seg = accel.len() / ns;
     let per_segment: Vec<f64> = accel
         .chunks_exact(ns)
-        .map(|seg| {
-            let mut sum = 0.0;
-            for i in i_lo..=i_hi {
-                let (mut re, mut im) = (0.0, 0.0);
-                let mut idx = 0usize;
-                for &a in seg {
-                    let (c, sn) = table[idx];
-                    re += a * c;
-                    im -= a * sn;
-                    idx += i;
-                    if idx >= ns {
-                        idx -= ns;
-                    }
-                }
-                let scale = if 2 * i == ns { 1.0 } else { 2.0 };
-                let amp_cm = 100.0 * scale * (re * re + im * im).sqrt() / ns as f64;
-                let f = i as f64 * df;
-                sum += amp_cm.powi(3) * weighting(s.direction, f) / f;
-            }
-            0.896 * sum.powf(0.1)
-        })
+        .map(|seg| lines.segment_w(seg, settings.direction))
         .collect();
     let w = per_segment.iter().copied().fold(0.0, f64::max);
     let mean = per_segment.iter().sum::<f64>() / n_seg as f64;

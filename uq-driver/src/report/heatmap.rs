@@ -21,7 +21,7 @@ pub struct Heatmap {
     pub x_label: String,
     /// Label of the vertical axis, with unit.
     pub y_label: String,
-    /// Horizontal cell centres (length nx), e.g. times [s].
+    /// Horizontal cell centres (length nx), e.g. times (s).
     pub x: Vec<f64>,
     /// Vertical cell centres (length ny), e.g. the grid of q.
     pub y: Vec<f64>,
@@ -69,6 +69,10 @@ const MIN_W: usize = 600;
 const MIN_H: usize = 400;
 /// Maximum PNG size in pixels per direction; larger grids are subsampled.
 const MAX_PIXELS: usize = 4096;
+/// Gap between the plot and the colorbar (px).
+const BAR_GAP: f64 = 22.0;
+/// Width of the colorbar (px).
+const BAR_W: f64 = 16.0;
 
 impl Heatmap {
     /// Size (width, height) of the PNG in pixels: at least one pixel per cell (up to 4096),
@@ -140,8 +144,6 @@ impl Heatmap {
             Some(s) => Axis::linear_exact(Some((s.lo, s.hi))),
             None => Axis::linear_exact(None),
         };
-        const BAR_GAP: f64 = 22.0;
-        const BAR_W: f64 = 16.0;
         let right = BAR_GAP + BAR_W + 10.0 + bar_axis.label_chars() as f64 * 6.4 + 26.0;
         let frame = Frame::new(x_axis, y_axis, right);
 
@@ -164,7 +166,29 @@ impl Heatmap {
         out.push_str("</g>\n");
         frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
 
-        // Colorbar: a gradient through the viridis table, with its own axis on the right.
+        self.colorbar(&mut out, &frame, scale.is_some(), &bar_axis);
+
+        let mut entries: Vec<LegendEntry> = self
+            .overlay
+            .iter()
+            .map(|s| LegendEntry::line(&s.label, &s.color, s.dashed))
+            .collect();
+        entries.retain(|e| !e.label.is_empty());
+        let lw = legend_width(&entries);
+        legend(
+            &mut out,
+            &entries,
+            frame.left + frame.width - lw - 4.0,
+            frame.top + 10.0,
+            true,
+        );
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// The colorbar right of `frame`: a gradient through the viridis table (grey when there
+    /// is no scale), with its own axis and label.
+    fn colorbar(&self, out: &mut String, frame: &Frame, scaled: bool, bar_axis: &Axis) {
         let bx = frame.left + frame.width + BAR_GAP;
         let (top, h) = (frame.top, frame.height);
         out.push_str("<g class=\"colorbar\">\n<defs><linearGradient id=\"cmap\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">");
@@ -179,11 +203,7 @@ impl Heatmap {
             );
         }
         out.push_str("</linearGradient></defs>\n");
-        let fill = if scale.is_some() {
-            "url(#cmap)"
-        } else {
-            "#eee"
-        };
+        let fill = if scaled { "url(#cmap)" } else { "#eee" };
         let _ = writeln!(
             out,
             "<rect x=\"{}\" y=\"{}\" width=\"{BAR_W}\" height=\"{}\" fill=\"{fill}\" stroke=\"#333\"/>",
@@ -191,7 +211,7 @@ impl Heatmap {
             c(top),
             c(h)
         );
-        if scale.is_some() {
+        if scaled {
             let bar_y = |v: f64| top + (1.0 - bar_axis.frac(v)) * h;
             let mut ticks = String::new();
             for &v in &bar_axis.ticks {
@@ -222,23 +242,6 @@ impl Heatmap {
             c(ly),
             escape_xml(&self.colorbar_label)
         );
-
-        let mut entries: Vec<LegendEntry> = self
-            .overlay
-            .iter()
-            .map(|s| LegendEntry::line(&s.label, &s.color, s.dashed))
-            .collect();
-        entries.retain(|e| !e.label.is_empty());
-        let lw = legend_width(&entries);
-        legend(
-            &mut out,
-            &entries,
-            frame.left + frame.width - lw - 4.0,
-            frame.top + 10.0,
-            true,
-        );
-        out.push_str("</svg>\n");
-        out
     }
 
     /// Writes [`Self::to_svg`] referencing the PNG file `png_file_name` (relative to the SVG;

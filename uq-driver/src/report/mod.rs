@@ -5,7 +5,9 @@
 //! - [`svg`]: hand-written SVG line plots (mean, ±3σ bands, differences) and density plots
 //!   (PDF curves, histograms, limit markers), with 1-2-5 ticks;
 //! - [`heatmap`]: PDF-evolution heat maps as a viridis PNG plus an SVG frame with axes and colorbar;
-//! - [`html`]: the self-contained `index.html` that ties the files together.
+//! - [`html`]: the self-contained `index.html` that ties the files together;
+//! - [`study`]: the files of one study's output folder (one writer per file);
+//! - [`suite`]: the comparison of a suite's variants.
 //!
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
 //! file. Only I/O (and, for CSV, inconsistent column lengths) produce a [`ReportError`].
@@ -13,6 +15,8 @@
 pub mod csv;
 pub mod heatmap;
 pub mod html;
+pub mod study;
+pub mod suite;
 pub mod svg;
 
 use std::path::{Path, PathBuf};
@@ -20,13 +24,14 @@ use std::path::{Path, PathBuf};
 pub use csv::{write_columns, write_grid};
 pub use heatmap::Heatmap;
 pub use html::{ReportPage, Section, Table};
+pub use study::StudyReport;
 pub use svg::{histogram_density, nice_ticks, palette, Band, DensityPlot, LinePlot, Series};
 
 /// Errors of the report writers.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
     /// Writing a file failed.
-    #[error("cannot write {}: {source}", path.display())]
+    #[error("cannot write {}", path.display())]
     Io {
         /// The file that could not be written.
         path: PathBuf,
@@ -35,7 +40,7 @@ pub enum ReportError {
         source: std::io::Error,
     },
     /// Encoding a PNG image failed.
-    #[error("cannot encode PNG {}: {source}", path.display())]
+    #[error("cannot encode PNG {}", path.display())]
     Png {
         /// The image that could not be encoded.
         path: PathBuf,

@@ -1,108 +1,108 @@
-//! From finished runs to statistics: moments over time, quantiles, PDF evolution, chaos
-//! coefficients and Sobol' indices (SCM, SGM), and scalar quantities of interest.
+//! From a method's estimates to the statistics of the report: quantiles and the PDF evolution
+//! of every output, the distribution of every scalar quantity. Quantiles and densities come
+//! from the draws the estimate names: the runs, or a large sample of its chaos surrogate.
+//! Nothing here depends on which method produced the estimate.
+
+use std::borrow::Cow;
 
 use nalgebra::DMatrix;
-use serde::Serialize;
 
-use super::design::Design;
-use super::spec::{MethodKind, Study};
 use super::store::Record;
 use crate::qoi::scalar::Code;
-use crate::qoi::{kde, moments};
-use crate::uq::pce::{MultiIndexSet, Pce};
-use crate::uq::rng;
+use crate::qoi::{kde, QoiSpec};
+use crate::results::{OutputStats, ScalarStats};
+use crate::spec::{Analysis, Study};
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
+use crate::uq::moments;
 
-/// First-order and total Sobol' indices over time, each `[time][parameter]`.
-pub type SobolSeries = (Vec<Vec<f64>>, Vec<Vec<f64>>);
+/// Offset of the surrogate's random streams from the design's (independent draws).
+const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
 
-/// Statistics of one output variable over time.
-#[derive(Clone, Debug)]
-pub struct OutputStats {
-    /// Variable name.
-    pub name: String,
-    /// Communication points (s).
-    pub times: Vec<f64>,
-    /// Mean over time.
-    pub mean: Vec<f64>,
-    /// Standard deviation over time (SCM: from the quadrature; SGM: from the chaos;
-    /// MC/LHS: unbiased sample Std).
-    pub std: Vec<f64>,
-    /// Quantiles over time: (level, values).
-    pub quantiles: Vec<(f64, Vec<f64>)>,
-    /// SCM: Std from the chaos coefficients (truncated at the study's order).
-    pub std_pce: Option<Vec<f64>>,
-    /// SCM/SGM: first-order and total Sobol' indices over time (`[time][parameter]`).
-    pub sobol: Option<SobolSeries>,
-    /// PDF evolution: times of the columns.
-    pub pdf_times: Vec<f64>,
-    /// Grid of the densities.
-    pub pdf_grid: Vec<f64>,
-    /// `pdf[i][j]`: density at `pdf_times[i]`, `pdf_grid[j]`.
-    pub pdf: Vec<Vec<f64>>,
+/// Failures of the analysis.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// Too few runs succeeded.
+    #[error("only {ok} successful runs: nothing to analyse")]
+    TooFewRuns {
+        /// Successful runs.
+        ok: usize,
+    },
+    /// The estimator refused an output.
+    #[error("output '{name}'")]
+    Output {
+        /// The output.
+        name: String,
+        /// Why.
+        #[source]
+        source: MethodError,
+    },
+    /// No run gave a value of a quantity.
+    #[error(
+        "quantity '{name}': no run gave a value ({never_hunts} never hunt, {never_stops} never stop)"
+    )]
+    NoValue {
+        /// The quantity.
+        name: String,
+        /// Runs that never hunt.
+        never_hunts: usize,
+        /// Runs whose oscillation never stops.
+        never_stops: usize,
+    },
+    /// The estimator refused a quantity (e.g. a weighted point without a value).
+    #[error(
+        "quantity '{name}' ({never_hunts} runs never hunt, {never_stops} never stop; use a method \
+         that can leave points out, such as LHS or MC, or change the detection settings or the run length)"
+    )]
+    Quantity {
+        /// The quantity.
+        name: String,
+        /// Runs that never hunt.
+        never_hunts: usize,
+        /// Runs whose oscillation never stops.
+        never_stops: usize,
+        /// Why.
+        #[source]
+        source: MethodError,
+    },
+    /// An estimate asks for draws it cannot give.
+    #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
+    NoDraws(String),
 }
 
-/// Statistics of one scalar quantity of interest.
-#[derive(Clone, Debug, Serialize)]
-pub struct ScalarStats {
-    /// Quantity name.
-    pub name: String,
-    /// Mean (SCM: quadrature; MC/LHS: sample mean over valid runs).
-    pub mean: f64,
-    /// Standard deviation.
-    pub std: f64,
-    /// Standard error of the mean (MC/LHS: std/√n; SCM: 0, quadrature).
-    pub std_error_mean: f64,
-    /// Runs with a valid value.
-    pub n_valid: usize,
-    /// Critical speed: runs that never hunt.
-    pub n_never_hunts: usize,
-    /// Critical speed: runs whose oscillation never dies out.
-    pub n_never_stops: usize,
-    /// (level, value) quantiles (SCM: of the chaos surrogate).
-    pub quantiles: Vec<(f64, f64)>,
-    /// Smallest and largest value over the runs.
-    pub min: f64,
-    /// Largest.
-    pub max: f64,
-    /// P(q > limit): (limit, p, standard error of p).
-    pub exceedance: Vec<(f64, f64, f64)>,
-    /// PDF grid.
-    pub pdf_x: Vec<f64>,
-    /// PDF values (KDE of the runs, or of the chaos surrogate for SCM).
-    pub pdf: Vec<f64>,
-    /// The valid values of the runs (for histograms).
-    #[serde(skip)]
-    pub samples: Vec<f64>,
-    /// The samples the PDF and quantiles come from (runs, or the surrogate).
-    #[serde(skip)]
-    pub density_samples: Vec<f64>,
-    /// SCM: first-order Sobol' indices per parameter.
-    pub sobol_first: Option<Vec<f64>>,
-    /// SCM: total Sobol' indices per parameter.
-    pub sobol_total: Option<Vec<f64>>,
+/// The analysis settings of a study.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings<'a> {
+    /// `[analysis]`.
+    pub analysis: &'a Analysis,
+    /// The study's seed.
+    pub seed: u64,
 }
 
-/// Draws of the standard-normal germ for surrogate sampling, as basis values (n × P).
-fn surrogate_basis(study: &Study, basis: &MultiIndexSet) -> DMatrix<f64> {
-    let n = study.file.analysis.surrogate_samples.max(2);
-    let d = basis.dim();
-    let p = basis.len();
-    let mut psi = DMatrix::<f64>::zeros(n, p);
-    let mut z = vec![0.0; d];
-    let mut row = vec![0.0; p];
-    // Streams offset from the design's so the surrogate draws are independent of it.
-    let seed = study.file.seed ^ 0x5eed_5a4d_0000_0000;
-    for i in 0..n {
-        let mut r = rng::stream(seed, i as u64);
-        for zj in z.iter_mut() {
-            *zj = rng::standard_normal(&mut r);
-        }
-        basis.eval(&z, &mut row);
-        for (j, v) in row.iter().enumerate() {
-            psi[(i, j)] = *v;
+impl<'a> Settings<'a> {
+    /// The settings of `study`.
+    pub fn of(study: &'a Study) -> Settings<'a> {
+        Settings {
+            analysis: &study.analysis,
+            seed: study.seed,
         }
     }
-    psi
+
+    /// The matrix quantiles and densities are taken from: `runs`, or draws of the chaos.
+    fn draws<'m>(
+        &self,
+        name: &str,
+        estimate: &Estimate,
+        runs: Option<&'m DMatrix<f64>>,
+    ) -> Result<Cow<'m, DMatrix<f64>>, AnalysisError> {
+        match (estimate.draws, &estimate.chaos, runs) {
+            (Draws::Chaos, Some(pce), _) => {
+                let n = self.analysis.surrogate_samples.max(2);
+                Ok(Cow::Owned(pce.sample(n, self.seed ^ SURROGATE_SEED)))
+            }
+            (Draws::Runs, _, Some(r)) => Ok(Cow::Borrowed(r)),
+            _ => Err(AnalysisError::NoDraws(name.to_owned())),
+        }
+    }
 }
 
 /// Column indices of at most `max` evenly spaced columns out of `n`, always with the last.
@@ -118,20 +118,18 @@ fn thinned(n: usize, max: usize) -> Vec<usize> {
     v
 }
 
-/// Quantiles and PDF evolution from a samples matrix (rows: samples, columns: times).
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    study: &Study,
+/// Statistics of an output over `times` from its estimate; `runs` are the successful runs
+/// (rows) over time (columns), if the model was run.
+pub fn output_stats(
     name: &str,
     times: &[f64],
-    mean: Vec<f64>,
-    std: Vec<f64>,
-    std_pce: Option<Vec<f64>>,
-    pce: Option<&Pce>,
-    samples: &DMatrix<f64>,
-) -> OutputStats {
-    let a = &study.file.analysis;
-    let cols = moments::column_quantiles(samples, &a.quantiles);
+    estimate: &Estimate,
+    runs: Option<&DMatrix<f64>>,
+    settings: &Settings,
+) -> Result<OutputStats, AnalysisError> {
+    let a = settings.analysis;
+    let samples = settings.draws(name, estimate, runs)?;
+    let cols = moments::column_quantiles(&samples, &a.quantiles);
     let quantiles = a
         .quantiles
         .iter()
@@ -148,240 +146,218 @@ fn finish(
     }
     let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
     let grid = kde::auto_grid(lo - pad, hi + pad, a.pdf_grid);
-    let pdf: Vec<Vec<f64>> = picked
+    let pdf = picked
         .iter()
         .map(|&k| {
             let col: Vec<f64> = samples.column(k).iter().copied().collect();
             kde::gaussian_kde(&col, None, &grid, kde::silverman_bandwidth(&col))
         })
         .collect();
-    let sobol = pce.map(|p| {
-        let first = (0..times.len()).map(|k| p.sobol_first(k)).collect();
-        let total = (0..times.len()).map(|k| p.sobol_total(k)).collect();
-        (first, total)
-    });
-    OutputStats {
+    let (lower_3sigma, upper_3sigma) = OutputStats::band(&estimate.mean, &estimate.std, 3.0);
+    Ok(OutputStats {
         name: name.to_owned(),
         times: times.to_vec(),
-        mean,
-        std,
+        mean: estimate.mean.clone(),
+        std: estimate.std.clone(),
+        lower_3sigma,
+        upper_3sigma,
         quantiles,
-        std_pce,
-        sobol,
+        std_pce: estimate.std_chaos.clone(),
+        sobol: estimate.sobol.clone(),
         pdf_times: picked.iter().map(|&k| times[k]).collect(),
         pdf_grid: grid,
         pdf,
-    }
+        draws: estimate.draws,
+    })
 }
 
-/// Statistics of an output known by its chaos (SGM).
-pub fn stats_from_pce(study: &Study, name: &str, pce: &Pce) -> OutputStats {
-    let times = study.file.experiment.times();
-    let samples = surrogate_basis(study, &pce.basis) * &pce.coeffs;
-    finish(
-        study,
-        name,
-        &times,
-        pce.mean(),
-        pce.std(),
-        None,
-        Some(pce),
-        &samples,
-    )
+/// The values of one quantity over the successful runs, with their outcome codes.
+struct QuantityRuns {
+    /// Design indices of the runs with a valid value.
+    rows: Vec<usize>,
+    /// Their values.
+    valid: Vec<f64>,
+    never_hunts: usize,
+    never_stops: usize,
 }
 
-/// Indices of the successful runs.
-fn ok_points(records: &[Option<Record>]) -> Vec<usize> {
-    (0..records.len())
-        .filter(|&i| matches!(records[i], Some(Record::Ok(_))))
-        .collect()
+/// Statistics of a scalar quantity from its estimate and its valid run values.
+fn scalar_stats(
+    q: &QoiSpec,
+    estimate: &Estimate,
+    runs: QuantityRuns,
+    settings: &Settings,
+) -> Result<ScalarStats, AnalysisError> {
+    let a = settings.analysis;
+    let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
+    let density_samples: Vec<f64> = settings
+        .draws(q.name(), estimate, Some(&data))?
+        .column(0)
+        .iter()
+        .copied()
+        .collect();
+    let mut sorted = density_samples.clone();
+    sorted.sort_by(f64::total_cmp);
+    let quantiles = a
+        .quantiles
+        .iter()
+        .map(|&p| (p, moments::quantile(&sorted, p)))
+        .collect();
+    let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
+    let bw = kde::silverman_bandwidth(&sorted);
+    let grid = kde::auto_grid(lo - 3.0 * bw, hi + 3.0 * bw, a.pdf_grid);
+    let pdf = kde::gaussian_kde(&sorted, None, &grid, bw);
+    let exceedance = q
+        .limits()
+        .iter()
+        .map(|&l| {
+            let (p, se) = moments::exceedance_probability(&density_samples, l);
+            (l, p, se)
+        })
+        .collect();
+    let valid = runs.valid;
+    Ok(ScalarStats {
+        name: q.name().to_owned(),
+        mean: estimate.mean[0],
+        std: estimate.std[0],
+        std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
+        n_valid: valid.len(),
+        n_never_hunts: runs.never_hunts,
+        n_never_stops: runs.never_stops,
+        quantiles,
+        min: valid.iter().copied().fold(f64::INFINITY, f64::min),
+        max: valid.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        exceedance,
+        pdf_x: grid,
+        pdf,
+        samples: valid,
+        density_samples,
+        sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
+        sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
+        draws: estimate.draws,
+    })
 }
 
-/// Analyses every output of a sampled or collocated study. `records` must hold a record for
-/// every point.
-pub fn analyse(
-    study: &Study,
-    design: &Design,
-    records: &[Option<Record>],
-) -> Result<Vec<OutputStats>, String> {
-    let times = study.file.experiment.times();
-    let nt = times.len();
-    let ok = ok_points(records);
-    let needed = if design.method == MethodKind::Nominal {
-        1
-    } else {
-        2
-    };
-    if ok.len() < needed {
-        return Err(format!(
-            "only {} successful runs: nothing to analyse",
-            ok.len()
-        ));
-    }
-    let mut out = Vec::new();
-    for (o, name) in study.file.outputs.variables.iter().enumerate() {
-        let data = DMatrix::from_fn(ok.len(), nt, |r, k| match &records[ok[r]] {
-            Some(Record::Ok(v)) => v[o * nt + k],
-            _ => unreachable!("filtered above"),
-        });
-        match (design.method, &design.weights) {
-            (MethodKind::Scm, Some(w)) => {
-                if ok.len() != design.len() {
-                    return Err(
-                        "a collocation node is missing: refusing to drop a weighted node".into(),
-                    );
-                }
-                let (mean, std) = moments::weighted_mean_std(&data, w);
-                let pce = project(study, design, w, &data)?;
-                let samples = surrogate_basis(study, &pce.basis) * &pce.coeffs;
-                out.push(finish(
-                    study,
-                    name,
-                    &times,
-                    mean,
-                    std,
-                    Some(pce.std()),
-                    Some(&pce),
-                    &samples,
-                ));
-            }
-            (MethodKind::Nominal, Some(w)) => {
-                let (mean, std) = moments::weighted_mean_std(&data, w);
-                out.push(finish(study, name, &times, mean, std, None, None, &data));
-            }
-            _ => {
-                let (mean, std) = moments::sample_mean_std(&data);
-                out.push(finish(study, name, &times, mean, std, None, None, &data));
-            }
-        }
-    }
-    Ok(out)
+/// The values of the successful runs, in design order.
+struct Runs<'a> {
+    /// Design indices.
+    rows: Vec<usize>,
+    values: Vec<&'a [f64]>,
 }
 
-fn project(study: &Study, design: &Design, w: &[f64], data: &DMatrix<f64>) -> Result<Pce, String> {
-    let basis = MultiIndexSet::total_order(study.parameters.len(), design.order);
-    Pce::project(basis, &design.germ, w, data, &design.nodes_per_dim).map_err(|e| e.to_string())
-}
-
-/// Analyses the scalar quantities of interest.
-pub fn analyse_scalars(
-    study: &Study,
-    design: &Design,
-    records: &[Option<Record>],
-) -> Result<Vec<ScalarStats>, String> {
-    let nt = study.file.experiment.times().len();
-    let base = study.file.outputs.variables.len() * nt;
-    let ok = ok_points(records);
-    let a = &study.file.analysis;
-    let mut out = Vec::new();
-    for (qi, q) in study.file.qoi.iter().enumerate() {
-        let mut values = Vec::with_capacity(ok.len());
-        let mut codes = Vec::with_capacity(ok.len());
-        for &i in &ok {
-            if let Some(Record::Ok(v)) = &records[i] {
-                values.push(v[base + 2 * qi]);
-                codes.push(Code::from_f64(v[base + 2 * qi + 1]));
-            }
-        }
-        let n_never_hunts = codes.iter().filter(|c| **c == Code::NeverHunts).count();
-        let n_never_stops = codes.iter().filter(|c| **c == Code::NeverStops).count();
-        let valid: Vec<f64> = values
+impl<'a> Runs<'a> {
+    fn of(records: &'a [Option<Record>]) -> Runs<'a> {
+        let (rows, values) = records
             .iter()
-            .zip(&codes)
-            .filter(|(_, c)| **c == Code::Ok)
-            .map(|(v, _)| *v)
-            .collect();
-        if valid.is_empty() {
-            return Err(format!(
-                "quantity '{}': no run gave a value ({n_never_hunts} never hunt, {n_never_stops} never stop)",
-                q.name()
-            ));
-        }
-        let (mean, std, sem, density_samples, sobol_first, sobol_total) = match (
-            design.method,
-            &design.weights,
-        ) {
-            (MethodKind::Scm, Some(w)) => {
-                if valid.len() != design.len() {
-                    return Err(format!(
-                        "quantity '{}': {} of {} collocation nodes have no value ({n_never_hunts} never hunt, \
-                         {n_never_stops} never stop); a chaos cannot be projected without them — use LHS/MC, \
-                         or change the detection settings or the run length",
-                        q.name(),
-                        design.len() - valid.len(),
-                        design.len()
-                    ));
-                }
-                let data = DMatrix::from_column_slice(valid.len(), 1, &valid);
-                let (m, s) = moments::weighted_mean_std(&data, w);
-                let pce = project(study, design, w, &data)?;
-                let sur = (surrogate_basis(study, &pce.basis) * &pce.coeffs)
-                    .column(0)
-                    .iter()
-                    .copied()
-                    .collect();
-                (
-                    m[0],
-                    s[0],
-                    0.0,
-                    sur,
-                    Some(pce.sobol_first(0)),
-                    Some(pce.sobol_total(0)),
-                )
-            }
-            (MethodKind::Nominal, _) => (valid[0], 0.0, 0.0, valid.clone(), None, None),
-            _ => {
-                let sum = moments::ScalarSummary::from_samples(&valid);
-                (
-                    sum.mean,
-                    sum.std,
-                    sum.std_error_mean,
-                    valid.clone(),
-                    None,
-                    None,
-                )
-            }
-        };
-        let mut sorted = density_samples.clone();
-        sorted.sort_by(f64::total_cmp);
-        let quantiles = a
-            .quantiles
-            .iter()
-            .map(|&p| (p, moments::quantile(&sorted, p)))
-            .collect();
-        let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
-        let bw = kde::silverman_bandwidth(&sorted);
-        let grid = kde::auto_grid(lo - 3.0 * bw, hi + 3.0 * bw, a.pdf_grid);
-        let pdf = kde::gaussian_kde(&sorted, None, &grid, bw);
-        let exceedance = q
-            .limits()
-            .iter()
-            .map(|&l| {
-                let (p, se) = moments::exceedance_probability(&density_samples, l);
-                (l, p, se)
+            .enumerate()
+            .filter_map(|(i, r)| match r {
+                Some(Record::Ok(v)) => Some((i, v.as_slice())),
+                _ => None,
             })
-            .collect();
-        out.push(ScalarStats {
-            name: q.name().to_owned(),
-            mean,
-            std,
-            std_error_mean: sem,
-            n_valid: valid.len(),
-            n_never_hunts,
-            n_never_stops,
-            quantiles,
-            min: valid.iter().copied().fold(f64::INFINITY, f64::min),
-            max: valid.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            exceedance,
-            pdf_x: grid,
-            pdf,
-            samples: valid,
-            density_samples,
-            sobol_first,
-            sobol_total,
+            .unzip();
+        Runs { rows, values }
+    }
+
+    /// Output `o` (of `nt` times each) as runs × times.
+    fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(self.rows.len(), nt, |r, k| self.values[r][o * nt + k])
+    }
+
+    /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
+    fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
+        let mut out = QuantityRuns {
+            rows: Vec::new(),
+            valid: Vec::new(),
+            never_hunts: 0,
+            never_stops: 0,
+        };
+        for (&row, v) in self.rows.iter().zip(&self.values) {
+            match Code::from_f64(v[base + 2 * qi + 1]) {
+                Code::Ok => {
+                    out.rows.push(row);
+                    out.valid.push(v[base + 2 * qi]);
+                }
+                Code::NeverHunts => out.never_hunts += 1,
+                Code::NeverStops => out.never_stops += 1,
+            }
+        }
+        out
+    }
+}
+
+/// Statistics of every output and quantity of a study whose points have all been run
+/// (`records` holds one record per point of `design`).
+pub fn analyse_runs(
+    study: &Study,
+    method: &dyn Sampling,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<(Vec<OutputStats>, Vec<ScalarStats>), AnalysisError> {
+    let settings = Settings::of(study);
+    let times = study.times();
+    let nt = times.len();
+    let runs = Runs::of(records);
+    if runs.rows.len() < method.min_runs() {
+        return Err(AnalysisError::TooFewRuns {
+            ok: runs.rows.len(),
         });
     }
-    Ok(out)
+    let mut outputs = Vec::new();
+    for (o, name) in study.outputs.iter().enumerate() {
+        let data = runs.output(o, nt);
+        let estimate = method
+            .estimate(design, &runs.rows, &data)
+            .map_err(|source| AnalysisError::Output {
+                name: name.clone(),
+                source,
+            })?;
+        outputs.push(output_stats(
+            name,
+            &times,
+            &estimate,
+            Some(&data),
+            &settings,
+        )?);
+    }
+    let base = study.outputs.len() * nt;
+    let mut quantities = Vec::new();
+    for (qi, q) in study.qoi.iter().enumerate() {
+        let qr = runs.quantity(base, qi);
+        if qr.valid.is_empty() {
+            return Err(AnalysisError::NoValue {
+                name: q.name().to_owned(),
+                never_hunts: qr.never_hunts,
+                never_stops: qr.never_stops,
+            });
+        }
+        let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
+        let estimate =
+            method
+                .estimate(design, &qr.rows, &data)
+                .map_err(|source| AnalysisError::Quantity {
+                    name: q.name().to_owned(),
+                    never_hunts: qr.never_hunts,
+                    never_stops: qr.never_stops,
+                    source,
+                })?;
+        quantities.push(scalar_stats(q, &estimate, qr, &settings)?);
+    }
+    Ok((outputs, quantities))
+}
+
+/// Statistics of every output of an intrusive method's solution.
+pub fn analyse_solution(
+    study: &Study,
+    solution: &Solution,
+) -> Result<Vec<OutputStats>, AnalysisError> {
+    let settings = Settings::of(study);
+    let times = study.times();
+    study
+        .outputs
+        .iter()
+        .zip(&solution.outputs)
+        .map(|(name, estimate)| output_stats(name, &times, estimate, None, &settings))
+        .collect()
 }
 
 #[cfg(test)]

@@ -8,11 +8,12 @@ use std::time::Instant;
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use super::design::Design;
-use super::spec::{QoiSpec, Study};
+use super::interface::{Interface, InterfaceError};
 use super::store::{Manifest, Record, Store, StoreError};
-use crate::fmu::{Fmu, FmuError, Instance, ScalarVariable, VariableKind};
-use crate::qoi::scalar;
+use crate::fmu::{Fmu, FmuError, Instance};
+use crate::qoi::scalar::{self, QoiError};
+use crate::spec::Study;
+use crate::uq::method::{Design, MethodError};
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -21,7 +22,7 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
-    /// MC/LHS: continue past failed points (overrides the study file when true).
+    /// Unweighted designs: continue past failed points (overrides the study file when true).
     pub allow_failures: bool,
     /// Discard earlier results in the output folder.
     pub fresh: bool,
@@ -31,188 +32,90 @@ pub struct RunOptions {
     pub points: Option<Vec<usize>>,
 }
 
+impl RunOptions {
+    /// Whether failed points may be left out (the option or the study's `allow_failures`).
+    pub fn allow_failures(&self, study: &Study) -> bool {
+        self.allow_failures || study.analysis.allow_failures
+    }
+}
+
+/// Why one model run failed. Its text is stored with the point, so it is complete on its own.
+#[derive(Debug, thiserror::Error)]
+pub enum PointError {
+    /// An FMI call failed (the message lists what the FMU logged).
+    #[error(transparent)]
+    Fmu(#[from] FmuError),
+    /// An output became NaN or infinite.
+    #[error("non-finite value of {signal} at t = {time} s")]
+    NonFinite {
+        /// The variable.
+        signal: String,
+        /// When (s).
+        time: f64,
+    },
+    /// A quantity of interest could not be evaluated on the run.
+    #[error("quantity '{name}': {error}")]
+    Quantity {
+        /// The quantity.
+        name: String,
+        /// Why.
+        error: QoiError,
+    },
+}
+
+/// A point that failed: where and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FailedPoint {
+    /// Index in the design.
+    pub index: usize,
+    /// Its parameter values, by name.
+    pub parameters: Vec<(String, f64)>,
+    /// Why it failed, with what the FMU logged.
+    pub message: String,
+}
+
+impl std::fmt::Display for FailedPoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "point {} with ", self.index)?;
+        for (i, (name, v)) in self.parameters.iter().enumerate() {
+            let sep = if i == 0 { "" } else { ", " };
+            write!(f, "{sep}{name} = {v}")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
 /// Runner failures.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    /// The FMU could not be opened or does not fit the study.
+    /// The FMU could not be opened.
     #[error(transparent)]
     Fmu(#[from] FmuError),
     /// The store could not be used.
     #[error(transparent)]
     Store(#[from] StoreError),
     /// A study variable does not fit the FMU.
-    #[error("{fmu}: {message}")]
-    Interface {
-        /// FMU path.
-        fmu: String,
-        /// What does not fit.
-        message: String,
-    },
+    #[error(transparent)]
+    Interface(#[from] InterfaceError),
     /// The design could not be built.
-    #[error("{0}")]
-    Design(String),
+    #[error(transparent)]
+    Design(#[from] MethodError),
     /// Points failed and failures are not allowed.
-    #[error("{failed} of {total} points failed; first: point {index} with {params}: {message}")]
+    #[error("{failed} of {total} points failed; first: {first}")]
     PointsFailed {
         /// Number of failed points.
         failed: usize,
         /// Number of points.
         total: usize,
-        /// First failed point.
-        index: usize,
-        /// Its parameter values.
-        params: String,
-        /// Why it failed.
-        message: String,
+        /// The first failed point.
+        first: FailedPoint,
     },
-    /// Thread pool could not be built.
-    #[error("thread pool: {0}")]
-    Pool(String),
-}
-
-/// Value references resolved against the FMU.
-#[derive(Clone, Debug)]
-pub struct Interface {
-    /// Random parameters, in study order.
-    pub random: Vec<u32>,
-    /// Fixed Real parameters (name order) and values.
-    pub fixed: Vec<(u32, f64)>,
-    /// Fixed Integer parameters (e.g. a spectrum or seed number).
-    pub fixed_int: Vec<(u32, i32)>,
-    /// Every variable read at each communication point: the outputs, then the signals the
-    /// quantities of interest need.
-    pub signals: Vec<u32>,
-    /// Their names.
-    pub signal_names: Vec<String>,
-    /// Number of leading signals that are stored as time series (the study's outputs).
-    pub n_stored: usize,
-    /// Scalar quantities of interest.
-    pub qois: Vec<QoiSpec>,
-}
-
-impl Interface {
-    /// Values recorded per successful point: stored series, then (value, code) per quantity.
-    pub fn n_values(&self, n_times: usize) -> usize {
-        self.n_stored * n_times + 2 * self.qois.len()
-    }
-}
-
-/// A variable of the FMU by name, or an error naming it.
-fn any_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError> {
-    fmu.description()
-        .variable(name)
-        .ok_or_else(|| RunError::Interface {
-            fmu: fmu.path().display().to_string(),
-            message: format!(
-                "the study names variable '{name}', which the FMU ({}) does not have",
-                fmu.description().model_name
-            ),
-        })
-}
-
-fn real_var<'a>(fmu: &'a Fmu, name: &str) -> Result<&'a ScalarVariable, RunError> {
-    let var = any_var(fmu, name)?;
-    if !matches!(var.kind, VariableKind::Real { .. }) {
-        return Err(RunError::Interface {
-            fmu: fmu.path().display().to_string(),
-            message: format!(
-                "variable '{name}' is a {}, not a Real",
-                var.kind.type_name()
-            ),
-        });
-    }
-    Ok(var)
-}
-
-fn check_settable(fmu: &Fmu, var: &ScalarVariable) -> Result<(), RunError> {
-    if fmu.description().settable_before_init(var) {
-        return Ok(());
-    }
-    Err(RunError::Interface {
-        fmu: fmu.path().display().to_string(),
-        message: format!(
-            "variable '{}' (causality {}, variability {}) may not be set before initialization, \
-             so a study cannot set it",
-            var.name,
-            var.causality.as_str(),
-            var.variability.as_str()
-        ),
-    })
-}
-
-/// Deterministic settings: (value reference, value) for Reals and for Integers.
-type FixedValues = (Vec<(u32, f64)>, Vec<(u32, i32)>);
-
-/// Splits deterministic values into Real and Integer settings, checking each variable.
-fn fixed_values<'a>(
-    fmu: &Fmu,
-    values: impl Iterator<Item = (&'a str, f64)>,
-) -> Result<FixedValues, RunError> {
-    let mut reals = Vec::new();
-    let mut ints = Vec::new();
-    for (name, v) in values {
-        let var = any_var(fmu, name)?;
-        check_settable(fmu, var)?;
-        match var.kind {
-            VariableKind::Real { .. } => reals.push((var.value_reference, v)),
-            VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => {
-                if v.fract() != 0.0 || v.abs() > f64::from(i32::MAX) {
-                    return Err(RunError::Interface {
-                        fmu: fmu.path().display().to_string(),
-                        message: format!("'{name}' is an Integer; {v} is not a whole number"),
-                    });
-                }
-                ints.push((var.value_reference, v as i32));
-            }
-            _ => {
-                return Err(RunError::Interface {
-                    fmu: fmu.path().display().to_string(),
-                    message: format!(
-                        "'{name}' is a {}; only Real and Integer values can be set",
-                        var.kind.type_name()
-                    ),
-                })
-            }
-        }
-    }
-    Ok((reals, ints))
-}
-
-/// Checks the study's variables against the FMU and resolves their value references.
-pub fn resolve_interface(study: &Study, fmu: &Fmu) -> Result<Interface, RunError> {
-    let settable = |name: &str| -> Result<u32, RunError> {
-        let var = real_var(fmu, name)?;
-        check_settable(fmu, var)?;
-        Ok(var.value_reference)
-    };
-    let random = study
-        .parameters
-        .iter()
-        .map(|p| settable(&p.name))
-        .collect::<Result<_, _>>()?;
-    let (fixed, fixed_int) =
-        fixed_values(fmu, study.file.fixed.iter().map(|(n, v)| (n.as_str(), *v)))?;
-    let mut signal_names: Vec<String> = study.file.outputs.variables.clone();
-    for q in &study.file.qoi {
-        for s in q.signals() {
-            if !signal_names.iter().any(|n| n == s) {
-                signal_names.push(s.to_owned());
-            }
-        }
-    }
-    let signals = signal_names
-        .iter()
-        .map(|n| Ok(real_var(fmu, n)?.value_reference))
-        .collect::<Result<_, RunError>>()?;
-    Ok(Interface {
-        random,
-        fixed,
-        fixed_int,
-        signals,
-        signal_names,
-        n_stored: study.file.outputs.variables.len(),
-        qois: study.file.qoi.clone(),
-    })
+    /// A single run failed (`simulate`).
+    #[error(transparent)]
+    Point(#[from] PointError),
+    /// The thread pool could not be built.
+    #[error("cannot start the worker threads")]
+    Pool(#[source] rayon::ThreadPoolBuildError),
 }
 
 /// SHA-256 of an FMU, hex: of the file, or, for an extracted FMU folder, of every file's
@@ -247,18 +150,62 @@ pub fn sha256_file(path: &Path) -> std::io::Result<String> {
     Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
 
-/// Hash of everything in a study that changes its numbers (not its name or description).
+/// Hash of everything in a study that changes the stored records (not its name, description
+/// or analysis settings). The quantities of interest are stored with every run, so their
+/// settings are part of it (a study without any keeps the hash it always had).
 pub fn study_hash(study: &Study) -> String {
-    let f = &study.file;
-    let key = serde_json::json!({
-        "seed": f.seed,
-        "experiment": f.experiment,
-        "method": f.method,
+    let mut key = serde_json::json!({
+        "seed": study.seed,
+        "experiment": study.experiment,
+        "method": study.method,
         "parameters": study.parameters,
-        "fixed": f.fixed,
-        "outputs": f.outputs,
+        "fixed": study.fixed,
+        "outputs": { "variables": study.outputs },
     });
+    if !study.qoi.is_empty() {
+        key["qoi"] = serde_json::json!(study.qoi);
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
+}
+
+/// Starts (or resets) `slot`'s instance, sets the parameters, initializes and records the
+/// signals at `times`: `traces[o * nt + k]` is signal `o` at `times[k]`.
+fn simulate_point(
+    fmu: &Fmu,
+    slot: &mut Option<Instance>,
+    iface: &Interface,
+    values: &[f64],
+    times: &[f64],
+) -> Result<Vec<f64>, FmuError> {
+    let nt = times.len();
+    let inst = match slot {
+        Some(inst) => {
+            inst.reset()?;
+            inst
+        }
+        None => slot.insert(fmu.instantiate("uq-driver", false)?),
+    };
+    let (fixed_vr, fixed_v): (Vec<u32>, Vec<f64>) = iface.fixed.iter().copied().unzip();
+    inst.set_real(&fixed_vr, &fixed_v)?;
+    let (int_vr, int_v): (Vec<u32>, Vec<i32>) = iface.fixed_int.iter().copied().unzip();
+    inst.set_integer(&int_vr, &int_v)?;
+    inst.set_real(&iface.random, values)?;
+    let stop = *times.last().expect("at least one time");
+    inst.setup_experiment(None, times[0], Some(stop))?;
+    inst.enter_initialization_mode()?;
+    inst.exit_initialization_mode()?;
+    let mut traces = vec![0.0; iface.signals.len() * nt];
+    let mut buf = vec![0.0; iface.signals.len()];
+    for k in 0..nt {
+        if k > 0 {
+            inst.do_step(times[k - 1], times[k] - times[k - 1], true)?;
+        }
+        inst.get_real(&iface.signals, &mut buf)?;
+        for (o, v) in buf.iter().enumerate() {
+            traces[o * nt + k] = *v;
+        }
+    }
+    Ok(traces)
 }
 
 /// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
@@ -270,68 +217,34 @@ pub fn run_point(
     iface: &Interface,
     values: &[f64],
     times: &[f64],
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>, PointError> {
     let nt = times.len();
-    let ns = iface.signals.len();
-    let result = (|| -> Result<Vec<f64>, FmuError> {
-        let inst = match slot {
-            Some(inst) => {
-                inst.reset()?;
-                inst
-            }
-            None => slot.insert(fmu.instantiate("uq-driver", false)?),
-        };
-        let (fixed_vr, fixed_v): (Vec<u32>, Vec<f64>) = iface.fixed.iter().copied().unzip();
-        inst.set_real(&fixed_vr, &fixed_v)?;
-        let (int_vr, int_v): (Vec<u32>, Vec<i32>) = iface.fixed_int.iter().copied().unzip();
-        inst.set_integer(&int_vr, &int_v)?;
-        inst.set_real(&iface.random, values)?;
-        let start = times[0];
-        let stop = *times.last().expect("at least one time");
-        inst.setup_experiment(None, start, Some(stop))?;
-        inst.enter_initialization_mode()?;
-        inst.exit_initialization_mode()?;
-        let mut traces = vec![0.0; ns * nt];
-        let mut buf = vec![0.0; ns];
-        for k in 0..nt {
-            if k > 0 {
-                inst.do_step(times[k - 1], times[k] - times[k - 1], true)?;
-            }
-            inst.get_real(&iface.signals, &mut buf)?;
-            for (o, v) in buf.iter().enumerate() {
-                traces[o * nt + k] = *v;
-            }
-        }
-        Ok(traces)
-    })();
-    let traces = match result {
-        Ok(t) => t,
-        Err(e) => {
-            // A failed instance may be in Error state: start the next point on a fresh one.
-            *slot = None;
-            return Err(e.to_string());
-        }
-    };
+    let traces = simulate_point(fmu, slot, iface, values, times).inspect_err(|_| {
+        // A failed instance may be in Error state: start the next point on a fresh one.
+        *slot = None;
+    })?;
     if let Some(pos) = traces.iter().position(|v| !v.is_finite()) {
         *slot = None;
-        return Err(format!(
-            "non-finite value of {} at t = {} s",
-            iface.signal_names[pos / nt],
-            times[pos % nt]
-        ));
+        return Err(PointError::NonFinite {
+            signal: iface.signal_names[pos / nt].clone(),
+            time: times[pos % nt],
+        });
     }
     let mut out = traces[..iface.n_stored * nt].to_vec();
+    let signal = |name: &str| -> &[f64] {
+        let i = iface
+            .signal_names
+            .iter()
+            .position(|n| n == name)
+            .expect("resolved");
+        &traces[i * nt..(i + 1) * nt]
+    };
     for q in &iface.qois {
-        let signal = |name: &str| -> &[f64] {
-            let i = iface
-                .signal_names
-                .iter()
-                .position(|n| n == name)
-                .expect("resolved");
-            &traces[i * nt..(i + 1) * nt]
-        };
-        let (v, code) = scalar::evaluate(q, times, signal)
-            .map_err(|e| format!("quantity '{}': {e}", q.name()))?;
+        let (v, code) =
+            scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
+                name: q.name().to_owned(),
+                error,
+            })?;
         out.push(v);
         out.push(code as u8 as f64);
     }
@@ -355,6 +268,35 @@ pub struct RunOutcome {
     pub fmu_sha256: String,
 }
 
+/// The store manifest of `study` on `fmu` with `design`.
+pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, RunError> {
+    let iface = Interface::resolve(study, fmu)?;
+    let fmu_sha256 = sha256_file(fmu.path()).map_err(|source| FmuError::Io {
+        path: fmu.path().to_path_buf(),
+        source,
+    })?;
+    Ok(Manifest {
+        study_hash: study_hash(study),
+        fmu_sha256,
+        n_points: design.len(),
+        n_values: iface.n_values(study.experiment.times().len()),
+    })
+}
+
+fn progress_bar(show: bool, n: usize) -> Option<indicatif::ProgressBar> {
+    if !show || n == 0 {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(n as u64);
+    b.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} points  {elapsed} elapsed, ~{eta} left",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    Some(b)
+}
+
 /// Runs every point of `design` not yet in the store of `out_dir`.
 pub fn run_points(
     study: &Study,
@@ -364,18 +306,7 @@ pub fn run_points(
     opts: &RunOptions,
 ) -> Result<RunOutcome, RunError> {
     let started = Instant::now();
-    let iface = resolve_interface(study, fmu)?;
-    let times = study.file.experiment.times();
-    let fmu_sha256 = sha256_file(fmu.path()).map_err(|source| FmuError::Io {
-        path: fmu.path().to_path_buf(),
-        source,
-    })?;
-    let manifest = Manifest {
-        study_hash: study_hash(study),
-        fmu_sha256: fmu_sha256.clone(),
-        n_points: design.len(),
-        n_values: iface.n_values(times.len()),
-    };
+    let manifest = manifest(study, fmu, design)?;
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
     if let Some(note) = store.recovery().summary() {
         eprintln!("warning: {note}");
@@ -389,7 +320,6 @@ pub fn run_points(
         .copied()
         .filter(|&i| records[i].is_none())
         .collect();
-    let n_resumed = wanted.len() - missing.len();
     let threads = opts
         .threads
         .unwrap_or_else(rayon::current_num_threads)
@@ -397,57 +327,18 @@ pub fn run_points(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| RunError::Pool(e.to_string()))?;
-    let allow_failures = opts.allow_failures || study.file.analysis.allow_failures;
-    let stop = AtomicBool::new(false);
-    let finished = AtomicUsize::new(0);
-    let bar = if opts.progress && !missing.is_empty() {
-        let b = indicatif::ProgressBar::new(missing.len() as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} points  {elapsed} elapsed, ~{eta} left",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        Some(b)
-    } else {
-        None
+        .map_err(RunError::Pool)?;
+    let batch = Batch {
+        fmu,
+        iface: Interface::resolve(study, fmu)?,
+        design,
+        times: study.times(),
+        store: &store,
+        stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
+        max_new: opts.max_new_points,
     };
-    let new: Vec<(usize, Record)> = pool.install(|| {
-        missing
-            .par_iter()
-            .with_min_len(1)
-            .map_init(
-                || None::<Instance>,
-                |slot, &i| -> Result<Option<(usize, Record)>, StoreError> {
-                    if stop.load(Ordering::Relaxed) {
-                        return Ok(None);
-                    }
-                    if let Some(max) = opts.max_new_points {
-                        if finished.fetch_add(1, Ordering::SeqCst) >= max {
-                            stop.store(true, Ordering::Relaxed);
-                            return Ok(None);
-                        }
-                    }
-                    let rec = match run_point(fmu, slot, &iface, &design.values[i], &times) {
-                        Ok(v) => Record::Ok(v),
-                        Err(m) => {
-                            if !allow_failures || design.weights.is_some() {
-                                stop.store(true, Ordering::Relaxed);
-                            }
-                            Record::Failed(m)
-                        }
-                    };
-                    store.append(i, &rec)?;
-                    if let Some(b) = &bar {
-                        b.inc(1);
-                    }
-                    Ok(Some((i, rec)))
-                },
-            )
-            .filter_map(Result::transpose)
-            .collect::<Result<Vec<_>, StoreError>>()
-    })?;
+    let bar = progress_bar(opts.progress, missing.len());
+    let new = pool.install(|| batch.run(&missing, bar.as_ref()))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -458,14 +349,73 @@ pub fn run_points(
     Ok(RunOutcome {
         records,
         n_new,
-        n_resumed,
+        n_resumed: wanted.len() - missing.len(),
         wall_time: started.elapsed().as_secs_f64(),
         threads,
-        fmu_sha256,
+        fmu_sha256: manifest.fmu_sha256,
     })
 }
 
-/// Fails with a clear message when points failed and that is not allowed.
+/// Points to run in parallel, each appended to the store as it finishes.
+struct Batch<'a> {
+    fmu: &'a Fmu,
+    iface: Interface,
+    design: &'a Design,
+    times: Vec<f64>,
+    store: &'a Store,
+    /// Stop at the first failure (failures not allowed, or a weighted design).
+    stop_on_failure: bool,
+    /// Stop after this many new points.
+    max_new: Option<usize>,
+}
+
+impl Batch<'_> {
+    fn run(
+        &self,
+        points: &[usize],
+        bar: Option<&indicatif::ProgressBar>,
+    ) -> Result<Vec<(usize, Record)>, StoreError> {
+        let stop = AtomicBool::new(false);
+        let started = AtomicUsize::new(0);
+        points
+            .par_iter()
+            .with_min_len(1)
+            .map_init(
+                || None::<Instance>,
+                |slot, &i| -> Result<Option<(usize, Record)>, StoreError> {
+                    if stop.load(Ordering::Relaxed) {
+                        return Ok(None);
+                    }
+                    if let Some(max) = self.max_new {
+                        if started.fetch_add(1, Ordering::SeqCst) >= max {
+                            stop.store(true, Ordering::Relaxed);
+                            return Ok(None);
+                        }
+                    }
+                    let values = &self.design.values[i];
+                    let rec = match run_point(self.fmu, slot, &self.iface, values, &self.times) {
+                        Ok(v) => Record::Ok(v),
+                        Err(e) => {
+                            if self.stop_on_failure {
+                                stop.store(true, Ordering::Relaxed);
+                            }
+                            Record::Failed(e.to_string())
+                        }
+                    };
+                    self.store.append(i, &rec)?;
+                    if let Some(b) = bar {
+                        b.inc(1);
+                    }
+                    Ok(Some((i, rec)))
+                },
+            )
+            .filter_map(Result::transpose)
+            .collect()
+    }
+}
+
+/// The number of failed points; an error naming the first when failures are not allowed
+/// (or the design is weighted: dropping a weighted point would bias every moment silently).
 pub fn check_failures(
     study: &Study,
     design: &Design,
@@ -480,28 +430,27 @@ pub fn check_failures(
             _ => None,
         })
         .collect();
-    if failed.is_empty() {
+    let Some(&(index, message)) = failed.first() else {
         return Ok(0);
+    };
+    if allow && !design.is_weighted() {
+        return Ok(failed.len());
     }
-    // Collocation nodes carry weights: dropping one would bias every moment silently.
-    if !allow || design.weights.is_some() {
-        let (index, message) = failed[0];
-        let params = study
-            .parameters
-            .iter()
-            .zip(&design.values[index])
-            .map(|(p, v)| format!("{} = {v}", p.name))
-            .collect::<Vec<_>>()
-            .join(", ");
-        return Err(RunError::PointsFailed {
-            failed: failed.len(),
-            total: records.len(),
+    let parameters = study
+        .parameters
+        .iter()
+        .zip(&design.values[index])
+        .map(|(p, v)| (p.name.clone(), *v))
+        .collect();
+    Err(RunError::PointsFailed {
+        failed: failed.len(),
+        total: records.len(),
+        first: FailedPoint {
             index,
-            params,
+            parameters,
             message: message.clone(),
-        });
-    }
-    Ok(failed.len())
+        },
+    })
 }
 
 /// One deterministic run of `fmu` with `params` set before initialization, recording `outputs`
@@ -513,35 +462,37 @@ pub fn simulate(
     outputs: &[String],
     times: &[f64],
 ) -> Result<(Vec<String>, Vec<Vec<f64>>), RunError> {
-    let md = fmu.description();
-    let names: Vec<String> = if outputs.is_empty() {
-        md.output_variables()
-            .filter(|v| matches!(v.kind, VariableKind::Real { .. }))
-            .map(|v| v.name.clone())
-            .collect()
-    } else {
-        outputs.to_vec()
-    };
-    let (fixed, fixed_int) = fixed_values(fmu, params.iter().map(|(n, v)| (n.as_str(), *v)))?;
-    let signals = names
-        .iter()
-        .map(|n| Ok(real_var(fmu, n)?.value_reference))
-        .collect::<Result<Vec<_>, RunError>>()?;
-    let iface = Interface {
-        random: Vec::new(),
-        fixed,
-        fixed_int,
-        signals,
-        signal_names: names.clone(),
-        n_stored: names.len(),
-        qois: Vec::new(),
-    };
-    let mut slot = None;
-    let flat =
-        run_point(fmu, &mut slot, &iface, &[], times).map_err(|message| RunError::Interface {
-            fmu: fmu.path().display().to_string(),
-            message,
-        })?;
-    let nt = times.len();
-    Ok((names, flat.chunks(nt).map(<[f64]>::to_vec).collect()))
+    let iface = Interface::for_run(fmu, params, outputs)?;
+    let flat = run_point(fmu, &mut None, &iface, &[], times)?;
+    let series = flat.chunks(times.len()).map(<[f64]>::to_vec).collect();
+    Ok((iface.signal_names, series))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn changed_quantity_settings_do_not_resume_stale_records() {
+        let base = crate::spec::builtin("bogie-lhs-500").unwrap();
+        let study = |text: &str| Study::parse(text, "t.toml", None).unwrap();
+        let a = study_hash(&study(base));
+        let b = study_hash(&study(
+            &base.replace("threshold = 1e-4", "threshold = 2e-4"),
+        ));
+        assert_ne!(a, b, "a record holds v_cr for one threshold only");
+        // Name, description and analysis settings do not change the records.
+        let renamed = base.replace("name = \"bogie-lhs-500\"", "name = \"renamed\"");
+        let c = study_hash(&study(&format!("{renamed}\n[analysis]\npdf_grid = 50\n")));
+        assert_eq!(a, c);
+    }
+
+    #[test]
+    fn studies_without_quantities_keep_their_hash() {
+        // The hash of wheel-scm in the store/manifest.json that uq-driver wrote before the
+        // restructuring (commit 7b51554): old result folders still resume.
+        let s = Study::load("builtin:wheel-scm").unwrap();
+        let expected = "9c4270a27263cfdb71ef7669728eefc88c107f891685caf239948c85fa49637a";
+        assert_eq!(study_hash(&s), expected);
+    }
 }

@@ -17,12 +17,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::design::Design;
+use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
-use super::spec::Study;
+use super::single::{finish, open_fmu};
 use super::store::{Manifest, Record, Store, StoreError};
-use super::{StudyResult, StudyRunError};
-use crate::fmu::Fmu;
+use crate::spec::Study;
+use crate::uq::method::{Design, Evaluation, Sampling};
 
 /// Version of the plan layout.
 pub const PLAN_VERSION: u32 = 1;
@@ -70,6 +70,9 @@ pub enum ShardError {
     /// Wrong arguments.
     #[error("{0}")]
     Usage(String),
+    /// The study cannot be read back from the plan.
+    #[error(transparent)]
+    Study(#[from] crate::spec::StudyError),
     /// A shard does not belong to this plan, is missing, or overlaps another.
     #[error("{0}")]
     Shard(String),
@@ -96,15 +99,21 @@ pub fn shard_points(len: usize, n: usize, k: usize) -> Vec<usize> {
     (k..len).step_by(n.max(1)).collect()
 }
 
-fn manifest_for(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, ShardError> {
-    let iface = runner::resolve_interface(study, fmu)?;
-    let fmu_sha256 = runner::sha256_file(fmu.path()).map_err(io(fmu.path()))?;
-    Ok(Manifest {
-        study_hash: runner::study_hash(study),
-        fmu_sha256,
-        n_points: design.len(),
-        n_values: iface.n_values(study.file.experiment.times().len()),
-    })
+/// The study's sampling method, or a usage error for a method that runs no design.
+fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
+    match study.method().evaluation() {
+        Evaluation::Sampling(m) => Ok(m),
+        Evaluation::Intrusive(_) => Err(ShardError::Usage(format!(
+            "a {} study solves its own system without running a model: nothing to shard",
+            study.method().kind()
+        ))),
+    }
+}
+
+/// The study's design.
+fn design(study: &Study) -> Result<Design, ShardError> {
+    let d = sampling(study)?.design(&study.parameters, study.seed);
+    Ok(d.map_err(RunError::from)?)
 }
 
 /// `uq-driver plan`: writes `DIR/plan.json` and `DIR/design.csv`.
@@ -117,15 +126,13 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
             "a suite (a study with [[variants]]) cannot be planned as one; plan each variant's study".into(),
         ));
     }
-    if study.file.method.kind == super::MethodKind::Sgm {
-        return Err(ShardError::Usage(
-            "an SGM study is one Galerkin solve: nothing to shard".into(),
-        ));
-    }
-    let fmu_path = std::fs::canonicalize(&study.fmu_path).map_err(io(&study.fmu_path))?;
-    let fmu = Fmu::open(&fmu_path).map_err(RunError::from)?;
-    let design = Design::build(study).map_err(|e| RunError::Design(e.to_string()))?;
-    let manifest = manifest_for(study, &fmu, &design)?;
+    let design = design(study)?;
+    let given = study.fmu_path.clone().unwrap_or_default();
+    let fmu_path = std::fs::canonicalize(&given).map_err(io(&given))?;
+    let mut study = study.clone();
+    study.fmu_path = Some(fmu_path.clone());
+    let fmu = open_fmu(&study)?;
+    let manifest = runner::manifest(&study, &fmu, &design)?;
     let p = Plan {
         version: PLAN_VERSION,
         driver_version: env!("CARGO_PKG_VERSION").into(),
@@ -190,9 +197,8 @@ pub fn load_plan(dir: &Path) -> Result<Plan, ShardError> {
 }
 
 fn plan_study(p: &Plan) -> Result<Study, ShardError> {
-    let mut study = Study::parse(&p.study_source, &p.study_origin, p.study_base.as_deref())
-        .map_err(|e| ShardError::Run(StudyRunError::Study(e)))?;
-    study.fmu_path = p.fmu_path.clone();
+    let mut study = Study::parse(&p.study_source, &p.study_origin, p.study_base.as_deref())?;
+    study.fmu_path = Some(p.fmu_path.clone());
     Ok(study)
 }
 
@@ -206,9 +212,9 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
         )));
     }
     let study = plan_study(&p)?;
-    let fmu = Fmu::open(&p.fmu_path).map_err(RunError::from)?;
-    let design = Design::build(&study).map_err(|e| RunError::Design(e.to_string()))?;
-    let now = manifest_for(&study, &fmu, &design)?;
+    let fmu = open_fmu(&study)?;
+    let design = design(&study)?;
+    let now = runner::manifest(&study, &fmu, &design)?;
     if now != p.manifest {
         return Err(ShardError::Shard(format!(
             "{}: the FMU or the study changed since the plan was written (SHA-256 now {}, planned {})",
@@ -223,9 +229,12 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
     };
     let sdir = dir.join("shards").join(k.to_string());
     let outcome = runner::run_points(&study, &fmu, &design, &sdir, &opts)?;
-    let allow = opts.allow_failures || study.file.analysis.allow_failures;
-    let shard_records: Vec<Option<Record>> = outcome.records.clone();
-    runner::check_failures(&study, &design, &shard_records, allow)?;
+    runner::check_failures(
+        &study,
+        &design,
+        &outcome.records,
+        opts.allow_failures(&study),
+    )?;
     Ok(outcome)
 }
 
@@ -233,8 +242,9 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
 pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, ShardError> {
     let p = load_plan(dir)?;
     let study = plan_study(&p)?;
-    let fmu = Fmu::open(&p.fmu_path).map_err(RunError::from)?;
-    let design = Design::build(&study).map_err(|e| RunError::Design(e.to_string()))?;
+    let method = sampling(&study)?;
+    let fmu = open_fmu(&study)?;
+    let design = design(&study)?;
     let n = design.len();
     let mut records: Vec<Option<Record>> = vec![None; n];
     let mut owner: Vec<Option<usize>> = vec![None; n];
@@ -305,7 +315,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         threads: 0,
         fmu_sha256: p.manifest.fmu_sha256.clone(),
     };
-    super::finish(&study, &fmu, design, outcome, out, opts).map_err(ShardError::Run)
+    finish(&study, method, &fmu, &design, outcome, out, opts).map_err(ShardError::Run)
 }
 
 /// Options of `uq-driver slurm`.

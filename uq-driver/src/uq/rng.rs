@@ -7,12 +7,20 @@
 //! The generator is ChaCha20 ([`rand_chacha::ChaCha20Rng`]): a stable,
 //! documented, portable algorithm whose output for a given key, stream and
 //! position is fixed by its specification, unlike `rand::rngs::StdRng` whose
-//! algorithm may change between releases. Conversions from raw `u64` words to
-//! floating-point numbers are implemented here (not delegated to `rand`
-//! distributions) so that they are pinned as well.
+//! algorithm may change between releases. The conversion of a `u64` word to a
+//! uniform in (0, 1) is `rand_distr::Open01`; the tests pin it against its
+//! closed form, so a release of `rand` that changed it would be noticed.
+//!
+//! Designs draw every random coordinate as such a uniform and map it through the
+//! quantile function (inversion), never with the samplers of `rand_distr`
+//! (ziggurat normals, rejection gammas): inversion gives each point a coordinate in
+//! the standard space of the method (needed by Latin hypercube strata and by a chaos
+//! fitted on the same points), consumes exactly one word per coordinate and keeps
+//! every design a function of (seed, index) only.
 
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha20Rng;
+use rand_distr::{Distribution as _, Open01};
 
 use crate::uq::special::norm_ppf;
 
@@ -28,14 +36,13 @@ pub fn stream(seed: u64, index: u64) -> ChaCha20Rng {
     rng
 }
 
-/// A uniform draw strictly inside (0, 1).
+/// A uniform draw strictly inside (0, 1): `rand_distr::Open01` on one `u64`.
 ///
-/// Uses the top 52 bits of one `u64`: `((w >> 12) + 0.5) * 2^-52`, so the
+/// Uses the top 52 bits of the word, `((w >> 12) + 0.5) * 2^-52`, so the
 /// result lies on the grid `{(k + 1/2) 2^-52}`: never 0, never 1, and exactly
 /// symmetric about 1/2.
 pub fn uniform_open01<R: RngCore + ?Sized>(rng: &mut R) -> f64 {
-    let w = rng.next_u64() >> 12;
-    (w as f64 + 0.5) * (1.0 / 4_503_599_627_370_496.0) // 2^52
+    Open01.sample(rng)
 }
 
 /// A standard-normal draw by inversion, `norm_ppf(uniform_open01(rng))`.
@@ -68,6 +75,24 @@ pub fn uniform_below<R: RngCore + ?Sized>(rng: &mut R, bound: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A "generator" that returns the same word every time.
+    struct Fixed(u64);
+    impl RngCore for Fixed {
+        fn next_u32(&mut self) -> u32 {
+            self.0 as u32
+        }
+        fn next_u64(&mut self) -> u64 {
+            self.0
+        }
+        fn fill_bytes(&mut self, dest: &mut [u8]) {
+            dest.fill(0);
+        }
+        fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand::Error> {
+            dest.fill(0);
+            Ok(())
+        }
+    }
 
     #[test]
     fn stream_value_stability_seed_42() {
@@ -116,22 +141,6 @@ mod tests {
 
     #[test]
     fn uniform_open01_never_hits_the_ends() {
-        struct Fixed(u64);
-        impl RngCore for Fixed {
-            fn next_u32(&mut self) -> u32 {
-                self.0 as u32
-            }
-            fn next_u64(&mut self) -> u64 {
-                self.0
-            }
-            fn fill_bytes(&mut self, dest: &mut [u8]) {
-                dest.fill(0);
-            }
-            fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand::Error> {
-                dest.fill(0);
-                Ok(())
-            }
-        }
         let lo = uniform_open01(&mut Fixed(0));
         let hi = uniform_open01(&mut Fixed(u64::MAX));
         assert!(lo > 0.0 && lo < 1e-15);
@@ -139,6 +148,21 @@ mod tests {
         assert_eq!(lo, 1.0 - hi);
         assert!(standard_normal(&mut Fixed(0)).is_finite());
         assert!(standard_normal(&mut Fixed(u64::MAX)).is_finite());
+    }
+
+    #[test]
+    fn open01_is_the_pinned_closed_form() {
+        // ((w >> 12) + 1/2) 2^-52, written out independently of rand.
+        let closed = |w: u64| ((w >> 12) as f64 + 0.5) / 4_503_599_627_370_496.0;
+        let mut r = stream(42, 3);
+        let words: Vec<u64> = (0..10_000).map(|_| r.next_u64()).collect();
+        let mut r = stream(42, 3);
+        for w in words {
+            assert_eq!(uniform_open01(&mut r).to_bits(), closed(w).to_bits());
+        }
+        for w in [0, 1 << 12, u64::MAX, u64::MAX >> 1, 0x8000_0000_0000_0000] {
+            assert_eq!(uniform_open01(&mut Fixed(w)).to_bits(), closed(w).to_bits());
+        }
     }
 
     #[test]

@@ -1,0 +1,372 @@
+//! The files of a suite's output folder: differences of mean and Std over time against the
+//! reference variant, PDFs of the scalar quantities side by side, mean and Std against the
+//! number of model runs, a table with published values where given, `summary.json` and
+//! `index.html`. Each variant's own report is in its sub-folder.
+
+use std::path::Path;
+
+use super::{
+    palette, write_bytes, write_columns, DensityPlot, LinePlot, ReportError, ReportPage, Section,
+    Series, Table,
+};
+use crate::results::{self, OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::spec::PaperValue;
+
+/// One variant's results.
+#[derive(Clone, Copy, Debug)]
+pub struct VariantResults<'a> {
+    /// Its summary.
+    pub summary: &'a Summary,
+    /// Statistics per output.
+    pub outputs: &'a [OutputStats],
+    /// Statistics per scalar quantity.
+    pub quantities: &'a [ScalarStats],
+}
+
+/// Writes the suite's comparison into `dir` (`variants` in the order of `summary.variants`).
+pub fn write(
+    dir: &Path,
+    summary: &SuiteSummary,
+    variants: &[VariantResults],
+) -> Result<(), ReportError> {
+    let r = summary
+        .variants
+        .iter()
+        .position(|v| v.name == summary.reference)
+        .unwrap_or(0);
+    let mut sections = vec![variants_section(summary, &variants[r])];
+    for (o, rs) in variants[r].outputs.iter().enumerate() {
+        sections.push(compare_output(dir, summary, variants, r, o, rs)?);
+    }
+    for (qi, rq) in variants[r].quantities.iter().enumerate() {
+        sections.push(compare_scalar(dir, summary, variants, qi, rq)?);
+    }
+    if !summary.paper.is_empty() {
+        sections.push(paper_section(summary));
+    }
+    let json = results::to_json(summary);
+    write_bytes(&dir.join("summary.json"), json.as_bytes())?;
+    ReportPage {
+        title: format!("railuq suite {}", summary.suite),
+        summary_json: json,
+        sections,
+    }
+    .write(&dir.join("index.html"))
+}
+
+/// The table of variants: method, runs, wall time, differences against the reference, and
+/// the scalar quantities.
+fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Section {
+    let ref_name = &summary.reference;
+    let mut header: Vec<String> = ["variant", "method", "model runs", "wall time [s]"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    for s in reference.outputs {
+        header.push(format!("max |Δmean {}| vs {ref_name}", s.name));
+        header.push(format!("max |ΔStd {}| vs {ref_name}", s.name));
+    }
+    for q in reference.quantities {
+        header.push(format!("mean {}", q.name));
+        header.push(format!("Std {}", q.name));
+        for (l, _, _) in &q.exceedance {
+            header.push(format!("P({} > {l})", q.name));
+        }
+    }
+    let rows = summary
+        .variants
+        .iter()
+        .map(|v| {
+            let mut row = vec![
+                v.name.clone(),
+                v.method.clone(),
+                v.model_runs.to_string(),
+                format!("{:.3}", v.wall_time_s),
+            ];
+            for o in &v.outputs {
+                row.push(format!("{:.3e}", o.max_abs_mean_diff_vs_reference));
+                row.push(format!("{:.3e}", o.max_abs_std_diff_vs_reference));
+            }
+            for q in &v.quantities {
+                row.push(format!("{:.5}", q.mean));
+                row.push(format!("{:.5}", q.std));
+                row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+            }
+            row
+        })
+        .collect();
+    Section {
+        heading: "Variants".into(),
+        text: format!(
+            "{}\n\nEach variant's full report is in its own folder. Differences are taken against the reference variant '{ref_name}'.",
+            summary.description
+        ),
+        images: summary
+            .variants
+            .iter()
+            .map(|v| format!("{}/index.html", v.folder))
+            .collect(),
+        table: Some(Table { header, rows }),
+    }
+}
+
+/// `<V>_compare.csv`, `<V>_mean_diff.svg`, `<V>_std_diff.svg`, `<V>_bands.svg`.
+fn compare_output(
+    dir: &Path,
+    summary: &SuiteSummary,
+    variants: &[VariantResults],
+    r: usize,
+    o: usize,
+    rs: &OutputStats,
+) -> Result<Section, ReportError> {
+    let v = &rs.name;
+    let ref_name = &summary.reference;
+    let mut header = vec!["time".to_string()];
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    let mut mean_plot = LinePlot::new(
+        format!("{v}: mean − mean({ref_name})"),
+        "time [s]",
+        format!("Δ mean {v}"),
+    );
+    let mut std_plot = LinePlot::new(
+        format!("{v}: Std − Std({ref_name})"),
+        "time [s]",
+        format!("Δ Std {v}"),
+    );
+    let mut bands = LinePlot::new(
+        format!("{v}: mean ± 3σ of every variant"),
+        "time [s]",
+        v.clone(),
+    );
+    for (i, (d, vs)) in variants.iter().zip(&summary.variants).enumerate() {
+        let s = &d.outputs[o];
+        let (name, t, color) = (&vs.name, &s.times, palette(i));
+        header.push(format!("mean_{name}"));
+        cols.push(s.mean.clone());
+        header.push(format!("std_{name}"));
+        cols.push(s.std.clone());
+        bands.series.extend([
+            Series::new(format!("{name} mean"), t.clone(), s.mean.clone(), color),
+            Series::new(
+                format!("{name} ±3σ"),
+                t.clone(),
+                s.upper_3sigma.clone(),
+                color,
+            )
+            .dashed(),
+            Series::new("", t.clone(), s.lower_3sigma.clone(), color).dashed(),
+        ]);
+        if i != r {
+            let dm: Vec<f64> = s.mean.iter().zip(&rs.mean).map(|(a, b)| a - b).collect();
+            let ds: Vec<f64> = s.std.iter().zip(&rs.std).map(|(a, b)| a - b).collect();
+            header.push(format!("dmean_{name}"));
+            cols.push(dm.clone());
+            header.push(format!("dstd_{name}"));
+            cols.push(ds.clone());
+            mean_plot
+                .series
+                .push(Series::new(name.clone(), t.clone(), dm, color));
+            std_plot
+                .series
+                .push(Series::new(name.clone(), t.clone(), ds, color));
+        }
+    }
+    let mut all: Vec<&[f64]> = vec![&rs.times];
+    all.extend(cols.iter().map(Vec::as_slice));
+    let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
+    write_columns(&dir.join(format!("{v}_compare.csv")), &hdr, &all)?;
+    mean_plot.write(&dir.join(format!("{v}_mean_diff.svg")))?;
+    std_plot.write(&dir.join(format!("{v}_std_diff.svg")))?;
+    bands.write(&dir.join(format!("{v}_bands.svg")))?;
+    Ok(output_section(v, ref_name))
+}
+
+fn output_section(v: &str, ref_name: &str) -> Section {
+    Section {
+        heading: format!("Output {v}: differences against {ref_name}"),
+        text: format!(
+            "Mean and Std of every variant minus those of '{ref_name}', over time (the paper's Fig. 3 for the wheel). \
+             The reference's band and PDF evolution are in {ref_name}/index.html."
+        ),
+        images: vec![
+            format!("{v}_mean_diff.svg"),
+            format!("{v}_std_diff.svg"),
+            format!("{v}_bands.svg"),
+            format!("{v}_compare.csv"),
+        ],
+        table: None,
+    }
+}
+
+/// `<q>_pdf_compare.svg`, `<q>_mean_vs_runs.svg`, `<q>_std_vs_runs.svg`, `<q>_compare.csv`.
+fn compare_scalar(
+    dir: &Path,
+    summary: &SuiteSummary,
+    variants: &[VariantResults],
+    qi: usize,
+    rq: &ScalarStats,
+) -> Result<Section, ReportError> {
+    let q = &rq.name;
+    let runs: Vec<f64> = variants
+        .iter()
+        .map(|d| d.summary.model_runs as f64)
+        .collect();
+    let stats: Vec<&ScalarStats> = variants.iter().map(|d| &d.quantities[qi]).collect();
+    // A single deterministic run has no distribution: it would be a spike in the plots.
+    let curves = stats
+        .iter()
+        .zip(&summary.variants)
+        .enumerate()
+        .filter(|(i, _)| runs[*i] > 1.0)
+        .map(|(i, (s, v))| Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(i)))
+        .collect();
+    DensityPlot {
+        title: format!("PDF of {q}, every variant"),
+        x_label: q.clone(),
+        curves,
+        histogram: None,
+        markers: rq
+            .exceedance
+            .iter()
+            .map(|(l, _, _)| (*l, format!("limit {l}")))
+            .collect(),
+    }
+    .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
+    let kinds: Vec<&str> = variants
+        .iter()
+        .map(|d| d.summary.method.kind.as_str())
+        .collect();
+    let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
+    let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
+    let ses: Vec<f64> = stats.iter().map(|s| s.std_error_mean).collect();
+    let mean_plot = LinePlot::new(
+        format!("mean of {q} against model runs"),
+        "log10(model runs)",
+        format!("mean {q}"),
+    );
+    convergence(mean_plot, &kinds, &runs, &means)
+        .write(&dir.join(format!("{q}_mean_vs_runs.svg")))?;
+    let std_plot = LinePlot::new(
+        format!("Std of {q} against model runs"),
+        "log10(model runs)",
+        format!("Std {q}"),
+    );
+    convergence(std_plot, &kinds, &runs, &stds).write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
+    let idx: Vec<f64> = (0..variants.len()).map(|i| i as f64).collect();
+    write_columns(
+        &dir.join(format!("{q}_compare.csv")),
+        &[
+            "variant_index",
+            "model_runs",
+            "mean",
+            "std",
+            "std_error_mean",
+        ],
+        &[&idx, &runs, &means, &stds, &ses],
+    )?;
+    Ok(scalar_section(q, summary))
+}
+
+fn scalar_section(q: &str, summary: &SuiteSummary) -> Section {
+    let labels: Vec<&str> = summary.variants.iter().map(|v| v.name.as_str()).collect();
+    Section {
+        heading: format!("Quantity {q} across variants"),
+        text: format!(
+            "PDFs side by side, and mean and Std against the number of model runs. Variant order: {}.",
+            labels.join(", ")
+        ),
+        images: vec![
+            format!("{q}_pdf_compare.svg"),
+            format!("{q}_mean_vs_runs.svg"),
+            format!("{q}_std_vs_runs.svg"),
+            format!("{q}_compare.csv"),
+        ],
+        table: None,
+    }
+}
+
+/// `plot` with `y` against log10(model runs), one line per method kind (e.g. SCM 2, 3, 4, 5
+/// nodes; LHS 500, 20 000); single runs are left out.
+fn convergence(mut plot: LinePlot, kinds: &[&str], runs: &[f64], y: &[f64]) -> LinePlot {
+    let mut distinct: Vec<&str> = kinds.to_vec();
+    distinct.dedup();
+    for (ki, kind) in distinct.iter().enumerate() {
+        let idx: Vec<usize> = (0..kinds.len())
+            .filter(|&i| kinds[i] == *kind && runs[i] > 1.0)
+            .collect();
+        if idx.is_empty() {
+            continue;
+        }
+        plot.series.push(Series::new(
+            kind.to_string(),
+            idx.iter().map(|&i| runs[i].log10()).collect(),
+            idx.iter().map(|&i| y[i]).collect(),
+            palette(ki),
+        ));
+    }
+    plot
+}
+
+/// Our value of a published statistic, if the suite has it.
+fn ours(summary: &SuiteSummary, pv: &PaperValue) -> Option<f64> {
+    let q = summary
+        .variants
+        .iter()
+        .find(|v| v.name == pv.variant)?
+        .quantities
+        .iter()
+        .find(|q| q.name == pv.quantity)?;
+    match pv.statistic.as_str() {
+        "mean" => Some(q.mean),
+        "std" => Some(q.std),
+        s => {
+            let limit: f64 = s.strip_prefix("p>")?.parse().ok()?;
+            q.exceedance
+                .iter()
+                .find(|e| (e.0 - limit).abs() < 1e-12)
+                .map(|e| e.1)
+        }
+    }
+}
+
+/// Published values beside ours.
+fn paper_section(summary: &SuiteSummary) -> Section {
+    let rows = summary
+        .paper
+        .iter()
+        .map(|pv| {
+            let ours = ours(summary, pv);
+            vec![
+                pv.variant.clone(),
+                pv.quantity.clone(),
+                pv.statistic.clone(),
+                format!("{}", pv.value),
+                ours.map(|v| format!("{v:.5}"))
+                    .unwrap_or_else(|| "n/a".into()),
+                ours.map(|v| format!("{:+.2} %", 100.0 * (v - pv.value) / pv.value))
+                    .unwrap_or_default(),
+                pv.source.clone(),
+            ]
+        })
+        .collect();
+    Section {
+        heading: "Against the paper".into(),
+        text: "Published values beside ours.".into(),
+        images: vec![],
+        table: Some(Table {
+            header: [
+                "variant",
+                "quantity",
+                "statistic",
+                "paper",
+                "railuq",
+                "difference",
+                "source",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            rows,
+        }),
+    }
+}

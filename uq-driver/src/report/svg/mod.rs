@@ -1,0 +1,383 @@
+//! Hand-written SVG plots: line plots with filled bands, and density plots with histograms.
+//!
+//! The SVG needs no fonts or scripts: axes with 1-2-5 ticks ([`nice_ticks`]), tick labels, axis
+//! labels, a title and a legend. Axis ranges are taken from the finite data; non-finite points
+//! (and non-positive values on a log axis) are skipped and break the line. Coordinates are
+//! rounded to 0.01 px and sub-pixel steps are dropped, so files stay small.
+//!
+//! The frame, axis and legend helpers are shared with [`super::heatmap`].
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+mod axis;
+mod frame;
+#[cfg(test)]
+mod tests;
+
+pub use axis::nice_ticks;
+pub(crate) use axis::{finite_range, Axis};
+pub(crate) use frame::{c, legend, legend_width, truncate, Frame, LegendEntry};
+
+use super::{escape_xml, write_bytes, ReportError};
+
+/// A line in a plot: `y` against `x` (points are paired by index; the shorter length wins).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Legend text; empty for no legend entry.
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Ordinates; non-finite values break the line.
+    pub y: Vec<f64>,
+    /// Any SVG color, e.g. `#1f77b4` (see [`palette`]).
+    pub color: String,
+    /// Draw dashed instead of solid.
+    pub dashed: bool,
+}
+
+impl Series {
+    /// A solid line.
+    pub fn new(
+        label: impl Into<String>,
+        x: Vec<f64>,
+        y: Vec<f64>,
+        color: impl Into<String>,
+    ) -> Self {
+        Self {
+            label: label.into(),
+            x,
+            y,
+            color: color.into(),
+            dashed: false,
+        }
+    }
+
+    /// The same line, dashed.
+    pub fn dashed(mut self) -> Self {
+        self.dashed = true;
+        self
+    }
+}
+
+/// A filled region between `lower` and `upper` over `x` (e.g. mean ± 3σ).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Band {
+    /// Legend text; empty for no legend entry.
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Lower edge; a non-finite value (in either edge) splits the band.
+    pub lower: Vec<f64>,
+    /// Upper edge.
+    pub upper: Vec<f64>,
+    /// Fill color, drawn with opacity 0.25.
+    pub color: String,
+}
+
+impl Band {
+    /// A band between `lower` and `upper`.
+    pub fn new(
+        label: impl Into<String>,
+        x: Vec<f64>,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        color: impl Into<String>,
+    ) -> Self {
+        Self {
+            label: label.into(),
+            x,
+            lower,
+            upper,
+            color: color.into(),
+        }
+    }
+}
+
+/// A plot of lines over filled bands, e.g. mean ± 3σ of q(t), or a difference SGM − LHS.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LinePlot {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the horizontal axis, with unit, e.g. `time [s]`.
+    pub x_label: String,
+    /// Label of the vertical axis, with unit.
+    pub y_label: String,
+    /// Lines, drawn on top of the bands in order.
+    pub series: Vec<Series>,
+    /// Filled bands, drawn first.
+    pub bands: Vec<Band>,
+    /// Logarithmic vertical axis (non-positive values are skipped).
+    pub log_y: bool,
+}
+
+impl LinePlot {
+    /// An empty plot with the given title and axis labels.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Self {
+        Self {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            ..Self::default()
+        }
+    }
+
+    /// Renders the plot as an SVG document.
+    pub fn to_svg(&self) -> String {
+        let log = self.log_y;
+        let xs = self
+            .series
+            .iter()
+            .flat_map(|s| paired(&s.x, &s.y).map(|(x, _)| x))
+            .chain(self.bands.iter().flat_map(|b| b.x.iter().copied()));
+        let ys = self
+            .series
+            .iter()
+            .flat_map(|s| paired(&s.x, &s.y).map(|(_, y)| y))
+            .chain(
+                self.bands
+                    .iter()
+                    .flat_map(|b| b.lower.iter().chain(&b.upper).copied()),
+            );
+        let x_axis = Axis::linear_exact(finite_range(xs, false));
+        let y_axis = if log {
+            Axis::log(finite_range(ys, true), true)
+        } else {
+            Axis::linear_padded(finite_range(ys, false))
+        };
+
+        let mut legend: Vec<LegendEntry> = Vec::new();
+        for b in &self.bands {
+            legend.push(LegendEntry::fill(&b.label, &b.color));
+        }
+        for s in &self.series {
+            legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
+        }
+        legend.retain(|e| !e.label.is_empty());
+
+        let frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        let mut out = String::new();
+        frame.open(&mut out);
+        frame.grid(&mut out);
+        out.push_str("<g class=\"bands\" clip-path=\"url(#plot-area)\">\n");
+        for b in &self.bands {
+            frame.band(&mut out, b);
+        }
+        out.push_str("</g>\n<g class=\"series\" clip-path=\"url(#plot-area)\">\n");
+        for s in &self.series {
+            frame.series(&mut out, s);
+        }
+        out.push_str("</g>\n");
+        frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
+        frame.legend_outside(&mut out, &legend);
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// Writes [`Self::to_svg`] to `path`.
+    pub fn write(&self, path: &Path) -> Result<(), ReportError> {
+        write_bytes(path, self.to_svg().as_bytes())
+    }
+}
+
+/// A plot of probability densities of a scalar quantity (e.g. critical speed, Sperling index):
+/// PDF curves, optionally over a histogram of samples, with vertical marker lines for limits.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DensityPlot {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the horizontal axis (the quantity, with unit); the vertical axis is
+    /// "probability density".
+    pub x_label: String,
+    /// PDF curves (e.g. kernel density estimates, one per method).
+    pub curves: Vec<Series>,
+    /// A histogram as (bin edges, density per bin), `edges.len() == density.len() + 1`;
+    /// see [`histogram_density`]. Extra entries of either are ignored.
+    pub histogram: Option<(Vec<f64>, Vec<f64>)>,
+    /// Vertical marker lines at x with a label, e.g. `(2.5, "limit W = 2.5")`.
+    pub markers: Vec<(f64, String)>,
+}
+
+impl DensityPlot {
+    /// Renders the plot as an SVG document.
+    pub fn to_svg(&self) -> String {
+        let (edges, dens): (&[f64], &[f64]) = match &self.histogram {
+            Some((e, d)) => (e, d),
+            None => (&[], &[]),
+        };
+        let bins = edges.len().saturating_sub(1).min(dens.len());
+        let bars = (0..bins).filter_map(|i| {
+            let (l, r, h) = (edges[i], edges[i + 1], dens[i]);
+            (l.is_finite() && r.is_finite() && h.is_finite()).then_some((l, r, h))
+        });
+
+        let xs = self
+            .curves
+            .iter()
+            .flat_map(|s| paired(&s.x, &s.y).map(|(x, _)| x))
+            .chain(bars.clone().flat_map(|(l, r, _)| [l, r]))
+            .chain(self.markers.iter().map(|m| m.0));
+        let ys = self
+            .curves
+            .iter()
+            .flat_map(|s| paired(&s.x, &s.y).map(|(_, y)| y))
+            .chain(bars.clone().map(|b| b.2))
+            .chain([0.0]);
+        let x_axis = Axis::linear_exact(finite_range(xs, false));
+        let y_axis = Axis::linear_padded(finite_range(ys, false));
+
+        let mut legend: Vec<LegendEntry> = Vec::new();
+        if self.histogram.is_some() {
+            legend.push(LegendEntry::fill("histogram", HISTOGRAM_COLOR));
+        }
+        for s in &self.curves {
+            legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
+        }
+        for (i, (_, label)) in self.markers.iter().enumerate() {
+            legend.push(LegendEntry::line(label, marker_color(i), true));
+        }
+        legend.retain(|e| !e.label.is_empty());
+
+        let frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        let mut out = String::new();
+        frame.open(&mut out);
+        frame.grid(&mut out);
+        histogram(&frame, &mut out, bars);
+        out.push_str("<g class=\"series\" clip-path=\"url(#plot-area)\">\n");
+        for s in &self.curves {
+            frame.series(&mut out, s);
+        }
+        out.push_str("</g>\n");
+        markers(&frame, &mut out, &self.markers);
+        frame.axes(&mut out, &self.title, &self.x_label, "probability density");
+        frame.legend_outside(&mut out, &legend);
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// Writes [`Self::to_svg`] to `path`.
+    pub fn write(&self, path: &Path) -> Result<(), ReportError> {
+        write_bytes(path, self.to_svg().as_bytes())
+    }
+}
+
+/// Draws histogram bars `(left, right, height)`.
+fn histogram(frame: &Frame, out: &mut String, bars: impl Iterator<Item = (f64, f64, f64)>) {
+    out.push_str("<g class=\"histogram\" clip-path=\"url(#plot-area)\">\n");
+    let y0 = frame.py(0.0);
+    for (l, r, h) in bars {
+        let (xl, xr) = (frame.px(l.min(r)), frame.px(l.max(r)));
+        let yt = frame.py(h.max(0.0));
+        let _ = writeln!(
+            out,
+            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{HISTOGRAM_COLOR}\" \
+             fill-opacity=\"0.55\" stroke=\"#fff\" stroke-width=\"0.5\"/>",
+            c(xl),
+            c(yt.min(y0)),
+            c(xr - xl),
+            c((y0 - yt).abs()),
+        );
+    }
+    out.push_str("</g>\n");
+}
+
+/// Draws dashed vertical marker lines with their labels.
+fn markers(frame: &Frame, out: &mut String, markers: &[(f64, String)]) {
+    out.push_str("<g class=\"markers\">\n");
+    for (i, (x, label)) in markers.iter().enumerate() {
+        if !x.is_finite() {
+            continue;
+        }
+        let px = frame.px(*x);
+        let color = marker_color(i);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"{color}\" \
+             stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>",
+            c(px),
+            c(frame.top),
+            c(frame.top + frame.height),
+        );
+        let _ = writeln!(
+            out,
+            "<text x=\"{}\" y=\"{}\" fill=\"{color}\" font-size=\"11\">{}</text>",
+            c(px + 4.0),
+            c(frame.top + 14.0 + 14.0 * (i % 3) as f64),
+            escape_xml(&truncate(label, 40)),
+        );
+    }
+    out.push_str("</g>\n");
+}
+
+/// A histogram of the finite `samples` as (bin edges, density per bin), normalized so that
+/// the bars integrate to 1. `bins == 0` chooses the number of bins by Sturges' rule.
+/// No finite samples give empty vectors; equal samples get one unit-wide range around them.
+pub fn histogram_density(samples: &[f64], bins: usize) -> (Vec<f64>, Vec<f64>) {
+    let finite: Vec<f64> = samples.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let n = finite.len();
+    let bins = if bins == 0 {
+        // Sturges: ceil(log2 n) + 1.
+        (usize::BITS - (n - 1).leading_zeros()) as usize + 1
+    } else {
+        bins
+    };
+    let (mut lo, mut hi) = finite
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi - lo <= 0.0 || !(hi - lo).is_finite() {
+        if hi - lo <= 0.0 {
+            lo -= 0.5;
+            hi += 0.5;
+        } else {
+            // Range overflows f64: clamp to a representable span.
+            lo = lo.max(-f64::MAX / 2.0);
+            hi = hi.min(f64::MAX / 2.0);
+        }
+    }
+    let width = (hi - lo) / bins as f64;
+    let edges: Vec<f64> = (0..=bins)
+        .map(|i| if i == bins { hi } else { lo + width * i as f64 })
+        .collect();
+    let mut counts = vec![0usize; bins];
+    for v in finite {
+        let k = (((v - lo) / width).floor().max(0.0) as usize).min(bins - 1);
+        counts[k] += 1;
+    }
+    let density = counts
+        .iter()
+        .map(|&k| k as f64 / (n as f64 * width))
+        .collect();
+    (edges, density)
+}
+
+/// Color `i` of a ten-color qualitative palette (matplotlib's tab10), cycling.
+pub fn palette(i: usize) -> &'static str {
+    const TAB10: [&str; 10] = [
+        "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+        "#bcbd22", "#17becf",
+    ];
+    TAB10[i % TAB10.len()]
+}
+
+const HISTOGRAM_COLOR: &str = "#8c9db5";
+
+fn marker_color(i: usize) -> &'static str {
+    ["#d62728", "#222222", "#9467bd"][i % 3]
+}
+
+/// Points of `x` and `y` paired by index (the shorter length wins).
+pub(super) fn paired<'a>(
+    x: &'a [f64],
+    y: &'a [f64],
+) -> impl Iterator<Item = (f64, f64)> + Clone + 'a {
+    x.iter().copied().zip(y.iter().copied())
+}

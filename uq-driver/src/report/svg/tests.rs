@@ -1,0 +1,232 @@
+//! Tests of the SVG plots: ticks, axes, odd data, files.
+
+use super::*;
+
+fn close(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12)
+}
+
+fn balanced(svg: &str, tag: &str) -> bool {
+    let open = svg.matches(&format!("<{tag} ")).count() + svg.matches(&format!("<{tag}>")).count();
+    open == svg.matches(&format!("</{tag}>")).count()
+}
+
+fn band_plot() -> LinePlot {
+    let t: Vec<f64> = (0..=500).map(|i| i as f64 * 0.01).collect();
+    let mean: Vec<f64> = t
+        .iter()
+        .map(|t| (3.0 * t).sin() * (-0.3 * t).exp())
+        .collect();
+    let sd: Vec<f64> = t.iter().map(|t| 0.02 + 0.05 * t).collect();
+    let lower = mean.iter().zip(&sd).map(|(m, s)| m - 3.0 * s).collect();
+    let upper = mean.iter().zip(&sd).map(|(m, s)| m + 3.0 * s).collect();
+    let mut plot = LinePlot::new("Lateral displacement q(t)", "time [s]", "q [m]");
+    plot.bands
+        .push(Band::new("mean ± 3σ", t.clone(), lower, upper, palette(0)));
+    plot.series.push(Series::new(
+        "mean (SGM)",
+        t.clone(),
+        mean.clone(),
+        palette(0),
+    ));
+    plot.series.push(
+        Series::new(
+            "mean (LHS)",
+            t,
+            mean.iter().map(|m| m * 1.05).collect(),
+            palette(1),
+        )
+        .dashed(),
+    );
+    plot
+}
+
+#[test]
+fn ticks_are_nice_1_2_5_steps() {
+    assert!(close(
+        &nice_ticks(0.0, 5.0, 6),
+        &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    ));
+    assert_eq!(
+        nice_ticks(0.0, 0.1, 6),
+        vec![0.0, 0.02, 0.04, 0.06, 0.08, 0.1],
+        "ticks should be the nearest doubles to the decimals"
+    );
+    assert!(close(
+        &nice_ticks(-1.0, 1.0, 6),
+        &[-1.0, -0.5, 0.0, 0.5, 1.0]
+    ));
+    assert!(close(
+        &nice_ticks(0.0, 100.0, 6),
+        &[0.0, 20.0, 40.0, 60.0, 80.0, 100.0]
+    ));
+    assert!(close(&nice_ticks(3.0, 7.0, 6), &[3.0, 4.0, 5.0, 6.0, 7.0]));
+    // Reversed bounds are sorted; degenerate input does not panic.
+    assert!(close(&nice_ticks(5.0, 0.0, 6), &nice_ticks(0.0, 5.0, 6)));
+    assert_eq!(nice_ticks(2.0, 2.0, 6), vec![2.0]);
+    assert_eq!(nice_ticks(f64::NAN, 1.0, 6), vec![1.0]);
+    assert!(nice_ticks(f64::NEG_INFINITY, f64::INFINITY, 6).is_empty());
+    assert_eq!(nice_ticks(0.0, 1.0, 0), vec![0.0, 1.0]);
+}
+
+#[test]
+fn tick_labels_use_step_decimals_or_exponents() {
+    let a = Axis::linear(0.0, 0.1);
+    assert_eq!(a.labels, ["0", "0.02", "0.04", "0.06", "0.08", "0.10"]);
+    let a = Axis::linear(0.0, 5e-6);
+    assert_eq!(a.labels[1], "1e-6");
+    let a = Axis::linear(-2.0, 2.0);
+    assert!(a.labels.iter().all(|l| l != "-0"), "{:?}", a.labels);
+    let a = Axis::log(Some((2e-4, 3.0)), true);
+    assert_eq!(a.labels, ["0.0001", "0.001", "0.01", "0.1", "1", "10"]);
+    assert_eq!((a.lo, a.hi), (1e-4, 10.0));
+    let a = Axis::log(Some((1e-30, 1.0)), true);
+    assert!(
+        a.ticks.len() <= 9 && a.labels[0] == "1e-30",
+        "{:?}",
+        a.labels
+    );
+}
+
+#[test]
+fn band_plot_svg_is_well_formed() {
+    let plot = band_plot();
+    let svg = plot.to_svg();
+    assert!(svg.starts_with("<svg "));
+    assert!(svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("Lateral displacement q(t)"));
+    assert!(svg.contains("mean ± 3σ"));
+    assert!(svg.contains("time [s]") && svg.contains("q [m]"));
+    assert!(balanced(&svg, "g"), "unbalanced <g>");
+    assert!(balanced(&svg, "text"));
+    assert!(svg.contains("stroke-dasharray"));
+    assert!(svg.contains("fill-opacity=\"0.25\""));
+    // Two data lines, one band, plus the tick path and two legend lines.
+    assert_eq!(svg.matches("<path ").count(), 2 + 1 + 1 + 2);
+    // Coordinates have at most two decimals.
+    let d = svg.split("class=\"series\"").nth(1).unwrap();
+    let d = &d[d.find("d=\"").unwrap() + 3..];
+    let d = &d[..d.find('"').unwrap()];
+    for num in d.split(|c: char| c.is_ascii_alphabetic() || c == ' ') {
+        if let Some((_, frac)) = num.split_once('.') {
+            assert!(frac.len() <= 2, "{num}");
+        }
+    }
+    assert!(svg.len() < 60_000, "svg is {} bytes", svg.len());
+}
+
+#[test]
+fn non_finite_points_break_the_line() {
+    let mut plot = LinePlot::new("gaps", "x", "y");
+    plot.series.push(Series::new(
+        "s",
+        vec![0.0, 1.0, 2.0, f64::NAN, 4.0, 5.0, 6.0],
+        vec![0.0, 1.0, f64::INFINITY, 3.0, 4.0, f64::NAN, 6.0],
+        "red",
+    ));
+    let svg = plot.to_svg();
+    assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    let d = svg.split("class=\"series\"").nth(1).unwrap();
+    let d = &d[d.find("d=\"").unwrap() + 3..];
+    let d = &d[..d.find('"').unwrap()];
+    // Runs: {0,1}, {4}, {6}.
+    assert_eq!(d.matches('M').count(), 3, "{d}");
+}
+
+#[test]
+fn empty_and_degenerate_plots_are_still_valid() {
+    let empty = LinePlot::default().to_svg();
+    assert!(empty.starts_with("<svg ") && balanced(&empty, "g"));
+    let mut flat = LinePlot::new("flat", "x", "y");
+    flat.series
+        .push(Series::new("c", vec![1.0, 1.0], vec![2.0, 2.0], "black"));
+    flat.series
+        .push(Series::new("nan", vec![f64::NAN], vec![f64::NAN], "black"));
+    flat.series
+        .push(Series::new("short", vec![0.0, 1.0], vec![], "black"));
+    let svg = flat.to_svg();
+    assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    assert_eq!(svg.matches("<path d=\"\"").count(), 2);
+    let mut log = LinePlot::new("log", "x", "y");
+    log.log_y = true;
+    log.series.push(Series::new(
+        "s",
+        vec![0.0, 1.0, 2.0],
+        vec![-1.0, 0.0, 1e-3],
+        "black",
+    ));
+    let svg = log.to_svg();
+    assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    let huge = LinePlot {
+        series: vec![Series::new(
+            "h",
+            vec![0.0, 1.0],
+            vec![-f64::MAX, f64::MAX],
+            "k",
+        )],
+        ..LinePlot::default()
+    };
+    let svg = huge.to_svg();
+    assert!(!svg.contains("NaN") && !svg.contains("inf"));
+}
+
+#[test]
+fn labels_are_escaped() {
+    let plot = LinePlot::new("<b>&</b>", "x", "y");
+    let svg = plot.to_svg();
+    assert!(svg.contains("&lt;b&gt;&amp;&lt;/b&gt;"));
+    assert!(!svg.contains("<b>"));
+}
+
+#[test]
+fn histogram_density_integrates_to_one() {
+    let samples: Vec<f64> = (0..1000).map(|i| (i as f64 * 0.7).sin()).collect();
+    let (edges, dens) = histogram_density(&samples, 20);
+    assert_eq!(edges.len(), 21);
+    let total: f64 = dens
+        .iter()
+        .zip(edges.windows(2))
+        .map(|(d, e)| d * (e[1] - e[0]))
+        .sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    let (edges, dens) = histogram_density(&[f64::NAN, 3.0, 3.0], 0);
+    assert_eq!(edges.len(), dens.len() + 1);
+    assert_eq!(edges.first(), Some(&2.5));
+    assert!(histogram_density(&[f64::NAN], 5).0.is_empty());
+}
+
+#[test]
+fn density_plot_has_histogram_curves_and_markers() {
+    let x: Vec<f64> = (0..=200).map(|i| i as f64 * 0.02).collect();
+    let pdf: Vec<f64> = x
+        .iter()
+        .map(|x| (-(x - 2.0f64).powi(2) / 0.5).exp() / (0.5 * std::f64::consts::PI).sqrt())
+        .collect();
+    let samples: Vec<f64> = (0..400).map(|i| 2.0 + (i as f64 * 0.37).sin()).collect();
+    let plot = DensityPlot {
+        title: "Sperling index W".into(),
+        x_label: "W [-]".into(),
+        curves: vec![Series::new("KDE", x, pdf, palette(0))],
+        histogram: Some(histogram_density(&samples, 0)),
+        markers: vec![(2.5, "limit W = 2.5".into()), (f64::NAN, "bad".into())],
+    };
+    let svg = plot.to_svg();
+    assert!(svg.starts_with("<svg ") && balanced(&svg, "g"));
+    assert!(svg.matches("<rect ").count() >= 10);
+    assert!(svg.contains("limit W = 2.5"));
+    assert!(svg.contains("probability density"));
+    assert!(!svg.contains("NaN"));
+    let empty = DensityPlot::default().to_svg();
+    assert!(empty.starts_with("<svg ") && balanced(&empty, "g"));
+}
+
+#[test]
+fn write_reports_the_path_on_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no/such/dir/p.svg");
+    let err = LinePlot::default().write(&path).unwrap_err();
+    assert!(err.to_string().contains("p.svg"));
+    let ok = dir.path().join("p.svg");
+    band_plot().write(&ok).unwrap();
+    assert!(std::fs::read_to_string(ok).unwrap().starts_with("<svg"));
+}

@@ -1,0 +1,301 @@
+//! Typed results of a study: statistics of every output over time and of every scalar
+//! quantity, the design's points, and the summaries written to `summary.json`.
+//!
+//! The field names of [`Summary`] and [`SuiteSummary`] are a public interface (they are the
+//! keys of `summary.json`): add fields, rename none.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::spec::{Experiment, PaperValue};
+use crate::uq::distributions::RandomParameter;
+use crate::uq::method::{Draws, MethodSummary, Sobol};
+
+/// Statistics of one output variable over time.
+#[derive(Clone, Debug)]
+pub struct OutputStats {
+    /// Variable name.
+    pub name: String,
+    /// Communication points (s).
+    pub times: Vec<f64>,
+    /// Mean over time.
+    pub mean: Vec<f64>,
+    /// Standard deviation over time.
+    pub std: Vec<f64>,
+    /// mean − 3 std.
+    pub lower_3sigma: Vec<f64>,
+    /// mean + 3 std.
+    pub upper_3sigma: Vec<f64>,
+    /// Quantiles over time: (level, values).
+    pub quantiles: Vec<(f64, Vec<f64>)>,
+    /// Std of the chaos surrogate where it differs from `std` (collocation).
+    pub std_pce: Option<Vec<f64>>,
+    /// First-order and total Sobol' indices over time.
+    pub sobol: Option<Sobol>,
+    /// PDF evolution: times of the columns.
+    pub pdf_times: Vec<f64>,
+    /// Grid of the densities.
+    pub pdf_grid: Vec<f64>,
+    /// `pdf[i][j]`: density at `pdf_times[i]`, `pdf_grid[j]`.
+    pub pdf: Vec<Vec<f64>>,
+    /// Where the quantiles and densities come from.
+    pub draws: Draws,
+}
+
+impl OutputStats {
+    /// The `mean ± k std` band.
+    pub fn band(mean: &[f64], std: &[f64], k: f64) -> (Vec<f64>, Vec<f64>) {
+        mean.iter()
+            .zip(std)
+            .map(|(m, s)| (m - k * s, m + k * s))
+            .unzip()
+    }
+}
+
+/// Statistics of one scalar quantity of interest.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScalarStats {
+    /// Quantity name.
+    pub name: String,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+    /// Standard error of the mean (sampling: std/√n; quadrature: 0).
+    pub std_error_mean: f64,
+    /// Runs with a valid value.
+    pub n_valid: usize,
+    /// Critical speed: runs that never hunt.
+    pub n_never_hunts: usize,
+    /// Critical speed: runs whose oscillation never dies out.
+    pub n_never_stops: usize,
+    /// (level, value) quantiles (of the runs, or of the chaos surrogate).
+    pub quantiles: Vec<(f64, f64)>,
+    /// Smallest value over the runs.
+    pub min: f64,
+    /// Largest.
+    pub max: f64,
+    /// P(q > limit): (limit, p, standard error of p).
+    pub exceedance: Vec<(f64, f64, f64)>,
+    /// PDF grid.
+    pub pdf_x: Vec<f64>,
+    /// PDF values (KDE of the runs, or of the chaos surrogate).
+    pub pdf: Vec<f64>,
+    /// The valid values of the runs (for histograms).
+    #[serde(skip)]
+    pub samples: Vec<f64>,
+    /// The samples the PDF and quantiles come from (runs, or the surrogate).
+    #[serde(skip)]
+    pub density_samples: Vec<f64>,
+    /// First-order Sobol' indices per parameter, where the method gives them.
+    pub sobol_first: Option<Vec<f64>>,
+    /// Total Sobol' indices per parameter.
+    pub sobol_total: Option<Vec<f64>>,
+    /// Where the quantiles and the PDF come from.
+    #[serde(skip)]
+    pub draws: Draws,
+}
+
+/// Outcome of one point of a design.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PointStatus {
+    /// The run succeeded.
+    Ok,
+    /// The run failed, with the reason.
+    Failed(String),
+    /// Not run.
+    Missing,
+}
+
+/// The design with the outcome of every point (`points.csv`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointTable {
+    /// Parameter names (columns).
+    pub names: Vec<String>,
+    /// Quadrature weights, if the design has them.
+    pub weights: Option<Vec<f64>>,
+    /// Parameter values per point.
+    pub values: Vec<Vec<f64>>,
+    /// Outcome per point.
+    pub status: Vec<PointStatus>,
+}
+
+/// The FMU a study ran.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FmuInfo {
+    /// Path as given.
+    pub path: String,
+    /// `modelName`.
+    pub model_name: String,
+    /// GUID.
+    pub guid: String,
+    /// `generationTool`.
+    pub generation_tool: Option<String>,
+    /// SHA-256 of the FMU.
+    pub sha256: String,
+}
+
+/// Versions of the driver and of FMI.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Versions {
+    /// uq-driver version.
+    pub uq_driver: String,
+    /// FMI version.
+    pub fmi: String,
+}
+
+impl Default for Versions {
+    fn default() -> Self {
+        Versions {
+            uq_driver: env!("CARGO_PKG_VERSION").into(),
+            fmi: "2.0".into(),
+        }
+    }
+}
+
+/// An output's entry in `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutputSummary {
+    /// `<V>.csv`.
+    pub csv: String,
+    /// `<V>_pdf.csv`.
+    pub pdf_csv: String,
+    /// Mean at the stop time.
+    pub mean_at_stop: f64,
+    /// Std at the stop time.
+    pub std_at_stop: f64,
+    /// Largest Std over time.
+    pub max_std: f64,
+    /// When it is reached (s).
+    pub time_of_max_std: f64,
+}
+
+impl OutputSummary {
+    /// The entry of `s`.
+    pub fn of(s: &OutputStats) -> OutputSummary {
+        let last = s.times.len() - 1;
+        let imax = (0..s.std.len())
+            .max_by(|&a, &b| s.std[a].total_cmp(&s.std[b]))
+            .unwrap_or(0);
+        OutputSummary {
+            csv: format!("{}.csv", s.name),
+            pdf_csv: format!("{}_pdf.csv", s.name),
+            mean_at_stop: s.mean[last],
+            std_at_stop: s.std[last],
+            max_std: s.std[imax],
+            time_of_max_std: s.times[imax],
+        }
+    }
+}
+
+/// `summary.json` of a study.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// Study name.
+    pub study: String,
+    /// Free text.
+    pub description: String,
+    /// Study file or `builtin:NAME`.
+    pub origin: String,
+    /// Method settings and diagnostics.
+    pub method: MethodSummary,
+    /// Seed.
+    pub seed: u64,
+    /// Time grid.
+    pub experiment: Experiment,
+    /// Random parameters.
+    pub parameters: Vec<RandomParameter>,
+    /// Deterministic values.
+    pub fixed: BTreeMap<String, f64>,
+    /// The FMU (null for intrusive methods).
+    pub fmu: Option<FmuInfo>,
+    /// Model runs of the study (1 for intrusive methods).
+    pub model_runs: usize,
+    /// Runs made by this invocation.
+    pub runs_this_invocation: usize,
+    /// Runs found finished in the store.
+    pub runs_resumed: usize,
+    /// Failed runs (allowed for unweighted designs).
+    pub failed_runs: usize,
+    /// Wall time of this invocation (s).
+    pub wall_time_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Versions.
+    pub versions: Versions,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+    /// Per output.
+    pub outputs: BTreeMap<String, OutputSummary>,
+    /// Per scalar quantity.
+    pub quantities: BTreeMap<String, ScalarStats>,
+}
+
+/// An output of a suite variant against the reference variant.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VariantOutput {
+    /// Output name.
+    pub name: String,
+    /// max over time of |mean − mean of the reference|.
+    pub max_abs_mean_diff_vs_reference: f64,
+    /// max over time of |Std − Std of the reference|.
+    pub max_abs_std_diff_vs_reference: f64,
+}
+
+/// A variant's entry in a suite's `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VariantSummary {
+    /// Variant name.
+    pub name: String,
+    /// Method label (e.g. `lhs 1000`).
+    pub method: String,
+    /// Model runs.
+    pub model_runs: usize,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+    /// Sub-folder with the variant's own report.
+    pub folder: String,
+    /// Outputs against the reference.
+    pub outputs: Vec<VariantOutput>,
+    /// Scalar quantities.
+    pub quantities: Vec<ScalarStats>,
+}
+
+/// `summary.json` of a suite.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SuiteSummary {
+    /// Suite name.
+    pub suite: String,
+    /// Free text.
+    pub description: String,
+    /// Study file or `builtin:NAME`.
+    pub origin: String,
+    /// Reference variant.
+    pub reference: String,
+    /// Per variant.
+    pub variants: Vec<VariantSummary>,
+    /// Published values.
+    pub paper: Vec<PaperValue>,
+    /// Total wall time (s).
+    pub wall_time_s: f64,
+}
+
+/// A summary as pretty JSON with its keys in alphabetical order (as `summary.json` has
+/// always been written).
+pub fn to_json(summary: &impl Serialize) -> String {
+    let value = serde_json::to_value(summary).expect("summaries serialize");
+    serde_json::to_string_pretty(&value).expect("JSON values print")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn band_is_mean_plus_minus_k_std() {
+        let (lo, hi) = OutputStats::band(&[1.0, 2.0], &[0.5, 0.0], 3.0);
+        assert_eq!(lo, vec![-0.5, 2.0]);
+        assert_eq!(hi, vec![2.5, 2.0]);
+    }
+}

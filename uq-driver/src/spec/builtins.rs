@@ -1,0 +1,76 @@
+//! The built-in studies, embedded in the binary (`uq-driver list`, `run builtin:NAME`).
+
+use super::error::StudyError;
+
+/// The built-in studies, embedded in the binary: (name, TOML).
+pub const BUILTINS: &[(&str, &str)] = &[
+    ("wheel-scm", include_str!("../../studies/wheel-scm.toml")),
+    (
+        "wheel-lhs-1000",
+        include_str!("../../studies/wheel-lhs-1000.toml"),
+    ),
+    (
+        "wheel-lhs-10000",
+        include_str!("../../studies/wheel-lhs-10000.toml"),
+    ),
+    (
+        "wheel-lhs-50000",
+        include_str!("../../studies/wheel-lhs-50000.toml"),
+    ),
+    ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
+    ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
+    (
+        "paper-wheel",
+        include_str!("../../studies/paper-wheel.toml"),
+    ),
+    (
+        "bogie-nominal",
+        include_str!("../../studies/bogie-nominal.toml"),
+    ),
+    ("bogie-scm", include_str!("../../studies/bogie-scm.toml")),
+    (
+        "bogie-lhs-500",
+        include_str!("../../studies/bogie-lhs-500.toml"),
+    ),
+    (
+        "bogie-lhs-20000",
+        include_str!("../../studies/bogie-lhs-20000.toml"),
+    ),
+    (
+        "paper-bogie",
+        include_str!("../../studies/paper-bogie.toml"),
+    ),
+    (
+        "vehicle-track-nominal",
+        include_str!("../../studies/vehicle-track-nominal.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov10",
+        include_str!("../../studies/vehicle-track-scm-cov10.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov20",
+        include_str!("../../studies/vehicle-track-scm-cov20.toml"),
+    ),
+    (
+        "vehicle-track-scm-cov30",
+        include_str!("../../studies/vehicle-track-scm-cov30.toml"),
+    ),
+    (
+        "vehicle-track-defect",
+        include_str!("../../studies/vehicle-track-defect.toml"),
+    ),
+    (
+        "paper-vehicle-track",
+        include_str!("../../studies/paper-vehicle-track.toml"),
+    ),
+];
+
+/// The text of a built-in study.
+pub fn builtin(name: &str) -> Result<&'static str, StudyError> {
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| StudyError::UnknownBuiltin(name.to_owned()))
+}

@@ -1,0 +1,213 @@
+//! The study file as written (serde): every table and key, unknown keys refused.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use toml::Spanned;
+
+use super::parameter::ParameterSpec;
+use crate::qoi::QoiSpec;
+use crate::uq::galerkin::system::SystemSpec;
+use crate::uq::method::MethodSpec;
+
+/// Start, stop and communication step (s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Experiment {
+    /// Start time (s).
+    #[serde(default)]
+    pub start: f64,
+    /// Stop time (s).
+    pub stop: f64,
+    /// Communication step (s).
+    pub step: f64,
+}
+
+impl Experiment {
+    /// Number of communication steps.
+    pub fn n_steps(&self) -> usize {
+        ((self.stop - self.start) / self.step).round() as usize
+    }
+
+    /// The communication points t_0 … t_n (s), computed as start + i·step (no drift).
+    pub fn times(&self) -> Vec<f64> {
+        let n = self.n_steps();
+        (0..=n)
+            .map(|i| {
+                if i == n {
+                    self.stop
+                } else {
+                    self.start + i as f64 * self.step
+                }
+            })
+            .collect()
+    }
+
+    /// Checks that start < stop and step > 0 (all finite) and that stop − start is a whole
+    /// number of steps.
+    pub fn check(&self) -> Result<(), InvalidExperiment> {
+        let finite = self.start.is_finite() && self.stop.is_finite() && self.step.is_finite();
+        if !finite || self.step <= 0.0 || self.stop <= self.start {
+            return Err(InvalidExperiment::Range {
+                start: self.start,
+                stop: self.stop,
+                step: self.step,
+            });
+        }
+        let ratio = (self.stop - self.start) / self.step;
+        if (ratio - ratio.round()).abs() > 1e-6 * ratio.max(1.0) {
+            return Err(InvalidExperiment::NotWholeSteps {
+                span: self.stop - self.start,
+                step: self.step,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A time grid that cannot be run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum InvalidExperiment {
+    /// Not start < stop with step > 0.
+    #[error(
+        "experiment needs finite start < stop and step > 0 (got start {start}, stop {stop}, step {step})"
+    )]
+    Range {
+        /// Start (s).
+        start: f64,
+        /// Stop (s).
+        stop: f64,
+        /// Step (s).
+        step: f64,
+    },
+    /// The span is not a whole number of steps.
+    #[error("stop − start = {span} s is not a whole number of communication steps of {step} s")]
+    NotWholeSteps {
+        /// stop − start (s).
+        span: f64,
+        /// Step (s).
+        step: f64,
+    },
+}
+
+/// Output variables to analyse as time series.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outputs {
+    /// FMU variable names (Real).
+    #[serde(default)]
+    pub variables: Vec<String>,
+}
+
+/// Analysis settings (all optional).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Analysis {
+    /// Points of the density grid of the PDF evolution.
+    pub pdf_grid: usize,
+    /// Largest number of time columns in the PDF evolution (evenly thinned).
+    pub pdf_times: usize,
+    /// Samples of a chaos surrogate used for densities and quantiles.
+    pub surrogate_samples: usize,
+    /// Quantile levels written to the CSV.
+    pub quantiles: Vec<f64>,
+    /// Unweighted designs (MC/LHS): continue when some points fail and report how many.
+    pub allow_failures: bool,
+}
+
+impl Default for Analysis {
+    fn default() -> Self {
+        Analysis {
+            pdf_grid: 200,
+            pdf_times: 250,
+            surrogate_samples: 20_000,
+            quantiles: vec![0.01, 0.5, 0.99],
+            allow_failures: false,
+        }
+    }
+}
+
+/// A study file as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudyFile {
+    /// Study name (used in reports).
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// The FMU path (every method that runs a model).
+    #[serde(default)]
+    pub fmu: Option<String>,
+    /// An intrusive method's equations.
+    #[serde(default)]
+    pub system: Option<SystemSpec>,
+    /// Seed of every random stream.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Time grid.
+    pub experiment: Spanned<Experiment>,
+    /// Method.
+    pub method: Spanned<MethodSpec>,
+    /// Random parameters.
+    pub parameters: Vec<Spanned<ParameterSpec>>,
+    /// Deterministic parameter values set before every run.
+    #[serde(default)]
+    pub fixed: BTreeMap<String, f64>,
+    /// Outputs.
+    #[serde(default)]
+    pub outputs: Outputs,
+    /// Scalar quantities of interest computed from each run.
+    #[serde(default)]
+    pub qoi: Vec<Spanned<QoiSpec>>,
+    /// Analysis settings.
+    #[serde(default)]
+    pub analysis: Analysis,
+    /// Variants run one after the other into sub-folders, then compared.
+    #[serde(default)]
+    pub variants: Vec<Spanned<Variant>>,
+    /// Name of the variant the others are compared against (default: the first).
+    #[serde(default)]
+    pub reference: Option<String>,
+    /// Published values to print beside ours in a suite's comparison table.
+    #[serde(default)]
+    pub paper: Vec<PaperValue>,
+}
+
+fn default_seed() -> u64 {
+    42
+}
+
+/// A published value: `statistic` ("mean", "std", or "p>LIMIT") of `quantity` in `variant`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaperValue {
+    /// Variant name.
+    pub variant: String,
+    /// Quantity (scalar QoI) name.
+    pub quantity: String,
+    /// "mean", "std" or "p>LIMIT" (e.g. "p>2.5").
+    pub statistic: String,
+    /// The published number.
+    pub value: f64,
+    /// Where it is published (e.g. "paper Table 3").
+    #[serde(default)]
+    pub source: String,
+}
+
+/// A variant of a study: another method and/or other random parameters.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variant {
+    /// Sub-folder and label.
+    pub name: String,
+    /// Method of this variant (default: the study's).
+    #[serde(default)]
+    pub method: Option<MethodSpec>,
+    /// Random parameters of this variant (default: the study's).
+    #[serde(default)]
+    pub parameters: Option<Vec<ParameterSpec>>,
+    /// Deterministic values of this variant, merged over the study's `[fixed]`.
+    #[serde(default)]
+    pub fixed: BTreeMap<String, f64>,
+}

@@ -1,0 +1,293 @@
+//! Loading a study: the file parsed into a [`StudyFile`], then validated in one place into a
+//! [`Study`] whose parameters, quantities, method and variants all make sense together.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use toml::Spanned;
+
+use super::builtins::builtin;
+use super::error::{location, Location, StudyError};
+use super::file::{Analysis, StudyFile, Variant};
+use super::parameter::ParameterSpec;
+use super::study::{Study, Suite};
+use crate::qoi::QoiSpec;
+use crate::uq::distributions::RandomParameter;
+use crate::uq::method::Evaluation;
+
+impl Study {
+    /// Loads `builtin:NAME` or a TOML file.
+    pub fn load(spec: &str) -> Result<Study, StudyError> {
+        if let Some(name) = spec.strip_prefix("builtin:") {
+            return Study::parse(builtin(name)?, spec, None);
+        }
+        let path = Path::new(spec);
+        let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Study::parse(&text, spec, path.parent())
+    }
+
+    /// Parses and validates a study; `base` is the folder relative FMU paths start from.
+    pub fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Study, StudyError> {
+        let file: StudyFile = toml::from_str(text).map_err(|e| StudyError::Parse {
+            origin: origin.to_owned(),
+            at: Location::of(text, e.span().map_or(0, |s| s.start)),
+            message: e.message().to_owned(),
+        })?;
+        study(file, origin, base, text)
+    }
+}
+
+/// Folders searched for an FMU named by a relative path that is not next to the study file:
+/// `$RAILUQ_FMU_DIR`, `<folder of the executable>/../fmu` (i.e. `target/fmu` for a cargo
+/// build), `./target/fmu`.
+pub fn fmu_search_path() -> Vec<PathBuf> {
+    let mut dirs = Vec::new();
+    if let Some(d) = std::env::var_os("RAILUQ_FMU_DIR") {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        if let Some(parent) = exe.parent().and_then(Path::parent) {
+            dirs.push(parent.join("fmu"));
+        }
+    }
+    dirs.push(PathBuf::from("target/fmu"));
+    dirs
+}
+
+/// Where errors point: the origin and the text the spans refer to.
+struct Context<'a> {
+    origin: &'a str,
+    text: &'a str,
+}
+
+impl Context<'_> {
+    /// An error at `span` (or at no particular place).
+    fn invalid(&self, span: Option<Range<usize>>, message: impl Into<String>) -> StudyError {
+        StudyError::Invalid {
+            origin: self.origin.to_owned(),
+            at: span.map(|s| location(self.text, s)),
+            message: message.into(),
+        }
+    }
+}
+
+/// Validates `file` (parsed from `text`) into a study.
+fn study(
+    file: StudyFile,
+    origin: &str,
+    base: Option<&Path>,
+    text: &str,
+) -> Result<Study, StudyError> {
+    let cx = Context { origin, text };
+    let e = &file.experiment;
+    e.get_ref()
+        .check()
+        .map_err(|err| cx.invalid(Some(e.span()), err.to_string()))?;
+    let params: Vec<(Range<usize>, &ParameterSpec)> = file
+        .parameters
+        .iter()
+        .map(|p| (p.span(), p.get_ref()))
+        .collect();
+    let parameters = parameters(&cx, &params, &file)?;
+    check_fixed(&cx, &file)?;
+    check_quantities(&cx, &file)?;
+    check_analysis(&cx, &file.analysis)?;
+    let mut study = Study {
+        name: file.name.clone(),
+        description: file.description.clone(),
+        origin: origin.to_owned(),
+        source: text.to_owned(),
+        base: base.map(Path::to_path_buf),
+        fmu_path: None,
+        seed: file.seed,
+        experiment: e.get_ref().clone(),
+        method: file.method.get_ref().clone(),
+        parameters,
+        fixed: file.fixed.clone(),
+        outputs: file.outputs.variables.clone(),
+        qoi: file.qoi.iter().map(|q| q.get_ref().clone()).collect(),
+        analysis: file.analysis.clone(),
+        system: file.system.clone(),
+        suite: None,
+    };
+    check_method(&cx, &study, file.method.span())?;
+    if let Evaluation::Sampling(_) = study.method().evaluation() {
+        let fmu = file
+            .fmu
+            .as_deref()
+            .ok_or_else(|| cx.invalid(None, "`fmu` is required (the FMU to run)"))?;
+        study.fmu_path = Some(resolve_fmu(fmu, base));
+    }
+    if !file.variants.is_empty() || file.reference.is_some() {
+        study.suite = Some(suite(&cx, &file, base)?);
+    }
+    Ok(study)
+}
+
+/// The validated random parameters: at least one, distinct, not also fixed.
+fn parameters(
+    cx: &Context,
+    specs: &[(Range<usize>, &ParameterSpec)],
+    file: &StudyFile,
+) -> Result<Vec<RandomParameter>, StudyError> {
+    if specs.is_empty() {
+        return Err(cx.invalid(None, "no random [[parameters]]"));
+    }
+    let mut out: Vec<RandomParameter> = Vec::new();
+    for (span, p) in specs {
+        let at = Some(span.clone());
+        if out.iter().any(|q| q.name == p.name) {
+            return Err(cx.invalid(at, format!("parameter '{}' is listed twice", p.name)));
+        }
+        if file.fixed.contains_key(&p.name) {
+            return Err(cx.invalid(
+                at,
+                format!("parameter '{}' is both random and fixed", p.name),
+            ));
+        }
+        let param = p
+            .to_parameter()
+            .map_err(|e| cx.invalid(at, format!("parameter '{}': {e}", p.name)))?;
+        out.push(param);
+    }
+    Ok(out)
+}
+
+fn check_fixed(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
+    match file.fixed.iter().find(|(_, v)| !v.is_finite()) {
+        Some((name, _)) => Err(cx.invalid(None, format!("fixed value of '{name}' is not finite"))),
+        None => Ok(()),
+    }
+}
+
+/// Something to analyse; unique names; each quantity's settings.
+fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
+    if file.outputs.variables.is_empty() && file.qoi.is_empty() {
+        return Err(cx.invalid(
+            None,
+            "nothing to analyse: give [outputs] variables and/or [[qoi]]",
+        ));
+    }
+    let duration = {
+        let e = file.experiment.get_ref();
+        e.stop - e.start
+    };
+    let mut names: Vec<&str> = file.outputs.variables.iter().map(String::as_str).collect();
+    for q in &file.qoi {
+        let (span, q): (_, &QoiSpec) = (q.span(), q.get_ref());
+        if names.contains(&q.name()) {
+            return Err(cx.invalid(
+                Some(span),
+                format!("quantity name '{}' is used twice", q.name()),
+            ));
+        }
+        names.push(q.name());
+        q.validate(duration)
+            .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
+    }
+    Ok(())
+}
+
+fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
+    if a.pdf_grid < 2 || a.pdf_times < 1 || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q)) {
+        return Err(cx.invalid(
+            None,
+            "analysis: pdf_grid >= 2, pdf_times >= 1, quantiles in [0, 1]",
+        ));
+    }
+    Ok(())
+}
+
+fn check_method(cx: &Context, study: &Study, span: Range<usize>) -> Result<(), StudyError> {
+    let times = study.times();
+    study
+        .method()
+        .validate(&study.problem(&times))
+        .map_err(|e| cx.invalid(Some(span), format!("method {}: {e}", study.method().kind())))
+}
+
+/// Each variant as a complete study: the study's method, parameters and fixed values
+/// replaced by the variant's.
+fn suite(cx: &Context, file: &StudyFile, base: Option<&Path>) -> Result<Suite, StudyError> {
+    let mut variants: Vec<Study> = Vec::new();
+    for v in &file.variants {
+        let (span, v): (_, &Variant) = (v.span(), v.get_ref());
+        let plain = !v.name.is_empty() && !v.name.contains(['/', '\\', '.']);
+        if !plain || variants.iter().any(|s| s.name == v.name) {
+            return Err(cx.invalid(
+                Some(span),
+                format!(
+                    "variant name '{}' is empty, repeated or not a plain folder name",
+                    v.name
+                ),
+            ));
+        }
+        variants.push(variant(cx, file, v, span, base)?);
+    }
+    let reference = match &file.reference {
+        None => 0,
+        Some(r) => variants.iter().position(|s| &s.name == r).ok_or_else(|| {
+            cx.invalid(None, format!("reference '{r}' is not one of the variants"))
+        })?,
+    };
+    Ok(Suite {
+        variants,
+        reference,
+        paper: file.paper.clone(),
+    })
+}
+
+fn variant(
+    cx: &Context,
+    file: &StudyFile,
+    v: &Variant,
+    span: Range<usize>,
+    base: Option<&Path>,
+) -> Result<Study, StudyError> {
+    let mut f = file.clone();
+    f.variants.clear();
+    f.reference = None;
+    f.paper.clear();
+    f.name = v.name.clone();
+    // Errors inside the variant point at the variant.
+    if let Some(m) = &v.method {
+        f.method = Spanned::new(span.clone(), m.clone());
+    }
+    if let Some(p) = &v.parameters {
+        f.parameters = p
+            .iter()
+            .map(|p| Spanned::new(span.clone(), p.clone()))
+            .collect();
+    }
+    for (k, x) in &v.fixed {
+        f.fixed.insert(k.clone(), *x);
+    }
+    let origin = format!("{} (variant {})", cx.origin, v.name);
+    study(f, &origin, base, cx.text)
+}
+
+fn resolve_fmu(fmu: &str, base: Option<&Path>) -> PathBuf {
+    let p = Path::new(fmu);
+    if p.is_absolute() {
+        return p.to_path_buf();
+    }
+    if let Some(b) = base {
+        let c = b.join(p);
+        if c.exists() {
+            return c;
+        }
+    }
+    if p.exists() {
+        return p.to_path_buf();
+    }
+    for d in fmu_search_path() {
+        let c = d.join(p);
+        if c.exists() {
+            return c;
+        }
+    }
+    base.map(|b| b.join(p)).unwrap_or_else(|| p.to_path_buf())
+}

@@ -1,0 +1,197 @@
+//! The `[[parameters]]` of a study file: a name and a distribution chosen by the
+//! `distribution` key (default `normal`), each distribution with its own keys.
+
+use serde::de::{Deserializer, Error as _};
+use serde::Deserialize;
+
+use crate::uq::distributions::{Distribution, DistributionError, RandomParameter};
+
+/// A random parameter as written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterSpec {
+    /// FMU variable name.
+    pub name: String,
+    /// Its distribution, as written.
+    pub distribution: DistributionSpec,
+}
+
+/// A distribution as written: `distribution = "<kind>"` and the kind's keys only.
+///
+/// `mean` and `std` are those of the variable (normal, lognormal) or of the parent normal
+/// (truncated normal); `cov` (coefficient of variation) replaces `std` as `std = |mean| cov`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "distribution", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DistributionSpec {
+    /// `distribution = "normal"` (the default): `mean` and `std` or `cov`.
+    Normal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation.
+        #[serde(default)]
+        std: Option<f64>,
+        /// Coefficient of variation.
+        #[serde(default)]
+        cov: Option<f64>,
+    },
+    /// `distribution = "lognormal"`: mean and `std` or `cov` of the variable itself.
+    #[serde(alias = "log_normal")]
+    Lognormal {
+        /// Mean (> 0).
+        mean: f64,
+        /// Standard deviation.
+        #[serde(default)]
+        std: Option<f64>,
+        /// Coefficient of variation.
+        #[serde(default)]
+        cov: Option<f64>,
+    },
+    /// `distribution = "uniform"` on `[low, high]`.
+    Uniform {
+        /// Lower bound.
+        low: f64,
+        /// Upper bound.
+        high: f64,
+    },
+    /// `distribution = "truncated_normal"`: the parent normal's `mean` and `std` or `cov`,
+    /// conditioned on `[low, high]` (bounds may be `inf`).
+    TruncatedNormal {
+        /// Mean of the parent normal.
+        mean: f64,
+        /// Standard deviation of the parent normal.
+        #[serde(default)]
+        std: Option<f64>,
+        /// Coefficient of variation of the parent normal.
+        #[serde(default)]
+        cov: Option<f64>,
+        /// Lower bound.
+        low: f64,
+        /// Upper bound.
+        high: f64,
+    },
+}
+
+/// Why a parameter's distribution is refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum InvalidParameter {
+    /// Both spreads were given.
+    #[error("give `std` or `cov`, not both")]
+    BothSpreads,
+    /// No spread was given.
+    #[error("`std` or `cov` is required")]
+    NoSpread,
+    /// The distribution's parameters are invalid.
+    #[error(transparent)]
+    Distribution(#[from] DistributionError),
+}
+
+impl<'de> Deserialize<'de> for ParameterSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut table = toml::Table::deserialize(d)?;
+        let name = match table.remove("name") {
+            Some(toml::Value::String(s)) => s,
+            Some(other) => {
+                return Err(D::Error::custom(format!(
+                    "`name` must be a string, not {}",
+                    other.type_str()
+                )))
+            }
+            None => return Err(D::Error::missing_field("name")),
+        };
+        table
+            .entry("distribution")
+            .or_insert_with(|| "normal".into());
+        let distribution = DistributionSpec::deserialize(toml::Value::Table(table))
+            .map_err(|e| D::Error::custom(format!("parameter '{name}': {}", e.message())))?;
+        Ok(ParameterSpec { name, distribution })
+    }
+}
+
+/// `std`, or `|mean| cov`.
+fn spread(mean: f64, std: Option<f64>, cov: Option<f64>) -> Result<f64, InvalidParameter> {
+    match (std, cov) {
+        (Some(s), None) => Ok(s),
+        (None, Some(c)) => Ok(mean.abs() * c),
+        (Some(_), Some(_)) => Err(InvalidParameter::BothSpreads),
+        (None, None) => Err(InvalidParameter::NoSpread),
+    }
+}
+
+impl DistributionSpec {
+    /// The validated distribution.
+    pub fn to_distribution(&self) -> Result<Distribution, InvalidParameter> {
+        Ok(match *self {
+            DistributionSpec::Normal { mean, std, cov } => {
+                Distribution::normal(mean, spread(mean, std, cov)?)?
+            }
+            DistributionSpec::Lognormal { mean, std, cov } => {
+                Distribution::lognormal_from_mean_std(mean, spread(mean, std, cov)?)?
+            }
+            DistributionSpec::Uniform { low, high } => Distribution::uniform(low, high)?,
+            DistributionSpec::TruncatedNormal {
+                mean,
+                std,
+                cov,
+                low,
+                high,
+            } => Distribution::truncated_normal(mean, spread(mean, std, cov)?, low, high)?,
+        })
+    }
+}
+
+impl ParameterSpec {
+    /// The validated parameter.
+    pub fn to_parameter(&self) -> Result<RandomParameter, InvalidParameter> {
+        Ok(RandomParameter {
+            name: self.name.clone(),
+            distribution: self.distribution.to_distribution()?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<ParameterSpec, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    #[test]
+    fn distribution_defaults_to_normal_and_std_or_cov() {
+        let p = parse("name = \"K\"\nmean = 100.0\ncov = 0.1").unwrap();
+        assert_eq!(p.name, "K");
+        assert_eq!(
+            p.to_parameter().unwrap().distribution,
+            Distribution::normal(100.0, 10.0).unwrap()
+        );
+        let p = parse("name = \"K\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2").unwrap();
+        assert_eq!(
+            p.distribution.to_distribution().unwrap(),
+            Distribution::uniform(1.0, 2.0).unwrap()
+        );
+        let p = parse(
+            "name = \"K\"\ndistribution = \"truncated_normal\"\nmean = 0\nstd = 1\nlow = 0\nhigh = inf",
+        )
+        .unwrap();
+        assert!(p.to_parameter().is_ok());
+    }
+
+    #[test]
+    fn wrong_keys_and_spreads_are_refused() {
+        let e = parse("name = \"K\"\nmean = 1.0\nstd = 0.1\nlow = 0.0").unwrap_err();
+        assert!(e.to_string().contains("unknown field `low`"), "{e}");
+        assert!(e.to_string().contains("parameter 'K'"), "{e}");
+        let e = parse("name = \"K\"\ndistribution = \"gamma\"\nmean = 1.0").unwrap_err();
+        assert!(e.to_string().contains("unknown variant `gamma`"), "{e}");
+        assert!(parse("mean = 1.0\nstd = 0.1").is_err());
+        let both = parse("name = \"K\"\nmean = 1.0\nstd = 0.1\ncov = 0.1").unwrap();
+        assert_eq!(both.to_parameter(), Err(InvalidParameter::BothSpreads));
+        let none = parse("name = \"K\"\nmean = 1.0").unwrap();
+        assert_eq!(none.to_parameter(), Err(InvalidParameter::NoSpread));
+        let neg = parse("name = \"K\"\nmean = 1.0\nstd = -1.0").unwrap();
+        assert!(matches!(
+            neg.to_parameter(),
+            Err(InvalidParameter::Distribution(_))
+        ));
+    }
+}

@@ -1,0 +1,109 @@
+//! Tests of study files: every built-in parses; wrong files give errors with their place.
+
+use super::*;
+
+#[test]
+fn every_builtin_parses() {
+    for (name, _) in BUILTINS {
+        let s = Study::load(&format!("builtin:{name}")).unwrap();
+        assert_eq!(&s.name, name);
+        if let Some(suite) = &s.suite {
+            assert!(suite.reference < suite.variants.len());
+        }
+    }
+}
+
+#[test]
+fn wrong_study_files_give_clear_errors() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let cases = [
+        (base.replace("stop = 5.0", "stop = -1.0"), "start < stop"),
+        (base.replace("order = 5", "order = 6"), "below the nodes"),
+        (base.replace("std = 10.0", "std = -10.0"), "parameter 'K'"),
+        (
+            base.replace("kind = \"scm\"", "kind = \"magic\""),
+            "unknown variant",
+        ),
+        (
+            base.replace("[outputs]", "[outputs]\ncolour = 1"),
+            "unknown field",
+        ),
+        (base.replace("step = 0.01", "step = 0.03"), "whole number"),
+        // Settings of another method are not representable.
+        (
+            base.replace("nodes = 6", "nodes = 6\nsamples = 100"),
+            "unknown field `samples`",
+        ),
+        (
+            base.replace("distribution = \"normal\"", "distribution = \"uniform\""),
+            "unknown field",
+        ),
+    ];
+    for (text, needle) in cases {
+        let err = Study::parse(&text, "t.toml", None).unwrap_err().to_string();
+        assert!(err.contains(needle), "{err} should mention {needle}");
+        assert!(err.starts_with("t.toml:"), "{err}");
+    }
+    assert!(matches!(
+        Study::load("builtin:nope"),
+        Err(StudyError::UnknownBuiltin(_))
+    ));
+    assert!(matches!(
+        Study::load("/nonexistent.toml"),
+        Err(StudyError::Io { .. })
+    ));
+}
+
+#[test]
+fn errors_point_at_the_line_and_column() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let line_of = |needle: &str| base.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    // A bad value inside the second parameter: the error names that [[parameters]] table.
+    let text = base.replace("std = 2.0", "std = -2.0");
+    match Study::parse(&text, "t.toml", None).unwrap_err() {
+        StudyError::Invalid { at: Some(at), .. } => {
+            let header = text
+                .lines()
+                .take(at.line)
+                .filter(|l| l.starts_with("[[parameters]]"));
+            assert_eq!(header.count(), 2, "{at}");
+        }
+        e => panic!("{e}"),
+    }
+    // A key the method does not have: the error points into [method].
+    let text = base.replace("order = 5", "order = 5\nlevel = 3");
+    match Study::parse(&text, "t.toml", None).unwrap_err() {
+        StudyError::Parse { at, message, .. } => {
+            assert!(message.contains("unknown field `level`"), "{message}");
+            assert!(at.line >= line_of("[method]") && at.line <= line_of("order = 5") + 1);
+        }
+        e => panic!("{e}"),
+    }
+    // A syntax error: its own line and column.
+    let text = base.replace("seed = 42", "seed = = 42");
+    match Study::parse(&text, "t.toml", None).unwrap_err() {
+        StudyError::Parse { at, .. } => assert_eq!(at.line, line_of("seed = 42")),
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
+fn location_counts_lines_and_characters() {
+    let text = "a = 1\nbé = 2\n";
+    assert_eq!(Location::of(text, 0), Location { line: 1, column: 1 });
+    assert_eq!(Location::of(text, 6), Location { line: 2, column: 1 });
+    assert_eq!(Location::of(text, 9), Location { line: 2, column: 3 });
+}
+
+#[test]
+fn times_do_not_drift() {
+    let e = Experiment {
+        start: 0.0,
+        stop: 5.0,
+        step: 0.01,
+    };
+    let t = e.times();
+    assert_eq!(t.len(), 501);
+    assert_eq!(t[500], 5.0);
+    assert_eq!(t[3], 0.03);
+}

@@ -1,0 +1,61 @@
+//! What running a study returns, and how it fails.
+
+use super::analysis::AnalysisError;
+use super::runner::RunError;
+use crate::report::ReportError;
+use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::uq::method::MethodError;
+
+/// Errors of a whole study run.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyRunError {
+    /// Running the points failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// An intrusive method failed.
+    #[error(transparent)]
+    Method(#[from] MethodError),
+    /// The statistics could not be computed.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+    /// Writing results failed.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    /// The study stopped before every point was run (see `max_new_points`).
+    #[error("stopped after {done} of {total} points; run again with the same --out to resume")]
+    Incomplete {
+        /// Points finished.
+        done: usize,
+        /// Points of the design.
+        total: usize,
+    },
+}
+
+/// What a finished study returns.
+#[derive(Clone, Debug)]
+pub struct StudyResult {
+    /// The summary written to `summary.json`.
+    pub summary: Summary,
+    /// Statistics per output.
+    pub outputs: Vec<OutputStats>,
+    /// Statistics per scalar quantity of interest.
+    pub quantities: Vec<ScalarStats>,
+}
+
+/// What a finished suite returns.
+#[derive(Clone, Debug)]
+pub struct SuiteResult {
+    /// The summary written to the suite's `summary.json`.
+    pub summary: SuiteSummary,
+    /// Each variant's result, in file order.
+    pub variants: Vec<StudyResult>,
+}
+
+/// A study's or a suite's result.
+#[derive(Clone, Debug)]
+pub enum Outcome {
+    /// One study.
+    Study(Box<StudyResult>),
+    /// A suite of variants.
+    Suite(SuiteResult),
+}

@@ -1,0 +1,220 @@
+//! One study (not a suite): the method's design run on the FMU (or its own solve), the
+//! statistics, the summary and the report.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use super::analysis;
+use super::outcome::{StudyResult, StudyRunError};
+use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::store::Record;
+use crate::fmu::Fmu;
+use crate::report::{self, ReportError, StudyReport};
+use crate::results::{
+    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, ScalarStats, Summary, Versions,
+};
+use crate::spec::Study;
+use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
+
+/// Runs a study that is not a suite.
+pub(crate) fn run_single(
+    study: &Study,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| ReportError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    match study.method().evaluation() {
+        Evaluation::Intrusive(method) => solve(study, method, out_dir),
+        Evaluation::Sampling(method) => {
+            let fmu = open_fmu(study)?;
+            let design = method.design(&study.parameters, study.seed)?;
+            let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
+            finish(study, method, &fmu, &design, outcome, out_dir, opts)
+        }
+    }
+}
+
+/// Opens the study's FMU.
+pub(crate) fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
+    let path = study.fmu_path.as_deref().unwrap_or(Path::new(""));
+    Ok(Fmu::open(path)?)
+}
+
+/// Facts of a run for the summary.
+struct RunFacts {
+    fmu: Option<FmuInfo>,
+    model_runs: usize,
+    runs_new: usize,
+    runs_resumed: usize,
+    failed: usize,
+    wall_time: f64,
+    threads: usize,
+}
+
+fn summary(
+    study: &Study,
+    facts: RunFacts,
+    method: MethodSummary,
+    warnings: Vec<String>,
+    outputs: &[OutputStats],
+    quantities: &[ScalarStats],
+) -> Summary {
+    Summary {
+        study: study.name.clone(),
+        description: study.description.clone(),
+        origin: study.origin.clone(),
+        method,
+        seed: study.seed,
+        experiment: study.experiment.clone(),
+        parameters: study.parameters.clone(),
+        fixed: study.fixed.clone(),
+        fmu: facts.fmu,
+        model_runs: facts.model_runs,
+        runs_this_invocation: facts.runs_new,
+        runs_resumed: facts.runs_resumed,
+        failed_runs: facts.failed,
+        wall_time_s: facts.wall_time,
+        threads: facts.threads,
+        versions: Versions::default(),
+        warnings,
+        outputs: outputs
+            .iter()
+            .map(|s| (s.name.clone(), OutputSummary::of(s)))
+            .collect(),
+        quantities: quantities
+            .iter()
+            .map(|q| (q.name.clone(), q.clone()))
+            .collect::<BTreeMap<_, _>>(),
+    }
+}
+
+/// Statistics and files of a study whose points have all been run (`outcome.records`).
+pub(crate) fn finish(
+    study: &Study,
+    method: &dyn Sampling,
+    fmu: &Fmu,
+    design: &Design,
+    outcome: RunOutcome,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<StudyResult, StudyRunError> {
+    let done = outcome.records.iter().filter(|r| r.is_some()).count();
+    let failed =
+        runner::check_failures(study, design, &outcome.records, opts.allow_failures(study))?;
+    if done < design.len() {
+        return Err(StudyRunError::Incomplete {
+            done,
+            total: design.len(),
+        });
+    }
+    let (outputs, quantities) = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let md = fmu.description();
+    let facts = RunFacts {
+        fmu: Some(FmuInfo {
+            path: fmu.path().display().to_string(),
+            model_name: md.model_name.clone(),
+            guid: md.guid.clone(),
+            generation_tool: md.generation_tool.clone(),
+            sha256: outcome.fmu_sha256.clone(),
+        }),
+        model_runs: design.len(),
+        runs_new: outcome.n_new,
+        runs_resumed: outcome.n_resumed,
+        failed,
+        wall_time: outcome.wall_time,
+        threads: outcome.threads,
+    };
+    let method_summary = study.method().summary(study.parameters.len());
+    let summary = summary(
+        study,
+        facts,
+        method_summary,
+        design.warnings.clone(),
+        &outputs,
+        &quantities,
+    );
+    let points = point_table(study, design, &outcome.records);
+    report::study::write(
+        out_dir,
+        &StudyReport {
+            summary: &summary,
+            outputs: &outputs,
+            quantities: &quantities,
+            qoi: &study.qoi,
+            points: Some(&points),
+        },
+    )?;
+    Ok(StudyResult {
+        summary,
+        outputs,
+        quantities,
+    })
+}
+
+/// An intrusive study: one solve, then statistics and files.
+fn solve(
+    study: &Study,
+    method: &dyn Intrusive,
+    out_dir: &Path,
+) -> Result<StudyResult, StudyRunError> {
+    let started = Instant::now();
+    let times = study.times();
+    let solution = method.solve(&study.problem(&times))?;
+    let wall_time = started.elapsed().as_secs_f64();
+    let outputs = analysis::analyse_solution(study, &solution)?;
+    let mut method_summary = study.method().summary(study.parameters.len());
+    method_summary.details.extend(solution.details);
+    let facts = RunFacts {
+        fmu: None,
+        model_runs: 1,
+        runs_new: 1,
+        runs_resumed: 0,
+        failed: 0,
+        wall_time,
+        threads: 1,
+    };
+    let summary = summary(
+        study,
+        facts,
+        method_summary,
+        solution.warnings,
+        &outputs,
+        &[],
+    );
+    report::study::write(
+        out_dir,
+        &StudyReport {
+            summary: &summary,
+            outputs: &outputs,
+            quantities: &[],
+            qoi: &study.qoi,
+            points: None,
+        },
+    )?;
+    Ok(StudyResult {
+        summary,
+        outputs,
+        quantities: Vec::new(),
+    })
+}
+
+/// The design with the status of each point.
+fn point_table(study: &Study, design: &Design, records: &[Option<Record>]) -> PointTable {
+    PointTable {
+        names: study.parameters.iter().map(|p| p.name.clone()).collect(),
+        weights: design.weights.clone(),
+        values: design.values.clone(),
+        status: records
+            .iter()
+            .map(|r| match r {
+                Some(Record::Ok(_)) => PointStatus::Ok,
+                Some(Record::Failed(m)) => PointStatus::Failed(m.clone()),
+                None => PointStatus::Missing,
+            })
+            .collect(),
+    }
+}

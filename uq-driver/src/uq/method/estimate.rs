@@ -1,0 +1,146 @@
+//! What an estimator returns: moments per column and, where the method has them, a chaos
+//! surrogate, Sobol' indices and standard errors.
+
+use nalgebra::DMatrix;
+
+use crate::uq::moments;
+use crate::uq::pce::Pce;
+
+/// Where quantiles and densities are drawn from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Draws {
+    /// The successful runs themselves.
+    Runs,
+    /// A large sample of the chaos surrogate ([`Estimate::chaos`]).
+    Chaos,
+}
+
+impl Draws {
+    /// How densities were obtained, for the report.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Draws::Runs => "kernel density of the runs",
+            Draws::Chaos => "kernel density of a large sample of the chaos surrogate",
+        }
+    }
+}
+
+/// First-order and total Sobol' indices, each `[column][parameter]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sobol {
+    /// First-order indices.
+    pub first: Vec<Vec<f64>>,
+    /// Total indices.
+    pub total: Vec<Vec<f64>>,
+}
+
+impl Sobol {
+    /// The indices of every column of a chaos (variance shares of its terms).
+    pub fn from_chaos(pce: &Pce) -> Sobol {
+        let cols = 0..pce.outputs();
+        Sobol {
+            first: cols.clone().map(|k| pce.sobol_first(k)).collect(),
+            total: cols.map(|k| pce.sobol_total(k)).collect(),
+        }
+    }
+}
+
+/// Statistics of a results matrix, one value per column (time step or quantity).
+#[derive(Clone, Debug)]
+pub struct Estimate {
+    /// Mean.
+    pub mean: Vec<f64>,
+    /// Standard deviation.
+    pub std: Vec<f64>,
+    /// Standard error of the mean, where the method estimates it (sampling).
+    pub std_error_mean: Option<Vec<f64>>,
+    /// Standard deviation of the chaos surrogate, where it differs from `std` (collocation:
+    /// `std` comes from the quadrature, this from the truncated chaos).
+    pub std_chaos: Option<Vec<f64>>,
+    /// The chaos surrogate of every column.
+    pub chaos: Option<Pce>,
+    /// Sobol' indices.
+    pub sobol: Option<Sobol>,
+    /// Where quantiles and densities come from.
+    pub draws: Draws,
+}
+
+impl Estimate {
+    /// Sample mean, unbiased Std and its standard error `std / sqrt(n)` of equally weighted
+    /// runs (`n` rows).
+    pub fn from_sample(data: &DMatrix<f64>) -> Estimate {
+        let (mean, std) = moments::sample_mean_std(data);
+        let root_n = (data.nrows() as f64).sqrt();
+        let sem = std.iter().map(|s| s / root_n).collect();
+        Estimate {
+            mean,
+            std,
+            std_error_mean: Some(sem),
+            ..Estimate::empty(Draws::Runs)
+        }
+    }
+
+    /// Quadrature mean and Std of weighted runs (one weight per row).
+    pub fn from_quadrature(data: &DMatrix<f64>, weights: &[f64]) -> Estimate {
+        let (mean, std) = moments::weighted_mean_std(data, weights);
+        Estimate {
+            mean,
+            std,
+            ..Estimate::empty(Draws::Runs)
+        }
+    }
+
+    /// Moments and Sobol' indices of a chaos; densities from samples of it.
+    pub fn from_chaos(pce: Pce) -> Estimate {
+        Estimate {
+            mean: pce.mean(),
+            std: pce.std(),
+            sobol: Some(Sobol::from_chaos(&pce)),
+            chaos: Some(pce),
+            ..Estimate::empty(Draws::Chaos)
+        }
+    }
+
+    fn empty(draws: Draws) -> Estimate {
+        Estimate {
+            mean: Vec::new(),
+            std: Vec::new(),
+            std_error_mean: None,
+            std_chaos: None,
+            chaos: None,
+            sobol: None,
+            draws,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::pce::MultiIndexSet;
+
+    #[test]
+    fn sample_estimate_has_the_standard_error() {
+        let data = DMatrix::from_column_slice(4, 1, &[1.0, 2.0, 3.0, 4.0]);
+        let e = Estimate::from_sample(&data);
+        assert_eq!(e.mean, vec![2.5]);
+        let std = (5.0f64 / 3.0).sqrt();
+        assert!((e.std[0] - std).abs() < 1e-15);
+        assert!((e.std_error_mean.unwrap()[0] - std / 2.0).abs() < 1e-15);
+        assert_eq!(e.draws, Draws::Runs);
+    }
+
+    #[test]
+    fn chaos_estimate_reads_moments_and_indices_from_the_coefficients() {
+        // f = 1 + 2 z1 + 3 z2: mean 1, variance 13, S1 = 4/13, S2 = 9/13.
+        let basis = MultiIndexSet::total_order(2, 1);
+        let coeffs = DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 3.0]);
+        let e = Estimate::from_chaos(Pce { basis, coeffs });
+        assert_eq!(e.mean, vec![1.0]);
+        assert!((e.std[0] - 13f64.sqrt()).abs() < 1e-15);
+        let s = e.sobol.unwrap();
+        assert!((s.first[0][0] - 4.0 / 13.0).abs() < 1e-15);
+        assert!((s.total[0][1] - 9.0 / 13.0).abs() < 1e-15);
+        assert_eq!(e.draws, Draws::Chaos);
+    }
+}

@@ -1,0 +1,213 @@
+//! UQ methods, one module per method. Each owns its design (where the model is run, with
+//! which weights) and its estimator (moments, chaos, Sobol' indices from the results).
+//!
+//! The study runner and the report see a method only through [`Method`]:
+//! - a [`Sampling`] method builds a [`Design`] (points in a standard space and their physical
+//!   values, optional weights) from the study's random parameters; the runner evaluates the
+//!   model at every point; the method's estimator turns a results matrix (points × columns:
+//!   the time steps of an output, or one scalar quantity) into an [`Estimate`];
+//! - an [`Intrusive`] method solves a projected system itself and returns one [`Estimate`]
+//!   per output ([`Solution`]).
+//!
+//! An [`Estimate`] holds moments per column, optionally a chaos surrogate (evaluable and
+//! sampleable), Sobol' indices and standard errors, and says where densities and quantiles
+//! are to be drawn from ([`Draws`]).
+//!
+//! **Adding a method**: write `uq/method/<name>.rs` with a settings struct (serde,
+//! `deny_unknown_fields`) that implements [`Method`] and [`Sampling`] or [`Intrusive`], and
+//! add one line `<name>::<Type>,` to the `methods!` list below. The study file then accepts
+//! `[method] kind = "<type in snake_case>"` with the struct's fields as keys.
+//!
+//! How the methods to come fit (settings and structure are the method's own; the estimator
+//! receives its settings as `&self`, so it can rebuild any structure of its design):
+//! - a sparse grid: a [`Design`] with (possibly negative) weights; the estimator combines
+//!   full-tensor projections over the grid's index sets into [`Estimate::chaos`];
+//! - regression chaos: the design of another sampling method, the chaos fitted to the rows
+//!   that succeeded (`rows`), its leave-one-out error as a new field of [`Estimate`];
+//! - quasi-Monte Carlo and replicated Latin hypercubes: point `i` belongs to replicate
+//!   `i / samples`; the standard error of the mean comes from the replicates;
+//! - pick-freeze Sobol' sampling: the blocks A, B and A_B^(j) by point index; [`Sobol`] from
+//!   the blocks;
+//! - a nested study: the product of an outer and an inner design, and for every outer sample
+//!   the inner method's own [`Sampling::estimate`] on that sample's rows.
+
+mod design;
+mod error;
+mod estimate;
+mod sample;
+mod traits;
+
+use serde::{Deserialize, Serialize};
+
+pub use design::Design;
+pub use error::{InvalidSettings, MethodError};
+pub use estimate::{Draws, Estimate, Sobol};
+pub use traits::{
+    details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
+};
+
+/// Declares the method modules and the `[method]` table: one line per method.
+macro_rules! methods {
+    ($($module:ident :: $Type:ident),* $(,)?) => {
+        $(pub mod $module;)*
+
+        /// The `[method]` table of a study: `kind` names the method (the type's name in
+        /// snake_case), the other keys are its settings.
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "kind", rename_all = "snake_case")]
+        pub enum MethodSpec {
+            $(
+                #[allow(missing_docs)]
+                $Type($module::$Type),
+            )*
+        }
+
+        impl MethodSpec {
+            /// The method these settings select.
+            pub fn method(&self) -> &dyn Method {
+                match self {
+                    $(MethodSpec::$Type(m) => m,)*
+                }
+            }
+        }
+    };
+}
+
+methods! {
+    mc::Mc,
+    lhs::Lhs,
+    scm::Scm,
+    sgm::Sgm,
+    nominal::Nominal,
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::DMatrix;
+
+    use super::*;
+    use crate::uq::distributions::RandomParameter;
+
+    #[test]
+    fn kinds_are_the_snake_case_variant_names() {
+        let toml_kind = |t: &str| -> MethodSpec { toml::from_str(t).unwrap() };
+        for (text, kind) in [
+            ("kind = \"mc\"\nsamples = 10", "mc"),
+            ("kind = \"lhs\"\nsamples = 10", "lhs"),
+            ("kind = \"scm\"\nnodes = 3", "scm"),
+            ("kind = \"sgm\"\norder = 2", "sgm"),
+            ("kind = \"nominal\"", "nominal"),
+        ] {
+            let m = toml_kind(text);
+            assert_eq!(m.method().kind(), kind);
+            // The serialized settings are those written (the study hash depends on them).
+            let json = serde_json::to_value(&m).unwrap();
+            assert_eq!(json["kind"], kind);
+        }
+    }
+
+    #[test]
+    fn settings_of_another_method_are_refused() {
+        for text in [
+            "kind = \"lhs\"\nnodes = 3\nsamples = 10",
+            "kind = \"scm\"\nsamples = 10\nnodes = 3",
+            "kind = \"nominal\"\norder = 1",
+            "kind = \"mc\"",
+        ] {
+            let r: Result<MethodSpec, _> = toml::from_str(text);
+            assert!(r.is_err(), "{text}");
+        }
+    }
+
+    /// The analytic fixture every sampling method is checked against, through the trait
+    /// only: f = K + K C + C² with K ~ N(a, s²), C ~ N(b, t²), independent. With K = a + sξ,
+    /// C = b + tη: mean a + ab + b² + t², variance s²(1+b)² + t²(a+2b)² + s²t² + 2t⁴.
+    #[test]
+    fn every_sampling_method_estimates_the_analytic_fixture() {
+        let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
+        let params = [
+            RandomParameter {
+                name: "K".into(),
+                distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
+            },
+            RandomParameter {
+                name: "C".into(),
+                distribution: crate::uq::Distribution::normal(b, t).unwrap(),
+            },
+        ];
+        let f = |v: &[f64]| v[0] + v[0] * v[1] + v[1] * v[1];
+        let mean = a + a * b + b * b + t * t;
+        let parts = [
+            s_k * s_k * (1.0 + b) * (1.0 + b),
+            t * t * (a + 2.0 * b) * (a + 2.0 * b) + 2.0 * t.powi(4),
+            s_k * s_k * t * t,
+        ];
+        let var: f64 = parts.iter().sum();
+        for text in [
+            "kind = \"mc\"\nsamples = 20000",
+            "kind = \"lhs\"\nsamples = 20000",
+            "kind = \"scm\"\nnodes = 3",
+            "kind = \"nominal\"",
+        ] {
+            let spec: MethodSpec = toml::from_str(text).unwrap();
+            let Evaluation::Sampling(m) = spec.method().evaluation() else {
+                panic!("{text} runs a design");
+            };
+            let design = m.design(&params, 7).unwrap();
+            let values: Vec<f64> = design.values.iter().map(|v| f(v)).collect();
+            let data = DMatrix::from_column_slice(values.len(), 1, &values);
+            let rows: Vec<usize> = (0..design.len()).collect();
+            let e = m.estimate(&design, &rows, &data).unwrap();
+            match spec.method().kind() {
+                "nominal" => {
+                    assert_eq!(e.mean[0], f(&[a, b]));
+                    assert_eq!(e.std[0], 0.0);
+                }
+                "scm" => {
+                    // Degree 4 in each germ: the 3-node rule is exact, and so is the order-2 chaos.
+                    assert!((e.mean[0] - mean).abs() < 1e-12, "{}", e.mean[0]);
+                    assert!((e.std[0] - var.sqrt()).abs() < 1e-12, "{}", e.std[0]);
+                    assert!((e.std_chaos.as_ref().unwrap()[0] - var.sqrt()).abs() < 1e-12);
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][0] - parts[0] / var).abs() < 1e-12);
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 1e-12);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-12);
+                    assert_eq!(e.draws, Draws::Chaos);
+                }
+                kind => {
+                    let se = e.std_error_mean.as_ref().unwrap()[0];
+                    assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    assert!((e.mean[0] - mean).abs() < 4.0 * se, "{kind}: {}", e.mean[0]);
+                    assert!(
+                        (e.std[0] / var.sqrt() - 1.0).abs() < 0.03,
+                        "{kind}: {}",
+                        e.std[0]
+                    );
+                    assert_eq!(e.draws, Draws::Runs);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_weighted_design_refuses_a_missing_point() {
+        let spec: MethodSpec = toml::from_str("kind = \"scm\"\nnodes = 2").unwrap();
+        let Evaluation::Sampling(m) = spec.method().evaluation() else {
+            panic!("scm runs a design");
+        };
+        let params = [RandomParameter {
+            name: "K".into(),
+            distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+        }];
+        let design = m.design(&params, 0).unwrap();
+        let data = DMatrix::from_element(1, 3, 1.0);
+        let e = m.estimate(&design, &[1], &data).unwrap_err();
+        assert!(matches!(
+            e,
+            MethodError::MissingPoints {
+                missing: 1,
+                total: 2
+            }
+        ));
+    }
+}

@@ -1,0 +1,72 @@
+//! One deterministic run with every random parameter at its mean.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::design::Design;
+use super::error::{InvalidSettings, MethodError};
+use super::estimate::Estimate;
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use crate::uq::distributions::{Germ, RandomParameter};
+
+/// `kind = "nominal"` (no settings).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Nominal {}
+
+impl Method for Nominal {
+    fn kind(&self) -> &'static str {
+        "nominal"
+    }
+
+    fn label(&self, _dim: usize) -> String {
+        "nominal".into()
+    }
+
+    fn validate(&self, _problem: &Problem) -> Result<(), InvalidSettings> {
+        Ok(())
+    }
+
+    fn summary(&self, _dim: usize) -> MethodSummary {
+        let size = DesignSize {
+            samples: None,
+            nodes_per_dimension: None,
+            order: None,
+        };
+        MethodSummary::new(self.kind(), &size)
+    }
+
+    fn evaluation(&self) -> Evaluation<'_> {
+        Evaluation::Sampling(self)
+    }
+}
+
+impl Sampling for Nominal {
+    /// One point of weight 1 at the parameters' means.
+    fn design(&self, parameters: &[RandomParameter], _seed: u64) -> Result<Design, MethodError> {
+        Ok(Design {
+            germ: Germ::Normal,
+            points: vec![vec![0.0; parameters.len()]],
+            values: vec![parameters.iter().map(|p| p.distribution.mean()).collect()],
+            weights: Some(vec![1.0]),
+            warnings: Vec::new(),
+        })
+    }
+
+    /// The run's values, Std 0.
+    fn estimate(
+        &self,
+        design: &Design,
+        rows: &[usize],
+        data: &DMatrix<f64>,
+    ) -> Result<Estimate, MethodError> {
+        Ok(Estimate::from_quadrature(
+            data,
+            design.complete_weights(rows)?,
+        ))
+    }
+
+    fn min_runs(&self) -> usize {
+        1
+    }
+}

@@ -1,0 +1,129 @@
+//! What a method is, as the study runner and the report see it: [`Method`] with its
+//! evaluation, [`Sampling`] (a design and an estimator) or [`Intrusive`] (its own solve).
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::design::Design;
+use super::error::{InvalidSettings, MethodError};
+use super::estimate::Estimate;
+use crate::uq::distributions::RandomParameter;
+use crate::uq::galerkin::system::SystemSpec;
+
+/// What a method knows of the study it belongs to.
+#[derive(Clone, Copy, Debug)]
+pub struct Problem<'a> {
+    /// The random parameters, in study order.
+    pub parameters: &'a [RandomParameter],
+    /// The output variables analysed over time.
+    pub outputs: &'a [String],
+    /// Number of scalar quantities of interest.
+    pub quantities: usize,
+    /// Communication points (s).
+    pub times: &'a [f64],
+    /// The study's `[system]` (the equations of an intrusive method), if any.
+    pub system: Option<&'a SystemSpec>,
+}
+
+/// The `method` entry of `summary.json`: the kind and the method's settings and diagnostics.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MethodSummary {
+    /// `kind` of the study file.
+    pub kind: String,
+    /// Per method (e.g. `samples`, `nodes_per_dimension`, `order`, `terms`, `definiteness`).
+    #[serde(flatten)]
+    pub details: serde_json::Map<String, serde_json::Value>,
+}
+
+impl MethodSummary {
+    /// A summary of `kind` with the fields of `settings` (a struct or map).
+    pub fn new(kind: &str, settings: &impl Serialize) -> MethodSummary {
+        MethodSummary {
+            kind: kind.to_owned(),
+            details: details(settings),
+        }
+    }
+}
+
+/// The fields of a struct (or map) as the entries of a JSON object; empty for anything else.
+pub fn details(value: &impl Serialize) -> serde_json::Map<String, serde_json::Value> {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::Object(map)) => map,
+        _ => serde_json::Map::new(),
+    }
+}
+
+/// The size of a design as summary.json has always reported it (`null` where it does not apply).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub(crate) struct DesignSize {
+    /// Samples (MC, LHS).
+    pub samples: Option<usize>,
+    /// Nodes per dimension (tensor grids).
+    pub nodes_per_dimension: Option<usize>,
+    /// Chaos order.
+    pub order: Option<usize>,
+}
+
+/// How a method obtains its results.
+pub enum Evaluation<'a> {
+    /// The model is run at the points of a design.
+    Sampling(&'a dyn Sampling),
+    /// The method solves its own projected system; the model is not run.
+    Intrusive(&'a dyn Intrusive),
+}
+
+/// A UQ method as the study runner and the report see it.
+pub trait Method: std::fmt::Debug + Send + Sync {
+    /// The `kind` in study files and summaries.
+    fn kind(&self) -> &'static str;
+
+    /// A short label for tables and logs, e.g. `lhs 1000`, `scm 6^2`, `sgm order 6`
+    /// (`dim`: number of random parameters).
+    fn label(&self, dim: usize) -> String;
+
+    /// Checks the settings against the study; called once, when the study is loaded.
+    fn validate(&self, problem: &Problem) -> Result<(), InvalidSettings>;
+
+    /// The settings written under `method` in `summary.json`.
+    fn summary(&self, dim: usize) -> MethodSummary;
+
+    /// Whether the method runs the model at a design or solves its own system.
+    fn evaluation(&self) -> Evaluation<'_>;
+}
+
+/// A method that runs the model at the points of a design.
+pub trait Sampling {
+    /// The design for `parameters` (deterministic in `seed`).
+    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError>;
+
+    /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
+    /// the points that gave a value; one column per time step or quantity).
+    fn estimate(
+        &self,
+        design: &Design,
+        rows: &[usize],
+        data: &DMatrix<f64>,
+    ) -> Result<Estimate, MethodError>;
+
+    /// The fewest successful runs the estimator can work with.
+    fn min_runs(&self) -> usize {
+        2
+    }
+}
+
+/// A method that solves a projected (intrusive) system instead of running the model.
+pub trait Intrusive {
+    /// One estimate per output of `problem`, over its times.
+    fn solve(&self, problem: &Problem) -> Result<Solution, MethodError>;
+}
+
+/// What an intrusive method returns.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// One estimate per output.
+    pub outputs: Vec<Estimate>,
+    /// Diagnostics for the method's entry in `summary.json`.
+    pub details: serde_json::Map<String, serde_json::Value>,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
