@@ -64,7 +64,7 @@ def assert_same_outputs(merged, reference):
 
 
 def record_size(shard_dir):
-    """Bytes of one successful record in a shard's store (see uq-driver's store.rs)."""
+    """Bytes of one successful record in a shard's store (format 2, see uq-driver's study/store/format.rs: 25-byte header, 4-byte trailer)."""
     manifest = json.loads((pathlib.Path(shard_dir) / "store" / "manifest.json").read_text())
     return 29 + 8 * manifest["n_values"]
 
@@ -163,7 +163,7 @@ def test_merge_names_a_duplicated_point(tmp_path):
     # Append shard 0's first record, verbatim, to shard 1's store: that point is then twice.
     size = record_size(d / "shards" / "0")
     first = (d / "shards" / "0" / "store" / "records.bin").read_bytes()[:size]
-    assert first[:4] == b"REC1"
+    assert first[:4] == b"\xf5RQ2"  # format 2 (study/store/format.rs)
     (index,) = struct.unpack("<Q", first[4:12])
     with open(d / "shards" / "1" / "store" / "records.bin", "ab") as f:
         f.write(first)
