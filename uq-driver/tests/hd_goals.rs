@@ -6,10 +6,10 @@
 
 use std::f64::consts::PI;
 
-use uq_driver::uq::hd::askey::Family;
 use uq_driver::uq::hd::lars::PathKind;
 use uq_driver::uq::hd::sobol_seq::Sobol;
 use uq_driver::uq::hd::sparse_chaos::{fit_chaos, FitKind};
+use uq_driver::uq::pce::askey::Family;
 use uq_driver::uq::quadrature::{gauss_hermite, gauss_legendre};
 use uq_driver::uq::special::norm_ppf;
 
@@ -75,7 +75,7 @@ fn ishigami_all_indices_within_0_01_with_100_runs() {
         println!(
             "ishigami: {n} runs, replicate {rep}: degree {}, {} terms, LOO {:.1e}, max |S - exact| = {err:.1e}",
             fit.degree,
-            fit.basis.len(),
+            fit.pce.basis.len(),
             fit.loo
         );
         assert!(err < 0.01, "replicate {rep}: {err}");
@@ -146,7 +146,7 @@ fn borehole_mean_within_0_1_percent_and_std_within_1_percent_with_100_runs() {
         println!(
             "borehole: {n} runs, replicate {rep}: degree {}, {} terms, LOO {:.1e}, mean error {:.3} %, std error {:.3} % (reference mean {m_ref:.4}, std {s_ref:.4})",
             fit.degree,
-            fit.basis.len(),
+            fit.pce.basis.len(),
             fit.loo,
             100.0 * em,
             100.0 * es
@@ -195,7 +195,7 @@ fn g_function_first_order_within_0_02_with_500_runs() {
         println!(
             "g-function: {n} runs, replicate {rep}: degree {}, {} terms, LOO {:.1e}, max |S1 - exact| = {err:.4}",
             fit.degree,
-            fit.basis.len(),
+            fit.pce.basis.len(),
             fit.loo
         );
         assert!(err < 0.02, "replicate {rep}: {err}");

@@ -392,8 +392,8 @@ pub fn sparse_regression(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::hd::askey::Family;
-    use crate::uq::hd::basis::{Basis, MultiIndexSet};
+    use crate::uq::pce::askey::Family;
+    use crate::uq::pce::basis::{Basis, MultiIndexSet};
     use crate::uq::rng::{standard_normal, stream, uniform_open01};
 
     #[test]

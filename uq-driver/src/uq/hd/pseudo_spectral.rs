@@ -17,9 +17,10 @@ use std::collections::HashMap;
 
 use nalgebra::DMatrix;
 
-use super::askey::Family;
-use super::basis::{Basis, BasisError, MultiIndexSet};
 use super::smolyak::{LevelSet, SparseGrid, TensorTerm};
+use crate::uq::pce::askey::Family;
+use crate::uq::pce::basis::{Basis, BasisError, MultiIndexSet};
+use crate::uq::pce::Pce;
 
 /// Errors of the projection.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -43,36 +44,6 @@ pub enum ProjectionError {
     NotNested(Vec<f64>),
 }
 
-/// A chaos from a sparse projection: basis and coefficients (one column per output).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SparseChaos {
-    /// The orthonormal basis (germ families per dimension, multi-index set).
-    pub basis: Basis,
-    /// Coefficients, `basis.len()` rows by one column per output.
-    pub coeffs: DMatrix<f64>,
-}
-
-impl SparseChaos {
-    /// Mean, variance and Sobol' indices of output column `output`.
-    pub fn stats(&self, output: usize) -> super::basis::ChaosStats {
-        super::basis::ChaosStats::new(self.basis.set(), self.coeffs.column(output).as_slice())
-    }
-
-    /// All outputs of the chaos at germ point `t`.
-    pub fn eval(&self, t: &[f64]) -> Vec<f64> {
-        let mut v = vec![0.0; self.basis.len()];
-        self.basis.eval(t, &mut v);
-        (0..self.coeffs.ncols())
-            .map(|o| {
-                v.iter()
-                    .enumerate()
-                    .map(|(k, vk)| vk * self.coeffs[(k, o)])
-                    .sum()
-            })
-            .collect()
-    }
-}
-
 /// Per-dimension maximal degree of the tensor projection of a term.
 fn term_degrees(term: &TensorTerm) -> Vec<usize> {
     term.exactness.iter().map(|&e| e / 2).collect()
@@ -83,7 +54,7 @@ fn term_degrees(term: &TensorTerm) -> Vec<usize> {
 pub fn sparse_pseudo_spectral(
     grid: &SparseGrid,
     values: &DMatrix<f64>,
-) -> Result<SparseChaos, ProjectionError> {
+) -> Result<Pce, ProjectionError> {
     if values.nrows() != grid.len() {
         return Err(ProjectionError::Rows {
             rows: values.nrows(),
@@ -156,7 +127,7 @@ pub fn sparse_pseudo_spectral(
         }
     }
     let set = MultiIndexSet::from_indices(d, entries.into_iter().map(|e| e.0).collect())?;
-    Ok(SparseChaos {
+    Ok(Pce {
         basis: Basis::new(fams, set)?,
         coeffs,
     })
@@ -349,8 +320,10 @@ mod tests {
             (0.3 * grid.points[j][0] + 0.2 * grid.points[j][1]).exp()
         });
         let pce = sparse_pseudo_spectral(&grid, &values).unwrap();
-        let st =
-            crate::uq::hd::basis::ChaosStats::new(pce.basis.set(), pce.coeffs.column(0).as_slice());
+        let st = crate::uq::pce::basis::ChaosStats::new(
+            pce.basis.set(),
+            pce.coeffs.column(0).as_slice(),
+        );
         let m = 0.065f64.exp();
         let v = 0.13f64.exp() * (0.13f64.exp() - 1.0);
         assert!((st.mean - m).abs() < 1e-10, "{} vs {m}", st.mean);
@@ -374,8 +347,10 @@ mod tests {
         });
         let pce = sparse_pseudo_spectral(&grid, &values).unwrap();
         assert_eq!(pce.basis.families(), &[Family::Hermite, Family::Legendre]);
-        let st =
-            crate::uq::hd::basis::ChaosStats::new(pce.basis.set(), pce.coeffs.column(0).as_slice());
+        let st = crate::uq::pce::basis::ChaosStats::new(
+            pce.basis.set(),
+            pce.coeffs.column(0).as_slice(),
+        );
         let var = 4.0 + 1.0 + 0.25 / 7.0 + 0.2;
         assert!((st.mean - 1.0).abs() < 1e-13);
         assert!(

@@ -32,7 +32,7 @@ use std::sync::OnceLock;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::askey::Family;
+use crate::uq::pce::askey::Family;
 
 /// Errors of the rule constructors.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

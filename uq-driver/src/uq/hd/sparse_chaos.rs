@@ -4,17 +4,18 @@
 //! leave-one-out error is kept (as UQLab and OpenTURNS do). Scanning stops after two
 //! degrees in a row without improvement.
 //!
-//! Points are given in germ space (see [`super::askey`]): one coordinate per input, in
+//! Points are given in germ space (see [`crate::uq::pce::askey`]): one coordinate per input, in
 //! the germ of that input's family.
 
 use std::ops::RangeInclusive;
 
 use nalgebra::DMatrix;
 
-use super::askey::Family;
-use super::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
 use super::lars::{sparse_regression, PathKind};
 use super::regression::{least_squares, RegressionError};
+use crate::uq::pce::askey::Family;
+use crate::uq::pce::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
+use crate::uq::pce::{Pce, PceError};
 
 /// Errors of the chaos fit.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -25,6 +26,9 @@ pub enum ChaosFitError {
     /// Every degree failed; the error of the lowest degree.
     #[error(transparent)]
     Regression(#[from] RegressionError),
+    /// The fitted coefficients do not match the basis.
+    #[error(transparent)]
+    Chaos(#[from] PceError),
     /// Empty degree range or no points.
     #[error("a chaos fit needs points and a non-empty degree range")]
     Empty,
@@ -42,10 +46,9 @@ pub enum FitKind {
 /// A fitted chaos.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChaosFit {
-    /// The selected basis (only the retained terms for a sparse fit).
-    pub basis: Basis,
-    /// Coefficients, one per basis term.
-    pub coeffs: Vec<f64>,
+    /// The chaos (one column), on the selected basis (only the retained terms for a sparse
+    /// fit).
+    pub pce: Pce,
     /// Corrected relative leave-one-out error of the selected model.
     pub loo: f64,
     /// Selected total degree.
@@ -57,14 +60,12 @@ pub struct ChaosFit {
 impl ChaosFit {
     /// Mean, variance and Sobol' indices.
     pub fn stats(&self) -> ChaosStats {
-        ChaosStats::new(self.basis.set(), &self.coeffs)
+        self.pce.stats(0)
     }
 
     /// Evaluates the chaos at a germ point.
     pub fn eval(&self, t: &[f64]) -> f64 {
-        let mut v = vec![0.0; self.basis.len()];
-        self.basis.eval(t, &mut v);
-        v.iter().zip(&self.coeffs).map(|(a, b)| a * b).sum()
+        self.pce.eval_column(0, t)
     }
 }
 
@@ -114,9 +115,9 @@ pub fn fit_chaos(
             Some(b) => loo < b.loo,
         };
         if improves {
+            let n = coeffs.len();
             best = Some(ChaosFit {
-                basis: b,
-                coeffs,
+                pce: Pce::new(b, DMatrix::from_vec(n, 1, coeffs))?,
                 loo,
                 degree: p,
                 tried: vec![],

@@ -117,7 +117,7 @@ impl Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::pce::MultiIndexSet;
+    use crate::uq::pce::{Basis, Family, MultiIndexSet};
 
     #[test]
     fn sample_estimate_has_the_standard_error() {
@@ -133,9 +133,10 @@ mod tests {
     #[test]
     fn chaos_estimate_reads_moments_and_indices_from_the_coefficients() {
         // f = 1 + 2 z1 + 3 z2: mean 1, variance 13, S1 = 4/13, S2 = 9/13.
-        let basis = MultiIndexSet::total_order(2, 1);
+        let set = MultiIndexSet::total_degree(2, 1).unwrap();
+        let basis = Basis::new(vec![Family::Hermite, Family::Legendre], set).unwrap();
         let coeffs = DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 3.0]);
-        let e = Estimate::from_chaos(Pce { basis, coeffs });
+        let e = Estimate::from_chaos(Pce::new(basis, coeffs).unwrap());
         assert_eq!(e.mean, vec![1.0]);
         assert!((e.std[0] - 13f64.sqrt()).abs() < 1e-15);
         let s = e.sobol.unwrap();

@@ -11,7 +11,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::{Germ, RandomParameter};
-use crate::uq::pce::{MultiIndexSet, Pce};
+use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
 
 /// Most nodes per dimension.
@@ -104,7 +104,8 @@ impl Sampling for Scm {
     ) -> Result<Estimate, MethodError> {
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
-        let basis = MultiIndexSet::total_order(dim, self.order());
+        let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
+        let basis = Basis::new(vec![Family::Hermite; dim], set).map_err(PceError::from)?;
         let pce = Pce::project(
             basis,
             &design.points,
