@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use uq_driver::fmu::{Fmu, VariableKind};
 use uq_driver::spec::{builtin, Experiment, Study, BUILTINS};
 use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
+use uq_driver::uq::surrogate::Surrogate;
 
 #[derive(Parser)]
 #[command(
@@ -79,6 +80,45 @@ enum Command {
     },
     /// Run an FMU once at given parameter values and write its outputs as CSV.
     Simulate(SimulateArgs),
+    /// Evaluate or sample the chaos surrogate a study exported (DIR/surrogate.json).
+    #[command(subcommand)]
+    Surrogate(SurrogateCommand),
+}
+
+#[derive(Subcommand)]
+enum SurrogateCommand {
+    /// The surrogate at one point, as CSV `name,time,value` (time empty for a scalar
+    /// quantity); inputs not given take their nominal value.
+    Eval {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Input value, NAME=VALUE (repeatable).
+        #[arg(long = "at", value_parser = parse_assignment)]
+        at: Vec<(String, f64)>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
+    /// N random draws of the inputs (their joint law, correlation included) with the
+    /// surrogate's values: CSV with the inputs, the scalar quantities and each output at the
+    /// chosen times (`NAME@TIME`).
+    Sample {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Number of draws.
+        #[arg(short = 'n', long)]
+        n: usize,
+        /// Seed (draw i comes from the stream (seed, i) only).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output times to write, s (repeatable; the nearest communication point; default:
+        /// the last).
+        #[arg(long = "time")]
+        times: Vec<f64>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -256,6 +296,82 @@ fn dispatch(cmd: Command) -> Result<()> {
         }
         Command::Inspect { fmu } => inspect(&fmu),
         Command::Simulate(args) => simulate(args),
+        Command::Surrogate(cmd) => surrogate(cmd),
+    }
+}
+
+/// Writes `text` to `out`, or to standard output.
+fn emit(text: &str, out: Option<&Path>) -> Result<()> {
+    match out {
+        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display())),
+        None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
+    }
+}
+
+/// `uq-driver surrogate eval|sample`.
+fn surrogate(cmd: SurrogateCommand) -> Result<()> {
+    match cmd {
+        SurrogateCommand::Eval { dir, at, out } => {
+            let s = Surrogate::load(&dir)?;
+            let x = s.point(&at)?;
+            let v = s.eval(&x);
+            let mut text = String::from("name,time,value\n");
+            for (o, vals) in s.file.outputs.iter().zip(&v.outputs) {
+                let times = o.times.as_deref().unwrap_or(&[]);
+                for (t, y) in times.iter().zip(vals) {
+                    text.push_str(&format!("{},{t},{y}\n", o.name));
+                }
+            }
+            for (q, y) in s.file.quantities.iter().zip(&v.quantities) {
+                text.push_str(&format!("{},,{y}\n", q.name));
+            }
+            emit(&text, out.as_deref())
+        }
+        SurrogateCommand::Sample {
+            dir,
+            n,
+            seed,
+            times,
+            out,
+        } => {
+            let s = Surrogate::load(&dir)?;
+            // (output index, time index, column name)
+            let mut picks: Vec<(usize, usize, String)> = Vec::new();
+            for (o, chaos) in s.file.outputs.iter().enumerate() {
+                let ts = chaos.times.as_deref().unwrap_or(&[]);
+                if ts.is_empty() {
+                    continue;
+                }
+                let wanted = if times.is_empty() {
+                    vec![ts.len() - 1]
+                } else {
+                    times
+                        .iter()
+                        .map(|&t| {
+                            (0..ts.len())
+                                .min_by(|&a, &b| (ts[a] - t).abs().total_cmp(&(ts[b] - t).abs()))
+                                .expect("non-empty")
+                        })
+                        .collect()
+                };
+                for k in wanted {
+                    picks.push((o, k, format!("{}@{}", chaos.name, ts[k])));
+                }
+            }
+            let mut header: Vec<String> = s.inputs.iter().map(|p| p.name.clone()).collect();
+            header.extend(s.file.quantities.iter().map(|q| q.name.clone()));
+            header.extend(picks.iter().map(|p| p.2.clone()));
+            let mut text = header.join(",");
+            text.push('\n');
+            for (x, v) in s.sample(n, seed) {
+                let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
+                row.extend(v.quantities.iter().map(f64::to_string));
+                row.extend(picks.iter().map(|&(o, k, _)| v.outputs[o][k].to_string()));
+                text.push_str(&row.join(","));
+                text.push('\n');
+            }
+            emit(&text, out.as_deref())
+        }
     }
 }
 

@@ -122,6 +122,10 @@ fn write_output_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
         header.push("std_pce".into());
         cols.push(sp);
     }
+    if let Some(e) = &s.chaos_error {
+        header.push(e.kind.name().into());
+        cols.push(&e.values);
+    }
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(&dir.join(format!("{}.csv", s.name)), &hdr, &cols)
 }

@@ -7,6 +7,7 @@ use super::file::{Analysis, Experiment, PaperValue};
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
+use crate::uq::inputs::{Correlation, Inputs};
 use crate::uq::method::{Method, MethodSpec, Problem};
 
 /// A validated study, ready to run.
@@ -32,6 +33,8 @@ pub struct Study {
     pub method: MethodSpec,
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
+    /// Their correlation (`[[correlation]]`), if any.
+    pub correlation: Option<Correlation>,
     /// Deterministic values.
     pub fixed: BTreeMap<String, f64>,
     /// Outputs analysed over time.
@@ -68,6 +71,14 @@ impl Study {
         self.method.method()
     }
 
+    /// The random inputs: parameters and correlation, as designs map to them.
+    pub fn inputs(&self) -> Inputs {
+        Inputs {
+            parameters: self.parameters.clone(),
+            correlation: self.correlation.clone(),
+        }
+    }
+
     /// The communication points (s).
     pub fn times(&self) -> Vec<f64> {
         self.experiment.times()
@@ -77,6 +88,7 @@ impl Study {
     pub fn problem<'a>(&'a self, times: &'a [f64]) -> Problem<'a> {
         Problem {
             parameters: &self.parameters,
+            correlation: self.correlation.as_ref(),
             outputs: &self.outputs,
             quantities: self.qoi.len(),
             times,

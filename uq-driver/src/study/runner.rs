@@ -165,6 +165,10 @@ pub fn study_hash(study: &Study) -> String {
     if !study.qoi.is_empty() {
         key["qoi"] = serde_json::json!(study.qoi);
     }
+    // Likewise the correlation: studies without one keep their hash.
+    if let Some(c) = &study.correlation {
+        key["correlation"] = serde_json::json!(c.pairs);
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }
 

@@ -25,6 +25,40 @@ impl Draws {
     }
 }
 
+/// How the truncation error of a chaos was estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChaosErrorKind {
+    /// Corrected relative leave-one-out error of a regression (Blatman & Sudret 2011):
+    /// `T(P, N) · mean((y_i - ŷ_(-i))²) / Var(y)`.
+    Loo,
+    /// Relative mean-square difference between the chaoses of sparse-grid levels `L` and
+    /// `L - 1` (same runs, nested rules): `Σ (c_L - c_(L-1))² / Var_L`.
+    LevelDifference,
+    /// Relative mean-square difference between the chaoses of orders `p` and `p - 1` (same
+    /// runs): the variance share of the terms of degree `p`.
+    OrderDifference,
+}
+
+impl ChaosErrorKind {
+    /// The column name in `<V>.csv` and the `kind` in `summary.json` and `surrogate.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChaosErrorKind::Loo => "loo",
+            ChaosErrorKind::LevelDifference => "level_difference",
+            ChaosErrorKind::OrderDifference => "order_difference",
+        }
+    }
+}
+
+/// An estimate of a chaos's relative truncation error, one value per column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChaosError {
+    /// How it was estimated.
+    pub kind: ChaosErrorKind,
+    /// Per column (relative to the variance; 0 for a column without variance).
+    pub values: Vec<f64>,
+}
+
 /// First-order and total Sobol' indices, each `[column][parameter]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sobol {
@@ -63,6 +97,8 @@ pub struct Estimate {
     pub sobol: Option<Sobol>,
     /// Where quantiles and densities come from.
     pub draws: Draws,
+    /// The estimated truncation error of the chaos, where the method estimates it.
+    pub chaos_error: Option<ChaosError>,
 }
 
 impl Estimate {
@@ -110,6 +146,7 @@ impl Estimate {
             chaos: None,
             sobol: None,
             draws,
+            chaos_error: None,
         }
     }
 }

@@ -8,7 +8,8 @@ use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::distributions::Germ;
+use crate::uq::inputs::Inputs;
 
 /// A method that draws `samples` equally weighted points in the unit cube.
 pub(crate) trait UnitCubeSample: std::fmt::Debug + Send + Sync {
@@ -54,9 +55,9 @@ impl<T: UnitCubeSample> Method for T {
 }
 
 impl<T: UnitCubeSample> Sampling for T {
-    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError> {
-        let points = T::points(self.samples(), parameters.len(), seed);
-        Ok(Design::mapped(Germ::Uniform, points, None, parameters))
+    fn design(&self, inputs: &Inputs, seed: u64) -> Result<Design, MethodError> {
+        let points = T::points(self.samples(), inputs.len(), seed);
+        Ok(Design::mapped(Germ::Uniform, points, None, inputs))
     }
 
     /// Any subset of the points is a valid (smaller) sample: failed points may be left out.

@@ -257,31 +257,12 @@ impl Pce {
         dot_column(&self.coeffs, col, &psi)
     }
 
-    /// `n` random germ points: point `i` takes one uniform per dimension from
-    /// `rng::stream(seed, i)` and maps it through the germ law's quantile (a Hermite germ
-    /// is [`rng::standard_normal`]), so the points depend on `(seed, i)` only.
-    pub fn germ_draws(&self, n: usize, seed: u64) -> Vec<Vec<f64>> {
-        let laws: Vec<_> = self.basis.families().iter().map(Family::law).collect();
-        (0..n)
-            .map(|i| {
-                let mut r = rng::stream(seed, i as u64);
-                self.basis
-                    .families()
-                    .iter()
-                    .zip(&laws)
-                    .map(|(f, law)| match f {
-                        Family::Hermite => rng::standard_normal(&mut r),
-                        _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
-                    })
-                    .collect()
-            })
-            .collect()
-    }
-
     /// `n` draws of every output of the surrogate, one row per draw: row `i` is the chaos at
-    /// point `i` of [`Pce::germ_draws`] (a function of `(seed, i)` only).
+    /// point `i` of [`germ_draws`] (a function of `(seed, i)` only).
     pub fn sample(&self, n: usize, seed: u64) -> DMatrix<f64> {
-        self.basis.design_matrix(&self.germ_draws(n, seed)) * &self.coeffs
+        self.basis
+            .design_matrix(&germ_draws(self.basis.families(), n, seed))
+            * &self.coeffs
     }
 
     /// First-order Sobol' indices of output `col`, one per germ dimension: the variance
@@ -337,6 +318,26 @@ impl Pce {
             })
             .collect()
     }
+}
+
+/// `n` random points of the germs of `families`: point `i` takes one uniform per dimension
+/// from `rng::stream(seed, i)` and maps it through the germ law's quantile (a Hermite germ is
+/// [`rng::standard_normal`]), so the points depend on `(seed, i)` only.
+pub fn germ_draws(families: &[Family], n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let laws: Vec<_> = families.iter().map(Family::law).collect();
+    (0..n)
+        .map(|i| {
+            let mut r = rng::stream(seed, i as u64);
+            families
+                .iter()
+                .zip(&laws)
+                .map(|(f, law)| match f {
+                    Family::Hermite => rng::standard_normal(&mut r),
+                    _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
+                })
+                .collect()
+        })
+        .collect()
 }
 
 fn dot_column(c: &DMatrix<f64>, col: usize, psi: &[f64]) -> f64 {
