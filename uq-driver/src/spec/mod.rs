@@ -14,7 +14,8 @@
 //! order = 5                    # SCM: total order of the Hermite chaos (default nodes − 1)
 //! [[parameters]]
 //! name = "K"
-//! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal"
+//! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal" |
+//!                              # "beta" | "gamma" | "weibull" | "integer_uniform"
 //! mean = 100.0
 //! std = 10.0                   # or cov = 0.1
 //! [fixed]                      # deterministic parameter values
