@@ -502,3 +502,47 @@ fn chaos_methods_refuse_integer_inputs_and_sampling_runs_them() {
         assert_eq!(x1.iter().filter(|&&v| v == k as f64).count(), 100, "{k}");
     }
 }
+
+#[test]
+fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let params = "[[parameters]]\nname = \"x1\"\nmean = 1.0\nstd = 0.5\n\
+         [[parameters]]\nname = \"x2\"\ndistribution = \"uniform\"\nlow = -1.0\nhigh = 2.0\n";
+    let dir = tempfile::tempdir().unwrap();
+    // A previous study's points.csv is a points file.
+    let lhs = run_study(&study(
+        dir.path(),
+        "src",
+        4,
+        params,
+        "kind = \"lhs\"\nsamples = 12",
+    ));
+    std::fs::copy(lhs.join("points.csv"), dir.path().join("pts.csv")).unwrap();
+    let s = study(
+        dir.path(),
+        "file",
+        4,
+        params,
+        "kind = \"pce_regression\"\npoints = \"pts.csv\"\norder = 2",
+    );
+    let out = run_study(&s);
+    let y = Csv::read(&out.join("y.csv"));
+    // y = x1 + x2²: E = 1 + 1 = 2; Var = 0.25 + Var(x2²) = 0.25 + (E x2⁴ - 1),
+    // E x2⁴ = (2⁵ + 1) / 15 = 2.2.
+    assert!((y.last("mean") - 2.0).abs() < 1e-12, "{}", y.last("mean"));
+    assert!((y.last("std") - (0.25f64 + 1.2).sqrt()).abs() < 1e-12);
+    assert_eq!(
+        Csv::read(&out.join("points.csv")).col("x1"),
+        Csv::read(&lhs.join("points.csv")).col("x1")
+    );
+    // The same folder with an edited file (one point fewer): a different study, refused.
+    let text = std::fs::read_to_string(dir.path().join("pts.csv")).unwrap();
+    let mut rows: Vec<&str> = text.lines().collect();
+    rows.pop();
+    std::fs::write(dir.path().join("pts.csv"), rows.join("\n")).unwrap();
+    let o = driver(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("different study"));
+}

@@ -314,7 +314,8 @@ impl Pce {
                     .filter(|(k, _)| selects(k, i))
                     .map(|(_, v)| v)
                     .sum();
-                s / var
+                // + 0.0: an empty sum is -0.0.
+                s / var + 0.0
             })
             .collect()
     }
