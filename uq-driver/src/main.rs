@@ -314,18 +314,7 @@ fn surrogate(cmd: SurrogateCommand) -> Result<()> {
         SurrogateCommand::Eval { dir, at, out } => {
             let s = Surrogate::load(&dir)?;
             let x = s.point(&at)?;
-            let v = s.eval(&x);
-            let mut text = String::from("name,time,value\n");
-            for (o, vals) in s.file.outputs.iter().zip(&v.outputs) {
-                let times = o.times.as_deref().unwrap_or(&[]);
-                for (t, y) in times.iter().zip(vals) {
-                    text.push_str(&format!("{},{t},{y}\n", o.name));
-                }
-            }
-            for (q, y) in s.file.quantities.iter().zip(&v.quantities) {
-                text.push_str(&format!("{},,{y}\n", q.name));
-            }
-            emit(&text, out.as_deref())
+            emit(&s.eval_csv(&x), out.as_deref())
         }
         SurrogateCommand::Sample {
             dir,
@@ -335,42 +324,7 @@ fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             out,
         } => {
             let s = Surrogate::load(&dir)?;
-            // (output index, time index, column name)
-            let mut picks: Vec<(usize, usize, String)> = Vec::new();
-            for (o, chaos) in s.file.outputs.iter().enumerate() {
-                let ts = chaos.times.as_deref().unwrap_or(&[]);
-                if ts.is_empty() {
-                    continue;
-                }
-                let wanted = if times.is_empty() {
-                    vec![ts.len() - 1]
-                } else {
-                    times
-                        .iter()
-                        .map(|&t| {
-                            (0..ts.len())
-                                .min_by(|&a, &b| (ts[a] - t).abs().total_cmp(&(ts[b] - t).abs()))
-                                .expect("non-empty")
-                        })
-                        .collect()
-                };
-                for k in wanted {
-                    picks.push((o, k, format!("{}@{}", chaos.name, ts[k])));
-                }
-            }
-            let mut header: Vec<String> = s.inputs.iter().map(|p| p.name.clone()).collect();
-            header.extend(s.file.quantities.iter().map(|q| q.name.clone()));
-            header.extend(picks.iter().map(|p| p.2.clone()));
-            let mut text = header.join(",");
-            text.push('\n');
-            for (x, v) in s.sample(n, seed) {
-                let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
-                row.extend(v.quantities.iter().map(f64::to_string));
-                row.extend(picks.iter().map(|&(o, k, _)| v.outputs[o][k].to_string()));
-                text.push_str(&row.join(","));
-                text.push('\n');
-            }
-            emit(&text, out.as_deref())
+            emit(&s.sample_csv(n, seed, &times), out.as_deref())
         }
     }
 }

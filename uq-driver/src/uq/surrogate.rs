@@ -369,6 +369,62 @@ impl Surrogate {
         }
     }
 
+    /// `eval` as CSV: `name,time,value`, one row per output and time, then one per quantity
+    /// (empty time).
+    pub fn eval_csv(&self, x: &[f64]) -> String {
+        let v = self.eval(x);
+        let mut text = String::from("name,time,value\n");
+        for (o, vals) in self.file.outputs.iter().zip(&v.outputs) {
+            let times = o.times.as_deref().unwrap_or(&[]);
+            for (t, y) in times.iter().zip(vals) {
+                text.push_str(&format!("{},{t},{y}\n", o.name));
+            }
+        }
+        for (q, y) in self.file.quantities.iter().zip(&v.quantities) {
+            text.push_str(&format!("{},,{y}\n", q.name));
+        }
+        text
+    }
+
+    /// `sample` as CSV: the inputs, the quantities, then each output at the communication
+    /// points nearest to `times` (default: its last), as columns `NAME@TIME`.
+    pub fn sample_csv(&self, n: usize, seed: u64, times: &[f64]) -> String {
+        // (output index, time index, column name)
+        let mut picks: Vec<(usize, usize, String)> = Vec::new();
+        for (o, chaos) in self.file.outputs.iter().enumerate() {
+            let ts = chaos.times.as_deref().unwrap_or(&[]);
+            if ts.is_empty() {
+                continue;
+            }
+            let nearest = |t: f64| {
+                (0..ts.len())
+                    .min_by(|&a, &b| (ts[a] - t).abs().total_cmp(&(ts[b] - t).abs()))
+                    .unwrap_or(0)
+            };
+            let wanted: Vec<usize> = if times.is_empty() {
+                vec![ts.len() - 1]
+            } else {
+                times.iter().map(|&t| nearest(t)).collect()
+            };
+            for k in wanted {
+                picks.push((o, k, format!("{}@{}", chaos.name, ts[k])));
+            }
+        }
+        let mut header: Vec<String> = self.inputs.iter().map(|p| p.name.clone()).collect();
+        header.extend(self.file.quantities.iter().map(|q| q.name.clone()));
+        header.extend(picks.iter().map(|p| p.2.clone()));
+        let mut text = header.join(",");
+        text.push('\n');
+        for (x, v) in self.sample(n, seed) {
+            let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
+            row.extend(v.quantities.iter().map(f64::to_string));
+            row.extend(picks.iter().map(|&(o, k, _)| v.outputs[o][k].to_string()));
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        text
+    }
+
     /// `n` random points of the inputs' joint law with the surrogate's values there: point
     /// `i` comes from the stream `(seed, i)` only ([`germ_draws`]).
     pub fn sample(&self, n: usize, seed: u64) -> Vec<(Vec<f64>, SurrogateValues)> {
@@ -380,5 +436,94 @@ impl Surrogate {
                 (x, self.eval_germ(&t))
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::inputs::CorrelationPair;
+
+    fn inputs(correlated: bool) -> Inputs {
+        let parameters = vec![
+            RandomParameter {
+                name: "a".into(),
+                distribution: Distribution::normal(2.0, 0.5).unwrap(),
+            },
+            RandomParameter {
+                name: "b".into(),
+                distribution: Distribution::uniform(0.0, 4.0).unwrap(),
+            },
+        ];
+        let pairs = if correlated {
+            vec![CorrelationPair {
+                between: ["a".into(), "b".into()],
+                rho: 0.4,
+            }]
+        } else {
+            vec![]
+        };
+        let correlation = Correlation::new(&parameters, pairs).unwrap();
+        Inputs {
+            parameters,
+            correlation,
+        }
+    }
+
+    /// f(t) = 1 + 2 p1(t_a) + 0.5 p1(t_b) p1(t_a), Hermite x Legendre (Askey germs).
+    fn chaos() -> NamedChaos {
+        let set = MultiIndexSet::from_indices(2, vec![vec![0, 0], vec![1, 0], vec![1, 1]]).unwrap();
+        let basis = Basis::new(vec![Family::Hermite, Family::Legendre], set).unwrap();
+        NamedChaos {
+            name: "f".into(),
+            times: Some(vec![0.0]),
+            pce: Pce::new(basis, DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 0.5])).unwrap(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_written_surrogate_reads_back_and_evaluates_at_physical_values() {
+        for correlated in [false, true] {
+            let ins = inputs(correlated);
+            let file = SurrogateFile::new("s", "sparse_grid", Germ::Askey, &ins, &[chaos()], &[]);
+            let text = serde_json::to_string(&file).unwrap();
+            assert!(
+                text.contains(r#""map":"affine","offset":2.0,"scale":0.5"#),
+                "{text}"
+            );
+            let s = Surrogate::new(serde_json::from_str(&text).unwrap()).unwrap();
+            // At physical values: germs by the inverse map, then the chaos.
+            let x = [2.5, 3.0];
+            let t = ins.to_germ(Germ::Askey, &x);
+            if !correlated {
+                assert_eq!(t, vec![1.0, 0.5]);
+            }
+            let want = 1.0 + 2.0 * t[0] + 0.5 * t[0] * (3f64.sqrt() * t[1]);
+            assert!((s.eval(&x).outputs[0][0] - want).abs() < 1e-12);
+            // Draws: the inputs' values and the chaos at the same germ points.
+            let draws = s.sample(50, 1);
+            assert_eq!(draws.len(), 50);
+            for (x, v) in &draws {
+                assert!((s.eval(x).outputs[0][0] - v.outputs[0][0]).abs() < 1e-9);
+                assert!((0.0..=4.0).contains(&x[1]));
+            }
+            assert_eq!(s.sample_csv(50, 1, &[]), s.sample_csv(50, 1, &[]));
+        }
+    }
+
+    #[test]
+    fn foreign_files_and_bad_points_are_refused() {
+        let ins = inputs(false);
+        let mut file = SurrogateFile::new("s", "scm", Germ::Askey, &ins, &[chaos()], &[]);
+        let s = Surrogate::new(file.clone()).unwrap();
+        assert!(s.point(&[("zz".into(), 1.0)]).is_err());
+        assert!(s.point(&[("b".into(), 5.0)]).is_err());
+        assert_eq!(s.point(&[("a".into(), 1.0)]).unwrap(), vec![1.0, 2.0]);
+        file.version = 2;
+        assert!(Surrogate::new(file.clone()).is_err());
+        file.version = VERSION;
+        file.outputs[0].coefficients[0].pop();
+        assert!(Surrogate::new(file).is_err());
     }
 }
