@@ -8,7 +8,8 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
-use uq_driver::spec::{builtin, Experiment, Study, BUILTINS};
+use uq_driver::report::csv::push_shortest;
+use uq_driver::spec::{builtin, Experiment, FixedValue, InvalidExperiment, Study, BUILTINS};
 use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
 
 #[derive(Parser)]
@@ -133,12 +134,18 @@ struct SlurmArgs {
 struct SimulateArgs {
     /// The .fmu file.
     fmu: PathBuf,
-    /// Parameter values, NAME=VALUE (repeatable).
+    /// Parameter values, NAME=VALUE (repeatable): a number, true/false or a text, as the
+    /// variable's type (Real, Integer, Enumeration, Boolean, String) needs.
     #[arg(long = "set", value_parser = parse_assignment)]
-    set: Vec<(String, f64)>,
-    /// Outputs to record (repeatable; default: every Real output).
+    set: Vec<(String, String)>,
+    /// Outputs to record (repeatable; default: every output that is a Real, Integer,
+    /// Enumeration or Boolean).
     #[arg(long = "output")]
     outputs: Vec<String>,
+    /// Time-varying inputs: a CSV file with a time column, then one column per input
+    /// (Real ones interpolated linearly, the others held, as fmpy's input= does).
+    #[arg(long)]
+    input: Option<PathBuf>,
     /// Start time (s; default: the FMU's default experiment, else 0).
     #[arg(long)]
     start: Option<f64>,
@@ -153,15 +160,11 @@ struct SimulateArgs {
     out: Option<PathBuf>,
 }
 
-fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+fn parse_assignment(s: &str) -> Result<(String, String), String> {
     let (name, value) = s
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
-    let v: f64 = value
-        .trim()
-        .parse()
-        .map_err(|e| format!("value of {name}: {e}"))?;
-    Ok((name.trim().to_owned(), v))
+    Ok((name.trim().to_owned(), value.to_owned()))
 }
 
 fn main() -> ExitCode {
@@ -423,20 +426,45 @@ fn simulate(a: SimulateArgs) -> Result<()> {
         .or(de.step_size)
         .context("no --step and no default step size in the FMU")?;
     let experiment = Experiment { start, stop, step };
-    experiment.check()?;
+    experiment.check().map_err(|e| match e {
+        InvalidExperiment::ZeroStep => anyhow::anyhow!(
+            "--step 0: the communication step must be positive (s), e.g. --step 0.01"
+        ),
+        other => other.into(),
+    })?;
     let times = experiment.times();
-    let (names, series) = runner::simulate(&fmu, &a.set, &a.outputs, &times)?;
+    let params: Vec<(String, FixedValue)> = a
+        .set
+        .into_iter()
+        .map(|(n, v)| (n, FixedValue::Text(v)))
+        .collect();
+    let sim = runner::simulate(&fmu, &params, &a.outputs, a.input.as_deref(), &times)?;
+    for (name, why) in &sim.skipped {
+        eprintln!("uq-driver: note: output '{name}' not recorded: {why}");
+    }
+    if sim.names.is_empty() {
+        eprintln!(
+            "uq-driver: warning: nothing to record: the FMU has no output that can be written \
+             as a number (name variables with --output)"
+        );
+    }
+    if let Some(t) = sim.ended_at {
+        eprintln!(
+            "uq-driver: note: the FMU ended the simulation at t = {t} s (before the stop time \
+             {stop} s); the output ends there"
+        );
+    }
     let mut text = String::from("time");
-    for n in &names {
+    for n in &sim.names {
         text.push(',');
         text.push_str(n);
     }
     text.push('\n');
-    for (k, t) in times.iter().enumerate() {
-        text.push_str(&t.to_string());
-        for s in &series {
+    for (k, t) in sim.times.iter().enumerate() {
+        push_shortest(&mut text, *t);
+        for s in &sim.series {
             text.push(',');
-            text.push_str(&s[k].to_string());
+            push_shortest(&mut text, s[k]);
         }
         text.push('\n');
     }

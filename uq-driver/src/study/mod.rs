@@ -7,6 +7,7 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+pub mod inputs;
 pub mod interface;
 mod outcome;
 pub mod runner;
