@@ -51,6 +51,8 @@ enum Command {
         /// MC/LHS: continue past failed points.
         #[arg(long)]
         allow_failures: bool,
+        #[command(flatten)]
+        safety: SafetyArgs,
     },
     /// Check a plan's shards (every point exactly once, same study and FMU) and write the
     /// study's outputs, as `run` would.
@@ -80,6 +82,9 @@ enum Command {
     },
     /// Run an FMU once at given parameter values and write its outputs as CSV.
     Simulate(SimulateArgs),
+    /// Serve points to a parent uq-driver (`--isolate`) over stdin/stdout.
+    #[command(hide = true)]
+    Worker,
 }
 
 #[derive(Args)]
@@ -101,6 +106,47 @@ struct RunArgs {
     /// Stop after this many new points (the study can be resumed later).
     #[arg(long, hide = true)]
     max_points: Option<usize>,
+    #[command(flatten)]
+    safety: SafetyArgs,
+}
+
+/// How points are run: isolation, time limit, retries.
+#[derive(Args)]
+struct SafetyArgs {
+    /// Run each point in a worker process: an FMU that crashes, aborts, calls exit() or
+    /// outlives --timeout-per-run fails its point instead of ending the study.
+    #[arg(long)]
+    isolate: bool,
+    /// Longest a run may take (s). With --isolate the run is killed and fails its point;
+    /// in-process the study stops with a message naming the point.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
+    timeout_per_run: Option<std::time::Duration>,
+    /// Run again the points that failed in an earlier run into the same folder.
+    #[arg(long)]
+    retry_failed: bool,
+}
+
+impl SafetyArgs {
+    /// Fills the runner options.
+    fn apply(&self, opts: &mut RunOptions) -> Result<()> {
+        opts.retry_failed = self.retry_failed;
+        opts.timeout_per_run = self.timeout_per_run;
+        if self.isolate {
+            opts.isolate = Some(
+                uq_driver::study::isolate::default_exe()
+                    .context("locating the uq-driver executable for --isolate")?,
+            );
+        }
+        Ok(())
+    }
+}
+
+fn parse_timeout(s: &str) -> Result<std::time::Duration, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("{e}"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("must be a positive number of seconds, got {s}"));
+    }
+    std::time::Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
 }
 
 #[derive(Args)]
@@ -169,6 +215,10 @@ fn parse_assignment(s: &str) -> Result<(String, String), String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if matches!(cli.command, Command::Worker) {
+        return ExitCode::from(u8::try_from(uq_driver::study::isolate::serve()).unwrap_or(1));
+    }
+    uq_driver::study::guard::install_signal_handler();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // `uq-driver inspect X | head`: the reader went away; nothing left to say.
@@ -224,7 +274,8 @@ fn dispatch(cmd: Command) -> Result<()> {
             shard,
             threads,
             allow_failures,
-        } => run_shard(&dir, shard, threads, allow_failures),
+            safety,
+        } => run_shard(&dir, shard, threads, allow_failures, &safety),
         Command::Merge {
             dir,
             out,
@@ -259,20 +310,22 @@ fn dispatch(cmd: Command) -> Result<()> {
         }
         Command::Inspect { fmu } => inspect(&fmu),
         Command::Simulate(args) => simulate(args),
+        Command::Worker => unreachable!("handled in main"),
     }
 }
 
 /// `uq-driver run`.
 fn run(a: RunArgs) -> Result<()> {
     let s = Study::load(&a.study)?;
-    let opts = RunOptions {
+    let mut opts = RunOptions {
         threads: a.threads,
         progress: std::io::stderr().is_terminal(),
         allow_failures: a.allow_failures,
         fresh: a.fresh,
         max_new_points: a.max_points,
-        points: None,
+        ..RunOptions::default()
     };
+    a.safety.apply(&mut opts)?;
     let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
     match outcome {
         Outcome::Study(r) => print_study(&r, &a.out),
@@ -287,6 +340,7 @@ fn run_shard(
     shard: Option<usize>,
     threads: Option<usize>,
     allow_failures: bool,
+    safety: &SafetyArgs,
 ) -> Result<()> {
     let k = match shard {
         Some(k) => k,
@@ -295,12 +349,13 @@ fn run_shard(
             .parse()
             .context("SLURM_ARRAY_TASK_ID is not a number")?,
     };
-    let opts = RunOptions {
+    let mut opts = RunOptions {
         threads,
         progress: std::io::stderr().is_terminal(),
         allow_failures,
         ..RunOptions::default()
     };
+    safety.apply(&mut opts)?;
     let o = shard::run_shard(dir, k, &opts)?;
     println!(
         "shard {k}: {} points run, {} resumed, wall time {:.2} s",

@@ -32,7 +32,7 @@ pub struct InterfaceError {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum VariableProblem {
     /// No such variable.
-    #[error("the study names variable '{name}', which the FMU ({model}) does not have")]
+    #[error("the FMU ({model}) has no variable named '{name}'")]
     Unknown {
         /// The name.
         name: String,
@@ -77,6 +77,21 @@ pub enum VariableProblem {
     /// A fractional value for an Integer.
     #[error("'{name}' is an {found}; {value} is not a whole number (32-bit)")]
     NotWhole {
+        /// The variable.
+        name: String,
+        /// Its type (Integer or Enumeration).
+        found: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// A design value that is not a whole number for an Integer or Enumeration random
+    /// parameter.
+    #[error(
+        "random parameter '{name}' is an {found} variable, but the design has the value {value}, \
+         which is not a whole number (32-bit): give it a distribution with whole-number values \
+         (e.g. integer_uniform)"
+    )]
+    RandomNotWhole {
         /// The variable.
         name: String,
         /// Its type (Integer or Enumeration).
@@ -347,7 +362,7 @@ pub enum RandomValueError {
 }
 
 fn not_whole(target: &RandomTarget, value: f64) -> VariableProblem {
-    VariableProblem::NotWhole {
+    VariableProblem::RandomNotWhole {
         name: target.name.clone(),
         found: if target.type_name == "Enumeration" {
             "Enumeration"

@@ -1,19 +1,21 @@
 //! The parallel runner: one FMU instance per worker, `fmi2Reset` between points, every
 //! finished point appended to the results store.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use super::inputs::isclose;
-use super::interface::{Interface, InterfaceError, RandomValueError};
+use super::guard::{self, StudyGuard};
+use super::interface::{Interface, InterfaceError};
+use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
+use super::lock::{FolderLock, LockError};
+pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
 use super::store::{Manifest, Record, Store, StoreError};
-use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
-use crate::qoi::scalar::{self, QoiError};
-use crate::spec::{FixedValue, Study};
+use crate::fmu::{Fmu, FmuError, Instance};
+use crate::spec::Study;
 use crate::uq::method::{Design, MethodError};
 
 /// How to run a study.
@@ -31,6 +33,14 @@ pub struct RunOptions {
     pub max_new_points: Option<usize>,
     /// Run only these points of the design (a shard); None: all.
     pub points: Option<Vec<usize>>,
+    /// Run the points that failed in an earlier run again (`--retry-failed`).
+    pub retry_failed: bool,
+    /// `--isolate`: run each point in a worker process started from this uq-driver executable
+    /// (see [`isolate`]); None: in-process.
+    pub isolate: Option<PathBuf>,
+    /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point; in-process
+    /// the study stops with a message naming the point (an FMU call cannot be interrupted).
+    pub timeout_per_run: Option<Duration>,
 }
 
 impl RunOptions {
@@ -38,48 +48,6 @@ impl RunOptions {
     pub fn allow_failures(&self, study: &Study) -> bool {
         self.allow_failures || study.analysis.allow_failures
     }
-}
-
-/// Why one model run failed. Its text is stored with the point, so it is complete on its own.
-#[derive(Debug, thiserror::Error)]
-pub enum PointError {
-    /// An FMI call failed (the message lists what the FMU logged).
-    #[error(transparent)]
-    Fmu(#[from] FmuError),
-    /// An output became NaN or infinite.
-    #[error("non-finite value of {signal} at t = {time} s")]
-    NonFinite {
-        /// The variable.
-        signal: String,
-        /// When (s).
-        time: f64,
-    },
-    /// A design value does not fit its variable.
-    #[error("{0}")]
-    Value(String),
-    /// The FMU ended the simulation before the stop time. Statistics over time need every run
-    /// on the whole grid (a mean at t over the runs that reached t would be conditioned on
-    /// reaching it), so such a run is a failed point.
-    #[error(
-        "the FMU ended the simulation at t = {time} s, before the stop time {stop} s \
-         (fmi2DoStep returned fmi2Discard and fmi2Terminated is true); statistics over time \
-         need every run on the whole grid, so the point counts as failed (a stop time of at \
-         most {time} s keeps such runs)"
-    )]
-    EndedEarly {
-        /// When the FMU ended it (s).
-        time: f64,
-        /// The study's stop time (s).
-        stop: f64,
-    },
-    /// A quantity of interest could not be evaluated on the run.
-    #[error("quantity '{name}': {error}")]
-    Quantity {
-        /// The quantity.
-        name: String,
-        /// Why.
-        error: QoiError,
-    },
 }
 
 /// A point that failed: where and why.
@@ -120,7 +88,11 @@ pub enum RunError {
     #[error(transparent)]
     Design(#[from] MethodError),
     /// Points failed and failures are not allowed.
-    #[error("{failed} of {total} points failed; first: {first}")]
+    #[error(
+        "{failed} of {total} points failed; first: {first}. After fixing the cause, run again \
+         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
+         and LHS, to analyse the others)"
+    )]
     PointsFailed {
         /// Number of failed points.
         failed: usize,
@@ -132,6 +104,21 @@ pub enum RunError {
     /// A single run failed (`simulate`).
     #[error(transparent)]
     Point(#[from] PointError),
+    /// The output path exists and is not a folder.
+    #[error("{}: the output path exists and is not a folder", .0.display())]
+    NotAFolder(PathBuf),
+    /// The output folder is locked by another run.
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    /// A worker process was stopped from outside (`--isolate`): the study stops, the point
+    /// has no result.
+    #[error("point {point}: {why}; the study stops (the point is run again on a re-run)")]
+    Interrupted {
+        /// The point.
+        point: usize,
+        /// What happened.
+        why: String,
+    },
     /// The thread pool could not be built.
     #[error("cannot start the worker threads")]
     Pool(#[source] rayon::ThreadPoolBuildError),
@@ -195,170 +182,6 @@ pub fn study_hash(study: &Study) -> String {
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }
 
-/// What one run recorded.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Trace {
-    /// `values[o * nt + k]` is signal `o` at `times[k]` (nt = the grid's length), for
-    /// `k < recorded`; the rest is zero.
-    pub values: Vec<f64>,
-    /// Grid times recorded: all of them unless the FMU ended the simulation early.
-    pub recorded: usize,
-    /// When the FMU ended the simulation before the stop time (`fmi2DoStep` returned
-    /// fmi2Discard and `fmi2GetBooleanStatus(fmi2Terminated)` was true): the time it ended
-    /// at (s, from `fmi2GetRealStatus(fmi2LastSuccessfulTime)`) and, when that is after the
-    /// last grid time recorded, the signals there.
-    pub ended: Option<(f64, Option<Vec<f64>>)>,
-}
-
-/// Starts (or resets) `slot`'s instance, sets the parameters and the inputs, initializes and
-/// records the signals at `times`, ending early where the FMU ends the simulation.
-fn simulate_point(
-    fmu: &Fmu,
-    slot: &mut Option<Instance>,
-    iface: &Interface,
-    values: &[f64],
-    times: &[f64],
-) -> Result<Trace, PointError> {
-    let nt = times.len();
-    let inst = match slot {
-        Some(inst) => {
-            inst.reset()?;
-            inst
-        }
-        None => slot.insert(fmu.instantiate("uq-driver", false)?),
-    };
-    iface.fixed.apply(inst)?;
-    iface.set_random(inst, values).map_err(|e| match e {
-        RandomValueError::Fmu(e) => PointError::Fmu(e),
-        RandomValueError::Value(p) => PointError::Value(p.to_string()),
-    })?;
-    let stop = *times.last().expect("at least one time");
-    inst.setup_experiment(None, times[0], Some(stop))?;
-    inst.enter_initialization_mode()?;
-    if let Some(inputs) = &iface.inputs {
-        inputs.apply(inst, times[0], false)?;
-    }
-    inst.exit_initialization_mode()?;
-    let mut trace = Trace {
-        values: vec![0.0; iface.signals.len * nt],
-        recorded: 0,
-        ended: None,
-    };
-    let mut buf = vec![0.0; iface.signals.len];
-    for k in 0..nt {
-        if k > 0 {
-            if let Some(inputs) = &iface.inputs {
-                inputs.apply(inst, times[k - 1], true)?;
-            }
-            if let Err(e) = inst.do_step(times[k - 1], times[k] - times[k - 1], true) {
-                let Some(end) = ended_by_fmu(inst, &e, times[k - 1]) else {
-                    return Err(e.into());
-                };
-                if isclose(end, times[k]) {
-                    // The step completed and the FMU ends there.
-                    iface.signals.read(inst, &mut buf)?;
-                    store_column(&mut trace.values, &buf, nt, k);
-                    trace.recorded = k + 1;
-                    if k + 1 < nt {
-                        trace.ended = Some((times[k], None));
-                    }
-                } else if end > times[k - 1] && !isclose(end, times[k - 1]) {
-                    iface.signals.read(inst, &mut buf)?;
-                    trace.ended = Some((end, Some(buf.clone())));
-                } else {
-                    trace.ended = Some((times[k - 1], None));
-                }
-                return Ok(trace);
-            }
-        }
-        iface.signals.read(inst, &mut buf)?;
-        store_column(&mut trace.values, &buf, nt, k);
-        trace.recorded = k + 1;
-    }
-    Ok(trace)
-}
-
-/// Writes one time's signals into the signal-major matrix.
-fn store_column(values: &mut [f64], column: &[f64], nt: usize, k: usize) {
-    for (o, v) in column.iter().enumerate() {
-        values[o * nt + k] = *v;
-    }
-}
-
-/// When `error` from `fmi2DoStep` from `current` means the FMU ended the simulation
-/// (fmi2Discard and fmi2Terminated true): the time it ended at (its last successful time, or
-/// `current` if it cannot say).
-fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f64> {
-    let FmuError::Call {
-        status: Status::Discard,
-        ..
-    } = error
-    else {
-        return None;
-    };
-    if !inst.get_boolean_status(StatusKind::Terminated).ok()? {
-        return None;
-    }
-    let end = inst
-        .get_real_status(StatusKind::LastSuccessfulTime)
-        .ok()
-        .filter(|t| t.is_finite() && *t >= current)
-        .unwrap_or(current);
-    Some(end)
-}
-
-/// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
-/// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
-/// (value, code) of each quantity of interest. A run the FMU ends before the stop time is a
-/// failed point ([`PointError::EndedEarly`]).
-pub fn run_point(
-    fmu: &Fmu,
-    slot: &mut Option<Instance>,
-    iface: &Interface,
-    values: &[f64],
-    times: &[f64],
-) -> Result<Vec<f64>, PointError> {
-    let nt = times.len();
-    let trace = simulate_point(fmu, slot, iface, values, times).inspect_err(|_| {
-        // A failed instance may be in Error state: start the next point on a fresh one.
-        *slot = None;
-    })?;
-    if let Some((time, _)) = trace.ended {
-        *slot = None;
-        return Err(PointError::EndedEarly {
-            time,
-            stop: times[nt - 1],
-        });
-    }
-    let traces = trace.values;
-    if let Some(pos) = traces.iter().position(|v| !v.is_finite()) {
-        *slot = None;
-        return Err(PointError::NonFinite {
-            signal: iface.signal_names[pos / nt].clone(),
-            time: times[pos % nt],
-        });
-    }
-    let mut out = traces[..iface.n_stored * nt].to_vec();
-    let signal = |name: &str| -> &[f64] {
-        let i = iface
-            .signal_names
-            .iter()
-            .position(|n| n == name)
-            .expect("resolved");
-        &traces[i * nt..(i + 1) * nt]
-    };
-    for q in &iface.qois {
-        let (v, code) =
-            scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
-                name: q.name().to_owned(),
-                error,
-            })?;
-        out.push(v);
-        out.push(code as u8 as f64);
-    }
-    Ok(out)
-}
-
 /// What a run produced: every point's record, in design order.
 #[derive(Debug)]
 pub struct RunOutcome {
@@ -405,7 +228,9 @@ fn progress_bar(show: bool, n: usize) -> Option<indicatif::ProgressBar> {
     Some(b)
 }
 
-/// Runs every point of `design` not yet in the store of `out_dir`.
+/// Runs every point of `design` not yet in the store of `out_dir` (with
+/// [`RunOptions::retry_failed`], also the points that failed before), holding the folder's
+/// lock ([`FolderLock`]) meanwhile.
 pub fn run_points(
     study: &Study,
     fmu: &Fmu,
@@ -415,6 +240,14 @@ pub fn run_points(
 ) -> Result<RunOutcome, RunError> {
     let started = Instant::now();
     let manifest = manifest(study, fmu, design)?;
+    prepare_out_dir(out_dir)?;
+    let lock = FolderLock::acquire(out_dir)?;
+    if let Some(previous) = lock.taken_over() {
+        eprintln!(
+            "note: {} was locked by a run that is no longer running ({previous}); taking it over",
+            out_dir.display()
+        );
+    }
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
     if let Some(note) = store.recovery().summary() {
         eprintln!("warning: {note}");
@@ -423,10 +256,27 @@ pub fn run_points(
         Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
         None => (0..design.len()).collect(),
     };
+    let failed_before = wanted
+        .iter()
+        .filter(|&&i| matches!(records[i], Some(Record::Failed(_))))
+        .count();
+    if failed_before > 0 && !opts.retry_failed {
+        eprintln!(
+            "note: {failed_before} point{} failed in an earlier run and {} not run again \
+             (--retry-failed runs {} again)",
+            if failed_before == 1 { "" } else { "s" },
+            if failed_before == 1 { "is" } else { "are" },
+            if failed_before == 1 { "it" } else { "them" },
+        );
+    }
     let missing: Vec<usize> = wanted
         .iter()
         .copied()
-        .filter(|&i| records[i].is_none())
+        .filter(|&i| match &records[i] {
+            None => true,
+            Some(Record::Failed(_)) => opts.retry_failed,
+            Some(Record::Ok(_)) => false,
+        })
         .collect();
     let threads = opts
         .threads
@@ -438,17 +288,40 @@ pub fn run_points(
         .map_err(RunError::Pool)?;
     let iface = Interface::resolve(study, fmu)?;
     iface.check_design(fmu, &design.values)?;
+    let times = study.times();
+    let workers = opts.isolate.as_ref().map(|exe| {
+        WorkerPool::new(
+            IsolateOptions {
+                exe: exe.clone(),
+                timeout: opts.timeout_per_run,
+            },
+            &isolate::setup(fmu, &iface, &times),
+        )
+    });
+    let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
     let batch = Batch {
         fmu,
         iface,
+        study,
         design,
-        times: study.times(),
+        times,
         store: &store,
         stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
         max_new: opts.max_new_points,
+        workers,
+        guard: &guard,
     };
     let bar = progress_bar(opts.progress, missing.len());
-    let new = pool.install(|| batch.run(&missing, bar.as_ref()))?;
+    let done = AtomicBool::new(false);
+    let new = std::thread::scope(|scope| {
+        if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
+            let (guard, done) = (&guard, &done);
+            scope.spawn(move || watchdog(guard, limit, done));
+        }
+        let new = pool.install(|| batch.run(&missing, bar.as_ref()));
+        done.store(true, Ordering::Release);
+        new
+    })?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -466,10 +339,52 @@ pub fn run_points(
     })
 }
 
+/// Creates the output folder, or checks that the existing path is one.
+pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotAFolder(dir.to_path_buf()));
+    }
+    std::fs::create_dir_all(dir).map_err(|source| {
+        RunError::Store(StoreError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })
+    })
+}
+
+/// In-process runs cannot be interrupted: when one outlives `limit`, name it and end the
+/// process (the store keeps every finished point).
+fn watchdog(guard: &StudyGuard, limit: Duration, done: &AtomicBool) {
+    let tick = (limit / 10).clamp(Duration::from_millis(10), Duration::from_millis(250));
+    while !done.load(Ordering::Acquire) {
+        std::thread::sleep(tick);
+        let overdue = guard.overdue(limit);
+        if overdue.is_empty() {
+            continue;
+        }
+        let points: Vec<String> = overdue
+            .iter()
+            .map(|(p, v, t)| format!("point {p} ({v}) has run for {:.1} s", t.as_secs_f64()))
+            .collect();
+        guard::exit_now(
+            guard::EXIT_FAILURE,
+            &format!(
+                "uq-driver: error: {}, longer than --timeout-per-run {} s. An FMU call cannot be \
+                 interrupted inside this process, so the study stops here; finished points are \
+                 kept in the results store. Run again with --isolate to have such runs killed \
+                 and marked failed while the study goes on.",
+                points.join("; "),
+                limit.as_secs_f64()
+            ),
+        );
+    }
+}
+
 /// Points to run in parallel, each appended to the store as it finishes.
 struct Batch<'a> {
     fmu: &'a Fmu,
     iface: Interface,
+    study: &'a Study,
     design: &'a Design,
     times: Vec<f64>,
     store: &'a Store,
@@ -477,6 +392,9 @@ struct Batch<'a> {
     stop_on_failure: bool,
     /// Stop after this many new points.
     max_new: Option<usize>,
+    /// `--isolate`: the worker processes.
+    workers: Option<WorkerPool>,
+    guard: &'a StudyGuard,
 }
 
 impl Batch<'_> {
@@ -484,7 +402,7 @@ impl Batch<'_> {
         &self,
         points: &[usize],
         bar: Option<&indicatif::ProgressBar>,
-    ) -> Result<Vec<(usize, Record)>, StoreError> {
+    ) -> Result<Vec<(usize, Record)>, RunError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
         points
@@ -492,7 +410,7 @@ impl Batch<'_> {
             .with_min_len(1)
             .map_init(
                 || None::<Instance>,
-                |slot, &i| -> Result<Option<(usize, Record)>, StoreError> {
+                |slot, &i| -> Result<Option<(usize, Record)>, RunError> {
                     if stop.load(Ordering::Relaxed) {
                         return Ok(None);
                     }
@@ -502,16 +420,16 @@ impl Batch<'_> {
                             return Ok(None);
                         }
                     }
-                    let values = &self.design.values[i];
-                    let rec = match run_point(self.fmu, slot, &self.iface, values, &self.times) {
-                        Ok(v) => Record::Ok(v),
+                    let rec = match self.run_one(slot, i) {
+                        Ok(rec) => rec,
                         Err(e) => {
-                            if self.stop_on_failure {
-                                stop.store(true, Ordering::Relaxed);
-                            }
-                            Record::Failed(e.to_string())
+                            stop.store(true, Ordering::Relaxed);
+                            return Err(e);
                         }
                     };
+                    if matches!(rec, Record::Failed(_)) && self.stop_on_failure {
+                        stop.store(true, Ordering::Relaxed);
+                    }
                     self.store.append(i, &rec)?;
                     if let Some(b) = bar {
                         b.inc(1);
@@ -522,6 +440,36 @@ impl Batch<'_> {
             .filter_map(Result::transpose)
             .collect()
     }
+
+    /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
+    fn run_one(&self, slot: &mut Option<Instance>, i: usize) -> Result<Record, RunError> {
+        let values = &self.design.values[i];
+        let _running = self.guard.running(i, describe_values(self.study, values));
+        let Some(workers) = &self.workers else {
+            return Ok(
+                match run_point(self.fmu, slot, &self.iface, values, &self.times) {
+                    Ok(v) => Record::Ok(v),
+                    Err(e) => Record::Failed(e.to_string()),
+                },
+            );
+        };
+        match workers.run(values) {
+            Ok(v) => Ok(Record::Ok(v)),
+            Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => Ok(Record::Failed(m)),
+            Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
+        }
+    }
+}
+
+/// "K = 1.2, C = 3" for messages.
+fn describe_values(study: &Study, values: &[f64]) -> String {
+    study
+        .parameters
+        .iter()
+        .zip(values)
+        .map(|(p, v)| format!("{} = {v}", p.name))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The number of failed points; an error naming the first when failures are not allowed
@@ -560,57 +508,6 @@ pub fn check_failures(
             parameters,
             message: message.clone(),
         },
-    })
-}
-
-/// One deterministic run: its times and, per recorded variable, the series.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Simulation {
-    /// The variables recorded.
-    pub names: Vec<String>,
-    /// Communication points (s): the grid, cut where the FMU ended the simulation.
-    pub times: Vec<f64>,
-    /// `series[o][k]`: variable `o` at `times[k]`.
-    pub series: Vec<Vec<f64>>,
-    /// Outputs not recorded, with the reason (when every output was asked for).
-    pub skipped: Vec<(String, String)>,
-    /// When the FMU ended the simulation before the stop time, the time (s).
-    pub ended_at: Option<f64>,
-}
-
-/// One deterministic run of `fmu` with `params` set before initialization, `inputs` (a CSV
-/// file, see [`super::inputs`]) applied during the run, recording `outputs` (names; every
-/// output that can be recorded when empty) at `times`. Where the FMU ends the simulation
-/// early, the run ends there (its last row at the FMU's last successful time), as in fmpy.
-pub fn simulate(
-    fmu: &Fmu,
-    params: &[(String, FixedValue)],
-    outputs: &[String],
-    inputs: Option<&Path>,
-    times: &[f64],
-) -> Result<Simulation, RunError> {
-    let iface = Interface::for_run(fmu, params, outputs, inputs)?;
-    let trace = simulate_point(fmu, &mut None, &iface, &[], times)?;
-    let nt = times.len();
-    let mut out_times = times[..trace.recorded].to_vec();
-    let mut series: Vec<Vec<f64>> = trace
-        .values
-        .chunks(nt)
-        .map(|s| s[..trace.recorded].to_vec())
-        .collect();
-    let ended_at = trace.ended.as_ref().map(|(t, _)| *t);
-    if let Some((t, Some(row))) = trace.ended {
-        out_times.push(t);
-        for (s, v) in series.iter_mut().zip(row) {
-            s.push(v);
-        }
-    }
-    Ok(Simulation {
-        names: iface.signal_names,
-        times: out_times,
-        series,
-        skipped: iface.skipped,
-        ended_at,
     })
 }
 
