@@ -74,14 +74,24 @@ pub(crate) struct FmuInner {
     _extracted: Option<Extracted>,
 }
 
-/// A temporary extraction folder, known to [`cleanup`] while it exists.
+/// A temporary extraction folder, known to [`cleanup`] until it is removed.
 #[derive(Debug)]
-struct Extracted(tempfile::TempDir);
+struct Extracted(Option<tempfile::TempDir>);
+
+impl Extracted {
+    fn path(&self) -> &Path {
+        self.0.as_ref().expect("present until dropped").path()
+    }
+}
 
 impl Drop for Extracted {
     fn drop(&mut self) {
-        cleanup::unregister(self.0.path());
-        // The TempDir removes the folder after this.
+        if let Some(dir) = self.0.take() {
+            let path = dir.path().to_path_buf();
+            // Removed first, forgotten after: a signal meanwhile still finds it registered.
+            let _ = dir.close();
+            cleanup::unregister(&path);
+        }
     }
 }
 
@@ -97,18 +107,17 @@ impl Fmu {
         if metadata.is_dir() {
             return Self::load(path, path, None);
         }
-        let dir = tempfile::Builder::new()
-            .prefix("uq-fmu-")
-            .tempdir()
-            .map_err(|source| FmuError::Io {
-                path: std::env::temp_dir(),
-                source,
-            })?;
-        // Registered before extracting: a signal during a long extraction still removes it.
-        cleanup::register(dir.path());
-        let dir = Extracted(dir);
-        archive::extract(path, dir.0.path())?;
-        let root = dir.0.path().to_path_buf();
+        // Registered as it is created: a signal during a long extraction still removes it.
+        let dir = cleanup::temp_dir("uq-fmu-").map_err(|source| FmuError::Io {
+            path: std::env::temp_dir(),
+            source,
+        })?;
+        let dir = Extracted(Some(dir));
+        {
+            let _filling = cleanup::filling();
+            archive::extract(path, dir.path())?;
+        }
+        let root = dir.path().to_path_buf();
         Self::load(path, &root, Some(dir))
     }
 
