@@ -113,12 +113,12 @@ fn simulate_point(
                     return Err(e.into());
                 };
                 if isclose(end, times[k]) {
-                    // The step completed and the FMU ends there.
+                    // The step completed and the FMU ends there (at `end`, as it says).
                     iface.signals.read(inst, &mut buf)?;
                     store_column(&mut trace.values, &buf, nt, k);
                     trace.recorded = k + 1;
                     if k + 1 < nt {
-                        trace.ended = Some((times[k], None));
+                        trace.ended = Some((end, None));
                     }
                 } else if end > times[k - 1] && !isclose(end, times[k - 1]) {
                     iface.signals.read(inst, &mut buf)?;
@@ -253,11 +253,19 @@ pub fn simulate(
         .map(|s| s[..trace.recorded].to_vec())
         .collect();
     let ended_at = trace.ended.as_ref().map(|(t, _)| *t);
-    if let Some((t, Some(row))) = trace.ended {
-        out_times.push(t);
-        for (s, v) in series.iter_mut().zip(row) {
-            s.push(v);
+    match trace.ended {
+        Some((t, Some(row))) => {
+            out_times.push(t);
+            for (s, v) in series.iter_mut().zip(row) {
+                s.push(v);
+            }
         }
+        // Ended at (within 1e-9 of) a grid time: the last row is at the FMU's own time, as fmpy
+        // writes it.
+        Some((t, None)) if trace.recorded > 0 && isclose(t, times[trace.recorded - 1]) => {
+            out_times[trace.recorded - 1] = t;
+        }
+        _ => {}
     }
     Ok(Simulation {
         names: iface.signal_names,
