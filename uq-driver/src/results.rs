@@ -8,10 +8,10 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::spec::{Experiment, PaperValue};
+use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::inputs::Correlation;
 use crate::uq::method::{ChaosError, Draws, MethodSummary, Sobol};
+use crate::uq::random_inputs::Correlation;
 
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
@@ -228,7 +228,7 @@ pub struct Summary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub correlation: Option<Correlation>,
     /// Deterministic values.
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
     /// The FMU (null for intrusive methods).
     pub fmu: Option<FmuInfo>,
     /// Model runs of the study (1 for intrusive methods).

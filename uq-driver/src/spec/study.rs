@@ -4,11 +4,12 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use super::file::{Analysis, Experiment, PaperValue};
+use super::value::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
-use crate::uq::inputs::{Correlation, Inputs};
 use crate::uq::method::{Method, MethodSpec, Problem};
+use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// A validated study, ready to run.
 #[derive(Clone, Debug)]
@@ -36,7 +37,9 @@ pub struct Study {
     /// Their correlation (`[[correlation]]`), if any.
     pub correlation: Option<Correlation>,
     /// Deterministic values.
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
+    /// Time-varying inputs: the CSV file, resolved against the study's folder.
+    pub inputs: Option<PathBuf>,
     /// Outputs analysed over time.
     pub outputs: Vec<String>,
     /// Scalar quantities of interest.
@@ -72,8 +75,8 @@ impl Study {
     }
 
     /// The random inputs: parameters and correlation, as designs map to them.
-    pub fn inputs(&self) -> Inputs {
-        Inputs {
+    pub fn random_inputs(&self) -> RandomInputs {
+        RandomInputs {
             parameters: self.parameters.clone(),
             correlation: self.correlation.clone(),
         }

@@ -112,7 +112,7 @@ fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
 
 /// The study's design.
 fn design(study: &Study) -> Result<Design, ShardError> {
-    let d = sampling(study)?.design(&study.inputs(), study.seed);
+    let d = sampling(study)?.design(&study.random_inputs(), study.seed);
     Ok(d.map_err(RunError::from)?)
 }
 
@@ -167,7 +167,8 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     for (i, vals) in design.values.iter().enumerate() {
         csv.push_str(&format!("{i},{}", i % shards));
         for v in vals {
-            csv.push_str(&format!(",{v}"));
+            csv.push(',');
+            crate::report::csv::push_shortest(&mut csv, *v);
         }
         csv.push('\n');
     }

@@ -16,8 +16,8 @@ use crate::results::{
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
-use crate::uq::inputs::Inputs;
 use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
 /// Runs a study that is not a suite.
@@ -34,7 +34,7 @@ pub(crate) fn run_single(
         Evaluation::Intrusive(method) => solve(study, method, out_dir),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
-            let design = method.design(&study.inputs(), study.seed)?;
+            let design = method.design(&study.random_inputs(), study.seed)?;
             eprintln!(
                 "{}: {} with {} model runs",
                 study.name,
@@ -198,7 +198,14 @@ fn solve(
             })
         })
         .collect();
-    write_surrogate(study, Germ::Normal, &study.inputs(), &chaos, &[], out_dir)?;
+    write_surrogate(
+        study,
+        Germ::Normal,
+        &study.random_inputs(),
+        &chaos,
+        &[],
+        out_dir,
+    )?;
     let mut method_summary = study.method().summary(study.parameters.len());
     method_summary.details.extend(solution.details);
     let facts = RunFacts {
@@ -239,7 +246,7 @@ fn solve(
 fn write_surrogate(
     study: &Study,
     germ: Germ,
-    inputs: &Inputs,
+    inputs: &RandomInputs,
     outputs: &[NamedChaos],
     quantities: &[NamedChaos],
     out_dir: &Path,

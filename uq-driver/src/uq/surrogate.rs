@@ -14,9 +14,9 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::uq::distributions::{Distribution, Germ, RandomParameter};
-use crate::uq::inputs::{Correlation, CorrelationPair, Inputs};
 use crate::uq::method::ChaosError;
 use crate::uq::pce::{germ_draws, Basis, Family, MultiIndexSet, Pce};
+use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
 
 /// `format` of the file.
 pub const FORMAT: &str = "railuq-surrogate";
@@ -158,7 +158,7 @@ impl SurrogateFile {
         study: &str,
         method: &str,
         germ: Germ,
-        inputs: &Inputs,
+        inputs: &RandomInputs,
         outputs: &[NamedChaos],
         quantities: &[NamedChaos],
     ) -> SurrogateFile {
@@ -225,7 +225,7 @@ pub struct Surrogate {
     /// The file it was read from.
     pub file: SurrogateFile,
     /// The inputs (marginals and copula).
-    pub inputs: Inputs,
+    pub inputs: RandomInputs,
     /// One chaos per output (columns: times), then one per quantity (one column).
     chaos: Vec<Pce>,
 }
@@ -285,7 +285,7 @@ impl Surrogate {
             .map_or(Vec::new(), |c| c.pairs.clone());
         let correlation =
             Correlation::new(&parameters, pairs).map_err(|e| invalid(e.to_string()))?;
-        let inputs = Inputs {
+        let inputs = RandomInputs {
             parameters,
             correlation,
         };
@@ -442,9 +442,9 @@ impl Surrogate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::inputs::CorrelationPair;
+    use crate::uq::random_inputs::CorrelationPair;
 
-    fn inputs(correlated: bool) -> Inputs {
+    fn inputs(correlated: bool) -> RandomInputs {
         let parameters = vec![
             RandomParameter {
                 name: "a".into(),
@@ -464,7 +464,7 @@ mod tests {
             vec![]
         };
         let correlation = Correlation::new(&parameters, pairs).unwrap();
-        Inputs {
+        RandomInputs {
             parameters,
             correlation,
         }

@@ -5,8 +5,8 @@ use serde::Serialize;
 
 use super::error::MethodError;
 use crate::uq::distributions::Germ;
-use crate::uq::inputs::Inputs;
 use crate::uq::pce::Family;
+use crate::uq::random_inputs::RandomInputs;
 
 /// Where a [`Sampling`](super::Sampling) method runs the model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -22,20 +22,20 @@ pub struct Design {
     pub weights: Option<Vec<f64>>,
     /// Notes for the user (e.g. points where a Gaussian stiffness is negative).
     pub warnings: Vec<String>,
-    /// The inputs `points` are mapped to ([`Inputs::to_physical`]): marginals and copula.
-    pub inputs: Inputs,
+    /// The inputs `points` are mapped to ([`RandomInputs::to_physical`]): marginals and copula.
+    pub inputs: RandomInputs,
 }
 
 impl Design {
     /// A design whose values are the images of `points` under the inputs' map from `germ`
-    /// ([`Inputs::to_physical`]: each input's isoprobabilistic map, correlated through the
+    /// ([`RandomInputs::to_physical`]: each input's isoprobabilistic map, correlated through the
     /// copula where the study correlates inputs), with a warning per parameter that reaches
     /// non-positive values although its mean is positive.
     pub fn mapped(
         germ: Germ,
         points: Vec<Vec<f64>>,
         weights: Option<Vec<f64>>,
-        inputs: &Inputs,
+        inputs: &RandomInputs,
     ) -> Design {
         let values = points.iter().map(|t| inputs.to_physical(germ, t)).collect();
         let mut design = Design {
@@ -131,7 +131,7 @@ mod tests {
 
     #[test]
     fn negative_values_of_a_positive_parameter_are_reported_with_their_weight() {
-        let params = Inputs::independent(vec![RandomParameter {
+        let params = RandomInputs::independent(vec![RandomParameter {
             name: "k".into(),
             distribution: Distribution::normal(1.0, 1.0).unwrap(),
         }]);

@@ -102,7 +102,7 @@ mod tests {
 
     use super::*;
     use crate::uq::distributions::RandomParameter;
-    use crate::uq::inputs::Inputs;
+    use crate::uq::random_inputs::RandomInputs;
 
     #[test]
     fn kinds_are_the_snake_case_variant_names() {
@@ -146,7 +146,7 @@ mod tests {
     #[test]
     fn every_sampling_method_estimates_the_analytic_fixture() {
         let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
-        let params = Inputs::independent(vec![
+        let params = RandomInputs::independent(vec![
             RandomParameter {
                 name: "K".into(),
                 distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
@@ -240,7 +240,7 @@ mod tests {
         let Evaluation::Sampling(m) = spec.method().evaluation() else {
             panic!("scm runs a design");
         };
-        let params = Inputs::independent(vec![RandomParameter {
+        let params = RandomInputs::independent(vec![RandomParameter {
             name: "K".into(),
             distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
         }]);

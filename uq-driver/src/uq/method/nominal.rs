@@ -8,7 +8,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
-use crate::uq::inputs::Inputs;
+use crate::uq::random_inputs::RandomInputs;
 
 /// `kind = "nominal"` (no settings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,7 +45,7 @@ impl Method for Nominal {
 impl Sampling for Nominal {
     /// One point of weight 1 at the parameters' means (a discrete input at the value of
     /// its support nearest to its mean, [`crate::uq::Distribution::nominal`]).
-    fn design(&self, inputs: &Inputs, _seed: u64) -> Result<Design, MethodError> {
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         Ok(Design {
             germ: Germ::Normal,
             points: vec![vec![0.0; inputs.len()]],

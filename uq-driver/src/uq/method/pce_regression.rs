@@ -27,7 +27,7 @@ use crate::uq::hd::lars::PathKind;
 use crate::uq::hd::regression::LeastSquares;
 use crate::uq::hd::sobol_seq::Sobol;
 use crate::uq::hd::sparse_chaos::{Candidates, FitKind};
-use crate::uq::inputs::Inputs;
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce};
 use crate::uq::sampling;
 
@@ -123,7 +123,7 @@ impl PceRegression {
     }
 
     /// The design read from the points file.
-    fn file_design(&self, path: &str, inputs: &Inputs) -> Result<Design, MethodError> {
+    fn file_design(&self, path: &str, inputs: &RandomInputs) -> Result<Design, MethodError> {
         let invalid = |m: String| MethodError::Invalid(InvalidSettings(m));
         let text = std::fs::read_to_string(path)
             .map_err(|e| invalid(format!("points file {path}: {e}")))?;
@@ -142,7 +142,7 @@ impl PceRegression {
 }
 
 /// The parameter values of a points file (header with the parameters' names).
-fn read_points(text: &str, inputs: &Inputs) -> Result<Vec<Vec<f64>>, String> {
+fn read_points(text: &str, inputs: &RandomInputs) -> Result<Vec<Vec<f64>>, String> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let header: Vec<&str> = lines
         .next()
@@ -261,7 +261,7 @@ fn under_determined(n: usize, terms: usize, m: &PceRegression) -> InvalidSetting
 impl Sampling for PceRegression {
     /// The random design mapped to the chaos germs (one uniform per coordinate through the
     /// germ law's quantile), or the points file.
-    fn design(&self, inputs: &Inputs, seed: u64) -> Result<Design, MethodError> {
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         if let Some(path) = &self.points {
             return self.file_design(path, inputs);
         }
@@ -380,8 +380,8 @@ mod tests {
     use super::*;
     use crate::uq::{Distribution, RandomParameter};
 
-    fn inputs() -> Inputs {
-        Inputs::independent(vec![
+    fn inputs() -> RandomInputs {
+        RandomInputs::independent(vec![
             RandomParameter {
                 name: "a".into(),
                 distribution: Distribution::normal(1.0, 0.5).unwrap(),

@@ -9,7 +9,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
-use crate::uq::inputs::Inputs;
+use crate::uq::random_inputs::RandomInputs;
 
 /// A method that draws `samples` equally weighted points in the unit cube.
 pub(crate) trait UnitCubeSample: std::fmt::Debug + Send + Sync {
@@ -55,7 +55,7 @@ impl<T: UnitCubeSample> Method for T {
 }
 
 impl<T: UnitCubeSample> Sampling for T {
-    fn design(&self, inputs: &Inputs, seed: u64) -> Result<Design, MethodError> {
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         let points = T::points(self.samples(), inputs.len(), seed);
         Ok(Design::mapped(Germ::Uniform, points, None, inputs))
     }

@@ -12,7 +12,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
-use crate::uq::inputs::Inputs;
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
 
@@ -88,7 +88,7 @@ impl Method for Scm {
 
 impl Sampling for Scm {
     /// The tensor grid, last parameter varying fastest; weights sum to one.
-    fn design(&self, inputs: &Inputs, _seed: u64) -> Result<Design, MethodError> {
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         let grid = quadrature::tensor_grid(&vec![self.nodes; inputs.len()])?;
         Ok(Design::mapped(
             Germ::Normal,

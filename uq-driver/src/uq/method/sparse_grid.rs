@@ -28,7 +28,7 @@ use crate::uq::distributions::RandomParameter;
 use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
 use crate::uq::hd::smolyak::{LevelSet, SparseGrid as Grid};
-use crate::uq::inputs::Inputs;
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::Family;
 
 /// Most points of a sparse grid accepted here.
@@ -176,7 +176,7 @@ impl Method for SparseGrid {
 impl Sampling for SparseGrid {
     /// The merged nodes of the sparse grid in the inputs' germs, with the (possibly
     /// negative) combined weights.
-    fn design(&self, inputs: &Inputs, _seed: u64) -> Result<Design, MethodError> {
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         let families = self.families(inputs);
         let grid = self.grid(&families)?;
         let germ = self.chaos.germ();
@@ -232,8 +232,8 @@ mod tests {
     use super::*;
     use crate::uq::Distribution;
 
-    fn inputs(ds: Vec<Distribution>) -> Inputs {
-        Inputs::independent(
+    fn inputs(ds: Vec<Distribution>) -> RandomInputs {
+        RandomInputs::independent(
             ds.into_iter()
                 .enumerate()
                 .map(|(i, d)| RandomParameter {

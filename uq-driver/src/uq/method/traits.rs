@@ -9,7 +9,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
-use crate::uq::inputs::{Correlation, Inputs};
+use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// What a method knows of the study it belongs to.
 #[derive(Clone, Copy, Debug)]
@@ -99,7 +99,7 @@ pub trait Sampling {
     /// The design for `inputs` (deterministic in `seed`): points in an independent standard
     /// space mapped to physical values by [`Design::mapped`], which honours the inputs'
     /// correlation.
-    fn design(&self, inputs: &Inputs, seed: u64) -> Result<Design, MethodError>;
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError>;
 
     /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
     /// the points that gave a value; one column per time step or quantity).

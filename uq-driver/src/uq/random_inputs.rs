@@ -1,7 +1,7 @@
 //! The random inputs of a study: their marginal distributions and, when some are
 //! correlated, the Gaussian copula (Nataf transformation) that joins them.
 //!
-//! Designs are built in an *independent* standard space ([`Germ`]); [`Inputs::to_physical`]
+//! Designs are built in an *independent* standard space ([`Germ`]); [`RandomInputs::to_physical`]
 //! is the map from a design point to the inputs' values:
 //! - an uncorrelated input takes its own isoprobabilistic (or Askey) map of its coordinate;
 //! - correlated inputs take the standard-normal scores `u` of their coordinates
@@ -9,7 +9,7 @@
 //!   normal-space correlation solved by [`GaussianCopula`] so that the *physical* Pearson
 //!   correlations are the requested ones), and map `z_i` through `F_i^-1(Phi(.))`.
 //!
-//! So every method that maps its points through [`Inputs::to_physical`] (all do, through
+//! So every method that maps its points through [`RandomInputs::to_physical`] (all do, through
 //! [`crate::uq::method::Design::mapped`]) honours the correlation, and a chaos built on the
 //! design's coordinates is a chaos in independent germs.
 
@@ -157,14 +157,14 @@ impl Correlation {
 
 /// The random inputs of a study (marginals in study order) and their correlation.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Inputs {
+pub struct RandomInputs {
     /// The random parameters.
     pub parameters: Vec<RandomParameter>,
     /// The Gaussian copula of correlated inputs, if any.
     pub correlation: Option<Correlation>,
 }
 
-impl Deref for Inputs {
+impl Deref for RandomInputs {
     type Target = [RandomParameter];
 
     fn deref(&self) -> &[RandomParameter] {
@@ -172,10 +172,10 @@ impl Deref for Inputs {
     }
 }
 
-impl Inputs {
+impl RandomInputs {
     /// Independent inputs.
-    pub fn independent(parameters: Vec<RandomParameter>) -> Inputs {
-        Inputs {
+    pub fn independent(parameters: Vec<RandomParameter>) -> RandomInputs {
+        RandomInputs {
             parameters,
             correlation: None,
         }
@@ -215,7 +215,7 @@ impl Inputs {
     }
 
     /// The design coordinates in `germ` of the physical values `x` (the inverse of
-    /// [`Inputs::to_physical`]).
+    /// [`RandomInputs::to_physical`]).
     pub fn to_germ(&self, germ: Germ, x: &[f64]) -> Vec<f64> {
         let mut t: Vec<f64> = self
             .parameters
@@ -278,7 +278,7 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(c.correlated, vec![true, true, false]);
-        let inputs = Inputs {
+        let inputs = RandomInputs {
             parameters: params(),
             correlation: Some(c),
         };
