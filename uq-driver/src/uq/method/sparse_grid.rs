@@ -303,4 +303,34 @@ mod tests {
         assert!(err.values[0] < 1e-24, "{:?}", err.values);
         assert!(m.estimate(&d, &rows[1..], &data.rows(1, d.len() - 1).into_owned()).is_err());
     }
+
+    #[test]
+    fn settings_that_do_not_fit_the_inputs_are_refused() {
+        let ins = inputs(vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::normal(2.0, 0.1).unwrap(),
+        ]);
+        fn problem(p: &RandomInputs) -> Problem<'_> {
+            Problem {
+                parameters: &p.parameters,
+                correlation: None,
+                outputs: &[],
+                quantities: 0,
+                times: &[0.0],
+                system: None,
+            }
+        }
+        let p = problem(&ins);
+        let e = method("level = 2\nrule = \"clenshaw_curtis\"")
+            .validate(&p)
+            .unwrap_err();
+        assert!(e.0.contains("fits none of the inputs"), "{e}");
+        let e = method("level = 5").validate(&p).unwrap_err();
+        assert!(e.0.contains("highest level of Genz-Keister (4)"), "{e}");
+        assert!(method("level = 5\nrule = \"gauss_hermite\"")
+            .validate(&p)
+            .is_ok());
+        let int = inputs(vec![Distribution::integer_uniform(1, 3).unwrap()]);
+        assert!(method("level = 1").validate(&problem(&int)).is_err());
+    }
 }
