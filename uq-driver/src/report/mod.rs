@@ -7,6 +7,7 @@
 //! - [`heatmap`]: PDF-evolution heat maps as a viridis PNG plus an SVG frame with axes and colorbar;
 //! - [`html`]: the self-contained `index.html` that ties the files together;
 //! - [`study`]: the files of one study's output folder (one writer per file);
+//! - [`nested`]: what a two-level study adds (conditional statistics, the variance split);
 //! - [`suite`]: the comparison of a suite's variants.
 //!
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
@@ -15,6 +16,7 @@
 pub mod csv;
 pub mod heatmap;
 pub mod html;
+pub mod nested;
 pub mod study;
 pub mod suite;
 pub mod svg;

@@ -27,6 +27,8 @@ pub struct StudyReport<'a> {
     pub qoi: &'a [QoiSpec],
     /// The design and the outcome of each point, if the model was run.
     pub points: Option<&'a PointTable>,
+    /// Further sections of `index.html` (e.g. a nested study's split), after the others.
+    pub extra: &'a [Section],
 }
 
 /// Column name of a quantile level: 0.01 → `q1`, 0.5 → `q50`, 0.025 → `q2.5`.
@@ -90,6 +92,7 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<(), ReportError> {
     write_bytes(&dir.join("summary.json"), json.as_bytes())?;
     let mut page = head_sections(r);
     page.extend(sections);
+    page.extend(r.extra.iter().cloned());
     ReportPage {
         title: format!("railuq study {}", r.summary.study),
         summary_json: json,

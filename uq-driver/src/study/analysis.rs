@@ -174,30 +174,36 @@ pub fn output_stats(
 }
 
 /// The values of one quantity over the successful runs, with their outcome codes.
-struct QuantityRuns {
+pub(crate) struct QuantityRuns {
     /// Design indices of the runs with a valid value.
-    rows: Vec<usize>,
+    pub rows: Vec<usize>,
     /// Their values.
-    valid: Vec<f64>,
-    never_hunts: usize,
-    never_stops: usize,
+    pub valid: Vec<f64>,
+    pub never_hunts: usize,
+    pub never_stops: usize,
 }
 
-/// Statistics of a scalar quantity from its estimate and its valid run values.
-fn scalar_stats(
+/// Statistics of a scalar quantity from its estimate and its valid run values; quantiles and
+/// the density from `density` where given (e.g. the pooled draws of a nested study), else from
+/// the draws the estimate names.
+pub(crate) fn scalar_stats(
     q: &QoiSpec,
     estimate: &Estimate,
     runs: QuantityRuns,
     settings: &Settings,
+    density: Option<Vec<f64>>,
 ) -> Result<ScalarStats, AnalysisError> {
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
-    let density_samples: Vec<f64> = settings
-        .draws(q.name(), estimate, Some(&data))?
-        .column(0)
-        .iter()
-        .copied()
-        .collect();
+    let density_samples: Vec<f64> = match density {
+        Some(d) => d,
+        None => settings
+            .draws(q.name(), estimate, Some(&data))?
+            .column(0)
+            .iter()
+            .copied()
+            .collect(),
+    };
     let mut sorted = density_samples.clone();
     sorted.sort_by(f64::total_cmp);
     let quantiles = a
@@ -241,18 +247,19 @@ fn scalar_stats(
             kind: e.kind.name(),
             value: e.values[0],
         }),
+        nested: None,
     })
 }
 
 /// The values of the successful runs, in design order.
-struct Runs<'a> {
+pub(crate) struct Runs<'a> {
     /// Design indices.
-    rows: Vec<usize>,
+    pub rows: Vec<usize>,
     values: Vec<&'a [f64]>,
 }
 
 impl<'a> Runs<'a> {
-    fn of(records: &'a [Option<Record>]) -> Runs<'a> {
+    pub(crate) fn of(records: &'a [Option<Record>]) -> Runs<'a> {
         let (rows, values) = records
             .iter()
             .enumerate()
@@ -265,12 +272,12 @@ impl<'a> Runs<'a> {
     }
 
     /// Output `o` (of `nt` times each) as runs × times.
-    fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
+    pub(crate) fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
         DMatrix::from_fn(self.rows.len(), nt, |r, k| self.values[r][o * nt + k])
     }
 
     /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
-    fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
+    pub(crate) fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
         let mut out = QuantityRuns {
             rows: Vec::new(),
             valid: Vec::new(),
@@ -369,7 +376,7 @@ pub fn analyse_runs(
                     never_stops: qr.never_stops,
                     source,
                 })?;
-        quantities.push(scalar_stats(q, &estimate, qr, &settings)?);
+        quantities.push(scalar_stats(q, &estimate, qr, &settings, None)?);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
                 name: q.name().to_owned(),

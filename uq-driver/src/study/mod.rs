@@ -12,6 +12,7 @@ pub mod inputs;
 pub mod interface;
 pub mod isolate;
 pub mod lock;
+pub mod nested;
 mod outcome;
 mod point;
 pub mod runner;

@@ -16,7 +16,7 @@ use crate::results::{
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
-use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
+use crate::uq::method::{Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
@@ -121,7 +121,17 @@ pub(crate) fn finish(
             total: design.len(),
         });
     }
-    let analysed = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let (analysed, splits, mut warnings) = match &study.method {
+        MethodSpec::Nested(nested) => {
+            let n = super::nested::analyse(study, nested, design, &outcome.records)?;
+            (n.analysed, n.splits, n.warnings)
+        }
+        _ => (
+            analysis::analyse_runs(study, method, design, &outcome.records)?,
+            Vec::new(),
+            Vec::new(),
+        ),
+    };
     let (outputs, quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let facts = RunFacts {
@@ -140,11 +150,12 @@ pub(crate) fn finish(
         threads: outcome.threads,
     };
     let method_summary = study.method().summary(study.parameters.len());
+    warnings.splice(0..0, design.warnings.iter().cloned());
     let summary = summary(
         study,
         facts,
         method_summary,
-        design.warnings.clone(),
+        warnings,
         &outputs,
         &quantities,
     );
@@ -157,6 +168,7 @@ pub(crate) fn finish(
         out_dir,
     )?;
     let points = point_table(study, design, &outcome.records);
+    let extra = report::nested::write(out_dir, &quantities, &splits)?;
     report::study::write(
         out_dir,
         &StudyReport {
@@ -165,6 +177,7 @@ pub(crate) fn finish(
             quantities: &quantities,
             qoi: &study.qoi,
             points: Some(&points),
+            extra: &extra,
         },
     )?;
     Ok(StudyResult {
@@ -233,6 +246,7 @@ fn solve(
             quantities: &[],
             qoi: &study.qoi,
             points: None,
+            extra: &[],
         },
     )?;
     Ok(StudyResult {
