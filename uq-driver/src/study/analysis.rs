@@ -10,8 +10,9 @@ use nalgebra::DMatrix;
 use super::store::Record;
 use crate::qoi::scalar::Code;
 use crate::qoi::{kde, QoiSpec};
-use crate::results::{OutputStats, ScalarStats};
+use crate::results::{OutputStats, ScalarStats, SobolSummary};
 use crate::spec::{Analysis, Study};
+use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
 use crate::uq::moments;
 
@@ -76,6 +77,8 @@ pub struct Settings<'a> {
     pub analysis: &'a Analysis,
     /// The study's seed.
     pub seed: u64,
+    /// The names of the random parameters, in study order (labels of Sobol' indices).
+    pub parameters: &'a [RandomParameter],
 }
 
 impl<'a> Settings<'a> {
@@ -84,6 +87,7 @@ impl<'a> Settings<'a> {
         Settings {
             analysis: &study.analysis,
             seed: study.seed,
+            parameters: &study.parameters,
         }
     }
 
@@ -163,6 +167,7 @@ pub fn output_stats(
         upper_3sigma,
         quantiles,
         std_pce: estimate.std_chaos.clone(),
+        std_error_mean: estimate.std_error_mean.clone(),
         sobol: estimate.sobol.clone(),
         pdf_times: picked.iter().map(|&k| times[k]).collect(),
         pdf_grid: grid,
@@ -234,6 +239,14 @@ fn scalar_stats(
         density_samples,
         sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
         sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
+        sobol: estimate.sobol.as_ref().map(|s| {
+            let names: Vec<&str> = settings
+                .parameters
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect();
+            SobolSummary::of(s, 0, &names)
+        }),
         draws: estimate.draws,
     })
 }

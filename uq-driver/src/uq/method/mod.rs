@@ -41,7 +41,7 @@ use serde::{Deserialize, Serialize};
 
 pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
-pub use estimate::{Draws, Estimate, Sobol};
+pub use estimate::{Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
     details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
 };
@@ -76,6 +76,8 @@ macro_rules! methods {
 methods! {
     mc::Mc,
     lhs::Lhs,
+    qmc::Qmc,
+    sobol_sampling::SobolSampling,
     scm::Scm,
     sgm::Sgm,
     nominal::Nominal,
@@ -94,6 +96,9 @@ mod tests {
         for (text, kind) in [
             ("kind = \"mc\"\nsamples = 10", "mc"),
             ("kind = \"lhs\"\nsamples = 10", "lhs"),
+            ("kind = \"lhs\"\nsamples = 10\nreplicates = 4", "lhs"),
+            ("kind = \"qmc\"\nsamples = 16", "qmc"),
+            ("kind = \"sobol_sampling\"\nsamples = 16", "sobol_sampling"),
             ("kind = \"scm\"\nnodes = 3", "scm"),
             ("kind = \"sgm\"\norder = 2", "sgm"),
             ("kind = \"nominal\"", "nominal"),
@@ -113,6 +118,8 @@ mod tests {
             "kind = \"scm\"\nsamples = 10\nnodes = 3",
             "kind = \"nominal\"\norder = 1",
             "kind = \"mc\"",
+            "kind = \"mc\"\nsamples = 10\nreplicates = 4",
+            "kind = \"qmc\"\nnodes = 3",
         ] {
             let r: Result<MethodSpec, _> = toml::from_str(text);
             assert!(r.is_err(), "{text}");
@@ -146,6 +153,9 @@ mod tests {
         for text in [
             "kind = \"mc\"\nsamples = 20000",
             "kind = \"lhs\"\nsamples = 20000",
+            "kind = \"lhs\"\nsamples = 2000\nreplicates = 10",
+            "kind = \"qmc\"\nsamples = 4096\nreplicates = 8",
+            "kind = \"sobol_sampling\"\nsamples = 8192",
             "kind = \"scm\"\nnodes = 3",
             "kind = \"nominal\"",
         ] {
@@ -174,9 +184,21 @@ mod tests {
                     assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-12);
                     assert_eq!(e.draws, Draws::Chaos);
                 }
+                "sobol_sampling" => {
+                    // Pick-freeze indices of the same fixture, within sampling error.
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][0] - parts[0] / var).abs() < 0.03);
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 0.03);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 0.03);
+                    assert!(sobol.intervals.is_some());
+                    assert!((e.mean[0] - mean).abs() < 4.0 * e.std_error_mean.unwrap()[0]);
+                    assert!((e.std[0] / var.sqrt() - 1.0).abs() < 0.03);
+                }
                 kind => {
                     let se = e.std_error_mean.as_ref().unwrap()[0];
-                    assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    if !text.contains("replicates") {
+                        assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    }
                     assert!((e.mean[0] - mean).abs() < 4.0 * se, "{kind}: {}", e.mean[0]);
                     assert!(
                         (e.std[0] / var.sqrt() - 1.0).abs() < 0.03,

@@ -69,4 +69,8 @@ impl Sampling for Nominal {
     fn min_runs(&self) -> usize {
         1
     }
+
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        Some(1.0)
+    }
 }

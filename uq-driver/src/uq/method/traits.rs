@@ -109,6 +109,14 @@ pub trait Sampling {
     fn min_runs(&self) -> usize {
         2
     }
+
+    /// The number of model runs of the design for `dim` random parameters, computed without
+    /// building it (as a float: it may be far beyond any integer type), or `None` when only
+    /// the design knows. The study checks it before anything is allocated (`study::guard`):
+    /// every method should give it.
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        None
+    }
 }
 
 /// A method that solves a projected (intrusive) system instead of running the model.
