@@ -9,7 +9,9 @@ use clap::{Args, Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
 use uq_driver::spec::{builtin, Experiment, Study, BUILTINS};
-use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
+use uq_driver::study::{
+    guard, run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult,
+};
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +38,9 @@ enum Command {
         /// Plan folder.
         #[arg(long, short)]
         out: PathBuf,
+        /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+        #[arg(long)]
+        yes: bool,
     },
     /// Run one shard of a plan (resumable); K defaults to $SLURM_ARRAY_TASK_ID.
     RunShard {
@@ -100,6 +105,9 @@ struct RunArgs {
     /// Stop after this many new points (the study can be resumed later).
     #[arg(long, hide = true)]
     max_points: Option<usize>,
+    /// Start a large study (more than 100 000 runs, or much memory or time) without asking.
+    #[arg(long)]
+    yes: bool,
 }
 
 #[derive(Args)]
@@ -127,6 +135,9 @@ struct SlurmArgs {
     /// Write the scripts but do not submit.
     #[arg(long)]
     dry_run: bool,
+    /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+    #[arg(long)]
+    yes: bool,
 }
 
 #[derive(Args)]
@@ -202,8 +213,14 @@ fn causes(e: &anyhow::Error) -> String {
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Run(args) => run(args),
-        Command::Plan { study, shards, out } => {
+        Command::Plan {
+            study,
+            shards,
+            out,
+            yes,
+        } => {
             let s = Study::load(&study)?;
+            guard_plan(&s, yes)?;
             let p = shard::plan(&s, shards, &out)?;
             println!(
                 "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
@@ -269,12 +286,23 @@ fn run(a: RunArgs) -> Result<()> {
         fresh: a.fresh,
         max_new_points: a.max_points,
         points: None,
+        yes: a.yes,
     };
     let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
     match outcome {
         Outcome::Study(r) => print_study(&r, &a.out),
         Outcome::Suite(r) => print_suite(&r, &a.out),
     }
+    Ok(())
+}
+
+/// The size checks of `run` for a plan (whose shards run with the default thread count).
+fn guard_plan(s: &Study, yes: bool) -> Result<()> {
+    let opts = RunOptions {
+        yes,
+        ..RunOptions::default()
+    };
+    guard::check(s, &opts).with_context(|| format!("study {}", s.origin))?;
     Ok(())
 }
 
@@ -309,6 +337,7 @@ fn run_shard(
 /// `uq-driver slurm`: plan, write the batch scripts and (unless --dry-run) submit them.
 fn slurm(a: SlurmArgs) -> Result<()> {
     let s = Study::load(&a.study)?;
+    guard_plan(&s, a.yes)?;
     shard::plan(&s, a.shards, &a.out)?;
     let driver = std::env::current_exe().context("locating the uq-driver executable")?;
     let o = shard::SlurmOptions {
@@ -424,6 +453,12 @@ fn simulate(a: SimulateArgs) -> Result<()> {
         .context("no --step and no default step size in the FMU")?;
     let experiment = Experiment { start, stop, step };
     experiment.check()?;
+    let series = if a.outputs.is_empty() {
+        fmu.description().output_variables().count()
+    } else {
+        a.outputs.len()
+    };
+    guard::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
     let (names, series) = runner::simulate(&fmu, &a.set, &a.outputs, &times)?;
     let mut text = String::from("time");

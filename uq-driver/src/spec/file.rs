@@ -10,6 +10,10 @@ use crate::qoi::QoiSpec;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::MethodSpec;
 
+/// Most communication points of one run (the limit of [`Experiment::check`]): 10^8 points
+/// hold 800 MB per recorded variable.
+pub const MAX_TIME_POINTS: f64 = 1e8;
+
 /// Start, stop and communication step (s).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -43,8 +47,9 @@ impl Experiment {
             .collect()
     }
 
-    /// Checks that start < stop and step > 0 (all finite) and that stop − start is a whole
-    /// number of steps.
+    /// Checks that start < stop and step > 0 (all finite), that the grid has fewer than
+    /// [`MAX_TIME_POINTS`] points (before anything allocates it) and that stop − start is a
+    /// whole number of steps.
     pub fn check(&self) -> Result<(), InvalidExperiment> {
         let finite = self.start.is_finite() && self.stop.is_finite() && self.step.is_finite();
         if !finite || self.step <= 0.0 || self.stop <= self.start {
@@ -55,6 +60,12 @@ impl Experiment {
             });
         }
         let ratio = (self.stop - self.start) / self.step;
+        if ratio.is_nan() || ratio.round() >= MAX_TIME_POINTS {
+            return Err(InvalidExperiment::TooManyPoints {
+                points: ratio.round() + 1.0,
+                step: self.step,
+            });
+        }
         if (ratio - ratio.round()).abs() > 1e-6 * ratio.max(1.0) {
             return Err(InvalidExperiment::NotWholeSteps {
                 span: self.stop - self.start,
@@ -77,6 +88,19 @@ pub enum InvalidExperiment {
         start: f64,
         /// Stop (s).
         stop: f64,
+        /// Step (s).
+        step: f64,
+    },
+    /// More communication points than [`MAX_TIME_POINTS`].
+    #[error(
+        "experiment: {points:.3e} communication points (step {step:e} s), more than the limit of \
+         1e8 per run (each recorded variable would take {:.1e} bytes of memory); use a \
+         coarser step or a shorter experiment",
+        8.0 * points
+    )]
+    TooManyPoints {
+        /// Communication points (t_0 … t_n).
+        points: f64,
         /// Step (s).
         step: f64,
     },

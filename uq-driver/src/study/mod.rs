@@ -7,6 +7,7 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+pub mod guard;
 pub mod interface;
 mod outcome;
 pub mod runner;
@@ -24,11 +25,15 @@ use crate::spec::Study;
 
 /// Runs a study into `out_dir` (resuming what a previous run there finished). A suite runs
 /// every variant into `out_dir/<variant>/` and writes the comparison into `out_dir`.
+///
+/// Nothing is allocated, run or written (`out_dir` is not even created) before the study
+/// passes [`guard::check`]: too large to run, it is refused; large, it needs `opts.yes`.
 pub fn run_study(
     study: &Study,
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<Outcome, StudyRunError> {
+    guard::check(study, opts)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),
         None => single::run_single(study, out_dir, opts).map(|r| Outcome::Study(Box::new(r))),

@@ -1,6 +1,7 @@
 //! What running a study returns, and how it fails.
 
 use super::analysis::AnalysisError;
+use super::guard::GuardError;
 use super::runner::RunError;
 use crate::report::ReportError;
 use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
@@ -12,6 +13,9 @@ pub enum StudyRunError {
     /// Running the points failed.
     #[error(transparent)]
     Run(#[from] RunError),
+    /// The study is too large to start (or to start without `--yes`).
+    #[error(transparent)]
+    Guard(#[from] GuardError),
     /// An intrusive method failed.
     #[error(transparent)]
     Method(#[from] MethodError),

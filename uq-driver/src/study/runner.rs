@@ -30,6 +30,8 @@ pub struct RunOptions {
     pub max_new_points: Option<usize>,
     /// Run only these points of the design (a shard); None: all.
     pub points: Option<Vec<usize>>,
+    /// Start a large study without asking (`--yes`; see [`super::guard`]).
+    pub yes: bool,
 }
 
 impl RunOptions {

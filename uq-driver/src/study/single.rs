@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::analysis;
+use super::guard;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::store::Record;
@@ -32,6 +33,10 @@ pub(crate) fn run_single(
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
             let design = method.design(&study.parameters, study.seed)?;
+            if method.planned_runs(study.parameters.len()).is_none() {
+                // Only the design knew its size: check it before it runs.
+                guard::check_runs(study, design.len(), opts)?;
+            }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
             finish(study, method, &fmu, &design, outcome, out_dir, opts)
         }
