@@ -320,3 +320,41 @@ fn more_than_100000_runs_need_yes() {
         stderr(&o)
     );
 }
+
+/// A study of fewer than 100 000 runs that takes hours (VehicleTrack over 60 s, about 1.5 s a
+/// run here, 99 000 runs on one thread): timed on a short run, it needs --yes.
+#[test]
+fn a_long_study_needs_yes() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vehicle-track-nominal.toml"),
+    )
+    .unwrap()
+    .replace("kind = \"nominal\"", "kind = \"lhs\"\nsamples = 99000")
+    .replace("stop = 6.0", "stop = 60.0")
+    .replace("variables = [\"Zc_acc\", \"P1\"]", "variables = []");
+    let p = dir.path().join("long.toml");
+    std::fs::write(&p, text).unwrap();
+    let out = dir.path().join("out");
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    assert_refused(
+        &o,
+        &[
+            "more than 60 min",
+            "on 1 thread",
+            "per run, measured",
+            "--yes",
+        ],
+    );
+    let err = stderr(&o);
+    assert!(!err.contains("model runs, more than"), "{err}");
+    assert!(!err.contains("of memory, more than"), "{err}");
+    assert!(!out.exists());
+}

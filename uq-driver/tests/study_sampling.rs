@@ -374,7 +374,8 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
             let v = q[kind][&p].as_f64().unwrap();
             let ci = &q[format!("{kind}_ci")][&p];
             let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
-            assert!((v - exact).abs() < 0.02, "{kind} {p}: {v} vs {exact}");
+            // Measured: within 0.002 of the closed form.
+            assert!((v - exact).abs() < 0.01, "{kind} {p}: {v} vs {exact}");
             assert!(hi - lo < 0.1, "{kind} {p}: [{lo}, {hi}]");
             covered += usize::from(lo <= exact && exact <= hi);
         }
@@ -423,8 +424,9 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices(
             / var;
         let f = q["first"][&p].as_f64().unwrap();
         let t = q["total"][&p].as_f64().unwrap();
-        assert!((f - first).abs() < 0.02, "S_{p}: {f} vs {first}");
-        assert!((t - total).abs() < 0.02, "ST_{p}: {t} vs {total}");
+        // Measured: within 0.0013 of the closed form.
+        assert!((f - first).abs() < 0.005, "S_{p}: {f} vs {first}");
+        assert!((t - total).abs() < 0.005, "ST_{p}: {t} vs {total}");
     }
     assert_eq!(summary(&out)["model_runs"], 4096 * 10);
 }

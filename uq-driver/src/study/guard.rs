@@ -12,8 +12,8 @@
 //! quantities, `g` signals read per step, `d` random parameters, `T` threads:
 //! - the records of every run, held until the analysis: `n (8 (s nt + 2 q) + 64)`;
 //! - the results store read back whole when a study resumes: `n (8 (s nt + 2 q) + 48)`;
-//! - the analysis of one output: its matrix and the estimators' copies, `1.5 × 8 n nt`, and, for a chaos,
-//!   its surrogate draws `8 × surrogate_samples × nt`;
+//! - the analysis of one output: its matrix and the estimators' copies, `1.5 × 8 n nt`, and,
+//!   for a method that may build a chaos, its surrogate draws `8 × surrogate_samples × nt`;
 //! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
 //! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
 //! - the time grid (a few copies): `4 × 8 nt`.
@@ -21,11 +21,17 @@
 //! The peak is the design, grid and records plus the larger of the store read and the
 //! analysis (with the worker buffers).
 //!
-//! Time: measured. The FMU is run at the parameters' means on a short grid (a warm-up of one
-//! communication step, then 1 and [`PROBE_STEPS`] steps); the cost of a run is the cost of
-//! the first step plus that of the others, per step, and the study takes `n` such runs on `T`
-//! threads. An FMU that fails the probe gives no time estimate (the study then reports the
-//! failure itself).
+//! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
+//! (runs × steps; a smaller study reaches an hour only if one step costs more than 0.36 ms on
+//! one thread, and is not timed). The FMU is run at the parameters' means on short grids: a
+//! warm-up of one communication step, then 1 step (best of 3), then [`PROBE_STEPS`], 4×, 16×,
+//! … steps (best of 2) until a run takes 4 times the one-step run and [`PROBE_MIN_SECONDS`]
+//! more (the steps show above the initialisation and the timer's noise), the whole
+//! experiment or [`PROBE_SECONDS`]; the cost of a run is the cost of the one-step run
+//! plus that of the other steps at the measured rate, and the study takes `n` such
+//! runs on `T` threads (the runner's own work, e.g. writing the store, is not included: the
+//! wheel's runs take about twice the estimate). An FMU that fails the probe gives no time
+//! estimate (the study then reports the failure itself).
 
 use std::fmt;
 use std::time::Instant;
@@ -42,8 +48,14 @@ pub const MAX_RUNS: f64 = 100_000.0;
 pub const MEMORY_FRACTION: f64 = 0.5;
 /// A time estimate above this (s; one hour) needs `--yes`.
 pub const MAX_SECONDS: f64 = 3600.0;
-/// Communication steps of the timing probe.
+/// Communication steps of the first timed run of the probe (then 4×, 16×, … as needed).
 pub const PROBE_STEPS: usize = 50;
+/// The probe's runs stop growing once one takes this long (s).
+pub const PROBE_SECONDS: f64 = 1.0;
+/// ... or once the steps of one take this long beyond the one-step run (s).
+pub const PROBE_MIN_SECONDS: f64 = 0.02;
+/// Studies of fewer communication steps in all (runs × steps) are not timed.
+pub const PROBE_MIN_STEPS: f64 = 1e7;
 /// Memory assumed available where the system does not say (bytes; 4 GiB).
 pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
@@ -240,16 +252,19 @@ pub struct Shape {
     pub dim: usize,
     /// Worker threads.
     pub threads: usize,
-    /// Draws of a chaos surrogate per output (`[analysis] surrogate_samples`).
+    /// Draws of a chaos surrogate per output (`[analysis] surrogate_samples`; 0 for a method
+    /// that draws from its runs).
     pub surrogate_samples: usize,
 }
 
 impl Shape {
     /// The shape of `study` run on `threads` threads.
     pub fn of(study: &Study, threads: usize) -> Shape {
-        let runs = match study.method().evaluation() {
-            Evaluation::Sampling(m) => m.planned_runs(study.parameters.len()),
-            Evaluation::Intrusive(_) => Some(0.0),
+        let (runs, chaos) = match study.method().evaluation() {
+            Evaluation::Sampling(m) => {
+                (m.planned_runs(study.parameters.len()), m.draws_from_chaos())
+            }
+            Evaluation::Intrusive(_) => (Some(0.0), true),
         };
         let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
         for s in study.qoi.iter().flat_map(|q| q.signals()) {
@@ -266,7 +281,11 @@ impl Shape {
             signals: signals.len(),
             dim: study.parameters.len(),
             threads: threads.max(1),
-            surrogate_samples: study.analysis.surrogate_samples,
+            surrogate_samples: if chaos {
+                study.analysis.surrogate_samples
+            } else {
+                0
+            },
         }
     }
 
@@ -310,7 +329,7 @@ fn check_one(study: &Study, opts: &RunOptions) -> Result<Footprint, GuardError> 
     let mut footprint = estimate(&shape, shape.runs);
     judge(&footprint, true)?;
     if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
-        if n > 0.0 {
+        if n * (shape.time_points - 1.0).max(1.0) >= PROBE_MIN_STEPS {
             footprint.time = probe(study).map(|per_run| TimeEstimate {
                 per_run,
                 total: per_run * (n / threads as f64).ceil(),
@@ -434,23 +453,36 @@ fn probe(study: &Study) -> Option<f64> {
         .collect();
     let e = &study.experiment;
     let steps = ((e.stop - e.start) / e.step).round();
-    let k = (steps as usize).clamp(1, PROBE_STEPS);
     let grid = |m: usize| -> Vec<f64> { (0..=m).map(|i| e.start + i as f64 * e.step).collect() };
     let mut slot: Option<Instance> = None;
-    let mut time = |m: usize| -> Option<f64> {
+    // The best of a few repeats: other work on the machine only ever adds time.
+    let mut time = |m: usize, repeats: usize| -> Option<f64> {
         let times = grid(m);
-        let started = Instant::now();
-        runner::run_point(&fmu, &mut slot, &iface, &values, &times).ok()?;
-        Some(started.elapsed().as_secs_f64())
+        let mut best = f64::INFINITY;
+        for _ in 0..repeats {
+            let started = Instant::now();
+            runner::run_point(&fmu, &mut slot, &iface, &values, &times).ok()?;
+            best = best.min(started.elapsed().as_secs_f64());
+        }
+        Some(best)
     };
-    time(1)?; // warm-up: the instance is created here
-    let one = time(1)?;
-    if k == 1 {
-        return Some(one * steps);
+    time(1, 1)?; // warm-up: the instance is created here
+    let one = time(1, 3)?;
+    if steps <= 1.0 {
+        return Some(one);
     }
-    let many = time(k)?;
-    let per_step = ((many - one) / (k - 1) as f64).max(0.0);
-    Some(one + per_step * (steps - 1.0))
+    // Longer runs until the steps show well above the start-up (initialisation may cost as
+    // much as thousands of steps) and above timer noise, at most the whole run or a second.
+    let mut k = (steps as usize).clamp(2, PROBE_STEPS);
+    loop {
+        let many = time(k, 2)?;
+        let clear = many >= 4.0 * one && many - one >= PROBE_MIN_SECONDS;
+        if clear || k as f64 >= steps || many > PROBE_SECONDS {
+            let per_step = ((many - one) / (k - 1) as f64).max(0.0);
+            return Some(one + per_step * (steps - 1.0));
+        }
+        k = (k * 4).min(steps as usize);
+    }
 }
 
 /// Memory available to this process (bytes): the least of the system's available memory

@@ -2,7 +2,8 @@
 //! input; estimated like Monte Carlo (`sample.rs`).
 //!
 //! Without `replicates` the standard error is the plain Monte Carlo formula, an upper bound
-//! for a Latin hypercube (often a far too pessimistic one: about 30× on the wheel). With
+//! for a Latin hypercube, often a far too pessimistic one (on the wheel with 2 048 samples the
+//! actual errors are 0.001 to 0.8 of it, under 0.03 of it before 1 s). With
 //! `replicates = R`, `R` independent Latin hypercubes of `samples` points each give an honest
 //! standard error from the spread of their means. Replicate `r` is the Latin hypercube of
 //! seed `s_r` = the first word of the ChaCha20 stream `rng::stream(seed, 2^63 + r)`.
@@ -16,7 +17,7 @@ use crate::uq::{rng, sampling};
 
 /// `standard_error` of an unreplicated Latin hypercube.
 const SE_LHS_UPPER_BOUND: &str = "Monte Carlo formula std / sqrt(samples): an upper bound \
-     for a Latin hypercube, often far too pessimistic (about 30x on the wheel); \
+     for a Latin hypercube, often far too pessimistic (on the wheel, up to hundreds of times); \
      set `replicates` for an honest one";
 
 /// `kind = "lhs"`.

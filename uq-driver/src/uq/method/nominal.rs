@@ -73,4 +73,8 @@ impl Sampling for Nominal {
     fn planned_runs(&self, _dim: usize) -> Option<f64> {
         Some(1.0)
     }
+
+    fn draws_from_chaos(&self) -> bool {
+        false
+    }
 }

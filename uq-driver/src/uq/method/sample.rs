@@ -145,6 +145,10 @@ impl<T: UnitCubeSample> Sampling for T {
     fn planned_runs(&self, _dim: usize) -> Option<f64> {
         Some(self.samples() as f64 * self.replicates().unwrap_or(1) as f64)
     }
+
+    fn draws_from_chaos(&self) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]

@@ -231,6 +231,10 @@ impl Sampling for SobolSampling {
     fn planned_runs(&self, dim: usize) -> Option<f64> {
         Some(self.samples as f64 * (dim as f64 + 2.0))
     }
+
+    fn draws_from_chaos(&self) -> bool {
+        false
+    }
 }
 
 /// The indices of one column.

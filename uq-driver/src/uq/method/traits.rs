@@ -117,6 +117,13 @@ pub trait Sampling {
     fn planned_runs(&self, _dim: usize) -> Option<f64> {
         None
     }
+
+    /// Whether the estimates may draw their quantiles and densities from a chaos surrogate
+    /// (`[analysis] surrogate_samples` draws of every output time): counted in the memory
+    /// estimate of `study::guard`. `true` unless the method never builds a chaos.
+    fn draws_from_chaos(&self) -> bool {
+        true
+    }
 }
 
 /// A method that solves a projected (intrusive) system instead of running the model.
