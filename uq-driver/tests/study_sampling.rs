@@ -208,6 +208,52 @@ fn qmc_and_sobol_sampling_do_not_depend_on_the_thread_count() {
     }
 }
 
+/// A quasi-Monte Carlo study split into shards gives the files of the unsplit study.
+#[test]
+fn a_sharded_qmc_study_gives_the_files_of_the_whole_study() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = wheel_study(
+        dir.path(),
+        "shq",
+        9,
+        "kind = \"qmc\"\nsamples = 32\nreplicates = 4",
+        "",
+    );
+    let whole = dir.path().join("whole");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    let plan = dir.path().join("plan");
+    let result = dir.path().join("result");
+    run_ok(&[
+        "plan",
+        study.to_str().unwrap(),
+        "--shards",
+        "3",
+        "--out",
+        plan.to_str().unwrap(),
+    ]);
+    for k in ["0", "1", "2"] {
+        run_ok(&["run-shard", plan.to_str().unwrap(), "--shard", k]);
+    }
+    run_ok(&[
+        "merge",
+        plan.to_str().unwrap(),
+        "--out",
+        result.to_str().unwrap(),
+    ]);
+    for f in ["q.csv", "q_pdf.csv", "points.csv"] {
+        assert_eq!(
+            std::fs::read(whole.join(f)).unwrap(),
+            std::fs::read(result.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+}
+
 /// The Sobol' indices of the wheel by pick-freeze sampling (the built-in study) against the
 /// indices of the closed form on the Gauss–Hermite grid.
 #[test]
@@ -284,8 +330,9 @@ fn scm_sobol_indices_of_a_quantity_are_labelled_by_parameter_name() {
     for (j, p) in ["K", "C"].iter().enumerate() {
         let f = q["sobol"]["first"][p].as_f64().unwrap();
         let t = q["sobol"]["total"][p].as_f64().unwrap();
-        assert!((f - first[j]).abs() < 2e-3, "S_{p} = {f} vs {}", first[j]);
-        assert!((t - total[j]).abs() < 2e-3, "ST_{p} = {t} vs {}", total[j]);
+        // Measured: 1e-11 apart (the order-5 chaos of the 6 x 6 grid is that accurate at 1 s).
+        assert!((f - first[j]).abs() < 1e-8, "S_{p} = {f} vs {}", first[j]);
+        assert!((t - total[j]).abs() < 1e-8, "ST_{p} = {t} vs {}", total[j]);
         // The arrays of before, in parameter order, hold the same numbers.
         assert_eq!(q["sobol_first"][j].as_f64().unwrap(), f);
     }
@@ -295,7 +342,7 @@ fn scm_sobol_indices_of_a_quantity_are_labelled_by_parameter_name() {
     );
     // Over time too (q_sobol.csv, as before).
     let csv = read_csv(&out.join("q_sobol.csv"));
-    assert!((csv.at(1.0, "S_K") - first[0]).abs() < 2e-3);
+    assert!((csv.at(1.0, "S_K") - first[0]).abs() < 1e-8);
 }
 
 /// The Functions test FMU with `function` and uniform inputs `x1..xd` on `[low, high]`, Sobol'

@@ -34,6 +34,9 @@ use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::hd::sobol_seq::{self, Sobol as SobolSequence};
 use crate::uq::sampling;
 
+/// Most bootstrap resamples.
+const MAX_BOOTSTRAP: usize = 10_000;
+
 /// Seed of the bootstrap resamples.
 const BOOTSTRAP_SEED: u64 = 0x5eed_b007;
 
@@ -59,11 +62,13 @@ pub struct SobolSampling {
     /// Where `A` and `B` come from (default `qmc`).
     #[serde(default)]
     pub base: Base,
-    /// Bootstrap resamples for the confidence intervals (default 200; 0: no intervals).
-    #[serde(default = "default_bootstrap")]
+    /// Bootstrap resamples for the confidence intervals (default 200, at most 10 000; 0: no
+    /// intervals). Analysis only: not part of the study hash, so a changed value re-analyses
+    /// the stored runs instead of refusing the folder.
+    #[serde(default = "default_bootstrap", skip_serializing)]
     pub bootstrap: usize,
-    /// Confidence level of the intervals (default 0.95).
-    #[serde(default = "default_confidence")]
+    /// Confidence level of the intervals (default 0.95; analysis only, like `bootstrap`).
+    #[serde(default = "default_confidence", skip_serializing)]
     pub confidence: f64,
 }
 
@@ -94,6 +99,12 @@ impl Method for SobolSampling {
         let d = problem.parameters.len();
         if self.samples < 2 {
             return Err(InvalidSettings("`samples` must be at least 2".into()));
+        }
+        if self.bootstrap > MAX_BOOTSTRAP {
+            return Err(InvalidSettings(format!(
+                "`bootstrap` = {} resamples: at most {MAX_BOOTSTRAP}",
+                self.bootstrap
+            )));
         }
         if !(self.confidence > 0.0 && self.confidence < 1.0) {
             return Err(InvalidSettings(format!(
@@ -458,6 +469,15 @@ mod tests {
         assert!(m.validate(&problem).is_ok());
         let m: SobolSampling = toml::from_str("samples = 64\nconfidence = 1.0").unwrap();
         assert!(m.validate(&problem).is_err());
+        let m: SobolSampling = toml::from_str("samples = 64\nbootstrap = 100000").unwrap();
+        assert!(m.validate(&problem).is_err());
+        // The analysis settings are not in the serialized settings (the study hash).
+        let m: SobolSampling =
+            toml::from_str("samples = 64\nbootstrap = 50\nconfidence = 0.9").unwrap();
+        assert_eq!(
+            serde_json::to_string(&m).unwrap(),
+            r#"{"samples":64,"base":"qmc"}"#
+        );
         assert!(toml::from_str::<SobolSampling>("samples = 64\nbase = \"grid\"").is_err());
     }
 }
