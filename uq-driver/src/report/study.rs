@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::csv::push_shortest;
 use super::{
     histogram_density, palette, write_bytes, write_columns, write_grid, Band, DensityPlot, Heatmap,
     LinePlot, ReportError, ReportPage, Section, Series, Table,
@@ -434,10 +435,12 @@ pub fn write_points_csv(path: &Path, t: &PointTable) -> Result<(), ReportError> 
     for (i, vals) in t.values.iter().enumerate() {
         let _ = write!(text, "{i}");
         if let Some(w) = &t.weights {
-            let _ = write!(text, ",{}", w[i]);
+            text.push(',');
+            push_shortest(&mut text, w[i]);
         }
         for v in vals {
-            let _ = write!(text, ",{v}");
+            text.push(',');
+            push_shortest(&mut text, *v);
         }
         let status = match &t.status[i] {
             PointStatus::Ok => "ok".to_string(),

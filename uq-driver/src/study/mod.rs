@@ -8,11 +8,16 @@
 
 pub mod analysis;
 pub mod guard;
+pub mod inputs;
 pub mod interface;
+pub mod isolate;
+pub mod lock;
 mod outcome;
+mod point;
 pub mod runner;
 pub mod shard;
 mod single;
+pub mod size;
 pub mod store;
 pub mod suite;
 
@@ -27,13 +32,14 @@ use crate::spec::Study;
 /// every variant into `out_dir/<variant>/` and writes the comparison into `out_dir`.
 ///
 /// Nothing is allocated, run or written (`out_dir` is not even created) before the study
-/// passes [`guard::check`]: too large to run, it is refused; large, it needs `opts.yes`.
+/// passes [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`.
 pub fn run_study(
     study: &Study,
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<Outcome, StudyRunError> {
-    guard::check(study, opts)?;
+    size::check(study, out_dir, opts)?;
+    runner::prepare_out_dir(out_dir)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),
         None => single::run_single(study, out_dir, opts).map(|r| Outcome::Study(Box::new(r))),

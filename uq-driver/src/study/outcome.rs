@@ -1,8 +1,8 @@
 //! What running a study returns, and how it fails.
 
 use super::analysis::AnalysisError;
-use super::guard::GuardError;
 use super::runner::RunError;
+use super::size::SizeError;
 use crate::report::ReportError;
 use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
 use crate::uq::method::MethodError;
@@ -15,7 +15,7 @@ pub enum StudyRunError {
     Run(#[from] RunError),
     /// The study is too large to start (or to start without `--yes`).
     #[error(transparent)]
-    Guard(#[from] GuardError),
+    Size(#[from] SizeError),
     /// An intrusive method failed.
     #[error(transparent)]
     Method(#[from] MethodError),

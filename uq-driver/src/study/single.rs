@@ -6,9 +6,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::analysis;
-use super::guard;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::size;
 use super::store::Record;
 use crate::fmu::Fmu;
 use crate::report::{self, ReportError, StudyReport};
@@ -35,7 +35,7 @@ pub(crate) fn run_single(
             let design = method.design(&study.parameters, study.seed)?;
             if method.planned_runs(study.parameters.len()).is_none() {
                 // Only the design knew its size: check it before it runs.
-                guard::check_runs(study, design.len(), opts)?;
+                size::check_runs(study, design.len(), opts)?;
             }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
             finish(study, method, &fmu, &design, outcome, out_dir, opts)
