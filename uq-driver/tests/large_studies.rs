@@ -15,29 +15,7 @@ use wheel::{fmu_dir, wheel_fmu};
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 
 fn study(dir: &Path, name: &str, experiment: &str, method: &str) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-[experiment]
-{experiment}
-[method]
-{method}
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-std = 2.0
-[outputs]
-variables = ["q"]
-"#,
-        fmu = wheel_fmu().display()
-    );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    wheel::write_study(dir, name, name, 42, experiment, method, "")
 }
 
 const WHEEL_GRID: &str = "stop = 5.0\nstep = 0.01";
@@ -183,13 +161,14 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
     assert!(!plan.exists());
 }
 
-#[test]
-fn a_tiny_step_is_refused_before_the_grid_is_allocated() {
+/// Runs a study of the wheel with the `[experiment]` keys `experiment` and `--yes`: refused,
+/// with `needles` in the message and no output folder. Returns the temporary folder.
+fn refused_grid(experiment: &str, needles: &[&str]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     let p = study(
         dir.path(),
-        "tiny",
-        "stop = 5.0\nstep = 1e-12",
+        "grid",
+        experiment,
         "kind = \"lhs\"\nsamples = 10",
     );
     let out = dir.path().join("out");
@@ -200,36 +179,30 @@ fn a_tiny_step_is_refused_before_the_grid_is_allocated() {
         out.to_str().unwrap(),
         "--yes",
     ]);
-    assert_refused(
-        &o,
+    assert_refused(&o, needles);
+    assert!(!out.exists());
+    dir
+}
+
+#[test]
+fn a_tiny_step_is_refused_before_the_grid_is_allocated() {
+    refused_grid(
+        "stop = 5.0\nstep = 1e-12",
         &[
             "5.000e12 communication points",
             "limit of 1e8",
             "coarser step",
         ],
     );
-    assert!(!out.exists());
 }
 
 #[test]
 fn a_huge_stop_is_refused_before_the_grid_is_allocated() {
-    let dir = tempfile::tempdir().unwrap();
-    let p = study(
-        dir.path(),
-        "long",
+    let dir = refused_grid(
         "stop = 1e15\nstep = 1.0",
-        "kind = \"lhs\"\nsamples = 10",
+        &["1.000e15 communication points", "limit of 1e8"],
     );
     let out = dir.path().join("out");
-    let o = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--yes",
-    ]);
-    assert_refused(&o, &["1.000e15 communication points", "limit of 1e8"]);
-    assert!(!out.exists());
     // One run with such a grid (`simulate`) too.
     let csv = dir.path().join("y.csv");
     let o = run(&[

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use wheel::{read_csv, reference, reference_sobol, wheel_fmu};
+use wheel::{read_csv, reference, reference_sobol};
 
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
@@ -36,32 +36,8 @@ fn summary(dir: &Path) -> serde_json::Value {
 
 /// A wheel study (stop 5 s, step 0.01 s, output q) with `method`, seed `seed` and `extra`.
 fn wheel_study(dir: &Path, name: &str, seed: u64, method: &str, extra: &str) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = {seed}
-[experiment]
-stop = 5.0
-step = 0.01
-[method]
-{method}
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-std = 2.0
-[outputs]
-variables = ["q"]
-{extra}
-"#,
-        fmu = wheel_fmu().display()
-    );
-    let p = dir.join(format!("{name}-{seed}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    let file = format!("{name}-{seed}");
+    wheel::write_study(dir, &file, name, seed, wheel::EXPERIMENT, method, extra)
 }
 
 /// (mean − reference) / standard error of the mean at each of TIMES, for `method` and `seed`.

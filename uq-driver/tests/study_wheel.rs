@@ -32,33 +32,7 @@ fn run_ok(args: &[&str]) {
 }
 
 fn study_file(dir: &Path, name: &str, method: &str, extra: &str) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = 7
-[experiment]
-start = 0.0
-stop = 5.0
-step = 0.01
-[method]
-{method}
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-cov = 0.1
-[outputs]
-variables = ["q"]
-{extra}
-"#,
-        fmu = wheel_fmu().display()
-    );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    wheel::write_study(dir, name, name, 7, wheel::EXPERIMENT, method, extra)
 }
 
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];

@@ -31,6 +31,48 @@ pub fn wheel_fmu() -> PathBuf {
     p
 }
 
+/// The wheel's time grid in the paper: 0–5 s, step 0.01 s.
+pub const EXPERIMENT: &str = "start = 0.0\nstop = 5.0\nstep = 0.01";
+
+/// A study of the wheel (K ~ N(100, 10²), C ~ N(20, 2²) written as `cov = 0.1`, output `q`)
+/// with the `[experiment]` keys `experiment`, the `[method]` keys `method` and `extra` at the
+/// end, written to `DIR/<file>.toml`.
+pub fn write_study(
+    dir: &Path,
+    file: &str,
+    name: &str,
+    seed: u64,
+    experiment: &str,
+    method: &str,
+    extra: &str,
+) -> PathBuf {
+    let text = format!(
+        r#"name = "{name}"
+fmu = "{fmu}"
+seed = {seed}
+[experiment]
+{experiment}
+[method]
+{method}
+[[parameters]]
+name = "K"
+mean = 100.0
+std = 10.0
+[[parameters]]
+name = "C"
+mean = 20.0
+cov = 0.1
+[outputs]
+variables = ["q"]
+{extra}
+"#,
+        fmu = wheel_fmu().display()
+    );
+    let p = dir.join(format!("{file}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
 /// Probabilists' Gauss–Hermite rule by Golub–Welsch (weights normalised to 1).
 pub fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
     let j = DMatrix::from_fn(n, n, |i, k| {

@@ -35,6 +35,28 @@ fn default_replicates() -> usize {
     DEFAULT_REPLICATES
 }
 
+/// Whether a Sobol' sequence of `samples` points in `dim` dimensions exists (`hint`: what to
+/// do instead when the dimension is too high, appended to the message).
+pub(crate) fn check_sobol_points(
+    dim: usize,
+    samples: usize,
+    hint: &str,
+) -> Result<(), InvalidSettings> {
+    if dim > sobol_seq::MAX_DIM {
+        return Err(InvalidSettings(format!(
+            "Sobol' points are available in at most {} dimensions (this design needs {dim}){hint}",
+            sobol_seq::MAX_DIM
+        )));
+    }
+    if samples as u64 > 1u64 << sobol_seq::BITS {
+        return Err(InvalidSettings(format!(
+            "`samples` = {samples} is more than the 2^{} points of a Sobol' sequence",
+            sobol_seq::BITS
+        )));
+    }
+    Ok(())
+}
+
 impl UnitCubeSample for Qmc {
     const KIND: &'static str = "qmc";
 
@@ -62,21 +84,7 @@ impl UnitCubeSample for Qmc {
     }
 
     fn check(&self, problem: &Problem) -> Result<(), InvalidSettings> {
-        let d = problem.parameters.len();
-        if d > sobol_seq::MAX_DIM {
-            return Err(InvalidSettings(format!(
-                "Sobol' points are available for at most {} random parameters (the study has {d})",
-                sobol_seq::MAX_DIM
-            )));
-        }
-        if self.samples as u64 > 1u64 << sobol_seq::BITS {
-            return Err(InvalidSettings(format!(
-                "`samples` = {} is more than the 2^{} points of a Sobol' sequence",
-                self.samples,
-                sobol_seq::BITS
-            )));
-        }
-        Ok(())
+        check_sobol_points(problem.parameters.len(), self.samples, "")
     }
 
     fn notes(&self) -> Vec<String> {

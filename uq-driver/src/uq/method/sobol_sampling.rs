@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
+use super::qmc::check_sobol_points;
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::{Germ, RandomParameter};
@@ -113,21 +114,8 @@ impl Method for SobolSampling {
             )));
         }
         if self.base == Base::Qmc {
-            if 2 * d > sobol_seq::MAX_DIM {
-                return Err(InvalidSettings(format!(
-                    "base = \"qmc\" needs Sobol' points in 2d = {} dimensions (at most {}); \
-                     use base = \"lhs\"",
-                    2 * d,
-                    sobol_seq::MAX_DIM
-                )));
-            }
-            if self.samples as u64 > 1u64 << sobol_seq::BITS {
-                return Err(InvalidSettings(format!(
-                    "`samples` = {} is more than the 2^{} points of a Sobol' sequence",
-                    self.samples,
-                    sobol_seq::BITS
-                )));
-            }
+            let hint = " (twice the random parameters); use base = \"lhs\"";
+            check_sobol_points(2 * d, self.samples, hint)?;
         }
         Ok(())
     }
