@@ -13,6 +13,7 @@ use uq_driver::spec::{builtin, Experiment, FixedValue, InvalidExperiment, Study,
 use uq_driver::study::{
     run_study, runner, shard, size, Outcome, RunOptions, StudyResult, SuiteResult,
 };
+use uq_driver::uq::surrogate::Surrogate;
 
 #[derive(Parser)]
 #[command(
@@ -90,6 +91,45 @@ enum Command {
     /// Serve points to a parent uq-driver (`--isolate`) over stdin/stdout.
     #[command(hide = true)]
     Worker,
+    /// Evaluate or sample the chaos surrogate a study exported (DIR/surrogate.json).
+    #[command(subcommand)]
+    Surrogate(SurrogateCommand),
+}
+
+#[derive(Subcommand)]
+enum SurrogateCommand {
+    /// The surrogate at one point, as CSV `name,time,value` (time empty for a scalar
+    /// quantity); inputs not given take their nominal value.
+    Eval {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Input value, NAME=VALUE (repeatable).
+        #[arg(long = "at", value_parser = parse_number_assignment)]
+        at: Vec<(String, f64)>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
+    /// N random draws of the inputs (their joint law, correlation included) with the
+    /// surrogate's values: CSV with the inputs, the scalar quantities and each output at the
+    /// chosen times (`NAME@TIME`).
+    Sample {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Number of draws.
+        #[arg(short = 'n', long)]
+        n: usize,
+        /// Seed (draw i comes from the stream (seed, i) only).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output times to write, s (repeatable; the nearest communication point; default:
+        /// the last).
+        #[arg(long = "time")]
+        times: Vec<f64>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -224,6 +264,16 @@ fn parse_assignment(s: &str) -> Result<(String, String), String> {
     Ok((name.trim().to_owned(), value.to_owned()))
 }
 
+/// `NAME=NUMBER`.
+fn parse_number_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = parse_assignment(s)?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("value of {name}: {e}"))?;
+    Ok((name, v))
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if matches!(cli.command, Command::Worker) {
@@ -327,7 +377,37 @@ fn dispatch(cmd: Command) -> Result<()> {
         }
         Command::Inspect { fmu } => inspect(&fmu),
         Command::Simulate(args) => simulate(args),
+        Command::Surrogate(cmd) => surrogate(cmd),
         Command::Worker => unreachable!("handled in main"),
+    }
+}
+
+/// Writes `text` to `out`, or to standard output.
+fn emit(text: &str, out: Option<&Path>) -> Result<()> {
+    match out {
+        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display())),
+        None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
+    }
+}
+
+/// `uq-driver surrogate eval|sample`.
+fn surrogate(cmd: SurrogateCommand) -> Result<()> {
+    match cmd {
+        SurrogateCommand::Eval { dir, at, out } => {
+            let s = Surrogate::load(&dir)?;
+            let x = s.point(&at)?;
+            emit(&s.eval_csv(&x), out.as_deref())
+        }
+        SurrogateCommand::Sample {
+            dir,
+            n,
+            seed,
+            times,
+            out,
+        } => {
+            let s = Surrogate::load(&dir)?;
+            emit(&s.sample_csv(n, seed, &times), out.as_deref())
+        }
     }
 }
 

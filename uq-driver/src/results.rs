@@ -10,7 +10,8 @@ use serde::Serialize;
 
 use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::method::{Draws, MethodSummary, Sobol};
+use crate::uq::method::{ChaosError, Draws, MethodSummary, Sobol};
+use crate::uq::random_inputs::Correlation;
 
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
@@ -43,6 +44,9 @@ pub struct OutputStats {
     pub pdf: Vec<Vec<f64>>,
     /// Where the quantiles and densities come from.
     pub draws: Draws,
+    /// The chaos's estimated truncation error over time (a column of `<V>.csv` named after
+    /// its kind: `loo`, `level_difference` or `order_difference`).
+    pub chaos_error: Option<ChaosError>,
 }
 
 impl OutputStats {
@@ -101,6 +105,19 @@ pub struct ScalarStats {
     /// Where the quantiles and the PDF come from.
     #[serde(skip)]
     pub draws: Draws,
+    /// The chaos's estimated relative truncation error (chaos methods).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chaos_error: Option<ScalarChaosError>,
+}
+
+/// A scalar quantity's chaos truncation error in `summary.json`:
+/// `{"kind": "loo" | "level_difference" | "order_difference", "value": ...}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScalarChaosError {
+    /// How it was estimated.
+    pub kind: &'static str,
+    /// The relative error.
+    pub value: f64,
 }
 
 /// Sobol' indices of a scalar quantity by parameter name (`quantities.NAME.sobol` in
@@ -259,6 +276,10 @@ pub struct Summary {
     pub experiment: Experiment,
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
+    /// Their correlation: the requested pairs and the normal-space matrix of the Gaussian
+    /// copula (absent when the inputs are independent).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation: Option<Correlation>,
     /// Deterministic values.
     pub fixed: BTreeMap<String, FixedValue>,
     /// The FMU (null for intrusive methods).

@@ -423,3 +423,56 @@ method = { kind = "lhs", samples = 200 }
         assert!(out.join(f).is_file(), "{f}");
     }
 }
+
+#[test]
+fn sparse_grid_level_3_matches_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sparse");
+    run_ok(&[
+        "run",
+        "builtin:wheel-sparse",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let csv = read_csv(&out.join("q.csv"));
+    for t in TIMES {
+        let (m, s) = reference(t);
+        let (dm, ds) = (csv.at(t, "mean") - m, csv.at(t, "std") - s);
+        assert!(dm.abs() < 1e-9, "t = {t}: mean error {dm:e}");
+        assert!(ds.abs() < 1e-6, "t = {t}: std error {ds:e}");
+        // The level-2/level-3 difference is reported and small.
+        assert!(csv.at(t, "level_difference") < 0.05, "t = {t}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["model_runs"], 65);
+    assert_eq!(summary["method"]["kind"], "sparse_grid");
+    assert!(out.join("surrogate.json").is_file());
+}
+
+#[test]
+fn sparse_regression_chaos_on_100_runs_matches_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lars");
+    run_ok(&[
+        "run",
+        "builtin:wheel-pce-lars",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let csv = read_csv(&out.join("q.csv"));
+    for t in TIMES {
+        let (m, s) = reference(t);
+        let (dm, ds) = (csv.at(t, "mean") - m, csv.at(t, "std") - s);
+        assert!(
+            dm.abs() < 1e-3 * s,
+            "t = {t}: mean error {dm:e} (std {s:e})"
+        );
+        assert!(ds.abs() < 1e-2 * s, "t = {t}: std error {ds:e} (std {s:e})");
+        let loo = csv.at(t, "loo");
+        assert!((0.0..0.05).contains(&loo), "t = {t}: loo {loo}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["model_runs"], 100);
+}

@@ -127,6 +127,10 @@ fn write_output_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
         header.push("std_error_mean".into());
         cols.push(se);
     }
+    if let Some(e) = &s.chaos_error {
+        header.push(e.kind.name().into());
+        cols.push(&e.values);
+    }
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(&dir.join(format!("{}.csv", s.name)), &hdr, &cols)
 }

@@ -25,6 +25,14 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ),
     ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
     (
+        "wheel-sparse",
+        include_str!("../../studies/wheel-sparse.toml"),
+    ),
+    (
+        "wheel-pce-lars",
+        include_str!("../../studies/wheel-pce-lars.toml"),
+    ),
+    (
         "paper-wheel",
         include_str!("../../studies/paper-wheel.toml"),
     ),
@@ -64,6 +72,14 @@ pub const BUILTINS: &[(&str, &str)] = &[
     (
         "vehicle-track-defect",
         include_str!("../../studies/vehicle-track-defect.toml"),
+    ),
+    (
+        "vehicle-track-8d-pce",
+        include_str!("../../studies/vehicle-track-8d-pce.toml"),
+    ),
+    (
+        "vehicle-track-8d-lhs",
+        include_str!("../../studies/vehicle-track-8d-lhs.toml"),
     ),
     (
         "paper-vehicle-track",

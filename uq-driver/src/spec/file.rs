@@ -202,6 +202,9 @@ pub struct StudyFile {
     pub method: Spanned<MethodSpec>,
     /// Random parameters.
     pub parameters: Vec<Spanned<ParameterSpec>>,
+    /// Correlations between random parameters (a Gaussian copula).
+    #[serde(default)]
+    pub correlation: Vec<Spanned<CorrelationSpec>>,
     /// Deterministic parameter values set before every run (numbers, Booleans or texts).
     #[serde(default)]
     pub fixed: BTreeMap<String, FixedValue>,
@@ -230,6 +233,16 @@ pub struct StudyFile {
 
 fn default_seed() -> u64 {
     42
+}
+
+/// `[[correlation]]`: the Pearson correlation `rho` of two random parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CorrelationSpec {
+    /// The two parameters, by name.
+    pub between: [String; 2],
+    /// Their correlation, in (-1, 1).
+    pub rho: f64,
 }
 
 /// A published value: `statistic` ("mean", "std", or "p>LIMIT") of `quantity` in `variant`.

@@ -181,6 +181,10 @@ pub fn study_hash(study: &Study) -> String {
             .unwrap_or_default();
         key["inputs"] = serde_json::json!(content);
     }
+    // Likewise the correlation: studies without one keep their hash.
+    if let Some(c) = &study.correlation {
+        key["correlation"] = serde_json::json!(c.pairs);
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }
 

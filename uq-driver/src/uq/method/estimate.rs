@@ -26,6 +26,40 @@ impl Draws {
     }
 }
 
+/// How the truncation error of a chaos was estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChaosErrorKind {
+    /// Corrected relative leave-one-out error of a regression (Blatman & Sudret 2011):
+    /// `T(P, N) · mean((y_i - ŷ_(-i))²) / Var(y)`.
+    Loo,
+    /// Relative mean-square difference between the chaoses of sparse-grid levels `L` and
+    /// `L - 1` (same runs, nested rules): `Σ (c_L - c_(L-1))² / Var_L`.
+    LevelDifference,
+    /// Relative mean-square difference between the chaoses of orders `p` and `p - 1` (same
+    /// runs): the variance share of the terms of degree `p`.
+    OrderDifference,
+}
+
+impl ChaosErrorKind {
+    /// The column name in `<V>.csv` and the `kind` in `summary.json` and `surrogate.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChaosErrorKind::Loo => "loo",
+            ChaosErrorKind::LevelDifference => "level_difference",
+            ChaosErrorKind::OrderDifference => "order_difference",
+        }
+    }
+}
+
+/// An estimate of a chaos's relative truncation error, one value per column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChaosError {
+    /// How it was estimated.
+    pub kind: ChaosErrorKind,
+    /// Per column (relative to the variance; 0 for a column without variance).
+    pub values: Vec<f64>,
+}
+
 /// First-order and total Sobol' indices, each `[column][parameter]`, with confidence
 /// intervals where the method estimates them (sampling).
 #[derive(Clone, Debug, PartialEq)]
@@ -87,6 +121,8 @@ pub struct Estimate {
     pub sobol: Option<Sobol>,
     /// Where quantiles and densities come from.
     pub draws: Draws,
+    /// The estimated truncation error of the chaos, where the method estimates it.
+    pub chaos_error: Option<ChaosError>,
 }
 
 impl Estimate {
@@ -169,6 +205,7 @@ impl Estimate {
             chaos: None,
             sobol: None,
             draws,
+            chaos_error: None,
         }
     }
 }
@@ -176,7 +213,7 @@ impl Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::pce::MultiIndexSet;
+    use crate::uq::pce::{Basis, Family, MultiIndexSet};
 
     #[test]
     fn sample_estimate_has_the_standard_error() {
@@ -192,9 +229,10 @@ mod tests {
     #[test]
     fn chaos_estimate_reads_moments_and_indices_from_the_coefficients() {
         // f = 1 + 2 z1 + 3 z2: mean 1, variance 13, S1 = 4/13, S2 = 9/13.
-        let basis = MultiIndexSet::total_order(2, 1);
+        let set = MultiIndexSet::total_degree(2, 1).unwrap();
+        let basis = Basis::new(vec![Family::Hermite, Family::Legendre], set).unwrap();
         let coeffs = DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 3.0]);
-        let e = Estimate::from_chaos(Pce { basis, coeffs });
+        let e = Estimate::from_chaos(Pce::new(basis, coeffs).unwrap());
         assert_eq!(e.mean, vec![1.0]);
         assert!((e.std[0] - 13f64.sqrt()).abs() < 1e-15);
         let s = e.sobol.unwrap();

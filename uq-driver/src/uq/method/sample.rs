@@ -16,7 +16,8 @@ use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::distributions::Germ;
+use crate::uq::random_inputs::RandomInputs;
 
 /// `standard_error` in the method's summary: from independent replicates.
 pub(crate) const SE_REPLICATES: &str = "replicates: the spread of the replicate means, \
@@ -112,8 +113,8 @@ impl<T: UnitCubeSample> Method for T {
 
 impl<T: UnitCubeSample> Sampling for T {
     /// Replicate by replicate (point `i` in replicate `i / samples`).
-    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError> {
-        let (n, d) = (self.samples(), parameters.len());
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        let (n, d) = (self.samples(), inputs.len());
         let points = match self.replicates() {
             None => self.block(n, d, seed, None)?,
             Some(r) => {
@@ -124,7 +125,7 @@ impl<T: UnitCubeSample> Sampling for T {
                 blocks.into_iter().flatten().collect()
             }
         };
-        let mut design = Design::mapped(Germ::Uniform, points, None, parameters);
+        let mut design = Design::mapped(Germ::Uniform, points, None, inputs);
         design.warnings.extend(self.notes());
         Ok(design)
     }
@@ -154,17 +155,20 @@ impl<T: UnitCubeSample> Sampling for T {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::uq::distributions::RandomParameter;
     use crate::uq::hd::sobol_seq::Sobol;
     use crate::uq::method::{lhs::Lhs, qmc::Qmc};
     use crate::uq::{sampling, Distribution};
 
-    fn unit_params(d: usize) -> Vec<RandomParameter> {
-        (0..d)
-            .map(|i| RandomParameter {
-                name: format!("u{i}"),
-                distribution: Distribution::uniform(0.0, 1.0).unwrap(),
-            })
-            .collect()
+    fn unit_params(d: usize) -> RandomInputs {
+        RandomInputs::independent(
+            (0..d)
+                .map(|i| RandomParameter {
+                    name: format!("u{i}"),
+                    distribution: Distribution::uniform(0.0, 1.0).unwrap(),
+                })
+                .collect(),
+        )
     }
 
     #[test]
@@ -221,6 +225,7 @@ mod tests {
             quantities: 0,
             times: &[0.0],
             system: None,
+            correlation: None,
         };
         for text in ["samples = 8\nreplicates = 1", "samples = 8\nreplicates = 0"] {
             let q: Qmc = toml::from_str(text).unwrap();

@@ -6,12 +6,14 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use super::chaos::{continuous_inputs, order_difference};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
-use crate::uq::pce::{MultiIndexSet, Pce};
+use crate::uq::distributions::Germ;
+use crate::uq::random_inputs::RandomInputs;
+use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
 
 /// Most nodes per dimension.
@@ -60,6 +62,7 @@ impl Method for Scm {
                  the quadrature cannot integrate the basis norms exactly otherwise"
             )));
         }
+        continuous_inputs(problem, "scm")?;
         let dim = problem.parameters.len();
         if (nodes as f64).powi(dim as i32) > MAX_POINTS {
             return Err(InvalidSettings(format!(
@@ -88,13 +91,13 @@ impl Method for Scm {
 
 impl Sampling for Scm {
     /// The tensor grid, last parameter varying fastest; weights sum to one.
-    fn design(&self, parameters: &[RandomParameter], _seed: u64) -> Result<Design, MethodError> {
-        let grid = quadrature::tensor_grid(&vec![self.nodes; parameters.len()])?;
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        let grid = quadrature::tensor_grid(&vec![self.nodes; inputs.len()])?;
         Ok(Design::mapped(
             Germ::Normal,
             grid.points,
             Some(grid.weights),
-            parameters,
+            inputs,
         ))
     }
 
@@ -111,7 +114,8 @@ impl Sampling for Scm {
     ) -> Result<Estimate, MethodError> {
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
-        let basis = MultiIndexSet::total_order(dim, self.order());
+        let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
+        let basis = Basis::new(vec![Family::Hermite; dim], set).map_err(PceError::from)?;
         let pce = Pce::project(
             basis,
             &design.points,
@@ -121,6 +125,7 @@ impl Sampling for Scm {
         )?;
         let mut estimate = Estimate::from_quadrature(data, weights);
         estimate.std_chaos = Some(pce.std());
+        estimate.chaos_error = order_difference(&pce);
         estimate.sobol = Some(Sobol::from_chaos(&pce));
         estimate.chaos = Some(pce);
         estimate.draws = Draws::Chaos;

@@ -30,9 +30,10 @@ use super::error::{InvalidSettings, MethodError};
 use super::qmc::check_sobol_points;
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::hd::sobol_seq::{self, Sobol as SobolSequence};
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::sampling;
 
 /// Most bootstrap resamples.
@@ -174,15 +175,17 @@ impl SobolSampling {
 }
 
 impl Sampling for SobolSampling {
-    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError> {
-        let d = parameters.len();
+    /// In the independent uniform space (with correlated inputs the indices are those of the
+    /// independent germs, one per input in study order, as for a chaos).
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        let d = inputs.len();
         let base = self.base_points(d, seed)?;
         let (a, b): (Vec<Vec<f64>>, Vec<Vec<f64>>) = base
             .into_iter()
             .map(|p| (p[..d].to_vec(), p[d..].to_vec()))
             .unzip();
         let points = sensitivity::pick_freeze_design(&a, &b)?;
-        let mut design = Design::mapped(Germ::Uniform, points, None, parameters);
+        let mut design = Design::mapped(Germ::Uniform, points, None, inputs);
         if self.base == Base::Qmc && !self.samples.is_power_of_two() {
             design.warnings.push(format!(
                 "sobol_sampling: samples = {} is not a power of two: the Sobol' base points are \
@@ -351,19 +354,22 @@ impl PickFreezeRows {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::uq::distributions::RandomParameter;
     use crate::uq::Distribution;
     use std::f64::consts::PI;
 
-    fn uniform_params(d: usize, low: f64, high: f64) -> Vec<RandomParameter> {
-        (0..d)
-            .map(|i| RandomParameter {
-                name: format!("x{}", i + 1),
-                distribution: Distribution::uniform(low, high).unwrap(),
-            })
-            .collect()
+    fn uniform_params(d: usize, low: f64, high: f64) -> RandomInputs {
+        RandomInputs::independent(
+            (0..d)
+                .map(|i| RandomParameter {
+                    name: format!("x{}", i + 1),
+                    distribution: Distribution::uniform(low, high).unwrap(),
+                })
+                .collect(),
+        )
     }
 
-    fn run(m: &SobolSampling, params: &[RandomParameter], f: impl Fn(&[f64]) -> f64) -> Estimate {
+    fn run(m: &SobolSampling, params: &RandomInputs, f: impl Fn(&[f64]) -> f64) -> Estimate {
         let design = m.design(params, 11).unwrap();
         assert_eq!(design.len(), m.samples * (params.len() + 2));
         let values: Vec<f64> = design.values.iter().map(|v| f(v)).collect();
@@ -449,6 +455,7 @@ mod tests {
             quantities: 0,
             times: &[0.0, 1.0],
             system: None,
+            correlation: None,
         };
         let m: SobolSampling = toml::from_str("samples = 64").unwrap();
         assert_eq!(m.base, Base::Qmc);
