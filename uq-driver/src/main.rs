@@ -100,6 +100,9 @@ struct RunArgs {
     /// Stop after this many new points (the study can be resumed later).
     #[arg(long, hide = true)]
     max_points: Option<usize>,
+    /// Write the CSV files and summary.json only: no plots, no index.html.
+    #[arg(long)]
+    no_report: bool,
 }
 
 #[derive(Args)]
@@ -269,6 +272,7 @@ fn run(a: RunArgs) -> Result<()> {
         fresh: a.fresh,
         max_new_points: a.max_points,
         points: None,
+        no_report: a.no_report,
     };
     let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
     match outcome {

@@ -192,10 +192,16 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
 }
 
 fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
-    if a.pdf_grid < 2 || a.pdf_times < 1 || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q)) {
+    if a.pdf_grid < 2
+        || a.pdf_times < 1
+        || a.series_samples < 2
+        || a.surrogate_samples < 2
+        || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q))
+    {
         return Err(cx.invalid(
             None,
-            "analysis: pdf_grid >= 2, pdf_times >= 1, quantiles in [0, 1]",
+            "analysis: pdf_grid >= 2, pdf_times >= 1, series_samples >= 2, \
+             surrogate_samples >= 2, quantiles in [0, 1]",
         ));
     }
     Ok(())

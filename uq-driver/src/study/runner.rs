@@ -30,6 +30,8 @@ pub struct RunOptions {
     pub max_new_points: Option<usize>,
     /// Run only these points of the design (a shard); None: all.
     pub points: Option<Vec<usize>>,
+    /// Write the CSV files and `summary.json` only: no plots, no `index.html`.
+    pub no_report: bool,
 }
 
 impl RunOptions {

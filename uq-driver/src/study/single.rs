@@ -10,9 +10,11 @@ use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::store::Record;
 use crate::fmu::Fmu;
+use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
 use crate::results::{
-    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, ScalarStats, Summary, Versions,
+    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout, ScalarStats,
+    Summary, Timing, Versions,
 };
 use crate::spec::Study;
 use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
@@ -28,7 +30,7 @@ pub(crate) fn run_single(
         source,
     })?;
     match study.method().evaluation() {
-        Evaluation::Intrusive(method) => solve(study, method, out_dir),
+        Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
             let design = method.design(&study.parameters, study.seed)?;
@@ -53,6 +55,7 @@ struct RunFacts {
     failed: usize,
     wall_time: f64,
     threads: usize,
+    analysis_time: f64,
 }
 
 fn summary(
@@ -89,6 +92,16 @@ fn summary(
             .iter()
             .map(|q| (q.name.clone(), q.clone()))
             .collect::<BTreeMap<_, _>>(),
+        timing: Timing {
+            runs_s: facts.wall_time,
+            analysis_s: facts.analysis_time,
+            report_s: 0.0,
+        },
+        units: BTreeMap::new(),
+        record_layout: RecordLayout {
+            outputs: study.outputs.clone(),
+            quantities: study.qoi.iter().map(|q| q.name().to_owned()).collect(),
+        },
     }
 }
 
@@ -111,8 +124,13 @@ pub(crate) fn finish(
             total: design.len(),
         });
     }
-    let (outputs, quantities) = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let started = Instant::now();
+    let (mut outputs, mut quantities) =
+        analysis::analyse_runs(study, method, design, &outcome.records)?;
     let md = fmu.description();
+    let units = units::study_units(study, Some(md));
+    units::annotate(&units, &mut outputs, &mut quantities);
+    let analysis_time = started.elapsed().as_secs_f64();
     let facts = RunFacts {
         fmu: Some(FmuInfo {
             path: fmu.path().display().to_string(),
@@ -127,9 +145,10 @@ pub(crate) fn finish(
         failed,
         wall_time: outcome.wall_time,
         threads: outcome.threads,
+        analysis_time,
     };
     let method_summary = study.method().summary(study.parameters.len());
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -137,8 +156,9 @@ pub(crate) fn finish(
         &outputs,
         &quantities,
     );
+    summary.units = units;
     let points = point_table(study, design, &outcome.records);
-    report::study::write(
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -146,6 +166,7 @@ pub(crate) fn finish(
             quantities: &quantities,
             qoi: &study.qoi,
             points: Some(&points),
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {
@@ -160,12 +181,15 @@ fn solve(
     study: &Study,
     method: &dyn Intrusive,
     out_dir: &Path,
+    opts: &RunOptions,
 ) -> Result<StudyResult, StudyRunError> {
     let started = Instant::now();
     let times = study.times();
     let solution = method.solve(&study.problem(&times))?;
     let wall_time = started.elapsed().as_secs_f64();
+    let started = Instant::now();
     let outputs = analysis::analyse_solution(study, &solution)?;
+    let analysis_time = started.elapsed().as_secs_f64();
     let mut method_summary = study.method().summary(study.parameters.len());
     method_summary.details.extend(solution.details);
     let facts = RunFacts {
@@ -176,8 +200,9 @@ fn solve(
         failed: 0,
         wall_time,
         threads: 1,
+        analysis_time,
     };
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -185,7 +210,8 @@ fn solve(
         &outputs,
         &[],
     );
-    report::study::write(
+    summary.units = units::study_units(study, None);
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -193,6 +219,7 @@ fn solve(
             quantities: &[],
             qoi: &study.qoi,
             points: None,
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {
