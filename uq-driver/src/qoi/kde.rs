@@ -3,10 +3,11 @@
 //! [`gaussian_kde`] sums every kernel (within 8 bandwidths) at every grid point: exact, and
 //! `O(grid · k)` for `k` samples near a point. [`gaussian_kde_binned`] is the fast path for the
 //! report's many densities (every time step of an output, from tens of thousands of draws):
-//! linear binning onto a lattice at most `h / 16` apart that contains the (uniform) grid,
+//! linear binning onto a lattice at most `h / 8` apart that contains the (uniform) grid,
 //! then one discrete convolution with the kernel (Wand & Jones, *Kernel Smoothing*, 1995,
-//! appendix D; Hall & Wand, 1996): `O(n + grid · 16 · 16)` whatever the sample size, within
-//! 5e-4 of the peak density of the exact sum.
+//! appendix D; Hall & Wand, 1996): `O(n + grid · 8 · 16)` whatever the sample size, within
+//! 1.5e-3 of the peak density of the exact sum (far below the statistical error of a kernel
+//! density; the tests measure it).
 
 use crate::uq::special::{norm_cdf, norm_pdf};
 
@@ -124,21 +125,22 @@ pub fn gaussian_kde(
         .collect()
 }
 
-/// Lattice points per bandwidth of [`gaussian_kde_binned`] (at least).
-const LATTICE_PER_BANDWIDTH: f64 = 16.0;
+/// Lattice points per bandwidth of [`gaussian_kde_binned`] and
+/// [`gaussian_kde_cell_average`] (at least).
+const LATTICE_PER_BANDWIDTH: f64 = 8.0;
 /// Largest lattice (points) before [`gaussian_kde_binned`] falls back to the exact sum.
 const MAX_LATTICE: usize = 1 << 20;
 
 /// Equal-weight Gaussian kernel density estimate on the uniform grid of `n` points from `lo`
 /// to `hi` (as [`auto_grid`] makes it), by linear binning: every finite sample splits its
 /// unit mass between the two nearest points of a lattice that contains the grid (every `k`-th
-/// lattice point is a grid point, spacing `δ ≤ h / 16`, reaching 8 bandwidths beyond each
+/// lattice point is a grid point, spacing `δ ≤ h / 8`, reaching 8 bandwidths beyond each
 /// end), and the density at a grid point is the discrete convolution of the lattice masses
 /// with the kernel. Samples more than 8 bandwidths from the grid carry no mass to it (as in
 /// [`gaussian_kde`]). A non-positive or non-finite `bandwidth` is replaced by
 /// [`silverman_bandwidth`]; a lattice that would be too fine falls back to [`gaussian_kde`].
 ///
-/// Cost `O(samples + n · 16 · 16)`; the difference to the exact sum is below 5e-4 of the
+/// Cost `O(samples + n · 8 · 16)`; the difference to the exact sum is below 1.5e-3 of the
 /// peak density (linear binning errs by `O(δ² / h²)`; the tests measure it).
 pub fn gaussian_kde_binned(
     samples: &[f64],
@@ -165,7 +167,7 @@ pub fn gaussian_kde_binned(
     } else {
         (grid[0], h)
     };
-    // k lattice intervals per grid interval, delta = step / k <= h / 16.
+    // k lattice intervals per grid interval, delta = step / k <= h / 8.
     let k = ((LATTICE_PER_BANDWIDTH * step / h).ceil().max(1.0)) as usize;
     let delta = step / k as f64;
     let taps = (CUTOFF * h / delta).ceil();
@@ -215,12 +217,16 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The Gaussian kernel density estimate averaged over each cell `[g_i − Δ/2, g_i + Δ/2]` of
-/// the uniform grid of `n` points from `lo` to `hi` (Δ the grid step): every finite sample
-/// puts the kernel's probability of each cell, a difference of normal CDFs, into it. This
-/// is what a heat map can show of a distribution narrower than its grid (point values of
-/// [`gaussian_kde_binned`] would fall between the grid points and miss it); mass beyond
-/// the outer cells is left out. Cost `O(samples · (16 h / Δ + 2))`: meant for `h` up to
-/// a few grid steps.
+/// the uniform grid of `n` points from `lo` to `hi` (Δ the grid step). This is what a heat
+/// map can show of a distribution narrower than its grid: point values
+/// ([`gaussian_kde_binned`]) would fall between the grid points and miss it. Mass beyond the
+/// outer cells is left out.
+///
+/// The density is taken by linear binning and convolution on a lattice `h / 8` apart that
+/// spans the data (± 8 bandwidths), then integrated over each cell (piecewise linear);
+/// `O(samples + (range / h + 16) · 8 · 129)`. Where that lattice would be too large (data
+/// spread over far more than the bandwidth), every sample adds the kernel's probability of
+/// each cell instead, a difference of normal CDFs.
 pub fn gaussian_kde_cell_average(
     samples: &[f64],
     lo: f64,
@@ -228,7 +234,8 @@ pub fn gaussian_kde_cell_average(
     n: usize,
     bandwidth: f64,
 ) -> Vec<f64> {
-    let total = samples.iter().filter(|x| x.is_finite()).count();
+    let finite = || samples.iter().copied().filter(|x| x.is_finite());
+    let total = finite().count();
     if n == 0 || total == 0 || !(lo.is_finite() && hi.is_finite()) {
         return vec![0.0; n];
     }
@@ -244,6 +251,71 @@ pub fn gaussian_kde_cell_average(
         grid[0].abs().max(1.0) * 1e-3
     };
     let first_edge = grid[0] - 0.5 * step;
+    let (xmin, xmax) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    let delta = h / LATTICE_PER_BANDWIDTH;
+    let taps = (CUTOFF * LATTICE_PER_BANDWIDTH) as usize;
+    let points = ((xmax - xmin) / delta).ceil() + 2.0 * taps as f64 + 2.0;
+    if !(points.is_finite() && points <= MAX_LATTICE as f64) {
+        return cell_average_exact(samples, first_edge, step, n, h, total);
+    }
+    let m = points as usize;
+    let origin = xmin - taps as f64 * delta;
+    // Masses padded by `taps` zeros on each side for the convolution.
+    let mut mass = vec![0.0; m + 2 * taps + 1];
+    for x in finite() {
+        let u = (x - origin) / delta;
+        let j = u.floor() as usize;
+        let f = u - j as f64;
+        mass[taps + j] += 1.0 - f;
+        mass[taps + j + 1] += f;
+    }
+    let scale = 1.0 / (total as f64 * h);
+    let kernel: Vec<f64> = (0..=2 * taps)
+        .map(|t| norm_pdf((t as f64 - taps as f64) * delta / h) * scale)
+        .collect();
+    let density: Vec<f64> = (0..m)
+        .map(|j| dot(&kernel, &mass[j..j + 2 * taps + 1]))
+        .collect();
+    // Only the cells the lattice reaches have mass; the cumulative integral is evaluated at
+    // their edges in one sweep.
+    let mut out = vec![0.0; n];
+    let a = (((origin - first_edge) / step).floor().max(0.0) as usize).min(n);
+    let b = ((((origin + (m - 1) as f64 * delta) - first_edge) / step)
+        .ceil()
+        .max(0.0) as usize)
+        .min(n);
+    if a < b {
+        let mut prefix = vec![0.0; m];
+        for j in 1..m {
+            prefix[j] = prefix[j - 1] + 0.5 * (density[j - 1] + density[j]) * delta;
+        }
+        let at = |x: f64| -> f64 {
+            let u = ((x - origin) / delta).clamp(0.0, (m - 1) as f64);
+            let j = (u.floor() as usize).min(m - 2);
+            let f = u - j as f64;
+            prefix[j] + f * delta * (density[j] + 0.5 * f * (density[j + 1] - density[j]))
+        };
+        let mut below = at(first_edge + a as f64 * step);
+        for (i, cell) in out.iter_mut().enumerate().take(b).skip(a) {
+            let above = at(first_edge + (i + 1) as f64 * step);
+            *cell = (above - below) / step;
+            below = above;
+        }
+    }
+    out
+}
+
+/// [`gaussian_kde_cell_average`] by a difference of normal CDFs per sample and cell.
+fn cell_average_exact(
+    samples: &[f64],
+    first_edge: f64,
+    step: f64,
+    n: usize,
+    h: f64,
+    total: usize,
+) -> Vec<f64> {
     let mut mass = vec![0.0; n];
     for &x in samples.iter().filter(|x| x.is_finite()) {
         // Cells whose edges lie within 8 bandwidths of x.
@@ -412,10 +484,10 @@ mod tests {
     fn binned_kde_matches_the_exact_sum() {
         let normal = normal_samples(20_000, 5);
         let h = silverman_bandwidth(&normal);
-        assert!(binned_error(&normal, -5.0, 5.0, 200, h) < 5e-4);
+        assert!(binned_error(&normal, -5.0, 5.0, 200, h) < 1.5e-3);
         // A grid much coarser than the bandwidth, and one much finer.
-        assert!(binned_error(&normal, -5.0, 5.0, 11, h) < 5e-4);
-        assert!(binned_error(&normal, -1.0, 1.0, 400, h) < 5e-4);
+        assert!(binned_error(&normal, -5.0, 5.0, 11, h) < 1.5e-3);
+        assert!(binned_error(&normal, -1.0, 1.0, 400, h) < 1.5e-3);
         // Bimodal and skewed, with samples far outside the grid on both sides.
         let mixed: Vec<f64> = normal
             .iter()
@@ -423,12 +495,12 @@ mod tests {
             .map(|(i, z)| if i % 3 == 0 { 6.0 + 0.2 * z } else { z.exp() })
             .collect();
         let h = silverman_bandwidth(&mixed);
-        assert!(binned_error(&mixed, 0.0, 7.0, 200, h) < 5e-4);
-        assert!(binned_error(&mixed, 1.0, 3.0, 50, h) < 5e-4);
+        assert!(binned_error(&mixed, 0.0, 7.0, 200, h) < 1.5e-3);
+        assert!(binned_error(&mixed, 1.0, 3.0, 50, h) < 1.5e-3);
         // Few samples: the bandwidth spans many grid points.
         let few = [0.3, 1.1, 1.2, 2.9, 4.0];
-        assert!(binned_error(&few, -2.0, 6.0, 200, 0.8) < 5e-4);
-        assert!(binned_error(&few, -2.0, 6.0, 200, 0.01) < 5e-4);
+        assert!(binned_error(&few, -2.0, 6.0, 200, 0.8) < 1.5e-3);
+        assert!(binned_error(&few, -2.0, 6.0, 200, 0.01) < 1.5e-3);
     }
 
     #[test]
@@ -460,6 +532,11 @@ mod tests {
         assert!((f[5] - 10.0).abs() < 1e-9, "{f:?}");
         let points = gaussian_kde_binned(&xs, 0.0, 1.0, 11, h);
         assert!(points.iter().all(|v| *v < 1e-6), "{points:?}");
+        // The exact per-sample sum (the fallback) agrees.
+        let exact = cell_average_exact(&xs, -0.05, 0.1, 11, h, xs.len());
+        for (a, b) in f.iter().zip(&exact) {
+            assert!((a - b).abs() < 1e-6 * 10.0, "{a} vs {b}");
+        }
         // A wide one: cell averages of the exact density (by a fine trapezoid here).
         let ys = normal_samples(500, 8);
         let f = gaussian_kde_cell_average(&ys, -3.0, 3.0, 13, 0.4);
@@ -468,7 +545,7 @@ mod tests {
         for (i, v) in f.iter().enumerate() {
             let seg = &exact[i * 400..=(i + 1) * 400];
             let avg = seg.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>() / 400.0;
-            assert!((v - avg).abs() < 1e-6, "cell {i}: {v} vs {avg}");
+            assert!((v - avg).abs() < 1.5e-3 * 0.4, "cell {i}: {v} vs {avg}");
         }
     }
 }

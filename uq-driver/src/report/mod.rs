@@ -15,6 +15,7 @@
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
 //! file. Only I/O (and, for CSV, inconsistent column lengths) produce a [`ReportError`].
 
+pub mod compare;
 pub mod csv;
 pub mod heatmap;
 pub mod html;
@@ -70,7 +71,7 @@ pub enum ReportError {
 }
 
 /// Writes `bytes` to `path`, attaching the path to any I/O error.
-pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     std::fs::write(path, bytes).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,

@@ -123,7 +123,7 @@ impl Default for Analysis {
     fn default() -> Self {
         Analysis {
             pdf_grid: 200,
-            pdf_times: 250,
+            pdf_times: 150,
             surrogate_samples: 20_000,
             series_samples: 4_000,
             quantiles: vec![0.01, 0.5, 0.99],

@@ -38,7 +38,7 @@ mod study;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{Analysis, Experiment, InvalidExperiment, Outputs, PaperValue, StudyFile, Variant};
-pub use load::fmu_search_path;
+pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, ParameterSpec};
 pub use study::{Study, Suite};
 

@@ -7,8 +7,10 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+pub mod export;
 pub mod interface;
 mod outcome;
+pub mod progress;
 pub mod runner;
 pub mod shard;
 mod single;

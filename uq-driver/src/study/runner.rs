@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::interface::{Interface, InterfaceError};
+use super::progress::{Progress, ProgressMode};
 use super::store::{Manifest, Record, Store, StoreError};
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::qoi::scalar::{self, QoiError};
@@ -22,6 +23,9 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
+    /// Print progress lines (when the output is a log file, not a terminal); ignored when
+    /// `progress` is set.
+    pub progress_lines: bool,
     /// Unweighted designs: continue past failed points (overrides the study file when true).
     pub allow_failures: bool,
     /// Discard earlier results in the output folder.
@@ -285,20 +289,6 @@ pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, R
     })
 }
 
-fn progress_bar(show: bool, n: usize) -> Option<indicatif::ProgressBar> {
-    if !show || n == 0 {
-        return None;
-    }
-    let b = indicatif::ProgressBar::new(n as u64);
-    b.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} points  {elapsed} elapsed, ~{eta} left",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    Some(b)
-}
-
 /// Runs every point of `design` not yet in the store of `out_dir`.
 pub fn run_points(
     study: &Study,
@@ -339,11 +329,14 @@ pub fn run_points(
         stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
         max_new: opts.max_new_points,
     };
-    let bar = progress_bar(opts.progress, missing.len());
-    let new = pool.install(|| batch.run(&missing, bar.as_ref()))?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    let mode = match (opts.progress, opts.progress_lines) {
+        (true, _) => ProgressMode::Bar,
+        (false, true) => ProgressMode::Lines,
+        _ => ProgressMode::Off,
+    };
+    let progress = Progress::new(mode, missing.len());
+    let new = pool.install(|| batch.run(&missing, &progress))?;
+    progress.finish();
     let n_new = new.len();
     for (i, r) in new {
         records[i] = Some(r);
@@ -375,7 +368,7 @@ impl Batch<'_> {
     fn run(
         &self,
         points: &[usize],
-        bar: Option<&indicatif::ProgressBar>,
+        progress: &Progress,
     ) -> Result<Vec<(usize, Record)>, StoreError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
@@ -405,9 +398,7 @@ impl Batch<'_> {
                         }
                     };
                     self.store.append(i, &rec)?;
-                    if let Some(b) = bar {
-                        b.inc(1);
-                    }
+                    progress.inc();
                     Ok(Some((i, rec)))
                 },
             )
