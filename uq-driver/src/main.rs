@@ -12,7 +12,10 @@ use uq_driver::report::units::with_unit;
 use uq_driver::results::sig;
 use uq_driver::spec::{builtin, fmu_candidates, Experiment, Study, StudyError, BUILTINS};
 use uq_driver::study::interface::{InterfaceError, VariableProblem};
-use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
+use uq_driver::study::{
+    run_study, runner, shard, Outcome, RunError, RunOptions, StudyResult, StudyRunError,
+    SuiteResult,
+};
 use uq_driver::suggest;
 
 #[derive(Parser)]
@@ -239,7 +242,18 @@ fn hints(e: &anyhow::Error) -> Vec<String> {
         if let Some(StudyError::Parse { message, .. }) = cause.downcast_ref::<StudyError>() {
             out.extend(suggest::for_serde_message(message));
         }
-        if let Some(ie) = cause.downcast_ref::<InterfaceError>() {
+        // `transparent` errors hide their inner error from the chain: look inside.
+        let ie = cause
+            .downcast_ref::<InterfaceError>()
+            .or_else(|| match cause.downcast_ref::<RunError>() {
+                Some(RunError::Interface(ie)) => Some(ie),
+                _ => None,
+            })
+            .or_else(|| match cause.downcast_ref::<StudyRunError>() {
+                Some(StudyRunError::Run(RunError::Interface(ie))) => Some(ie),
+                _ => None,
+            });
+        if let Some(ie) = ie {
             if let VariableProblem::Unknown { name, .. } = &ie.problem {
                 if let Ok(fmu) = Fmu::open(&ie.fmu) {
                     let names = fmu.description().variables.iter().map(|v| v.name.as_str());

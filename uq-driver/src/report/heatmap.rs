@@ -567,6 +567,18 @@ mod tests {
     }
 
     #[test]
+    fn colour_scale_starts_at_zero_and_needs_a_positive_value() {
+        let mut map = gaussian_map();
+        let s = map.color_scale().unwrap();
+        assert_eq!(s.lo, 0.0);
+        assert!(map.to_svg("x.png").contains(">0</text>"));
+        map.z = vec![vec![0.0; 5]; 3];
+        assert!(map.color_scale().is_none(), "no density, no scale");
+        map.z = vec![vec![f64::NAN; 5]; 3];
+        assert!(map.color_scale().is_none());
+    }
+
+    #[test]
     fn embedded_svg_carries_the_png() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("e.svg");
