@@ -83,6 +83,7 @@ win64-toolchain:
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
 	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
+	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme README.md
 
 $(VPY): tests/python/requirements.txt
 	$(PYTHON) -m venv $(VENV)

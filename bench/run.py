@@ -55,6 +55,7 @@ GOAL_RTF = 5.0
 GOAL_VT_DEFAULT = 40.0
 GOAL_VT_FINE = 4.0
 GOAL_VT_ACCURACY = 1e-12
+GOAL_ISOLATE = 0.10
 
 
 class BenchError(Exception):
@@ -867,6 +868,96 @@ def bench_analysis_report(work, repeats, checks, all_builtins):
 
 # ------------------------------------------------------------------ BENCHMARKS.md
 
+# ------------------------------------------------------------------ --isolate overhead
+
+ISOLATE_VT_STUDY = """name = "bench-isolate-vt"
+description = "VehicleTrack, 40 Latin hypercube points of 6 s (the paper's section 5 settings)."
+fmu = "VehicleTrack.fmu"
+seed = 42
+[experiment]
+stop = 6.0
+step = 0.002
+[method]
+kind = "lhs"
+samples = 40
+[[parameters]]
+name = "Kpz"
+mean = 1773000.0
+cov = 0.1
+[[parameters]]
+name = "Csz"
+mean = 120000.0
+cov = 0.1
+[fixed]
+irregularity = 3
+seed = 1
+[outputs]
+variables = ["Zc_acc", "P1"]
+[[qoi]]
+kind = "sperling"
+name = "W"
+signal = "Zc_acc"
+direction = "vertical"
+segment = 5.0
+f_min = 0.5
+f_max = 40.0
+skip = 1.0
+"""
+
+
+def bench_isolate(work, repeats):
+    """In-process runs against --isolate (a worker process per thread, one round trip of
+    parameters and records per point) on VehicleTrack and on the Wheel."""
+    sec = Section("9. uq-driver --isolate vs in-process (VehicleTrack 40 × 6 s, Wheel 1 000 × 5 s)",
+                  ["study", "mode", "runs wall, best (s)", "runs median (s)",
+                   "command wall, best (s)", "overhead (best runs)"])
+    vt_toml = work / "bench-isolate-vt.toml"
+    vt_toml.write_text(ISOLATE_VT_STUDY)
+    studies = [("VehicleTrack", str(vt_toml), "Zc_acc.csv"),
+               ("Wheel", "builtin:wheel-lhs-1000", "q.csv")]
+    overheads, same = {}, True
+    for name, study, csv_name in studies:
+        res = {m: ([], []) for m in ("in-process", "isolate")}
+        for m in res:
+            flag = " --isolate" if m == "isolate" else ""
+            sec.cmd(f"target/release/uq-driver run {rel(study) if study.endswith('.toml') else study} "
+                    f"--out {rel(work / f'isolate-{name}-{m}')} --fresh{flag}   # x{repeats}")
+        for _ in range(repeats):
+            for m in res:  # alternate, so that slow phases of other load hit both
+                out_dir = work / f"isolate-{name}-{m}"
+                cmd = [str(DRIVER), "run", study, "--out", str(out_dir), "--fresh"]
+                if m == "isolate":
+                    cmd.append("--isolate")
+                wall, _, _ = run_cmd(cmd)
+                s = json.loads((out_dir / "summary.json").read_text())
+                if s["failed_runs"]:
+                    die(f"{out_dir}/summary.json: {s['failed_runs']} failed runs")
+                res[m][0].append(s["wall_time_s"])
+                res[m][1].append(wall)
+        base = min(res["in-process"][0])
+        for m in res:
+            rb, rm = best_median(res[m][0])
+            cb, _ = best_median(res[m][1])
+            over = rb / base - 1.0
+            sec.row(name, m, fmt_s(rb), fmt_s(rm), fmt_s(cb),
+                    "—" if m == "in-process" else f"{100 * over:+.1f} %")
+        overheads[name] = min(res["isolate"][0]) / base - 1.0
+        ok = all((work / f"isolate-{name}-in-process" / f).read_bytes()
+                 == (work / f"isolate-{name}-isolate" / f).read_bytes()
+                 for f in (csv_name, "points.csv"))
+        same = same and ok
+        sec.note(f"Check: {csv_name} and points.csv of {name} are byte-identical in-process and "
+                 f"with --isolate: {'OK' if ok else 'FAILED'}.")
+    vt = overheads["VehicleTrack"]
+    sec.done(f"--isolate costs {100 * vt:+.1f} % on the VehicleTrack runs (goal ≤ "
+             f"{100 * GOAL_ISOLATE:.0f} %: {goal(vt <= GOAL_ISOLATE)}) and "
+             f"{100 * overheads['Wheel']:+.1f} % on the Wheel (runs of well under a millisecond, "
+             f"where the round trip per point would show; best times of runs alternated with "
+             f"the in-process ones).")
+    return sec, same
+
+
+
 def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     lines = [
         "# Benchmarks",
@@ -948,16 +1039,17 @@ def main():
         s6 = bench_realtime(work, repeats if args.quick else max(repeats, 5), step_cost)
         s_parse = bench_parse_description(work, repeats)
         s7 = bench_vt_stepping(work, s1.other)
+        s_iso, same_iso = bench_isolate(work, repeats)
         s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
         if env_fmu is None:
             del os.environ["RAILUQ_FMU_DIR"]
     except BenchError as e:
         print(f"\nbench/run.py: error: {e}", file=sys.stderr)
         return 2
-    checks_ok = all(ok for _, _, ok in checks) and same_threads
+    checks_ok = all(ok for _, _, ok in checks) and same_threads and same_iso
     total = time.perf_counter() - t_start
-    write_markdown(md, mach, [s1, s2, s3, s4, s5, s6, s7, s_parse] + s_analysis, total, argv,
-                   checks_ok, lib_same)
+    write_markdown(md, mach, [s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis, total,
+                   argv, checks_ok, lib_same)
     print(f"\nwrote {rel(md)} ({total:.0f} s in all)", flush=True)
     if not checks_ok:
         print("bench/run.py: a correctness check FAILED (see above)", file=sys.stderr)

@@ -8,9 +8,12 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
+use uq_driver::report::csv::push_shortest;
 use uq_driver::report::units::with_unit;
 use uq_driver::results::sig;
-use uq_driver::spec::{builtin, fmu_candidates, Experiment, Study, StudyError, BUILTINS};
+use uq_driver::spec::{
+    builtin, fmu_candidates, Experiment, FixedValue, InvalidExperiment, Study, StudyError, BUILTINS,
+};
 use uq_driver::study::interface::{InterfaceError, VariableProblem};
 use uq_driver::study::{
     run_study, runner, shard, Outcome, RunError, RunOptions, StudyResult, StudyRunError,
@@ -57,6 +60,8 @@ enum Command {
         /// MC/LHS: continue past failed points.
         #[arg(long)]
         allow_failures: bool,
+        #[command(flatten)]
+        safety: SafetyArgs,
     },
     /// Check a plan's shards (every point exactly once, same study and FMU) and write the
     /// study's outputs, as `run` would.
@@ -108,6 +113,9 @@ enum Command {
         #[arg(long, short)]
         out: Option<PathBuf>,
     },
+    /// Serve points to a parent uq-driver (`--isolate`) over stdin/stdout.
+    #[command(hide = true)]
+    Worker,
 }
 
 #[derive(Args)]
@@ -132,6 +140,47 @@ struct RunArgs {
     /// Write the CSV files and summary.json only: no plots, no index.html.
     #[arg(long)]
     no_report: bool,
+    #[command(flatten)]
+    safety: SafetyArgs,
+}
+
+/// How points are run: isolation, time limit, retries.
+#[derive(Args)]
+struct SafetyArgs {
+    /// Run each point in a worker process: an FMU that crashes, aborts, calls exit() or
+    /// outlives --timeout-per-run fails its point instead of ending the study.
+    #[arg(long)]
+    isolate: bool,
+    /// Longest a run may take (s). With --isolate the run is killed and fails its point;
+    /// in-process the study stops with a message naming the point.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
+    timeout_per_run: Option<std::time::Duration>,
+    /// Run again the points that failed in an earlier run into the same folder.
+    #[arg(long)]
+    retry_failed: bool,
+}
+
+impl SafetyArgs {
+    /// Fills the runner options.
+    fn apply(&self, opts: &mut RunOptions) -> Result<()> {
+        opts.retry_failed = self.retry_failed;
+        opts.timeout_per_run = self.timeout_per_run;
+        if self.isolate {
+            opts.isolate = Some(
+                uq_driver::study::isolate::default_exe()
+                    .context("locating the uq-driver executable for --isolate")?,
+            );
+        }
+        Ok(())
+    }
+}
+
+fn parse_timeout(s: &str) -> Result<std::time::Duration, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("{e}"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("must be a positive number of seconds, got {s}"));
+    }
+    std::time::Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
 }
 
 #[derive(Args)]
@@ -165,12 +214,18 @@ struct SlurmArgs {
 struct SimulateArgs {
     /// The .fmu file.
     fmu: PathBuf,
-    /// Parameter values, NAME=VALUE (repeatable).
+    /// Parameter values, NAME=VALUE (repeatable): a number, true/false or a text, as the
+    /// variable's type (Real, Integer, Enumeration, Boolean, String) needs.
     #[arg(long = "set", value_parser = parse_assignment)]
-    set: Vec<(String, f64)>,
-    /// Outputs to record (repeatable; default: every Real output).
+    set: Vec<(String, String)>,
+    /// Outputs to record (repeatable; default: every output that is a Real, Integer,
+    /// Enumeration or Boolean).
     #[arg(long = "output")]
     outputs: Vec<String>,
+    /// Time-varying inputs: a CSV file with a time column, then one column per input
+    /// (Real ones interpolated linearly, the others held, as fmpy's input= does).
+    #[arg(long)]
+    input: Option<PathBuf>,
     /// Start time (s; default: the FMU's default experiment, else 0).
     #[arg(long)]
     start: Option<f64>,
@@ -185,19 +240,19 @@ struct SimulateArgs {
     out: Option<PathBuf>,
 }
 
-fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+fn parse_assignment(s: &str) -> Result<(String, String), String> {
     let (name, value) = s
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
-    let v: f64 = value
-        .trim()
-        .parse()
-        .map_err(|e| format!("value of {name}: {e}"))?;
-    Ok((name.trim().to_owned(), v))
+    Ok((name.trim().to_owned(), value.to_owned()))
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if matches!(cli.command, Command::Worker) {
+        return ExitCode::from(u8::try_from(uq_driver::study::isolate::serve()).unwrap_or(1));
+    }
+    uq_driver::study::guard::install_signal_handler();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // `uq-driver inspect X | head`: the reader went away; nothing left to say.
@@ -409,7 +464,8 @@ fn dispatch(cmd: Command) -> Result<()> {
             shard,
             threads,
             allow_failures,
-        } => run_shard(&dir, shard, threads, allow_failures),
+            safety,
+        } => run_shard(&dir, shard, threads, allow_failures, &safety),
         Command::Merge {
             dir,
             out,
@@ -471,22 +527,24 @@ fn dispatch(cmd: Command) -> Result<()> {
             );
             Ok(())
         }
+        Command::Worker => unreachable!("handled in main"),
     }
 }
 
 /// `uq-driver run`.
 fn run(a: RunArgs) -> Result<()> {
     let s = load_study(&a.study)?;
-    let opts = RunOptions {
+    let mut opts = RunOptions {
         threads: a.threads,
         progress: std::io::stderr().is_terminal(),
         progress_lines: !std::io::stderr().is_terminal(),
         allow_failures: a.allow_failures,
         fresh: a.fresh,
         max_new_points: a.max_points,
-        points: None,
         no_report: a.no_report,
+        ..RunOptions::default()
     };
+    a.safety.apply(&mut opts)?;
     let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
     match outcome {
         Outcome::Study(r) => print_study(&r, &a.out),
@@ -501,6 +559,7 @@ fn run_shard(
     shard: Option<usize>,
     threads: Option<usize>,
     allow_failures: bool,
+    safety: &SafetyArgs,
 ) -> Result<()> {
     let k = match shard {
         Some(k) => k,
@@ -509,13 +568,14 @@ fn run_shard(
             .parse()
             .context("SLURM_ARRAY_TASK_ID is not a number")?,
     };
-    let opts = RunOptions {
+    let mut opts = RunOptions {
         threads,
         progress: std::io::stderr().is_terminal(),
         progress_lines: !std::io::stderr().is_terminal(),
         allow_failures,
         ..RunOptions::default()
     };
+    safety.apply(&mut opts)?;
     let o = shard::run_shard(dir, k, &opts)?;
     println!(
         "shard {k}: {} points run, {} resumed, wall time {:.2} s",
@@ -656,20 +716,45 @@ fn simulate(a: SimulateArgs) -> Result<()> {
         .or(de.step_size)
         .context("no --step and no default step size in the FMU")?;
     let experiment = Experiment { start, stop, step };
-    experiment.check()?;
+    experiment.check().map_err(|e| match e {
+        InvalidExperiment::ZeroStep => anyhow::anyhow!(
+            "--step 0: the communication step must be positive (s), e.g. --step 0.01"
+        ),
+        other => other.into(),
+    })?;
     let times = experiment.times();
-    let (names, series) = runner::simulate(&fmu, &a.set, &a.outputs, &times)?;
+    let params: Vec<(String, FixedValue)> = a
+        .set
+        .into_iter()
+        .map(|(n, v)| (n, FixedValue::Text(v)))
+        .collect();
+    let sim = runner::simulate(&fmu, &params, &a.outputs, a.input.as_deref(), &times)?;
+    for (name, why) in &sim.skipped {
+        eprintln!("uq-driver: note: output '{name}' not recorded: {why}");
+    }
+    if sim.names.is_empty() {
+        eprintln!(
+            "uq-driver: warning: nothing to record: the FMU has no output that can be written \
+             as a number (name variables with --output)"
+        );
+    }
+    if let Some(t) = sim.ended_at {
+        eprintln!(
+            "uq-driver: note: the FMU ended the simulation at t = {t} s (before the stop time \
+             {stop} s); the output ends there"
+        );
+    }
     let mut text = String::from("time");
-    for n in &names {
+    for n in &sim.names {
         text.push(',');
         text.push_str(n);
     }
     text.push('\n');
-    for (k, t) in times.iter().enumerate() {
-        text.push_str(&t.to_string());
-        for s in &series {
+    for (k, t) in sim.times.iter().enumerate() {
+        push_shortest(&mut text, *t);
+        for s in &sim.series {
             text.push(',');
-            text.push_str(&s[k].to_string());
+            push_shortest(&mut text, s[k]);
         }
         text.push('\n');
     }

@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::spec::{Experiment, PaperValue};
+use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Draws, MethodSummary, Sobol};
 
@@ -336,7 +336,7 @@ pub struct Summary {
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
     /// Deterministic values.
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
     /// The FMU (null for intrusive methods).
     pub fmu: Option<FmuInfo>,
     /// Model runs of the study (1 for intrusive methods).

@@ -2,21 +2,32 @@
 //! keys, FMU variables), by Jaro–Winkler similarity (the `strsim` crate), and the
 //! suggestions the command line adds to the messages of the TOML parser.
 
-/// The name of `candidates` closest to `wrong`, if one is close enough to be a likely typo
-/// (Jaro–Winkler similarity at least 0.8, or the same name in another case).
+/// The name of `candidates` closest to `wrong`, if one is close enough to be a likely typo:
+/// Jaro–Winkler similarity at least 0.8, or one edit away (insertion, deletion, substitution
+/// or swap of neighbours: `Kzp` for `Kpz`), or the same name in another case; `None` when
+/// `wrong` is one of the candidates. One edit ranks before similarity.
 pub fn closest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let lower = wrong.to_lowercase();
+    let candidates: Vec<&'a str> = candidates.into_iter().collect();
+    if candidates.contains(&wrong) {
+        return None;
+    }
     candidates
         .into_iter()
         .map(|c| {
-            let score = if c.to_lowercase() == lower {
-                1.0
+            let cl = c.to_lowercase();
+            let jw = strsim::jaro_winkler(&lower, &cl);
+            let one_edit = lower.chars().count() > 1 && strsim::osa_distance(&lower, &cl) <= 1;
+            let score = if cl == lower {
+                3.0
+            } else if one_edit {
+                1.0 + jw
             } else {
-                strsim::jaro_winkler(&lower, &c.to_lowercase())
+                jw
             };
             (c, score)
         })
-        .filter(|(c, score)| *score >= 0.8 && *c != wrong)
+        .filter(|(_, score)| *score >= 0.8)
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(c, _)| c)
 }

@@ -1,4 +1,5 @@
-//! Build helper: `railuq-fmu xml DIR` writes the model descriptions; `railuq-fmu package
+//! Build helper: `railuq-fmu xml DIR` writes the model descriptions; `railuq-fmu readme FILE`
+//! rewrites the marked variable tables of README.md; `railuq-fmu package
 //! [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]` writes one `.fmu` per model
 //! carrying every library given, each under the platform folder its header names.
 
@@ -11,6 +12,7 @@ use package::{model_info, package, write_descriptions, Library, PackageError};
 use railuq::models::registry;
 
 const USAGE: &str = "usage: railuq-fmu xml DIR
+       railuq-fmu readme FILE
        railuq-fmu package [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]
 
 package writes OUT_DIR/<Model>.fmu for each MODEL (default: every model) with the shared
@@ -75,6 +77,22 @@ fn run_package(a: &PackageArgs) -> Result<(), PackageError> {
     Ok(())
 }
 
+/// Rewrites the marked variable tables of `path` (README.md) from the models' tables.
+fn update_readme(path: &Path) -> Result<(), PackageError> {
+    let io = |source| PackageError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let text = std::fs::read_to_string(path).map_err(io)?;
+    let infos: Vec<_> = registry().iter().map(|e| e.info).collect();
+    let (new, found) = railuq::fmi2::xml::update_readme_tables(&text, &infos);
+    if new != text {
+        std::fs::write(path, new).map_err(io)?;
+    }
+    println!("{}: {found} variable tables up to date", path.display());
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
@@ -83,6 +101,7 @@ fn main() -> ExitCode {
                 println!("wrote {}", p.display());
             }
         }),
+        Some("readme") if args.len() == 2 => update_readme(Path::new(&args[1])),
         Some("package") => match parse_package(&args[1..]) {
             Some(a) => run_package(&a),
             None => return usage(),

@@ -25,6 +25,7 @@
 
 pub mod archive;
 mod binary;
+pub mod cleanup;
 pub mod description;
 mod error;
 mod ffi;
@@ -70,7 +71,28 @@ pub(crate) struct FmuInner {
     pub(crate) live_instances: AtomicUsize,
     /// Set when a call returned fmi2Fatal: no function of this FMU may be called again.
     pub(crate) fatal: AtomicBool,
-    _extracted: Option<tempfile::TempDir>,
+    _extracted: Option<Extracted>,
+}
+
+/// A temporary extraction folder, known to [`cleanup`] until it is removed.
+#[derive(Debug)]
+struct Extracted(Option<tempfile::TempDir>);
+
+impl Extracted {
+    fn path(&self) -> &Path {
+        self.0.as_ref().expect("present until dropped").path()
+    }
+}
+
+impl Drop for Extracted {
+    fn drop(&mut self) {
+        if let Some(dir) = self.0.take() {
+            let path = dir.path().to_path_buf();
+            // Removed first, forgotten after: a signal meanwhile still finds it registered.
+            let _ = dir.close();
+            cleanup::unregister(&path);
+        }
+    }
 }
 
 impl Fmu {
@@ -82,20 +104,54 @@ impl Fmu {
             source,
         };
         let metadata = fs::metadata(path).map_err(io)?;
-        let (extracted, root) = if metadata.is_dir() {
-            (None, path.to_path_buf())
-        } else {
-            let dir = archive::extract_to_temp(path)?;
-            let root = dir.path().to_path_buf();
-            (Some(dir), root)
+        if metadata.is_dir() {
+            return Self::load(path, path, None);
+        }
+        // Registered as it is created: a signal during a long extraction still removes it.
+        let dir = cleanup::temp_dir("uq-fmu-").map_err(|source| FmuError::Io {
+            path: std::env::temp_dir(),
+            source,
+        })?;
+        let dir = Extracted(Some(dir));
+        {
+            let _filling = cleanup::filling();
+            archive::extract(path, dir.path())?;
+        }
+        let root = dir.path().to_path_buf();
+        Self::load(path, &root, Some(dir))
+    }
+
+    /// Opens the FMU extracted in the folder `root` (used in place), naming it `shown` in
+    /// messages and in [`Fmu::path`] (e.g. the `.fmu` another process extracted it from).
+    pub fn open_extracted(root: &Path, shown: &Path) -> Result<Fmu, FmuError> {
+        Self::load(shown, root, None)
+    }
+
+    /// Loads the FMU extracted in `root`; `path` is what the user gave.
+    fn load(path: &Path, root: &Path, extracted: Option<Extracted>) -> Result<Fmu, FmuError> {
+        let io = |source| FmuError::Io {
+            path: path.to_path_buf(),
+            source,
         };
-        let root = fs::canonicalize(&root).map_err(io)?;
+        let root = fs::canonicalize(root).map_err(io)?;
 
         let md_path = root.join("modelDescription.xml");
         if !md_path.is_file() {
             return Err(FmuError::MissingModelDescription {
                 path: path.to_path_buf(),
             });
+        }
+        // The size first: an extracted folder is not bounded by the archive's limits.
+        let limit = description::ParseLimits::DEFAULT_MAX_BYTES;
+        let size = fs::metadata(&md_path).map_err(io)?.len();
+        if size > limit as u64 {
+            return Err(FmuError::from_description(
+                path,
+                DescriptionError::TooLarge {
+                    size: usize::try_from(size).unwrap_or(usize::MAX),
+                    limit,
+                },
+            ));
         }
         let xml = fs::read(&md_path).map_err(|source| FmuError::Io {
             path: md_path.clone(),
@@ -145,6 +201,12 @@ impl Fmu {
                 _extracted: extracted,
             }),
         })
+    }
+
+    /// Whether a call returned fmi2Fatal: no function of this FMU may be called again (open it
+    /// again, in another process, for a usable copy).
+    pub fn is_unusable(&self) -> bool {
+        self.inner.fatal.load(std::sync::atomic::Ordering::Acquire)
     }
 
     /// The parsed `modelDescription.xml`.

@@ -1,8 +1,9 @@
 //! CSV writers: columns side by side, and density grids in long format.
 //!
-//! Numbers are written with Rust's `Display` for `f64`, which is the shortest decimal that
-//! parses back to the same value (never exponent notation). NaN is written as `nan` and
-//! infinities as `inf` / `-inf`; pandas and spreadsheets read all three.
+//! Numbers are written in the shortest form that parses back to the same value
+//! ([`push_shortest`]: plain for 1e-4 <= |x| < 1e16, exponent notation outside, as Python's
+//! `repr`). NaN is written as `nan` and infinities as `inf` / `-inf`; pandas and spreadsheets
+//! read all three.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -113,13 +114,29 @@ fn push_header(out: &mut String, header: &[&str]) {
 }
 
 fn push_number(out: &mut String, v: f64) {
+    push_shortest(out, v);
+}
+
+/// Appends `v` in the shortest form that reads back as the same `f64`: Rust's shortest
+/// round-trip digits, in plain notation for 0 and 1e-4 <= |v| < 1e16 and in exponent notation
+/// otherwise (`2.2250738585072014e-308`, not a 326-character decimal), as Python's `repr` does.
+/// NaN is `nan`, infinities `inf` / `-inf`.
+pub fn push_shortest(out: &mut String, v: f64) {
+    // Writing to a String cannot fail.
     if v.is_nan() {
         out.push_str("nan");
-    } else {
-        // `Display` of f64 is the shortest round-trip representation; infinities print as
-        // `inf` / `-inf`. Writing to a String cannot fail.
+    } else if v.is_infinite() || v == 0.0 || (1e-4..1e16).contains(&v.abs()) {
         let _ = write!(out, "{v}");
+    } else {
+        let _ = write!(out, "{v:e}");
     }
+}
+
+/// [`push_shortest`] as a new string.
+pub fn shortest(v: f64) -> String {
+    let mut s = String::new();
+    push_shortest(&mut s, v);
+    s
 }
 
 #[cfg(test)]
@@ -149,12 +166,50 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.starts_with("time,q\n"));
         let body = text.split_once('\n').unwrap().1;
-        assert!(!body.contains('e'), "no exponent notation expected: {body}");
+        assert!(
+            body.starts_with("0,-0\n0.1,2.2250738585072014e-308\n"),
+            "{body}"
+        );
         let rows = parse(&text);
         assert_eq!(rows.len(), t.len());
         for (i, row) in rows.iter().enumerate() {
             assert_eq!(row[0].to_bits(), t[i].to_bits());
             assert_eq!(row[1].to_bits(), q[i].to_bits());
+        }
+    }
+
+    #[test]
+    fn tiny_and_huge_numbers_are_written_short_not_as_long_decimals() {
+        // Issue 13: 2.2e-308 was written as a 326-character decimal.
+        assert_eq!(shortest(2.2e-308), "2.2e-308");
+        assert_eq!(shortest(f64::MIN_POSITIVE), "2.2250738585072014e-308");
+        assert_eq!(shortest(5e-324), "5e-324");
+        assert_eq!(shortest(f64::MAX), "1.7976931348623157e308");
+        assert_eq!(shortest(1e16), "1e16");
+        assert_eq!(shortest(-2.5e-7), "-2.5e-7");
+        // Plain where Python's repr is plain.
+        assert_eq!(shortest(0.0001), "0.0001");
+        assert_eq!(shortest(0.01), "0.01");
+        assert_eq!(shortest(123456789.125), "123456789.125");
+        assert_eq!(shortest(9999999999999998.0), "9999999999999998");
+        assert_eq!(shortest(3.0), "3");
+    }
+
+    #[test]
+    fn every_number_round_trips_in_at_most_24_characters() {
+        // Bit patterns from a fixed-seed xorshift: every exponent range is hit.
+        let mut x = 0x9E37_79B9_7F4A_7C15_u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if !v.is_finite() {
+                continue;
+            }
+            let s = shortest(v);
+            assert!(s.len() <= 24, "{s}");
+            assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
         }
     }
 

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 use super::parameter::ParameterSpec;
+use super::value::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::MethodSpec;
@@ -24,40 +25,60 @@ pub struct Experiment {
 }
 
 impl Experiment {
-    /// Number of communication steps.
+    /// Relative tolerance within which stop − start counts as a whole number of steps.
+    const WHOLE: f64 = 1e-6;
+
+    /// Number of communication steps (the last one shorter when stop − start is not a whole
+    /// number of steps).
     pub fn n_steps(&self) -> usize {
-        ((self.stop - self.start) / self.step).round() as usize
+        let (n, short_last) = self.grid();
+        n + usize::from(short_last)
     }
 
-    /// The communication points t_0 … t_n (s), computed as start + i·step (no drift).
+    /// The number of full steps and whether a shorter last step follows.
+    fn grid(&self) -> (usize, bool) {
+        let ratio = (self.stop - self.start) / self.step;
+        if !ratio.is_finite() || ratio <= 0.0 {
+            return (0, false);
+        }
+        let whole = ratio.round();
+        if (ratio - whole).abs() <= Self::WHOLE * ratio.max(1.0) {
+            (whole as usize, false)
+        } else {
+            (ratio.floor() as usize, true)
+        }
+    }
+
+    /// The communication points t_0 … t_n (s), computed as start + i·step (no drift) and
+    /// ending at stop: when stop − start is not a whole number of steps, the last step is
+    /// shorter (as fmpy does).
     pub fn times(&self) -> Vec<f64> {
-        let n = self.n_steps();
-        (0..=n)
+        let (n, short_last) = self.grid();
+        let mut t: Vec<f64> = (0..=n)
             .map(|i| {
-                if i == n {
+                if i == n && !short_last {
                     self.stop
                 } else {
                     self.start + i as f64 * self.step
                 }
             })
-            .collect()
+            .collect();
+        if short_last {
+            t.push(self.stop);
+        }
+        t
     }
 
-    /// Checks that start < stop and step > 0 (all finite) and that stop − start is a whole
-    /// number of steps.
+    /// Checks that start < stop and step > 0, all finite.
     pub fn check(&self) -> Result<(), InvalidExperiment> {
+        if self.step == 0.0 {
+            return Err(InvalidExperiment::ZeroStep);
+        }
         let finite = self.start.is_finite() && self.stop.is_finite() && self.step.is_finite();
         if !finite || self.step <= 0.0 || self.stop <= self.start {
             return Err(InvalidExperiment::Range {
                 start: self.start,
                 stop: self.stop,
-                step: self.step,
-            });
-        }
-        let ratio = (self.stop - self.start) / self.step;
-        if (ratio - ratio.round()).abs() > 1e-6 * ratio.max(1.0) {
-            return Err(InvalidExperiment::NotWholeSteps {
-                span: self.stop - self.start,
                 step: self.step,
             });
         }
@@ -68,6 +89,9 @@ impl Experiment {
 /// A time grid that cannot be run.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum InvalidExperiment {
+    /// The communication step is zero.
+    #[error("the communication step is 0 s: give a positive step (s), e.g. 0.01")]
+    ZeroStep,
     /// Not start < stop with step > 0.
     #[error(
         "experiment needs finite start < stop and step > 0 (got start {start}, stop {stop}, step {step})"
@@ -80,14 +104,15 @@ pub enum InvalidExperiment {
         /// Step (s).
         step: f64,
     },
-    /// The span is not a whole number of steps.
-    #[error("stop − start = {span} s is not a whole number of communication steps of {step} s")]
-    NotWholeSteps {
-        /// stop − start (s).
-        span: f64,
-        /// Step (s).
-        step: f64,
-    },
+}
+
+/// Time-varying inputs of every run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inputs {
+    /// A CSV file: a time column (s) first, then one column per input variable, named after
+    /// it (relative paths start from the study file's folder).
+    pub file: String,
 }
 
 /// Output variables to analyse as time series.
@@ -156,9 +181,12 @@ pub struct StudyFile {
     pub method: Spanned<MethodSpec>,
     /// Random parameters.
     pub parameters: Vec<Spanned<ParameterSpec>>,
-    /// Deterministic parameter values set before every run.
+    /// Deterministic parameter values set before every run (numbers, Booleans or texts).
     #[serde(default)]
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
+    /// Time-varying inputs.
+    #[serde(default)]
+    pub inputs: Option<Inputs>,
     /// Outputs.
     #[serde(default)]
     pub outputs: Outputs,
@@ -214,5 +242,5 @@ pub struct Variant {
     pub parameters: Option<Vec<ParameterSpec>>,
     /// Deterministic values of this variant, merged over the study's `[fixed]`.
     #[serde(default)]
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
 }

@@ -127,6 +127,10 @@ fn study(
         method: file.method.get_ref().clone(),
         parameters,
         fixed: file.fixed.clone(),
+        inputs: file
+            .inputs
+            .as_ref()
+            .map(|i| resolve_relative(&i.file, base)),
         outputs: file.outputs.variables.clone(),
         qoi: file.qoi.iter().map(|q| q.get_ref().clone()).collect(),
         analysis: file.analysis.clone(),
@@ -289,10 +293,20 @@ fn variant(
             .collect();
     }
     for (k, x) in &v.fixed {
-        f.fixed.insert(k.clone(), *x);
+        f.fixed.insert(k.clone(), x.clone());
     }
     let origin = format!("{} (variant {})", cx.origin, v.name);
     study(f, &origin, base, cx.text)
+}
+
+/// A file named in the study: absolute, or relative to the study's folder (to the current
+/// folder for a built-in study).
+fn resolve_relative(file: &str, base: Option<&Path>) -> PathBuf {
+    let p = Path::new(file);
+    match base {
+        Some(b) if p.is_relative() => b.join(p),
+        _ => p.to_path_buf(),
+    }
 }
 
 /// The first of [`fmu_candidates`] that exists, else the first candidate (opening it then

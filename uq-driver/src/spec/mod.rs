@@ -17,8 +17,10 @@
 //! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal"
 //! mean = 100.0
 //! std = 10.0                   # or cov = 0.1
-//! [fixed]                      # deterministic parameter values
+//! [fixed]                      # deterministic values: numbers, true/false, "texts"
 //! h = 0.001
+//! [inputs]                     # optional: time-varying inputs
+//! file = "signal.csv"          # time column, then one column per input variable
 //! [outputs]
 //! variables = ["q"]
 //! ```
@@ -34,13 +36,17 @@ mod file;
 mod load;
 mod parameter;
 mod study;
+mod value;
 
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
-pub use file::{Analysis, Experiment, InvalidExperiment, Outputs, PaperValue, StudyFile, Variant};
+pub use file::{
+    Analysis, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue, StudyFile, Variant,
+};
 pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, ParameterSpec};
 pub use study::{Study, Suite};
+pub use value::FixedValue;
 
 #[cfg(test)]
 mod tests;

@@ -79,6 +79,14 @@ pub enum InvalidParameter {
     /// No spread was given.
     #[error("`std` or `cov` is required")]
     NoSpread,
+    /// The coefficient of variation is not positive (or the mean is zero).
+    #[error("`cov` must be positive and the mean non-zero (got cov = {cov}, mean = {mean})")]
+    BadCov {
+        /// The coefficient of variation given.
+        cov: f64,
+        /// The mean.
+        mean: f64,
+    },
     /// The distribution's parameters are invalid.
     #[error(transparent)]
     Distribution(#[from] DistributionError),
@@ -110,6 +118,10 @@ impl<'de> Deserialize<'de> for ParameterSpec {
 fn spread(mean: f64, std: Option<f64>, cov: Option<f64>) -> Result<f64, InvalidParameter> {
     match (std, cov) {
         (Some(s), None) => Ok(s),
+        // Checked here: a bad cov would otherwise be reported as the std it gives.
+        (None, Some(c)) if !(c > 0.0 && c.is_finite() && mean != 0.0) => {
+            Err(InvalidParameter::BadCov { cov: c, mean })
+        }
         (None, Some(c)) => Ok(mean.abs() * c),
         (Some(_), Some(_)) => Err(InvalidParameter::BothSpreads),
         (None, None) => Err(InvalidParameter::NoSpread),
@@ -154,6 +166,21 @@ mod tests {
 
     fn parse(text: &str) -> Result<ParameterSpec, toml::de::Error> {
         toml::from_str(text)
+    }
+
+    #[test]
+    fn a_negative_cov_is_reported_as_cov_not_as_std() {
+        // Issue 12: cov = -0.1 was reported as "std must be positive (got -10)".
+        let p = parse("name = \"K\"\nmean = 100\ncov = -0.1").unwrap();
+        let e = p.distribution.to_distribution().unwrap_err().to_string();
+        assert!(
+            e.contains("`cov` must be positive") && e.contains("-0.1"),
+            "{e}"
+        );
+        assert!(!e.contains("std"), "{e}");
+        let p = parse("name = \"K\"\nmean = 0\ncov = 0.1").unwrap();
+        let e = p.distribution.to_distribution().unwrap_err().to_string();
+        assert!(e.contains("mean non-zero"), "{e}");
     }
 
     #[test]

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use super::file::{Analysis, Experiment, PaperValue};
+use super::value::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
@@ -33,7 +34,9 @@ pub struct Study {
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
     /// Deterministic values.
-    pub fixed: BTreeMap<String, f64>,
+    pub fixed: BTreeMap<String, FixedValue>,
+    /// Time-varying inputs: the CSV file, resolved against the study's folder.
+    pub inputs: Option<PathBuf>,
     /// Outputs analysed over time.
     pub outputs: Vec<String>,
     /// Scalar quantities of interest.

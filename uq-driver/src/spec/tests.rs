@@ -28,7 +28,10 @@ fn wrong_study_files_give_clear_errors() {
             base.replace("[outputs]", "[outputs]\ncolour = 1"),
             "unknown field",
         ),
-        (base.replace("step = 0.01", "step = 0.03"), "whole number"),
+        (
+            base.replace("step = 0.01", "step = 0.0"),
+            "communication step is 0",
+        ),
         // Settings of another method are not representable.
         (
             base.replace("nodes = 6", "nodes = 6\nsamples = 100"),
@@ -106,4 +109,41 @@ fn times_do_not_drift() {
     assert_eq!(t.len(), 501);
     assert_eq!(t[500], 5.0);
     assert_eq!(t[3], 0.03);
+}
+
+#[test]
+fn a_stop_time_off_the_grid_gets_a_shorter_last_step_not_an_error() {
+    // Issue 13: stop − start not a whole number of steps was refused; fmpy ends with a
+    // shorter step.
+    let e = Experiment {
+        start: 0.0,
+        stop: 1.05,
+        step: 0.1,
+    };
+    e.check().unwrap();
+    let t = e.times();
+    assert_eq!(t.len(), 12);
+    assert_eq!(t[10], 10.0 * 0.1);
+    assert_eq!(t[11], 1.05);
+    assert_eq!(e.n_steps(), 11);
+    // Within 1e-6 of a whole number of steps: the grid ends at stop with a full step.
+    let e = Experiment {
+        start: 0.0,
+        stop: 5.0 + 1e-9,
+        step: 0.01,
+    };
+    assert_eq!(e.times().len(), 501);
+    assert_eq!(e.n_steps(), 500);
+}
+
+#[test]
+fn a_zero_step_has_its_own_message() {
+    let e = Experiment {
+        start: 0.0,
+        stop: 1.0,
+        step: 0.0,
+    };
+    let err = e.check().unwrap_err();
+    assert_eq!(err, InvalidExperiment::ZeroStep);
+    assert!(err.to_string().contains("step is 0"), "{err}");
 }

@@ -8,8 +8,13 @@
 
 pub mod analysis;
 pub mod export;
+pub mod guard;
+pub mod inputs;
 pub mod interface;
+pub mod isolate;
+pub mod lock;
 mod outcome;
+mod point;
 pub mod progress;
 pub mod runner;
 pub mod shard;
@@ -31,6 +36,7 @@ pub fn run_study(
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<Outcome, StudyRunError> {
+    runner::prepare_out_dir(out_dir)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),
         None => single::run_single(study, out_dir, opts).map(|r| Outcome::Study(Box::new(r))),

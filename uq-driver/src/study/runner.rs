@@ -1,18 +1,21 @@
 //! The parallel runner: one FMU instance per worker, `fmi2Reset` between points, every
 //! finished point appended to the results store.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
+use super::guard::{self, StudyGuard};
 use super::interface::{Interface, InterfaceError};
+use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
+use super::lock::{FolderLock, LockError};
+pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
 use super::store::{Manifest, Record, Store, StoreError};
 use crate::fmu::{Fmu, FmuError, Instance};
-use crate::qoi::scalar::{self, QoiError};
 use crate::spec::Study;
 use crate::uq::method::{Design, MethodError};
 
@@ -36,6 +39,14 @@ pub struct RunOptions {
     pub points: Option<Vec<usize>>,
     /// Write the CSV files and `summary.json` only: no plots, no `index.html`.
     pub no_report: bool,
+    /// Run the points that failed in an earlier run again (`--retry-failed`).
+    pub retry_failed: bool,
+    /// `--isolate`: run each point in a worker process started from this uq-driver executable
+    /// (see [`isolate`]); None: in-process.
+    pub isolate: Option<PathBuf>,
+    /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point; in-process
+    /// the study stops with a message naming the point (an FMU call cannot be interrupted).
+    pub timeout_per_run: Option<Duration>,
 }
 
 impl RunOptions {
@@ -43,30 +54,6 @@ impl RunOptions {
     pub fn allow_failures(&self, study: &Study) -> bool {
         self.allow_failures || study.analysis.allow_failures
     }
-}
-
-/// Why one model run failed. Its text is stored with the point, so it is complete on its own.
-#[derive(Debug, thiserror::Error)]
-pub enum PointError {
-    /// An FMI call failed (the message lists what the FMU logged).
-    #[error(transparent)]
-    Fmu(#[from] FmuError),
-    /// An output became NaN or infinite.
-    #[error("non-finite value of {signal} at t = {time} s")]
-    NonFinite {
-        /// The variable.
-        signal: String,
-        /// When (s).
-        time: f64,
-    },
-    /// A quantity of interest could not be evaluated on the run.
-    #[error("quantity '{name}': {error}")]
-    Quantity {
-        /// The quantity.
-        name: String,
-        /// Why.
-        error: QoiError,
-    },
 }
 
 /// A point that failed: where and why.
@@ -107,7 +94,11 @@ pub enum RunError {
     #[error(transparent)]
     Design(#[from] MethodError),
     /// Points failed and failures are not allowed.
-    #[error("{failed} of {total} points failed; first: {first}")]
+    #[error(
+        "{failed} of {total} points failed; first: {first}. After fixing the cause, run again \
+         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
+         and LHS, to analyse the others)"
+    )]
     PointsFailed {
         /// Number of failed points.
         failed: usize,
@@ -119,6 +110,21 @@ pub enum RunError {
     /// A single run failed (`simulate`).
     #[error(transparent)]
     Point(#[from] PointError),
+    /// The output path exists and is not a folder.
+    #[error("{}: the output path exists and is not a folder", .0.display())]
+    NotAFolder(PathBuf),
+    /// The output folder is locked by another run.
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    /// A worker process was stopped from outside (`--isolate`): the study stops, the point
+    /// has no result.
+    #[error("point {point}: {why}; the study stops (the point is run again on a re-run)")]
+    Interrupted {
+        /// The point.
+        point: usize,
+        /// What happened.
+        why: String,
+    },
     /// The thread pool could not be built.
     #[error("cannot start the worker threads")]
     Pool(#[source] rayon::ThreadPoolBuildError),
@@ -171,90 +177,15 @@ pub fn study_hash(study: &Study) -> String {
     if !study.qoi.is_empty() {
         key["qoi"] = serde_json::json!(study.qoi);
     }
+    if let Some(path) = &study.inputs {
+        // The signals themselves change the records, not the file's name. An unreadable file
+        // is refused before any run (Interface::resolve).
+        let content = std::fs::read(path)
+            .map(|b| format!("{:x}", Sha256::digest(&b)))
+            .unwrap_or_default();
+        key["inputs"] = serde_json::json!(content);
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
-}
-
-/// Starts (or resets) `slot`'s instance, sets the parameters, initializes and records the
-/// signals at `times`: `traces[o * nt + k]` is signal `o` at `times[k]`.
-fn simulate_point(
-    fmu: &Fmu,
-    slot: &mut Option<Instance>,
-    iface: &Interface,
-    values: &[f64],
-    times: &[f64],
-) -> Result<Vec<f64>, FmuError> {
-    let nt = times.len();
-    let inst = match slot {
-        Some(inst) => {
-            inst.reset()?;
-            inst
-        }
-        None => slot.insert(fmu.instantiate("uq-driver", false)?),
-    };
-    let (fixed_vr, fixed_v): (Vec<u32>, Vec<f64>) = iface.fixed.iter().copied().unzip();
-    inst.set_real(&fixed_vr, &fixed_v)?;
-    let (int_vr, int_v): (Vec<u32>, Vec<i32>) = iface.fixed_int.iter().copied().unzip();
-    inst.set_integer(&int_vr, &int_v)?;
-    inst.set_real(&iface.random, values)?;
-    let stop = *times.last().expect("at least one time");
-    inst.setup_experiment(None, times[0], Some(stop))?;
-    inst.enter_initialization_mode()?;
-    inst.exit_initialization_mode()?;
-    let mut traces = vec![0.0; iface.signals.len() * nt];
-    let mut buf = vec![0.0; iface.signals.len()];
-    for k in 0..nt {
-        if k > 0 {
-            inst.do_step(times[k - 1], times[k] - times[k - 1], true)?;
-        }
-        inst.get_real(&iface.signals, &mut buf)?;
-        for (o, v) in buf.iter().enumerate() {
-            traces[o * nt + k] = *v;
-        }
-    }
-    Ok(traces)
-}
-
-/// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
-/// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
-/// (value, code) of each quantity of interest.
-pub fn run_point(
-    fmu: &Fmu,
-    slot: &mut Option<Instance>,
-    iface: &Interface,
-    values: &[f64],
-    times: &[f64],
-) -> Result<Vec<f64>, PointError> {
-    let nt = times.len();
-    let traces = simulate_point(fmu, slot, iface, values, times).inspect_err(|_| {
-        // A failed instance may be in Error state: start the next point on a fresh one.
-        *slot = None;
-    })?;
-    if let Some(pos) = traces.iter().position(|v| !v.is_finite()) {
-        *slot = None;
-        return Err(PointError::NonFinite {
-            signal: iface.signal_names[pos / nt].clone(),
-            time: times[pos % nt],
-        });
-    }
-    let mut out = traces[..iface.n_stored * nt].to_vec();
-    let signal = |name: &str| -> &[f64] {
-        let i = iface
-            .signal_names
-            .iter()
-            .position(|n| n == name)
-            .expect("resolved");
-        &traces[i * nt..(i + 1) * nt]
-    };
-    for q in &iface.qois {
-        let (v, code) =
-            scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
-                name: q.name().to_owned(),
-                error,
-            })?;
-        out.push(v);
-        out.push(code as u8 as f64);
-    }
-    Ok(out)
 }
 
 /// What a run produced: every point's record, in design order.
@@ -289,7 +220,9 @@ pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, R
     })
 }
 
-/// Runs every point of `design` not yet in the store of `out_dir`.
+/// Runs every point of `design` not yet in the store of `out_dir` (with
+/// [`RunOptions::retry_failed`], also the points that failed before), holding the folder's
+/// lock ([`FolderLock`]) meanwhile.
 pub fn run_points(
     study: &Study,
     fmu: &Fmu,
@@ -299,6 +232,14 @@ pub fn run_points(
 ) -> Result<RunOutcome, RunError> {
     let started = Instant::now();
     let manifest = manifest(study, fmu, design)?;
+    prepare_out_dir(out_dir)?;
+    let lock = FolderLock::acquire(out_dir)?;
+    if let Some(previous) = lock.taken_over() {
+        eprintln!(
+            "note: {} was locked by a run that is no longer running ({previous}); taking it over",
+            out_dir.display()
+        );
+    }
     let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
     if let Some(note) = store.recovery().summary() {
         eprintln!("warning: {note}");
@@ -307,10 +248,27 @@ pub fn run_points(
         Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
         None => (0..design.len()).collect(),
     };
+    let failed_before = wanted
+        .iter()
+        .filter(|&&i| matches!(records[i], Some(Record::Failed(_))))
+        .count();
+    if failed_before > 0 && !opts.retry_failed {
+        eprintln!(
+            "note: {failed_before} point{} failed in an earlier run and {} not run again \
+             (--retry-failed runs {} again)",
+            if failed_before == 1 { "" } else { "s" },
+            if failed_before == 1 { "is" } else { "are" },
+            if failed_before == 1 { "it" } else { "them" },
+        );
+    }
     let missing: Vec<usize> = wanted
         .iter()
         .copied()
-        .filter(|&i| records[i].is_none())
+        .filter(|&i| match &records[i] {
+            None => true,
+            Some(Record::Failed(_)) => opts.retry_failed,
+            Some(Record::Ok(_)) => false,
+        })
         .collect();
     let threads = opts
         .threads
@@ -320,14 +278,30 @@ pub fn run_points(
         .num_threads(threads)
         .build()
         .map_err(RunError::Pool)?;
+    let iface = Interface::resolve(study, fmu)?;
+    iface.check_design(fmu, &design.values)?;
+    let times = study.times();
+    let workers = opts.isolate.as_ref().map(|exe| {
+        WorkerPool::new(
+            IsolateOptions {
+                exe: exe.clone(),
+                timeout: opts.timeout_per_run,
+            },
+            &isolate::setup(fmu, &iface, &times),
+        )
+    });
+    let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
     let batch = Batch {
         fmu,
-        iface: Interface::resolve(study, fmu)?,
+        iface,
+        study,
         design,
-        times: study.times(),
+        times,
         store: &store,
         stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
         max_new: opts.max_new_points,
+        workers,
+        guard: &guard,
     };
     let mode = match (opts.progress, opts.progress_lines) {
         (true, _) => ProgressMode::Bar,
@@ -335,7 +309,16 @@ pub fn run_points(
         _ => ProgressMode::Off,
     };
     let progress = Progress::new(mode, missing.len());
-    let new = pool.install(|| batch.run(&missing, &progress))?;
+    let done = AtomicBool::new(false);
+    let new = std::thread::scope(|scope| {
+        if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
+            let (guard, done) = (&guard, &done);
+            scope.spawn(move || watchdog(guard, limit, done));
+        }
+        let new = pool.install(|| batch.run(&missing, &progress));
+        done.store(true, Ordering::Release);
+        new
+    })?;
     progress.finish();
     let n_new = new.len();
     for (i, r) in new {
@@ -351,10 +334,52 @@ pub fn run_points(
     })
 }
 
+/// Creates the output folder, or checks that the existing path is one.
+pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotAFolder(dir.to_path_buf()));
+    }
+    std::fs::create_dir_all(dir).map_err(|source| {
+        RunError::Store(StoreError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })
+    })
+}
+
+/// In-process runs cannot be interrupted: when one outlives `limit`, name it and end the
+/// process (the store keeps every finished point).
+fn watchdog(guard: &StudyGuard, limit: Duration, done: &AtomicBool) {
+    let tick = (limit / 10).clamp(Duration::from_millis(10), Duration::from_millis(250));
+    while !done.load(Ordering::Acquire) {
+        std::thread::sleep(tick);
+        let overdue = guard.overdue(limit);
+        if overdue.is_empty() {
+            continue;
+        }
+        let points: Vec<String> = overdue
+            .iter()
+            .map(|(p, v, t)| format!("point {p} ({v}) has run for {:.1} s", t.as_secs_f64()))
+            .collect();
+        guard::exit_now(
+            guard::EXIT_FAILURE,
+            &format!(
+                "uq-driver: error: {}, longer than --timeout-per-run {} s. An FMU call cannot be \
+                 interrupted inside this process, so the study stops here; finished points are \
+                 kept in the results store. Run again with --isolate to have such runs killed \
+                 and marked failed while the study goes on.",
+                points.join("; "),
+                limit.as_secs_f64()
+            ),
+        );
+    }
+}
+
 /// Points to run in parallel, each appended to the store as it finishes.
 struct Batch<'a> {
     fmu: &'a Fmu,
     iface: Interface,
+    study: &'a Study,
     design: &'a Design,
     times: Vec<f64>,
     store: &'a Store,
@@ -362,14 +387,13 @@ struct Batch<'a> {
     stop_on_failure: bool,
     /// Stop after this many new points.
     max_new: Option<usize>,
+    /// `--isolate`: the worker processes.
+    workers: Option<WorkerPool>,
+    guard: &'a StudyGuard,
 }
 
 impl Batch<'_> {
-    fn run(
-        &self,
-        points: &[usize],
-        progress: &Progress,
-    ) -> Result<Vec<(usize, Record)>, StoreError> {
+    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Record)>, RunError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
         points
@@ -377,7 +401,7 @@ impl Batch<'_> {
             .with_min_len(1)
             .map_init(
                 || None::<Instance>,
-                |slot, &i| -> Result<Option<(usize, Record)>, StoreError> {
+                |slot, &i| -> Result<Option<(usize, Record)>, RunError> {
                     if stop.load(Ordering::Relaxed) {
                         return Ok(None);
                     }
@@ -387,16 +411,16 @@ impl Batch<'_> {
                             return Ok(None);
                         }
                     }
-                    let values = &self.design.values[i];
-                    let rec = match run_point(self.fmu, slot, &self.iface, values, &self.times) {
-                        Ok(v) => Record::Ok(v),
+                    let rec = match self.run_one(slot, i) {
+                        Ok(rec) => rec,
                         Err(e) => {
-                            if self.stop_on_failure {
-                                stop.store(true, Ordering::Relaxed);
-                            }
-                            Record::Failed(e.to_string())
+                            stop.store(true, Ordering::Relaxed);
+                            return Err(e);
                         }
                     };
+                    if matches!(rec, Record::Failed(_)) && self.stop_on_failure {
+                        stop.store(true, Ordering::Relaxed);
+                    }
                     self.store.append(i, &rec)?;
                     progress.inc();
                     Ok(Some((i, rec)))
@@ -405,6 +429,36 @@ impl Batch<'_> {
             .filter_map(Result::transpose)
             .collect()
     }
+
+    /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
+    fn run_one(&self, slot: &mut Option<Instance>, i: usize) -> Result<Record, RunError> {
+        let values = &self.design.values[i];
+        let _running = self.guard.running(i, describe_values(self.study, values));
+        let Some(workers) = &self.workers else {
+            return Ok(
+                match run_point(self.fmu, slot, &self.iface, values, &self.times) {
+                    Ok(v) => Record::Ok(v),
+                    Err(e) => Record::Failed(e.to_string()),
+                },
+            );
+        };
+        match workers.run(values) {
+            Ok(v) => Ok(Record::Ok(v)),
+            Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => Ok(Record::Failed(m)),
+            Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
+        }
+    }
+}
+
+/// "K = 1.2, C = 3" for messages.
+fn describe_values(study: &Study, values: &[f64]) -> String {
+    study
+        .parameters
+        .iter()
+        .zip(values)
+        .map(|(p, v)| format!("{} = {v}", p.name))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The number of failed points; an error naming the first when failures are not allowed
@@ -444,21 +498,6 @@ pub fn check_failures(
             message: message.clone(),
         },
     })
-}
-
-/// One deterministic run of `fmu` with `params` set before initialization, recording `outputs`
-/// (names; all the FMU's outputs when empty) at `times`. Returns the names and, per name,
-/// the series.
-pub fn simulate(
-    fmu: &Fmu,
-    params: &[(String, f64)],
-    outputs: &[String],
-    times: &[f64],
-) -> Result<(Vec<String>, Vec<Vec<f64>>), RunError> {
-    let iface = Interface::for_run(fmu, params, outputs)?;
-    let flat = run_point(fmu, &mut None, &iface, &[], times)?;
-    let series = flat.chunks(times.len()).map(<[f64]>::to_vec).collect();
-    Ok((iface.signal_names, series))
 }
 
 #[cfg(test)]

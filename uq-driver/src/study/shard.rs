@@ -167,7 +167,8 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     for (i, vals) in design.values.iter().enumerate() {
         csv.push_str(&format!("{i},{}", i % shards));
         for v in vals {
-            csv.push_str(&format!(",{v}"));
+            csv.push(',');
+            crate::report::csv::push_shortest(&mut csv, *v);
         }
         csv.push('\n');
     }

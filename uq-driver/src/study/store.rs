@@ -208,7 +208,8 @@ pub fn decode_all(bytes: &[u8], n_values: usize) -> (Vec<(usize, Record)>, usize
 
 impl Store {
     /// Opens (or creates) the store in `dir/store` for `manifest`. Returns the store and the
-    /// records already finished, by point index (first record wins). What was skipped or
+    /// records already finished, by point index (the first success, else the last failure, of
+    /// each point). What was skipped or
     /// repaired on the way is in [`Store::recovery`].
     pub fn open(
         dir: &Path,
@@ -316,7 +317,9 @@ fn read_records(
             });
             continue;
         }
-        if done[i].is_none() {
+        // The first result of a point is kept, except that a later record replaces a failure
+        // (a point run again by `--retry-failed`).
+        if matches!(done[i], None | Some(Record::Failed(_))) {
             done[i] = Some(rec);
         }
         kept.push((i, range));

@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::super::csv::push_shortest;
 use super::super::{write_bytes, write_columns, write_grid, ReportError};
 use super::quantile_column;
 use crate::results::{Convergence, OutputStats, PointStatus, PointTable, ScalarStats};
@@ -116,10 +117,12 @@ pub fn points_csv(path: &Path, t: &PointTable) -> Result<(), ReportError> {
     for (i, vals) in t.values.iter().enumerate() {
         let _ = write!(text, "{i}");
         if let Some(w) = &t.weights {
-            let _ = write!(text, ",{}", w[i]);
+            text.push(',');
+            push_shortest(&mut text, w[i]);
         }
         for v in vals {
-            let _ = write!(text, ",{v}");
+            text.push(',');
+            push_shortest(&mut text, *v);
         }
         let status = match &t.status[i] {
             PointStatus::Ok => "ok".to_string(),

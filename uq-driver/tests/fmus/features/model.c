@@ -207,10 +207,21 @@ static fmi2Status misbehave(Instance *inst, double end) {
     case MISBEHAVE_ERROR:
         LOG_ERROR(inst, "misbehave = 1: fmi2DoStep fails on purpose at t = %g", end);
         return fmi2Error;
-    case MISBEHAVE_SEGFAULT: *null_pointer = 1; return fmi2Error;
-    case MISBEHAVE_ABORT: abort();
-    case MISBEHAVE_EXIT: exit(0);
-    case MISBEHAVE_BLOCK: block_forever(); return fmi2Error;
+    /* 2..5 first log a warning, the last words an importer can show of the run. */
+    case MISBEHAVE_SEGFAULT:
+        LOG_WARNING(inst, "misbehave = 2: segfaulting on purpose at t = %g", end);
+        *null_pointer = 1;
+        return fmi2Error;
+    case MISBEHAVE_ABORT:
+        LOG_WARNING(inst, "misbehave = 3: calling abort() on purpose at t = %g", end);
+        abort();
+    case MISBEHAVE_EXIT:
+        LOG_WARNING(inst, "misbehave = 4: calling exit(0) on purpose at t = %g", end);
+        exit(0);
+    case MISBEHAVE_BLOCK:
+        LOG_WARNING(inst, "misbehave = 5: blocking forever on purpose at t = %g", end);
+        block_forever();
+        return fmi2Error;
     case MISBEHAVE_FATAL:
         fmu_log(inst, fmi2Fatal, "logStatusFatal", "misbehave = 7: fatal error on purpose at t = %g",
                 end);

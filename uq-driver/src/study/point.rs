@@ -1,0 +1,277 @@
+//! One model run: an instance started (or reset), its parameters and inputs set, stepped over
+//! the communication grid, its signals recorded; where the FMU ends the simulation itself the
+//! run ends there.
+
+use std::path::Path;
+
+use super::inputs::isclose;
+use super::interface::{Interface, RandomValueError};
+use super::runner::RunError;
+use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
+use crate::qoi::scalar::{self, QoiError};
+use crate::spec::FixedValue;
+
+/// Why one model run failed. Its text is stored with the point, so it is complete on its own.
+#[derive(Debug, thiserror::Error)]
+pub enum PointError {
+    /// An FMI call failed (the message lists what the FMU logged).
+    #[error(transparent)]
+    Fmu(#[from] FmuError),
+    /// An output became NaN or infinite.
+    #[error("non-finite value of {signal} at t = {time} s")]
+    NonFinite {
+        /// The variable.
+        signal: String,
+        /// When (s).
+        time: f64,
+    },
+    /// A design value does not fit its variable.
+    #[error("{0}")]
+    Value(String),
+    /// The FMU ended the simulation before the stop time. Statistics over time need every run
+    /// on the whole grid (a mean at t over the runs that reached t would be conditioned on
+    /// reaching it), so such a run is a failed point.
+    #[error(
+        "the FMU ended the simulation at t = {time} s, before the stop time {stop} s \
+         (fmi2DoStep returned fmi2Discard and fmi2Terminated is true); statistics over time \
+         need every run on the whole grid, so the point counts as failed (a stop time of at \
+         most {time} s keeps such runs)"
+    )]
+    EndedEarly {
+        /// When the FMU ended it (s).
+        time: f64,
+        /// The study's stop time (s).
+        stop: f64,
+    },
+    /// A quantity of interest could not be evaluated on the run.
+    #[error("quantity '{name}': {error}")]
+    Quantity {
+        /// The quantity.
+        name: String,
+        /// Why.
+        error: QoiError,
+    },
+}
+
+/// What one run recorded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trace {
+    /// `values[o * nt + k]` is signal `o` at `times[k]` (nt = the grid's length), for
+    /// `k < recorded`; the rest is zero.
+    pub values: Vec<f64>,
+    /// Grid times recorded: all of them unless the FMU ended the simulation early.
+    pub recorded: usize,
+    /// When the FMU ended the simulation before the stop time (`fmi2DoStep` returned
+    /// fmi2Discard and `fmi2GetBooleanStatus(fmi2Terminated)` was true): the time it ended
+    /// at (s, from `fmi2GetRealStatus(fmi2LastSuccessfulTime)`) and, when that is after the
+    /// last grid time recorded, the signals there.
+    pub ended: Option<(f64, Option<Vec<f64>>)>,
+}
+
+/// Starts (or resets) `slot`'s instance, sets the parameters and the inputs, initializes and
+/// records the signals at `times`, ending early where the FMU ends the simulation.
+fn simulate_point(
+    fmu: &Fmu,
+    slot: &mut Option<Instance>,
+    iface: &Interface,
+    values: &[f64],
+    times: &[f64],
+) -> Result<Trace, PointError> {
+    let nt = times.len();
+    let inst = match slot {
+        Some(inst) => {
+            inst.reset()?;
+            inst
+        }
+        None => slot.insert(fmu.instantiate("uq-driver", false)?),
+    };
+    iface.fixed.apply(inst)?;
+    iface.set_random(inst, values).map_err(|e| match e {
+        RandomValueError::Fmu(e) => PointError::Fmu(e),
+        RandomValueError::Value(p) => PointError::Value(p.to_string()),
+    })?;
+    let stop = *times.last().expect("at least one time");
+    inst.setup_experiment(None, times[0], Some(stop))?;
+    inst.enter_initialization_mode()?;
+    if let Some(inputs) = &iface.inputs {
+        inputs.apply(inst, times[0], false)?;
+    }
+    inst.exit_initialization_mode()?;
+    let mut trace = Trace {
+        values: vec![0.0; iface.signals.len * nt],
+        recorded: 0,
+        ended: None,
+    };
+    let mut buf = vec![0.0; iface.signals.len];
+    for k in 0..nt {
+        if k > 0 {
+            if let Some(inputs) = &iface.inputs {
+                inputs.apply(inst, times[k - 1], true)?;
+            }
+            if let Err(e) = inst.do_step(times[k - 1], times[k] - times[k - 1], true) {
+                let Some(end) = ended_by_fmu(inst, &e, times[k - 1]) else {
+                    return Err(e.into());
+                };
+                if isclose(end, times[k]) {
+                    // The step completed and the FMU ends there (at `end`, as it says).
+                    iface.signals.read(inst, &mut buf)?;
+                    store_column(&mut trace.values, &buf, nt, k);
+                    trace.recorded = k + 1;
+                    if k + 1 < nt {
+                        trace.ended = Some((end, None));
+                    }
+                } else if end > times[k - 1] && !isclose(end, times[k - 1]) {
+                    iface.signals.read(inst, &mut buf)?;
+                    trace.ended = Some((end, Some(buf.clone())));
+                } else {
+                    trace.ended = Some((times[k - 1], None));
+                }
+                return Ok(trace);
+            }
+        }
+        iface.signals.read(inst, &mut buf)?;
+        store_column(&mut trace.values, &buf, nt, k);
+        trace.recorded = k + 1;
+    }
+    Ok(trace)
+}
+
+/// Writes one time's signals into the signal-major matrix.
+fn store_column(values: &mut [f64], column: &[f64], nt: usize, k: usize) {
+    for (o, v) in column.iter().enumerate() {
+        values[o * nt + k] = *v;
+    }
+}
+
+/// When `error` from `fmi2DoStep` from `current` means the FMU ended the simulation
+/// (fmi2Discard and fmi2Terminated true): the time it ended at (its last successful time, or
+/// `current` if it cannot say).
+fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f64> {
+    let FmuError::Call {
+        status: Status::Discard,
+        ..
+    } = error
+    else {
+        return None;
+    };
+    if !inst.get_boolean_status(StatusKind::Terminated).ok()? {
+        return None;
+    }
+    let end = inst
+        .get_real_status(StatusKind::LastSuccessfulTime)
+        .ok()
+        .filter(|t| t.is_finite() && *t >= current)
+        .unwrap_or(current);
+    Some(end)
+}
+
+/// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
+/// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
+/// (value, code) of each quantity of interest. A run the FMU ends before the stop time is a
+/// failed point ([`PointError::EndedEarly`]).
+pub fn run_point(
+    fmu: &Fmu,
+    slot: &mut Option<Instance>,
+    iface: &Interface,
+    values: &[f64],
+    times: &[f64],
+) -> Result<Vec<f64>, PointError> {
+    let nt = times.len();
+    let trace = simulate_point(fmu, slot, iface, values, times).inspect_err(|_| {
+        // A failed instance may be in Error state: start the next point on a fresh one.
+        *slot = None;
+    })?;
+    if let Some((time, _)) = trace.ended {
+        *slot = None;
+        return Err(PointError::EndedEarly {
+            time,
+            stop: times[nt - 1],
+        });
+    }
+    let traces = trace.values;
+    if let Some(pos) = traces.iter().position(|v| !v.is_finite()) {
+        *slot = None;
+        return Err(PointError::NonFinite {
+            signal: iface.signal_names[pos / nt].clone(),
+            time: times[pos % nt],
+        });
+    }
+    let mut out = traces[..iface.n_stored * nt].to_vec();
+    let signal = |name: &str| -> &[f64] {
+        let i = iface
+            .signal_names
+            .iter()
+            .position(|n| n == name)
+            .expect("resolved");
+        &traces[i * nt..(i + 1) * nt]
+    };
+    for q in &iface.qois {
+        let (v, code) =
+            scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
+                name: q.name().to_owned(),
+                error,
+            })?;
+        out.push(v);
+        out.push(code as u8 as f64);
+    }
+    Ok(out)
+}
+
+/// One deterministic run: its times and, per recorded variable, the series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simulation {
+    /// The variables recorded.
+    pub names: Vec<String>,
+    /// Communication points (s): the grid, cut where the FMU ended the simulation.
+    pub times: Vec<f64>,
+    /// `series[o][k]`: variable `o` at `times[k]`.
+    pub series: Vec<Vec<f64>>,
+    /// Outputs not recorded, with the reason (when every output was asked for).
+    pub skipped: Vec<(String, String)>,
+    /// When the FMU ended the simulation before the stop time, the time (s).
+    pub ended_at: Option<f64>,
+}
+
+/// One deterministic run of `fmu` with `params` set before initialization, `inputs` (a CSV
+/// file, see [`super::inputs`]) applied during the run, recording `outputs` (names; every
+/// output that can be recorded when empty) at `times`. Where the FMU ends the simulation
+/// early, the run ends there (its last row at the FMU's last successful time), as in fmpy.
+pub fn simulate(
+    fmu: &Fmu,
+    params: &[(String, FixedValue)],
+    outputs: &[String],
+    inputs: Option<&Path>,
+    times: &[f64],
+) -> Result<Simulation, RunError> {
+    let iface = Interface::for_run(fmu, params, outputs, inputs)?;
+    let trace = simulate_point(fmu, &mut None, &iface, &[], times)?;
+    let nt = times.len();
+    let mut out_times = times[..trace.recorded].to_vec();
+    let mut series: Vec<Vec<f64>> = trace
+        .values
+        .chunks(nt)
+        .map(|s| s[..trace.recorded].to_vec())
+        .collect();
+    let ended_at = trace.ended.as_ref().map(|(t, _)| *t);
+    match trace.ended {
+        Some((t, Some(row))) => {
+            out_times.push(t);
+            for (s, v) in series.iter_mut().zip(row) {
+                s.push(v);
+            }
+        }
+        // Ended at (within 1e-9 of) a grid time: the last row is at the FMU's own time, as fmpy
+        // writes it.
+        Some((t, None)) if trace.recorded > 0 && isclose(t, times[trace.recorded - 1]) => {
+            out_times[trace.recorded - 1] = t;
+        }
+        _ => {}
+    }
+    Ok(Simulation {
+        names: iface.signal_names,
+        times: out_times,
+        series,
+        skipped: iface.skipped,
+        ended_at,
+    })
+}

@@ -1,0 +1,492 @@
+//! Issue 12, hardening of the runner, against the Features test FMU's `misbehave` modes
+//! (1 error, 2 segfault, 3 abort, 4 exit(0), 5 hang, 6 NaN outputs, 7 fatal, 8 warning, at
+//! `misbehave_at`): `--isolate`, `--timeout-per-run`, an in-process `exit()`, `--retry-failed`,
+//! the output folder's lock, and the smaller items. Each test is named after the problem it pins.
+
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use uq_driver::spec::Study;
+use uq_driver::study::runner::{self, RunOptions};
+use uq_driver::uq::distributions::Germ;
+use uq_driver::uq::method::Design;
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+/// Eight Monte Carlo points with misbehave_at ~ U(0.3, 1.8) and stop = 1: the points with
+/// misbehave_at <= 1 misbehave (by mode `mode`), the others run to the end.
+fn study_text(fmu: &Path, mode: i32) -> String {
+    format!(
+        "name = \"misbehave\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+         [method]\nkind = \"mc\"\nsamples = 8\n\
+         [[parameters]]\nname = \"misbehave_at\"\ndistribution = \"uniform\"\nlow = 0.3\nhigh = 1.8\n\
+         [fixed]\nmisbehave = {mode}\nread_file = \"\"\n\
+         [outputs]\nvariables = [\"u_integral\", \"int_out\"]\n\
+         [analysis]\nallow_failures = true\n",
+        fmu.to_str().unwrap()
+    )
+}
+
+struct Case {
+    dir: tempfile::TempDir,
+    study: PathBuf,
+    out: PathBuf,
+}
+
+fn case(mode: i32) -> Option<Case> {
+    let fmu = test_fmus::test_fmu("Features")?;
+    let dir = tempfile::tempdir().unwrap();
+    let study = dir.path().join("s.toml");
+    std::fs::write(&study, study_text(&fmu, mode)).unwrap();
+    let out = dir.path().join("out");
+    Some(Case { dir, study, out })
+}
+
+impl Case {
+    fn run(&self, extra: &[&str]) -> Output {
+        let mut args = vec![
+            "run",
+            self.study.to_str().unwrap(),
+            "--out",
+            self.out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        Command::new(DRIVER)
+            .args(&args)
+            .env("TMPDIR", self.tmp())
+            .output()
+            .expect("runs")
+    }
+
+    /// A private temporary folder, to see what the driver leaves behind.
+    fn tmp(&self) -> PathBuf {
+        let t = self.dir.path().join("tmp");
+        std::fs::create_dir_all(&t).unwrap();
+        t
+    }
+
+    fn points(&self) -> Vec<(f64, String)> {
+        let text = std::fs::read_to_string(self.out.join("points.csv")).unwrap();
+        let mut rows = Vec::new();
+        let mut lines = text.lines().skip(1).peekable();
+        while let Some(line) = lines.next() {
+            // A failure message may span lines (the FMU's log): join until the closing quote.
+            let mut row = line.to_owned();
+            while row.matches('"').count() % 2 == 1 {
+                row.push('\n');
+                row.push_str(lines.next().unwrap());
+            }
+            let mut parts = row.splitn(3, ',');
+            parts.next();
+            let at: f64 = parts.next().unwrap().parse().unwrap();
+            rows.push((at, parts.next().unwrap().to_owned()));
+        }
+        rows
+    }
+
+    /// Checks that the points that misbehave failed with `needle` in their message and the
+    /// others succeeded.
+    fn check_failed_with(&self, needle: &str) {
+        let points = self.points();
+        assert_eq!(points.len(), 8);
+        let mut failed = 0;
+        for (at, status) in &points {
+            if *at <= 1.0 {
+                failed += 1;
+                assert!(status.contains(needle), "misbehave_at {at}: {status}");
+            } else {
+                assert_eq!(status, "ok", "misbehave_at {at}");
+            }
+        }
+        assert!(failed >= 2, "the seed gives misbehaving points: {points:?}");
+    }
+
+    fn leftover_temp_folders(&self) -> usize {
+        std::fs::read_dir(self.tmp()).unwrap().count()
+    }
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn isolate_a_segfaulting_fmu_fails_its_points_with_the_signal_and_its_last_log_lines() {
+    let Some(c) = case(2) else { return };
+    let o = c.run(&["--isolate"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("killed by signal 11 (SIGSEGV");
+    c.check_failed_with("misbehave = 2: segfaulting on purpose");
+    assert_eq!(c.leftover_temp_folders(), 0);
+}
+
+#[test]
+fn isolate_an_aborting_fmu_fails_its_points_with_sigabrt() {
+    let Some(c) = case(3) else { return };
+    let o = c.run(&["--isolate"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("signal 6 (SIGABRT");
+}
+
+#[test]
+fn isolate_an_fmu_calling_exit_fails_its_points_with_the_exit_status() {
+    let Some(c) = case(4) else { return };
+    let o = c.run(&["--isolate"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("exited with status 0");
+}
+
+#[test]
+fn isolate_a_hanging_fmu_is_killed_after_the_timeout_and_the_study_goes_on() {
+    let Some(c) = case(5) else { return };
+    let t0 = Instant::now();
+    let o = c.run(&["--isolate", "--timeout-per-run", "0.5", "-t", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("longer than --timeout-per-run 0.5 s");
+    c.check_failed_with("misbehave = 5: blocking forever");
+    assert!(t0.elapsed() < Duration::from_secs(30));
+}
+
+#[test]
+fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
+    // In one process an fmi2Fatal leaves the FMU unusable for every later point; a worker that
+    // saw it is retired, so the points after it run on a fresh copy.
+    let Some(c) = case(7) else { return };
+    let o = c.run(&["--isolate", "-t", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("returned Fatal");
+}
+
+#[test]
+fn isolate_errors_nan_and_warnings_behave_as_in_process() {
+    for (mode, needle) in [(1, "returned Error"), (6, "non-finite value")] {
+        let Some(c) = case(mode) else { return };
+        let o = c.run(&["--isolate"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        c.check_failed_with(needle);
+        // In-process gives the same statuses and the same numbers.
+        let isolated = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+        let o = c.run(&["--fresh"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        c.check_failed_with(needle);
+        let in_process = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+        assert_eq!(isolated, in_process);
+    }
+    let Some(c) = case(8) else { return };
+    assert!(c.run(&["--isolate"]).status.success());
+    assert!(c.points().iter().all(|(_, s)| s == "ok"));
+}
+
+#[test]
+fn isolate_gives_the_in_process_records_bit_for_bit() {
+    // 101 communication points of 0.01 s (times like 0.41000000000000003 reach the worker
+    // exactly: its setup is JSON, parsed with exact float round trips) and a Real input.
+    let Some(c) = case(0) else { return };
+    let text = std::fs::read_to_string(&c.study)
+        .unwrap()
+        .replace("step = 0.1", "step = 0.01")
+        .replace("read_file = \"\"", "read_file = \"\"\nu = 0.7");
+    std::fs::write(&c.study, text).unwrap();
+    assert!(c.run(&["--isolate", "-t", "2"]).status.success());
+    let a = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    assert!(c.run(&["--fresh", "-t", "1"]).status.success());
+    let b = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
+    // Issue 12: an FMU calling exit(0) made `uq-driver run` exit 0 with no output and no
+    // message. Two threads: two instances may call exit() at the same moment.
+    let Some(c) = case(4) else { return };
+    for threads in ["1", "2"] {
+        let o = c.run(&["-t", threads, "--fresh"]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(err.contains("ended by a call to exit()"), "{err}");
+        assert!(err.contains("running point "), "{err}");
+        assert!(err.contains("--isolate"), "{err}");
+        assert_eq!(c.leftover_temp_folders(), 0);
+    }
+    // The finished points are in the store: --isolate resumes and completes the study.
+    let o = c.run(&["--isolate"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("exited with status 0");
+}
+
+#[test]
+fn in_process_timeout_stops_the_study_naming_the_point_and_keeps_the_store() {
+    // Issue 12: an FMU that blocks hung uq-driver forever.
+    let Some(c) = case(5) else { return };
+    let t0 = Instant::now();
+    let o = c.run(&["--timeout-per-run", "0.5", "-t", "1"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(t0.elapsed() < Duration::from_secs(30));
+    assert!(
+        err.contains("longer than --timeout-per-run 0.5 s") && err.contains("point "),
+        "{err}"
+    );
+    assert!(
+        err.contains("misbehave_at = "),
+        "names the point's values: {err}"
+    );
+    assert_eq!(c.leftover_temp_folders(), 0);
+    // The points finished before the hang are kept: --isolate resumes from them.
+    let o = c.run(&["--isolate", "--timeout-per-run", "0.5"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("note") || !err.contains("error"), "{err}");
+    c.check_failed_with("longer than --timeout-per-run");
+}
+
+#[test]
+fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
+    // Issue 12: failed points were never retried on a re-run; only --fresh helped, and the
+    // message did not say so.
+    let Some(c) = case(1) else { return };
+    // Failures not allowed: the study stops and names --retry-failed.
+    let text = std::fs::read_to_string(&c.study)
+        .unwrap()
+        .replace("allow_failures = true", "allow_failures = false");
+    std::fs::write(&c.study, &text).unwrap();
+    let o = c.run(&["-t", "1"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--retry-failed"), "{}", stderr(&o));
+    // The FMU is "fixed" (misbehave = 0 is a different study, so the fix is simulated by the
+    // same study with failures allowed): a plain re-run keeps the failures and says so ...
+    std::fs::write(
+        &c.study,
+        text.replace("allow_failures = false", "allow_failures = true"),
+    )
+    .unwrap();
+    let o = c.run(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not run again (--retry-failed"),
+        "{}",
+        stderr(&o)
+    );
+    let failed_before = c.points().iter().filter(|(_, s)| s != "ok").count();
+    assert!(failed_before >= 2);
+    // ... and --retry-failed runs them again (they fail again here: same FMU), with no point
+    // counted twice in the store.
+    let o = c.run(&["--retry-failed"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains(&format!("({} resumed)", 8 - failed_before)),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    c.check_failed_with("returned Error");
+}
+
+#[test]
+fn a_retried_point_that_now_succeeds_replaces_its_failure_in_the_store() {
+    use uq_driver::study::store::{Manifest, Record, Store};
+    let dir = tempfile::tempdir().unwrap();
+    let m = Manifest {
+        study_hash: "s".into(),
+        fmu_sha256: "f".into(),
+        n_points: 2,
+        n_values: 1,
+    };
+    let (s, _) = Store::open(dir.path(), &m, false).unwrap();
+    s.append(0, &Record::Failed("first".into())).unwrap();
+    s.append(1, &Record::Ok(vec![1.0])).unwrap();
+    s.append(0, &Record::Ok(vec![2.0])).unwrap();
+    s.append(1, &Record::Failed("later".into())).unwrap();
+    drop(s);
+    let (_, done) = Store::open(dir.path(), &m, false).unwrap();
+    assert_eq!(
+        done[0],
+        Some(Record::Ok(vec![2.0])),
+        "a success replaces a failure"
+    );
+    assert_eq!(
+        done[1],
+        Some(Record::Ok(vec![1.0])),
+        "a success is never replaced"
+    );
+}
+
+#[test]
+fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
+    // Issue 12: two runs in one folder both computed every point and doubled the store.
+    let Some(c) = case(5) else { return };
+    let mut first = Command::new(DRIVER)
+        .args([
+            "run",
+            c.study.to_str().unwrap(),
+            "--out",
+            c.out.to_str().unwrap(),
+            "-t",
+            "1",
+        ])
+        .env("TMPDIR", c.tmp())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until the first run holds the lock (it then hangs in the FMU).
+    let lock = c.out.join("uq-driver.lock");
+    let t0 = Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.starts_with("pid")) {
+        assert!(t0.elapsed() < Duration::from_secs(20), "no lock file");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = c.run(&["--isolate"]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("is in use by another uq-driver run")
+            && err.contains(&format!("pid {}", first.id())),
+        "{err}"
+    );
+    // The first one dies without releasing anything: its lock is stale and taken over.
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let o = c.run(&["--isolate", "--timeout-per-run", "0.5"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("no longer running"), "{err}");
+    assert!(!lock.exists(), "released at the end");
+}
+
+#[test]
+fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
+    // Issue 12: reported as "File exists".
+    let Some(c) = case(0) else { return };
+    std::fs::write(&c.out, "x").unwrap();
+    let o = c.run(&[]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(err.contains("exists and is not a folder"), "{err}");
+    assert!(!err.contains("File exists"), "{err}");
+}
+
+#[test]
+fn error_causes_are_printed_once() {
+    // Issue 12: error causes were printed twice.
+    let Some(c) = case(1) else { return };
+    let text = std::fs::read_to_string(&c.study)
+        .unwrap()
+        .replace("allow_failures = true", "allow_failures = false");
+    std::fs::write(&c.study, text).unwrap();
+    let o = c.run(&["-t", "1"]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert_eq!(err.matches("fails on purpose").count(), 1, "{err}");
+    let o = Command::new(DRIVER)
+        .args(["inspect", "/nonexistent/M.fmu"])
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
+}
+
+#[test]
+fn inspect_stopped_by_sigterm_leaves_no_temporary_folder() {
+    // Issue 12: a temp folder was left behind when `inspect` was stopped by SIGTERM.
+    let vt = std::env::var_os("RAILUQ_FMU_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
+        .join("VehicleTrack.fmu");
+    assert!(vt.is_file(), "{} is missing: run `make fmu`", vt.display());
+    let tmp = tempfile::tempdir().unwrap();
+    for delay_ms in [0, 2, 5, 10, 20] {
+        let child = Command::new(DRIVER)
+            .args(["inspect", vt.to_str().unwrap()])
+            .env("TMPDIR", tmp.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        // SAFETY: kill(2) on the child's own pid with a valid signal.
+        unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+        let o = child.wait_with_output().unwrap();
+        let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+        assert!(
+            left.is_empty(),
+            "after {delay_ms} ms ({:?}): {left:?}",
+            o.status
+        );
+    }
+}
+
+#[test]
+fn integral_design_values_set_an_integer_random_parameter() {
+    // A design for an Integer variable (as integer_uniform gives): each point's int_param is
+    // read back by int_out.
+    let Some(fmu_path) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let text = format!(
+        "name = \"int\"\nfmu = {:?}\n[experiment]\nstop = 0.2\nstep = 0.1\n\
+         [method]\nkind = \"mc\"\nsamples = 3\n\
+         [[parameters]]\nname = \"int_param\"\ndistribution = \"uniform\"\nlow = -10\nhigh = 10\n\
+         [outputs]\nvariables = [\"int_out\"]\n",
+        fmu_path.to_str().unwrap()
+    );
+    let study = Study::parse(&text, "int.toml", None).unwrap();
+    let fmu = uq_driver::fmu::Fmu::open(&fmu_path).unwrap();
+    let values = vec![vec![-7.0], vec![0.0], vec![2147483647.0]];
+    let design = Design {
+        germ: Germ::Uniform,
+        points: values.clone(),
+        values,
+        weights: None,
+        warnings: Vec::new(),
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let outcome =
+        runner::run_points(&study, &fmu, &design, dir.path(), &RunOptions::default()).unwrap();
+    let got: Vec<Vec<f64>> = outcome
+        .records
+        .iter()
+        .map(|r| match r {
+            Some(uq_driver::study::store::Record::Ok(v)) => v.clone(),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        got,
+        vec![vec![-7.0; 3], vec![0.0; 3], vec![2147483647.0; 3]]
+    );
+    // A fractional value is refused before any run.
+    let bad = Design {
+        values: vec![vec![1.5]],
+        points: vec![vec![0.5]],
+        ..design
+    };
+    let err = runner::run_points(
+        &study,
+        &fmu,
+        &bad,
+        &dir.path().join("b"),
+        &RunOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("not a whole number"), "{err}");
+}
+
+#[test]
+fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let md = dir.path().join("modelDescription.xml");
+    // A sparse file just over the limit: refused without reading 256 MiB.
+    let f = std::fs::File::create(&md).unwrap();
+    let limit = uq_driver::fmu::description::ParseLimits::DEFAULT_MAX_BYTES as u64;
+    f.set_len(limit + 1).unwrap();
+    drop(f);
+    let err = uq_driver::fmu::Fmu::open(dir.path())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("more than the limit"), "{err}");
+}
