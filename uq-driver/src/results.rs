@@ -198,8 +198,9 @@ pub struct QuantityDefinition {
     /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
     /// `window`, `statistic`).
     pub settings: serde_json::Map<String, serde_json::Value>,
-    /// The same in words, e.g. `Sperling index of Zc_acc, vertical weighting, 5 s
-    /// segments, no window, maximum over segments, 0.5–40 Hz, first 1 s left out`.
+    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
+    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
+    /// 1 s left out`.
     pub text: String,
 }
 

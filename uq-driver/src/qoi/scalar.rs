@@ -238,7 +238,7 @@ impl QoiSpec {
                     Statistic::Mean => "the mean of the segment W",
                 };
                 format!(
-                    "Sperling index of {signal} ({direction} weighting), {segment} s segments, \
+                    "Sperling index of {signal}, {direction} weighting, {segment} s segments, \
                      {window}, {statistic}, {f_min}–{f_max} Hz, first {skip} s left out"
                 )
             }

@@ -73,6 +73,32 @@ pub fn annotate(
     }
 }
 
+/// Adds to each quantity's definition what the FMU says of the signal it is computed from
+/// (`settings.signal_description`, and in the text after the signal's name): for a Sperling
+/// index, where on the carbody the acceleration is taken (`Zc_acc_front`: "above the front
+/// bogie centre").
+pub fn describe_signals(quantities: &mut [ScalarStats], qoi: &[QoiSpec], md: &ModelDescription) {
+    for (q, spec) in quantities.iter_mut().zip(qoi) {
+        let Some(signal) = spec.signals().first().map(|s| s.to_string()) else {
+            continue;
+        };
+        let Some(text) = md
+            .variable(&signal)
+            .and_then(|v| v.description.clone())
+            .filter(|d| !d.is_empty())
+        else {
+            continue;
+        };
+        q.definition
+            .settings
+            .insert("signal_description".into(), text.clone().into());
+        q.definition.text = q
+            .definition
+            .text
+            .replacen(&signal, &format!("{signal} ({text})"), 1);
+    }
+}
+
 /// `name [unit]` for an axis label: `q [m]`, `W [-]` for a dimensionless index, or the
 /// name alone when the unit is unknown.
 pub fn label(name: &str, unit: Option<&str>) -> String {

@@ -130,6 +130,7 @@ pub(crate) fn finish(
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
     units::annotate(&units, &mut outputs, &mut quantities);
+    units::describe_signals(&mut quantities, &study.qoi, md);
     let analysis_time = started.elapsed().as_secs_f64();
     let facts = RunFacts {
         fmu: Some(FmuInfo {
