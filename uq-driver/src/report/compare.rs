@@ -203,7 +203,11 @@ pub fn write(dirs: &[PathBuf], out: &Path) -> Result<(), CompareError> {
 }
 
 fn num(v: &Value) -> String {
-    v.as_f64().map(sig).unwrap_or_else(|| "–".into())
+    match (v.as_u64(), v.as_f64()) {
+        (Some(i), _) => i.to_string(),
+        (None, Some(x)) => sig(x),
+        _ => "–".into(),
+    }
 }
 
 /// The table of the studies, with links to their reports.

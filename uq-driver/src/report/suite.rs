@@ -122,7 +122,11 @@ fn compare_output(
 ) -> Result<Section, ReportError> {
     let v = &rs.name;
     let ref_name = &summary.reference;
-    let unit = variants[r].summary.units.get(v).map(String::as_str);
+    // The reference may have no FMU (SGM): any variant that ran the model knows the unit.
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(v))
+        .map(String::as_str);
     let mut header = vec!["time".to_string()];
     let mut cols: Vec<Vec<f64>> = Vec::new();
     let mut mean_plot = LinePlot::new(
@@ -288,7 +292,10 @@ fn compare_scalar(
     let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
     let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
     let ses: Vec<f64> = stats.iter().map(|s| s.std_error_mean).collect();
-    let unit = variants[0].summary.units.get(q).map(String::as_str);
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(q))
+        .map(String::as_str);
     let mut mean_plot = LinePlot::new(
         format!("mean of {q} against model runs"),
         "model runs",
