@@ -47,6 +47,14 @@ pub struct OutputStats {
     /// The chaos's estimated truncation error over time (a column of `<V>.csv` named after
     /// its kind: `loo`, `level_difference` or `order_difference`).
     pub chaos_error: Option<ChaosError>,
+    /// Every run (or draw) has the same value at every time: no density is drawn.
+    pub deterministic: bool,
+    /// Unit of the variable, from the FMU's modelDescription (`None`: not declared).
+    pub unit: Option<String>,
+    /// Mean and Std at `convergence_time` against the work spent (runs, or chaos order).
+    pub convergence: Option<Convergence>,
+    /// The time of the convergence plot: where the Std is largest (s).
+    pub convergence_time: Option<f64>,
 }
 
 impl OutputStats {
@@ -84,6 +92,21 @@ pub struct ScalarStats {
     pub max: f64,
     /// P(q > limit): (limit, p, standard error of p).
     pub exceedance: Vec<(f64, f64, f64)>,
+    /// P(q > limit) as counts: how many of how many draws exceeded, with the exact
+    /// (Clopper–Pearson) 95 % interval; the honest statement when none exceeded.
+    pub exceedance_counts: Vec<ExceedanceCount>,
+    /// Every run gives the same value (or there is one run): no density is estimated
+    /// (`pdf_x` and `pdf` are empty).
+    pub deterministic: bool,
+    /// Unit of the quantity (from the FMU's modelDescription; `"1"` for a dimensionless
+    /// index, `None` when not declared).
+    pub unit: Option<String>,
+    /// How the quantity is computed from each run: kind, signal and every setting
+    /// (defaults included), and one line of text.
+    pub definition: QuantityDefinition,
+    /// Mean and Std against the work spent (runs, or chaos order), for the report.
+    #[serde(skip)]
+    pub convergence: Option<Convergence>,
     /// PDF grid.
     pub pdf_x: Vec<f64>,
     /// PDF values (KDE of the runs, or of the chaos surrogate).
@@ -167,6 +190,106 @@ impl SobolSummary {
     }
 }
 
+/// P(q > limit) counted over the runs (or the draws of a surrogate).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ExceedanceCount {
+    /// The limit.
+    pub limit: f64,
+    /// Draws above it.
+    pub exceeded: usize,
+    /// Draws in all.
+    pub of: usize,
+    /// `exceeded / of`.
+    pub p: f64,
+    /// Clopper–Pearson (exact binomial) 95 % interval of the probability.
+    pub ci_95: [f64; 2],
+    /// One-sided 95 % upper bound (`1 − 0.05^(1/of)`, about `3/of`, when none exceeded).
+    pub upper_95: f64,
+    /// What was counted: `runs` or `draws of the chaos surrogate`.
+    pub of_what: String,
+}
+
+impl ExceedanceCount {
+    /// E.g. `0 of 10 000 runs exceeded 2.5 (95 % upper bound 3.0e-4)` or
+    /// `12 of 1 000 runs exceeded 2.5: P = 0.012 (95 % interval 0.0062–0.021)`.
+    pub fn describe(&self) -> String {
+        let head = format!(
+            "{} of {} {} exceeded {}",
+            group_digits(self.exceeded),
+            group_digits(self.of),
+            self.of_what,
+            self.limit
+        );
+        if self.exceeded == 0 {
+            format!("{head} (95 % upper bound of P: {})", sig(self.upper_95))
+        } else {
+            format!(
+                "{head}: P = {} (95 % interval {}–{})",
+                sig(self.p),
+                sig(self.ci_95[0]),
+                sig(self.ci_95[1])
+            )
+        }
+    }
+}
+
+/// `1234567` as `1 234 567`.
+pub fn group_digits(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, ch) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push('\u{202f}');
+        }
+        out.push(ch);
+    }
+    out
+}
+
+/// Three significant digits, plain for 1e-3 ≤ |x| < 1e5, else with an exponent.
+pub fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct QuantityDefinition {
+    /// `kind` of the `[[qoi]]` entry.
+    pub kind: String,
+    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
+    /// `window`, `statistic`).
+    pub settings: serde_json::Map<String, serde_json::Value>,
+    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
+    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
+    /// 1 s left out`.
+    pub text: String,
+}
+
+/// Mean and Std of an estimate against the work spent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Convergence {
+    /// What `x` counts: `runs` (running estimates over the first n runs) or `chaos order`.
+    pub axis: String,
+    /// Runs, or orders.
+    pub x: Vec<f64>,
+    /// Mean at each x.
+    pub mean: Vec<f64>,
+    /// Std at each x.
+    pub std: Vec<f64>,
+    /// Chaos: the Std of the terms of each total order alone (its decay shows the
+    /// convergence of the expansion); empty for runs.
+    pub std_of_order: Vec<f64>,
+}
+
 /// Outcome of one point of a design.
 #[derive(Clone, Debug, PartialEq)]
 pub enum PointStatus {
@@ -239,6 +362,11 @@ pub struct OutputSummary {
     pub max_std: f64,
     /// When it is reached (s).
     pub time_of_max_std: f64,
+    /// Unit of the variable (modelDescription); the unit of every column of `<V>.csv`
+    /// except `time` (s).
+    pub unit: Option<String>,
+    /// Every run has the same value at every time (no density is drawn).
+    pub deterministic: bool,
 }
 
 impl OutputSummary {
@@ -255,6 +383,8 @@ impl OutputSummary {
             std_at_stop: s.std[last],
             max_std: s.std[imax],
             time_of_max_std: s.times[imax],
+            unit: s.unit.clone(),
+            deterministic: s.deterministic,
         }
     }
 }
@@ -304,6 +434,37 @@ pub struct Summary {
     pub outputs: BTreeMap<String, OutputSummary>,
     /// Per scalar quantity.
     pub quantities: BTreeMap<String, ScalarStats>,
+    /// Wall time of each stage of this invocation (s).
+    pub timing: Timing,
+    /// Unit of every variable the study names (parameters, outputs, signals of the
+    /// quantities) and of every quantity, from the FMU's modelDescription; `time` is in s.
+    /// Undeclared units are left out.
+    pub units: BTreeMap<String, String>,
+    /// The order of the values in each record of `store/records.bin` (what
+    /// `uq-driver export` reads).
+    pub record_layout: RecordLayout,
+}
+
+/// Wall time of the stages of one invocation (s).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Timing {
+    /// The model runs (the same as `wall_time_s`): opening the store, running the points
+    /// not yet finished, appending them.
+    pub runs_s: f64,
+    /// The statistics: estimators, quantiles, densities, surrogate draws.
+    pub analysis_s: f64,
+    /// Writing the CSV files, plots and `index.html` (everything but `summary.json`
+    /// itself, which carries this number).
+    pub report_s: f64,
+}
+
+/// What a record of the store holds, in order.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RecordLayout {
+    /// The outputs stored as time series (all times of the first, then the second, …).
+    pub outputs: Vec<String>,
+    /// The scalar quantities, each as (value, outcome code), after the series.
+    pub quantities: Vec<String>,
 }
 
 /// An output of a suite variant against the reference variant.

@@ -4,7 +4,10 @@
 use serde::{Deserialize, Serialize};
 
 use crate::qoi::critical_speed::{critical_speed, CriticalSpeed, CriticalSpeedError};
-use crate::qoi::sperling::{sperling_index, Direction, SperlingError, SperlingSettings};
+use crate::qoi::sperling::{
+    sperling_index, Direction, SperlingError, SperlingSettings, Statistic, Window,
+};
+use crate::results::QuantityDefinition;
 
 /// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
 /// `kind`).
@@ -50,6 +53,13 @@ pub enum QoiSpec {
         /// Initial transient left out (s).
         #[serde(default)]
         skip: f64,
+        /// Window of each segment (default none). Left out of the serialized settings when
+        /// default, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "is_default")]
+        window: Window,
+        /// W of the record: the largest segment W (default) or their mean.
+        #[serde(default, skip_serializing_if = "is_default")]
+        statistic: Statistic,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -80,6 +90,10 @@ pub enum QoiSpec {
         #[serde(default)]
         limits: Vec<f64>,
     },
+}
+
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }
 
 fn default_window() -> f64 {
@@ -163,6 +177,83 @@ impl QoiSpec {
             | QoiSpec::Sperling { limits, .. }
             | QoiSpec::MaxAbs { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
+        }
+    }
+
+    /// The signal whose unit the quantity has (`None`: dimensionless, as the Sperling index).
+    pub fn unit_signal(&self) -> Option<&str> {
+        match self {
+            QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
+            QoiSpec::Sperling { .. } => None,
+            QoiSpec::MaxAbs { signal, .. } | QoiSpec::Final { signal, .. } => Some(signal),
+        }
+    }
+
+    /// How the quantity is computed, every setting explicit (defaults included), with a
+    /// line of text for the report.
+    pub fn definition(&self) -> QuantityDefinition {
+        let mut settings = match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(m)) => m,
+            _ => serde_json::Map::new(),
+        };
+        let kind = settings
+            .remove("kind")
+            .and_then(|k| k.as_str().map(str::to_owned))
+            .unwrap_or_default();
+        settings.remove("name");
+        let text = match self {
+            QoiSpec::CriticalSpeed {
+                signal,
+                speed,
+                window,
+                threshold,
+                ..
+            } => format!(
+                "critical speed: the {speed} at which the largest |{signal}| over a sliding \
+                 {window} s window last exceeds {threshold}"
+            ),
+            QoiSpec::Sperling {
+                signal,
+                direction,
+                segment,
+                f_min,
+                f_max,
+                skip,
+                window,
+                statistic,
+                ..
+            } => {
+                settings.insert("window".into(), window.as_str().into());
+                settings.insert("statistic".into(), statistic.as_str().into());
+                let direction = match direction {
+                    Direction::Vertical => "vertical",
+                    Direction::Lateral => "lateral",
+                };
+                let window = match window {
+                    Window::None => "no window",
+                    Window::Hann => "Hann window",
+                };
+                let statistic = match statistic {
+                    Statistic::Max => "the largest segment W",
+                    Statistic::Mean => "the mean of the segment W",
+                };
+                format!(
+                    "Sperling index of {signal}, {direction} weighting, {segment} s segments, \
+                     {window}, {statistic}, {f_min}–{f_max} Hz, first {skip} s left out"
+                )
+            }
+            QoiSpec::MaxAbs {
+                signal, from, to, ..
+            } => match to {
+                Some(to) => format!("largest |{signal}| over {from}–{to} s"),
+                None => format!("largest |{signal}| from {from} s to the end"),
+            },
+            QoiSpec::Final { signal, .. } => format!("{signal} at the stop time"),
+        };
+        QuantityDefinition {
+            kind,
+            settings,
+            text,
         }
     }
 
@@ -261,6 +352,8 @@ pub fn evaluate<'a>(
             f_min,
             f_max,
             skip,
+            window,
+            statistic,
             ..
         } => {
             let dt = times
@@ -270,14 +363,17 @@ pub fn evaluate<'a>(
             let start = times.partition_point(|&t| t < times[0] + skip - 1e-9 * dt);
             let settings = SperlingSettings {
                 direction: *direction,
+                window: *window,
                 segment_length_s: *segment,
                 f_min: *f_min,
                 f_max: *f_max,
             };
-            Ok((
-                sperling_index(&signal(s)[start..], dt, &settings)?.w,
-                Code::Ok,
-            ))
+            let r = sperling_index(&signal(s)[start..], dt, &settings)?;
+            let w = match statistic {
+                Statistic::Max => r.w,
+                Statistic::Mean => r.mean,
+            };
+            Ok((w, Code::Ok))
         }
         QoiSpec::MaxAbs {
             signal: s,
@@ -378,5 +474,49 @@ mod tests {
             evaluate(&q, &empty, |_| &empty[..]).unwrap_err(),
             QoiError::EmptySignal("x".into())
         );
+    }
+
+    #[test]
+    fn sperling_window_and_statistic_are_read_shown_and_hash_neutral() {
+        let base = "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"";
+        let q: QoiSpec = toml::from_str(base).unwrap();
+        // Defaults are not serialized: studies written before keep their hash.
+        let json = serde_json::to_value(&q).unwrap();
+        assert!(json.get("window").is_none() && json.get("statistic").is_none());
+        // ... but the definition states them.
+        let d = q.definition();
+        assert_eq!(d.kind, "sperling");
+        assert_eq!(d.settings["window"], "none");
+        assert_eq!(d.settings["statistic"], "max");
+        assert_eq!(d.settings["segment"], 5.0);
+        assert!(
+            d.text
+                .contains("5 s segments, no window, the largest segment W"),
+            "{}",
+            d.text
+        );
+        let q: QoiSpec = toml::from_str(&format!(
+            "{base}\nwindow = \"hann\"\nstatistic = \"mean\"\nsegment = 1.0"
+        ))
+        .unwrap();
+        assert!(q
+            .definition()
+            .text
+            .contains("1 s segments, Hann window, the mean"));
+        assert!(toml::from_str::<QoiSpec>(&format!("{base}\nwindow = \"hamming\"")).is_err());
+        // The mean of two segments of different amplitude lies below their maximum.
+        let dt = 0.01;
+        let times: Vec<f64> = (0..1000).map(|k| k as f64 * dt).collect();
+        let a: Vec<f64> = times
+            .iter()
+            .map(|t| {
+                let amp = if *t < 5.0 { 0.1 } else { 0.2 };
+                amp * (2.0 * std::f64::consts::PI * t).sin()
+            })
+            .collect();
+        let (mean, _) = evaluate(&q, &times, |_| &a[..]).unwrap();
+        let q_max: QoiSpec = toml::from_str(&format!("{base}\nwindow = \"hann\"")).unwrap();
+        let (max, _) = evaluate(&q_max, &times, |_| &a[..]).unwrap();
+        assert!(mean < max, "{mean} {max}");
     }
 }

@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use super::units::label;
 use super::{
     palette, write_bytes, write_columns, DensityPlot, LinePlot, ReportError, ReportPage, Section,
     Series, Table,
@@ -121,22 +122,27 @@ fn compare_output(
 ) -> Result<Section, ReportError> {
     let v = &rs.name;
     let ref_name = &summary.reference;
+    // The reference may have no FMU (SGM): any variant that ran the model knows the unit.
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(v))
+        .map(String::as_str);
     let mut header = vec!["time".to_string()];
     let mut cols: Vec<Vec<f64>> = Vec::new();
     let mut mean_plot = LinePlot::new(
         format!("{v}: mean − mean({ref_name})"),
         "time [s]",
-        format!("Δ mean {v}"),
+        label(&format!("Δ mean {v}"), unit),
     );
     let mut std_plot = LinePlot::new(
         format!("{v}: Std − Std({ref_name})"),
         "time [s]",
-        format!("Δ Std {v}"),
+        label(&format!("Δ Std {v}"), unit),
     );
     let mut bands = LinePlot::new(
         format!("{v}: mean ± 3σ of every variant"),
         "time [s]",
-        v.clone(),
+        label(v, unit),
     );
     for (i, (d, vs)) in variants.iter().zip(&summary.variants).enumerate() {
         let s = &d.outputs[o];
@@ -175,10 +181,57 @@ fn compare_output(
     all.extend(cols.iter().map(Vec::as_slice));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(&dir.join(format!("{v}_compare.csv")), &hdr, &all)?;
+    let log_mean = spans_decades(&mean_plot);
+    let log_std = spans_decades(&std_plot);
+    absolute_on_log(
+        &mut mean_plot,
+        log_mean,
+        &format!("|mean − mean({ref_name})| of {v}"),
+    );
+    absolute_on_log(
+        &mut std_plot,
+        log_std,
+        &format!("|Std − Std({ref_name})| of {v}"),
+    );
     mean_plot.write(&dir.join(format!("{v}_mean_diff.svg")))?;
     std_plot.write(&dir.join(format!("{v}_std_diff.svg")))?;
     bands.write(&dir.join(format!("{v}_bands.svg")))?;
     Ok(output_section(v, ref_name))
+}
+
+/// Whether the differences of the variants lie decades apart (more than a factor 100
+/// between the largest |Δ| of two variants): then a log axis shows them (SCM against SGM
+/// at 1e-10, LHS at 1e-5: on a linear axis the first is a flat zero).
+fn spans_decades(plot: &LinePlot) -> bool {
+    let peaks: Vec<f64> = plot
+        .series
+        .iter()
+        .map(|s| {
+            s.y.iter()
+                .filter(|y| y.is_finite())
+                .fold(0.0f64, |m, y| m.max(y.abs()))
+        })
+        .filter(|p| *p > 0.0)
+        .collect();
+    let (lo, hi) = peaks
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &p| (a.min(p), b.max(p)));
+    peaks.len() > 1 && hi / lo > 1e2
+}
+
+/// With `log`: the plot shows |Δ| on a log axis (its zeros drop out), titled `title`.
+fn absolute_on_log(plot: &mut LinePlot, log: bool, title: &str) {
+    if !log {
+        return;
+    }
+    for s in &mut plot.series {
+        for y in &mut s.y {
+            *y = y.abs();
+        }
+    }
+    plot.log_y = true;
+    plot.title = format!("{title} (log axis)");
+    plot.y_label = format!("|{}|", plot.y_label);
 }
 
 fn output_section(v: &str, ref_name: &str) -> Section {
@@ -217,12 +270,12 @@ fn compare_scalar(
         .iter()
         .zip(&summary.variants)
         .enumerate()
-        .filter(|(i, _)| runs[*i] > 1.0)
+        .filter(|(i, (s, _))| runs[*i] > 1.0 && !s.deterministic)
         .map(|(i, (s, v))| Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(i)))
         .collect();
     DensityPlot {
         title: format!("PDF of {q}, every variant"),
-        x_label: q.clone(),
+        x_label: label(q, rq.unit.as_deref()),
         curves,
         histogram: None,
         markers: rq
@@ -239,18 +292,24 @@ fn compare_scalar(
     let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
     let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
     let ses: Vec<f64> = stats.iter().map(|s| s.std_error_mean).collect();
-    let mean_plot = LinePlot::new(
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(q))
+        .map(String::as_str);
+    let mut mean_plot = LinePlot::new(
         format!("mean of {q} against model runs"),
-        "log10(model runs)",
-        format!("mean {q}"),
+        "model runs",
+        label(&format!("mean {q}"), unit),
     );
+    mean_plot.log_x = true;
     convergence(mean_plot, &kinds, &runs, &means)
         .write(&dir.join(format!("{q}_mean_vs_runs.svg")))?;
-    let std_plot = LinePlot::new(
+    let mut std_plot = LinePlot::new(
         format!("Std of {q} against model runs"),
-        "log10(model runs)",
-        format!("Std {q}"),
+        "model runs",
+        label(&format!("Std {q}"), unit),
     );
+    std_plot.log_x = true;
     convergence(std_plot, &kinds, &runs, &stds).write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
     let idx: Vec<f64> = (0..variants.len()).map(|i| i as f64).collect();
     write_columns(
@@ -285,7 +344,7 @@ fn scalar_section(q: &str, summary: &SuiteSummary) -> Section {
     }
 }
 
-/// `plot` with `y` against log10(model runs), one line per method kind (e.g. SCM 2, 3, 4, 5
+/// `plot` with `y` against the model runs (log axis), one line per method kind (e.g. SCM 2, 3, 4, 5
 /// nodes; LHS 500, 20 000); single runs are left out.
 fn convergence(mut plot: LinePlot, kinds: &[&str], runs: &[f64], y: &[f64]) -> LinePlot {
     let mut distinct: Vec<&str> = kinds.to_vec();
@@ -299,7 +358,7 @@ fn convergence(mut plot: LinePlot, kinds: &[&str], runs: &[f64], y: &[f64]) -> L
         }
         plot.series.push(Series::new(
             kind.to_string(),
-            idx.iter().map(|&i| runs[i].log10()).collect(),
+            idx.iter().map(|&i| runs[i]).collect(),
             idx.iter().map(|&i| y[i]).collect(),
             palette(ki),
         ));

@@ -158,8 +158,12 @@ pub struct Analysis {
     pub pdf_grid: usize,
     /// Largest number of time columns in the PDF evolution (evenly thinned).
     pub pdf_times: usize,
-    /// Samples of a chaos surrogate used for densities and quantiles.
+    /// Samples of a chaos surrogate used for the densities, quantiles and exceedance
+    /// probabilities of the scalar quantities.
     pub surrogate_samples: usize,
+    /// Samples of a chaos surrogate used for the quantiles and densities over time of the
+    /// outputs (at most `surrogate_samples`; the first of the same draws).
+    pub series_samples: usize,
     /// Quantile levels written to the CSV.
     pub quantiles: Vec<f64>,
     /// Unweighted designs (MC/LHS): continue when some points fail and report how many.
@@ -170,8 +174,9 @@ impl Default for Analysis {
     fn default() -> Self {
         Analysis {
             pdf_grid: 200,
-            pdf_times: 250,
+            pdf_times: 150,
             surrogate_samples: 20_000,
+            series_samples: 4_000,
             quantiles: vec![0.01, 0.5, 0.99],
             allow_failures: false,
         }

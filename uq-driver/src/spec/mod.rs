@@ -45,7 +45,7 @@ pub use file::{
     Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue,
     StudyFile, Variant,
 };
-pub use load::fmu_search_path;
+pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, ParameterSpec};
 pub use study::{Study, Suite};
 pub use value::FixedValue;

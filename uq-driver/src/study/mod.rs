@@ -7,6 +7,7 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+pub mod export;
 pub mod guard;
 pub mod inputs;
 pub mod interface;
@@ -14,6 +15,7 @@ pub mod isolate;
 pub mod lock;
 mod outcome;
 mod point;
+pub mod progress;
 pub mod runner;
 pub mod shard;
 mod single;

@@ -11,9 +11,11 @@ use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
 use super::store::Record;
 use crate::fmu::Fmu;
+use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
 use crate::results::{
-    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, ScalarStats, Summary, Versions,
+    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout, ScalarStats,
+    Summary, Timing, Versions,
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
@@ -32,7 +34,7 @@ pub(crate) fn run_single(
         source,
     })?;
     match study.method().evaluation() {
-        Evaluation::Intrusive(method) => solve(study, method, out_dir),
+        Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
@@ -67,6 +69,7 @@ struct RunFacts {
     failed: usize,
     wall_time: f64,
     threads: usize,
+    analysis_time: f64,
 }
 
 fn summary(
@@ -104,6 +107,16 @@ fn summary(
             .iter()
             .map(|q| (q.name.clone(), q.clone()))
             .collect::<BTreeMap<_, _>>(),
+        timing: Timing {
+            runs_s: facts.wall_time,
+            analysis_s: facts.analysis_time,
+            report_s: 0.0,
+        },
+        units: BTreeMap::new(),
+        record_layout: RecordLayout {
+            outputs: study.outputs.clone(),
+            quantities: study.qoi.iter().map(|q| q.name().to_owned()).collect(),
+        },
     }
 }
 
@@ -126,9 +139,14 @@ pub(crate) fn finish(
             total: design.len(),
         });
     }
+    let started = Instant::now();
     let analysed = analysis::analyse_runs(study, method, design, &outcome.records)?;
-    let (outputs, quantities) = (analysed.outputs, analysed.quantities);
+    let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
+    let units = units::study_units(study, Some(md));
+    units::annotate(&units, &mut outputs, &mut quantities);
+    units::describe_signals(&mut quantities, &study.qoi, md);
+    let analysis_time = started.elapsed().as_secs_f64();
     let facts = RunFacts {
         fmu: Some(FmuInfo {
             path: fmu.path().display().to_string(),
@@ -143,9 +161,10 @@ pub(crate) fn finish(
         failed,
         wall_time: outcome.wall_time,
         threads: outcome.threads,
+        analysis_time,
     };
     let method_summary = study.method().summary(study.parameters.len());
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -161,8 +180,9 @@ pub(crate) fn finish(
         &analysed.quantity_chaos,
         out_dir,
     )?;
+    summary.units = units;
     let points = point_table(study, design, &outcome.records);
-    report::study::write(
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -170,6 +190,7 @@ pub(crate) fn finish(
             quantities: &quantities,
             qoi: &study.qoi,
             points: Some(&points),
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {
@@ -184,11 +205,13 @@ fn solve(
     study: &Study,
     method: &dyn Intrusive,
     out_dir: &Path,
+    opts: &RunOptions,
 ) -> Result<StudyResult, StudyRunError> {
     let started = Instant::now();
     let times = study.times();
     let solution = method.solve(&study.problem(&times))?;
     let wall_time = started.elapsed().as_secs_f64();
+    let started = Instant::now();
     let outputs = analysis::analyse_solution(study, &solution)?;
     let chaos: Vec<NamedChaos> = study
         .outputs
@@ -211,6 +234,7 @@ fn solve(
         &[],
         out_dir,
     )?;
+    let analysis_time = started.elapsed().as_secs_f64();
     let mut method_summary = study.method().summary(study.parameters.len());
     method_summary.details.extend(solution.details);
     let facts = RunFacts {
@@ -221,8 +245,9 @@ fn solve(
         failed: 0,
         wall_time,
         threads: 1,
+        analysis_time,
     };
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -230,7 +255,8 @@ fn solve(
         &outputs,
         &[],
     );
-    report::study::write(
+    summary.units = units::study_units(study, None);
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -238,6 +264,7 @@ fn solve(
             quantities: &[],
             qoi: &study.qoi,
             points: None,
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {

@@ -6,15 +6,26 @@
 use std::borrow::Cow;
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+mod columns;
+mod exceedance;
+mod surrogate;
+
+pub use exceedance::{clopper_pearson, exceedance_count};
+
+use columns::{column, Column};
+use surrogate::Surrogates;
 
 use super::store::Record;
 use crate::qoi::scalar::Code;
 use crate::qoi::{kde, QoiSpec};
-use crate::results::{OutputStats, ScalarChaosError, ScalarStats, SobolSummary};
+use crate::results::{
+    Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
+};
 use crate::spec::{Analysis, Study};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
-use crate::uq::moments;
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
@@ -71,8 +82,8 @@ pub enum AnalysisError {
     NoDraws(String),
 }
 
-/// The analysis settings of a study.
-#[derive(Clone, Copy, Debug)]
+/// The analysis settings of a study, and the surrogate draws it shares.
+#[derive(Clone, Copy)]
 pub struct Settings<'a> {
     /// `[analysis]`.
     pub analysis: &'a Analysis,
@@ -80,29 +91,47 @@ pub struct Settings<'a> {
     pub seed: u64,
     /// The names of the random parameters, in study order (labels of Sobol' indices).
     pub parameters: &'a [RandomParameter],
+    surrogates: &'a Surrogates,
+}
+
+/// What quantiles and densities are taken from.
+enum Use {
+    /// The time series of an output.
+    Series,
+    /// A scalar quantity.
+    Scalar,
 }
 
 impl<'a> Settings<'a> {
-    /// The settings of `study`.
-    pub fn of(study: &'a Study) -> Settings<'a> {
+    /// The settings of `study`, drawing from `surrogates`.
+    fn of(study: &'a Study, surrogates: &'a Surrogates) -> Settings<'a> {
         Settings {
             analysis: &study.analysis,
             seed: study.seed,
             parameters: &study.parameters,
+            surrogates,
         }
     }
 
-    /// The matrix quantiles and densities are taken from: `runs`, or draws of the chaos.
+    /// The matrix quantiles and densities are taken from: `runs`, or draws of the chaos
+    /// (`series_samples` of them for a time series, `surrogate_samples` for a scalar).
     fn draws<'m>(
         &self,
         name: &str,
         estimate: &Estimate,
         runs: Option<&'m DMatrix<f64>>,
+        what: Use,
     ) -> Result<Cow<'m, DMatrix<f64>>, AnalysisError> {
         match (estimate.draws, &estimate.chaos, runs) {
             (Draws::Chaos, Some(pce), _) => {
-                let n = self.analysis.surrogate_samples.max(2);
-                Ok(Cow::Owned(pce.sample(n, self.seed ^ SURROGATE_SEED)))
+                let n = match what {
+                    Use::Series => self
+                        .analysis
+                        .series_samples
+                        .min(self.analysis.surrogate_samples),
+                    Use::Scalar => self.analysis.surrogate_samples,
+                };
+                Ok(Cow::Owned(self.surrogates.draws(pce, n.max(2))))
             }
             (Draws::Runs, _, Some(r)) => Ok(Cow::Borrowed(r)),
             _ => Err(AnalysisError::NoDraws(name.to_owned())),
@@ -123,9 +152,20 @@ fn thinned(n: usize, max: usize) -> Vec<usize> {
     v
 }
 
+/// A spread at or below this fraction of the largest magnitude of an output counts as none
+/// (a chaos surrogate of a deterministic value scatters at the rounding level of its
+/// coefficients).
+const ZERO_SPREAD: f64 = 1e-9;
+
 /// Statistics of an output over `times` from its estimate; `runs` are the successful runs
 /// (rows) over time (columns), if the model was run.
-pub fn output_stats(
+///
+/// Every column is summarised in parallel (quantiles by selection, Silverman's bandwidth),
+/// then the densities of at most `pdf_times` columns are taken on one common grid by the
+/// binned kernel estimate. A column whose values all agree (to [`ZERO_SPREAD`] of the
+/// output's magnitude) has no density: its entries are NaN. The results do not depend on
+/// the thread count.
+fn output_stats(
     name: &str,
     times: &[f64],
     estimate: &Estimate,
@@ -133,32 +173,75 @@ pub fn output_stats(
     settings: &Settings,
 ) -> Result<OutputStats, AnalysisError> {
     let a = settings.analysis;
-    let samples = settings.draws(name, estimate, runs)?;
-    let cols = moments::column_quantiles(&samples, &a.quantiles);
+    let samples = settings.draws(name, estimate, runs, Use::Series)?;
+    let rows = samples.nrows();
+    let all = samples.as_slice();
+    let cols: Vec<Column> = (0..samples.ncols())
+        .into_par_iter()
+        .map(|k| column(&all[k * rows..(k + 1) * rows], &a.quantiles))
+        .collect();
     let quantiles = a
         .quantiles
         .iter()
         .enumerate()
-        .map(|(qi, &p)| (p, cols.iter().map(|c| c[qi]).collect()))
+        .map(|(qi, &p)| (p, cols.iter().map(|c| c.quantiles[qi]).collect()))
         .collect();
-    let picked = thinned(times.len(), a.pdf_times);
+    let magnitude = cols
+        .iter()
+        .map(|c| c.min.abs().max(c.max.abs()))
+        .filter(|m| m.is_finite())
+        .fold(0.0, f64::max);
+    let spread = |c: &Column| c.max - c.min > ZERO_SPREAD * magnitude;
+    let deterministic = !cols.iter().any(spread);
+    let picked = if deterministic {
+        Vec::new()
+    } else {
+        thinned(times.len(), a.pdf_times)
+    };
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &k in &picked {
-        for v in samples.column(k).iter() {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
+        lo = lo.min(cols[k].min);
+        hi = hi.max(cols[k].max);
     }
     let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
-    let grid = kde::auto_grid(lo - pad, hi + pad, a.pdf_grid);
+    let grid = if picked.is_empty() {
+        Vec::new()
+    } else {
+        kde::auto_grid(lo - pad, hi + pad, a.pdf_grid)
+    };
+    let (g0, g1) = (
+        grid.first().copied().unwrap_or(0.0),
+        grid.last().copied().unwrap_or(0.0),
+    );
+    let step = (g1 - g0) / grid.len().saturating_sub(1).max(1) as f64;
     let pdf = picked
-        .iter()
+        .par_iter()
         .map(|&k| {
-            let col: Vec<f64> = samples.column(k).iter().copied().collect();
-            kde::gaussian_kde(&col, None, &grid, kde::silverman_bandwidth(&col))
+            if spread(&cols[k]) {
+                let col = &all[k * rows..(k + 1) * rows];
+                let h = cols[k].bandwidth;
+                if h < 2.0 * step {
+                    // Narrower than the grid: averages over the grid cells keep its mass.
+                    kde::gaussian_kde_cell_average(col, g0, g1, grid.len(), h)
+                } else {
+                    kde::gaussian_kde_binned(col, g0, g1, grid.len(), h)
+                }
+            } else {
+                vec![f64::NAN; grid.len()]
+            }
         })
         .collect();
     let (lower_3sigma, upper_3sigma) = OutputStats::band(&estimate.mean, &estimate.std, 3.0);
+    let k_max = (0..estimate.std.len())
+        .max_by(|&i, &j| estimate.std[i].total_cmp(&estimate.std[j]))
+        .filter(|_| !deterministic);
+    let convergence = k_max.and_then(|k| {
+        let runs = match estimate.draws {
+            Draws::Runs => &all[k * rows..(k + 1) * rows],
+            Draws::Chaos => &[],
+        };
+        convergence(estimate, k, runs)
+    });
     Ok(OutputStats {
         name: name.to_owned(),
         times: times.to_vec(),
@@ -175,6 +258,10 @@ pub fn output_stats(
         pdf,
         draws: estimate.draws,
         chaos_error: estimate.chaos_error.clone(),
+        deterministic,
+        unit: None,
+        convergence,
+        convergence_time: k_max.map(|k| times[k]),
     })
 }
 
@@ -198,28 +285,35 @@ fn scalar_stats(
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
     let density_samples: Vec<f64> = settings
-        .draws(q.name(), estimate, Some(&data))?
+        .draws(q.name(), estimate, Some(&data), Use::Scalar)?
         .column(0)
         .iter()
         .copied()
         .collect();
-    let mut sorted = density_samples.clone();
-    sorted.sort_by(f64::total_cmp);
-    let quantiles = a
-        .quantiles
-        .iter()
-        .map(|&p| (p, moments::quantile(&sorted, p)))
-        .collect();
-    let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
-    let bw = kde::silverman_bandwidth(&sorted);
-    let grid = kde::auto_grid(lo - 3.0 * bw, hi + 3.0 * bw, a.pdf_grid);
-    let pdf = kde::gaussian_kde(&sorted, None, &grid, bw);
-    let exceedance = q
+    let c = column(&density_samples, &a.quantiles);
+    let quantiles = a.quantiles.iter().copied().zip(c.quantiles).collect();
+    let magnitude = c.min.abs().max(c.max.abs());
+    let deterministic = runs.valid.len() < 2 || c.max - c.min <= ZERO_SPREAD * magnitude;
+    let (pdf_x, pdf) = if deterministic {
+        (Vec::new(), Vec::new())
+    } else {
+        let bw = c.bandwidth;
+        let (lo, hi) = (c.min - 3.0 * bw, c.max + 3.0 * bw);
+        (
+            kde::auto_grid(lo, hi, a.pdf_grid),
+            kde::gaussian_kde_binned(&density_samples, lo, hi, a.pdf_grid, bw),
+        )
+    };
+    let exceedance_counts: Vec<ExceedanceCount> = q
         .limits()
         .iter()
-        .map(|&l| {
-            let (p, se) = moments::exceedance_probability(&density_samples, l);
-            (l, p, se)
+        .map(|&l| exceedance_count(&density_samples, l, estimate.draws))
+        .collect();
+    let exceedance = exceedance_counts
+        .iter()
+        .map(|e| {
+            let se = (e.p * (1.0 - e.p) / e.of as f64).sqrt();
+            (e.limit, e.p, se)
         })
         .collect();
     let valid = runs.valid;
@@ -235,8 +329,13 @@ fn scalar_stats(
         min: valid.iter().copied().fold(f64::INFINITY, f64::min),
         max: valid.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         exceedance,
-        pdf_x: grid,
+        exceedance_counts,
+        pdf_x,
         pdf,
+        deterministic,
+        convergence: convergence(estimate, 0, &valid).filter(|_| !deterministic),
+        definition: q.definition(),
+        unit: None,
         samples: valid,
         density_samples,
         sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
@@ -254,6 +353,70 @@ fn scalar_stats(
             kind: e.kind.name(),
             value: e.values[0],
         }),
+    })
+}
+
+/// Mean and Std against the work spent: for a chaos, those of the expansion truncated at
+/// total order 0, 1, … (terms of a full-tensor projection do not depend on each other, so
+/// the truncation is the lower-order projection); for runs, the running estimates over the
+/// first n runs in design order (at about 30 values of n on a log scale).
+fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Convergence> {
+    if let Some(pce) = &estimate.chaos {
+        // An orthonormal basis: each term's variance is its coefficient squared.
+        let set = pce.set();
+        let c0 = set.position(&vec![0; set.dim()]);
+        let mean = c0.map_or(0.0, |t| pce.coeffs[(t, col)]);
+        let order = set.order();
+        let mut of_order = vec![0.0_f64; order + 1];
+        for (t, k) in set.indices().iter().enumerate() {
+            if Some(t) != c0 {
+                let degree: usize = k.iter().sum();
+                of_order[degree] += pce.coeffs[(t, col)].powi(2);
+            }
+        }
+        let cumulative: Vec<f64> = of_order
+            .iter()
+            .scan(0.0_f64, |acc, v| {
+                *acc += v;
+                Some(acc.sqrt())
+            })
+            .collect();
+        return Some(Convergence {
+            axis: "chaos order".into(),
+            x: (0..=order).map(|o| o as f64).collect(),
+            mean: vec![mean; order + 1],
+            std: cumulative,
+            std_of_order: of_order.iter().map(|v: &f64| v.sqrt()).collect(),
+        });
+    }
+    if valid.len() < 4 {
+        return None;
+    }
+    let n = valid.len();
+    let mut points: Vec<usize> = (0..=30)
+        .map(|i| (2.0 * (n as f64 / 2.0).powf(i as f64 / 30.0)).round() as usize)
+        .collect();
+    points.dedup();
+    let (mut mean, mut std) = (Vec::new(), Vec::new());
+    let (mut m, mut m2) = (0.0, 0.0);
+    let mut next = 0;
+    for (i, &x) in valid.iter().enumerate() {
+        // Welford's running mean and sum of squared deviations.
+        let d = x - m;
+        m += d / (i + 1) as f64;
+        m2 += d * (x - m);
+        if next < points.len() && i + 1 == points[next] {
+            mean.push(m);
+            std.push((m2 / i.max(1) as f64).sqrt());
+            next += 1;
+        }
+    }
+    Some(Convergence {
+        axis: "runs".into(),
+        x: points.iter().map(|&p| p as f64).collect(),
+        mean,
+        std,
+        std_of_order: Vec::new(),
     })
 }
 
@@ -325,7 +488,8 @@ pub fn analyse_runs(
     design: &Design,
     records: &[Option<Record>],
 ) -> Result<Analysed, AnalysisError> {
-    let settings = Settings::of(study);
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();
     let runs = Runs::of(records);
@@ -405,7 +569,8 @@ pub fn analyse_solution(
     study: &Study,
     solution: &Solution,
 ) -> Result<Vec<OutputStats>, AnalysisError> {
-    let settings = Settings::of(study);
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
     let times = study.times();
     study
         .outputs
@@ -418,6 +583,40 @@ pub fn analyse_solution(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Where the analysis of a chaos study spends its time:
+    /// `cargo test --release -p uq-driver --lib -- --ignored analysis_timing --nocapture`.
+    #[test]
+    #[ignore = "prints timings"]
+    fn analysis_timing() {
+        use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce};
+        let set = MultiIndexSet::total_degree(2, 5).unwrap();
+        let basis = Basis::new(vec![Family::Hermite; 2], set).unwrap();
+        let coeffs = DMatrix::from_fn(basis.len(), 501, |t, k| {
+            ((t + 1) as f64).recip() * (0.01 * k as f64).sin()
+        });
+        let pce = Pce { basis, coeffs };
+        let t = std::time::Instant::now();
+        let draws = Surrogates::new(1).draws(&pce, 4_000);
+        eprintln!("sample: {:?}", t.elapsed());
+        let t = std::time::Instant::now();
+        let rows = draws.nrows();
+        let cols: Vec<Column> = (0..draws.ncols())
+            .map(|k| {
+                column(
+                    &draws.as_slice()[k * rows..(k + 1) * rows],
+                    &[0.01, 0.5, 0.99],
+                )
+            })
+            .collect();
+        eprintln!("columns: {:?}", t.elapsed());
+        let t = std::time::Instant::now();
+        for (k, c) in cols.iter().enumerate().step_by(2) {
+            let col = &draws.as_slice()[k * rows..(k + 1) * rows];
+            kde::gaussian_kde_binned(col, -1.0, 1.0, 200, c.bandwidth);
+        }
+        eprintln!("kde: {:?}", t.elapsed());
+    }
 
     #[test]
     fn thinning_keeps_ends() {
