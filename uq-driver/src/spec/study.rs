@@ -81,7 +81,7 @@ impl Study {
         Problem {
             parameters: &self.parameters,
             outputs: &self.outputs,
-            quantities: self.qoi.len(),
+            quantities: self.qoi.iter().map(|q| q.quantity_names().len()).sum(),
             times,
             system: self.system.as_ref(),
         }

@@ -8,8 +8,8 @@ use std::borrow::Cow;
 use nalgebra::DMatrix;
 
 use super::store::Record;
+use crate::qoi::kde;
 use crate::qoi::scalar::Code;
-use crate::qoi::{kde, QoiSpec};
 use crate::results::{OutputStats, ScalarStats};
 use crate::spec::{Analysis, Study};
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
@@ -181,9 +181,11 @@ struct QuantityRuns {
     never_stops: usize,
 }
 
-/// Statistics of a scalar quantity from its estimate and its valid run values.
+/// Statistics of the scalar quantity `name` (exceedance `limits`) from its estimate and its
+/// valid run values.
 fn scalar_stats(
-    q: &QoiSpec,
+    name: &str,
+    limits: &[f64],
     estimate: &Estimate,
     runs: QuantityRuns,
     settings: &Settings,
@@ -191,7 +193,7 @@ fn scalar_stats(
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
     let density_samples: Vec<f64> = settings
-        .draws(q.name(), estimate, Some(&data))?
+        .draws(name, estimate, Some(&data))?
         .column(0)
         .iter()
         .copied()
@@ -207,8 +209,7 @@ fn scalar_stats(
     let bw = kde::silverman_bandwidth(&sorted);
     let grid = kde::auto_grid(lo - 3.0 * bw, hi + 3.0 * bw, a.pdf_grid);
     let pdf = kde::gaussian_kde(&sorted, None, &grid, bw);
-    let exceedance = q
-        .limits()
+    let exceedance = limits
         .iter()
         .map(|&l| {
             let (p, se) = moments::exceedance_probability(&density_samples, l);
@@ -217,7 +218,7 @@ fn scalar_stats(
         .collect();
     let valid = runs.valid;
     Ok(ScalarStats {
-        name: q.name().to_owned(),
+        name: name.to_owned(),
         mean: estimate.mean[0],
         std: estimate.std[0],
         std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
@@ -321,11 +322,15 @@ pub fn analyse_runs(
     }
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
-    for (qi, q) in study.qoi.iter().enumerate() {
+    let scalars = study
+        .qoi
+        .iter()
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q.limits())));
+    for (qi, (name, limits)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi);
         if qr.valid.is_empty() {
             return Err(AnalysisError::NoValue {
-                name: q.name().to_owned(),
+                name,
                 never_hunts: qr.never_hunts,
                 never_stops: qr.never_stops,
             });
@@ -335,12 +340,12 @@ pub fn analyse_runs(
             method
                 .estimate(design, &qr.rows, &data)
                 .map_err(|source| AnalysisError::Quantity {
-                    name: q.name().to_owned(),
+                    name: name.clone(),
                     never_hunts: qr.never_hunts,
                     never_stops: qr.never_stops,
                     source,
                 })?;
-        quantities.push(scalar_stats(q, &estimate, qr, &settings)?);
+        quantities.push(scalar_stats(&name, limits, &estimate, qr, &settings)?);
     }
     Ok((outputs, quantities))
 }

@@ -17,6 +17,7 @@ mod point;
 pub mod runner;
 pub mod shard;
 mod single;
+pub mod speed_runs;
 pub mod store;
 pub mod suite;
 
