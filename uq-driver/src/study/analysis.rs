@@ -8,8 +8,8 @@ use std::borrow::Cow;
 use nalgebra::DMatrix;
 
 use super::store::Record;
-use crate::qoi::kde;
 use crate::qoi::scalar::Code;
+use crate::qoi::{kde, QoiSpec};
 use crate::results::{OutputStats, ScalarStats};
 use crate::spec::{Analysis, Study};
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
@@ -63,6 +63,27 @@ pub enum AnalysisError {
         /// Why.
         #[source]
         source: MethodError,
+    },
+    /// A `hunting_speed` quantity whose bracket does not contain the transition at every
+    /// point that needs a value (all points, or any point of a weighted design).
+    #[error(
+        "quantity '{name}': at {decays_at_high} points the disturbance dies out even at the top of \
+         the bracket (high = {high}) and at {hunts_at_low} it keeps hunting even at the bottom \
+         (low = {low}); widen the bracket{more}"
+    )]
+    OutsideBracket {
+        /// The quantity.
+        name: String,
+        /// The bracket.
+        low: f64,
+        /// The bracket.
+        high: f64,
+        /// Points that die out at `high`.
+        decays_at_high: usize,
+        /// Points that keep hunting at `low`.
+        hunts_at_low: usize,
+        /// Further advice.
+        more: &'static str,
     },
     /// An estimate asks for draws it cannot give.
     #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
@@ -325,10 +346,24 @@ pub fn analyse_runs(
     let scalars = study
         .qoi
         .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q.limits())));
-    for (qi, (name, limits)) in scalars.enumerate() {
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
+    for (qi, (name, q)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi);
+        let outside = |more| match q {
+            QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
+                name: name.clone(),
+                low: h.low,
+                high: h.high,
+                decays_at_high: qr.never_hunts,
+                hunts_at_low: qr.never_stops,
+                more,
+            }),
+            _ => None,
+        };
         if qr.valid.is_empty() {
+            if let Some(e) = outside("") {
+                return Err(e);
+            }
             return Err(AnalysisError::NoValue {
                 name,
                 never_hunts: qr.never_hunts,
@@ -336,16 +371,18 @@ pub fn analyse_runs(
             });
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate =
-            method
-                .estimate(design, &qr.rows, &data)
-                .map_err(|source| AnalysisError::Quantity {
+        let estimate = method.estimate(design, &qr.rows, &data).map_err(|source| {
+            let more = " (or use a method that can leave points out, such as LHS or MC)";
+            outside(more)
+                .filter(|_| qr.never_hunts + qr.never_stops > 0)
+                .unwrap_or(AnalysisError::Quantity {
                     name: name.clone(),
                     never_hunts: qr.never_hunts,
                     never_stops: qr.never_stops,
                     source,
-                })?;
-        quantities.push(scalar_stats(&name, limits, &estimate, qr, &settings)?);
+                })
+        })?;
+        quantities.push(scalar_stats(&name, q.limits(), &estimate, qr, &settings)?);
     }
     Ok((outputs, quantities))
 }
