@@ -307,3 +307,77 @@ fn settings_that_do_not_fit_the_fmu_are_refused_before_any_run() {
         );
     }
 }
+
+/// A suite whose variants compute different quantities (`quantities = [...]`, as
+/// paper-bogie's LHS 20 000 leaves the constant-speed runs out): the comparison matches
+/// quantities by name, even when the reference lacks one.
+#[test]
+fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
+    let wheel = bogie_fmu().with_file_name("Wheel.fmu");
+    let dir = tempfile::tempdir().unwrap();
+    let study = dir.path().join("s.toml");
+    let text = format!(
+        "name = \"suite\"\nfmu = {:?}\nreference = \"b\"\n\
+         [experiment]\nstop = 1.0\nstep = 0.01\n[method]\nkind = \"mc\"\nsamples = 10\n\
+         [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [[parameters]]\nname = \"C\"\nmean = 20.0\nstd = 2.0\n\
+         [[qoi]]\nkind = \"max_abs\"\nname = \"peak\"\nsignal = \"q\"\nfrom = 0.5\n\
+         [[qoi]]\nkind = \"final\"\nname = \"end\"\nsignal = \"q\"\n\
+         [[variants]]\nname = \"a\"\n\
+         [[variants]]\nname = \"b\"\nmethod = {{ kind = \"mc\", samples = 12 }}\nquantities = [\"end\"]\n",
+        wheel.to_str().unwrap()
+    );
+    std::fs::write(&study, text).unwrap();
+    let out = dir.path().join("out");
+    check(&run(&study, &out, &[]));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let names = |v: &serde_json::Value| -> Vec<String> {
+        v["quantities"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|q| q["name"].as_str().unwrap().to_owned())
+            .collect()
+    };
+    assert_eq!(names(&summary["variants"][0]), ["peak", "end"]);
+    assert_eq!(names(&summary["variants"][1]), ["end"]);
+    // Each comparison file holds the variants that have the quantity, with their own means.
+    let rows = |q: &str| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(out.join(format!("{q}_compare.csv")))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let mean = |v: usize, qi: usize| {
+        summary["variants"][v]["quantities"][qi]["mean"]
+            .as_f64()
+            .unwrap()
+    };
+    let peak = rows("peak");
+    assert_eq!(peak.len(), 1);
+    assert_eq!(
+        (peak[0][0], peak[0][1], peak[0][2]),
+        (0.0, 10.0, mean(0, 0))
+    );
+    let end = rows("end");
+    assert_eq!(end.len(), 2);
+    assert_eq!((end[0][0], end[0][2]), (0.0, mean(0, 1)));
+    assert_eq!((end[1][0], end[1][1], end[1][2]), (1.0, 12.0, mean(1, 0)));
+    // The table of variants: the reference's quantities first (end, then peak); b's cells of
+    // peak are blank.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let row_b = html
+        .split("<tr>")
+        .find(|r| r.starts_with("<td>b</td>"))
+        .expect("row of b");
+    let row_b = &row_b[..row_b.find("</tr>").expect("end of the row")];
+    let cells: Vec<&str> = row_b.split("<td").skip(1).collect();
+    // variant, method, runs, wall time, mean/Std end, mean/Std peak (blank).
+    assert_eq!(cells.len(), 8, "{row_b}");
+    assert!(cells[4].contains(&format!("{:.5}", mean(1, 0))), "{row_b}");
+    assert!(html.contains("<th>mean end</th><th>Std end</th><th>mean peak</th>"));
+    assert_eq!(&cells[6..], ["></td>", "></td>"], "{row_b}");
+}

@@ -29,7 +29,7 @@
 //! a small disturbance finds the boundary of the basin instead, between the nonlinear and the
 //! linear critical speed). Just below the fold of the limit cycles the decay is slow: the
 //! motion lingers near the vanished cycle before it decays (measured on the bogie: 0.005 m/s
-//! below the fold, |Y| stays above 0.1 mm for 90 s; 0.3 m/s below, 76 s; 0.8 m/s below, 51 s).
+//! below the fold, |Y| stays above 0.1 mm for 90 s; 0.035 m/s below, 76 s; 0.8 m/s below, 51 s).
 //! A run that ends before the decay is counted as hunting, so a short `duration` biases both
 //! speeds downwards; choose it from a convergence check (see the README for the bogie's).
 
