@@ -109,12 +109,15 @@ test-python: venv
 bench: build fmu venv
 	CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
-# Every study of the paper (long: about half an hour on 2 cores, most of it the bogie's
-# 20 000-sample Latin hypercube). Re-running resumes what an interrupted run finished.
+# Every study of the paper (long: about an hour on 2 cores, most of it the bogie's 20 000-sample
+# and the 8-input vehicle-track's 5 000-sample Latin hypercubes). Re-running resumes what an
+# interrupted run finished.
 paper: build fmu
 	$(DRIVER) run builtin:paper-wheel --out out/paper-wheel
 	$(DRIVER) run builtin:paper-vehicle-track --out out/paper-vehicle-track
 	$(DRIVER) run builtin:vehicle-track-defect --out out/vehicle-track-defect
+	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
+	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
 	@echo "reports: out/paper-*/index.html"
 

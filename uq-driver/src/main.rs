@@ -10,7 +10,10 @@ use clap::{Args, Parser, Subcommand};
 use uq_driver::fmu::{Fmu, VariableKind};
 use uq_driver::report::csv::push_shortest;
 use uq_driver::spec::{builtin, Experiment, FixedValue, InvalidExperiment, Study, BUILTINS};
-use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
+use uq_driver::study::{
+    run_study, runner, shard, size, Outcome, RunOptions, StudyResult, SuiteResult,
+};
+use uq_driver::uq::surrogate::Surrogate;
 
 #[derive(Parser)]
 #[command(
@@ -37,6 +40,9 @@ enum Command {
         /// Plan folder.
         #[arg(long, short)]
         out: PathBuf,
+        /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+        #[arg(long)]
+        yes: bool,
     },
     /// Run one shard of a plan (resumable); K defaults to $SLURM_ARRAY_TASK_ID.
     RunShard {
@@ -85,6 +91,45 @@ enum Command {
     /// Serve points to a parent uq-driver (`--isolate`) over stdin/stdout.
     #[command(hide = true)]
     Worker,
+    /// Evaluate or sample the chaos surrogate a study exported (DIR/surrogate.json).
+    #[command(subcommand)]
+    Surrogate(SurrogateCommand),
+}
+
+#[derive(Subcommand)]
+enum SurrogateCommand {
+    /// The surrogate at one point, as CSV `name,time,value` (time empty for a scalar
+    /// quantity); inputs not given take their nominal value.
+    Eval {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Input value, NAME=VALUE (repeatable).
+        #[arg(long = "at", value_parser = parse_number_assignment)]
+        at: Vec<(String, f64)>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
+    /// N random draws of the inputs (their joint law, correlation included) with the
+    /// surrogate's values: CSV with the inputs, the scalar quantities and each output at the
+    /// chosen times (`NAME@TIME`).
+    Sample {
+        /// Study output folder (with surrogate.json), or the file itself.
+        dir: PathBuf,
+        /// Number of draws.
+        #[arg(short = 'n', long)]
+        n: usize,
+        /// Seed (draw i comes from the stream (seed, i) only).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output times to write, s (repeatable; the nearest communication point; default:
+        /// the last).
+        #[arg(long = "time")]
+        times: Vec<f64>,
+        /// CSV file to write (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -106,6 +151,9 @@ struct RunArgs {
     /// Stop after this many new points (the study can be resumed later).
     #[arg(long, hide = true)]
     max_points: Option<usize>,
+    /// Start a large study (more than 100 000 runs, or much memory or time) without asking.
+    #[arg(long)]
+    yes: bool,
     #[command(flatten)]
     safety: SafetyArgs,
 }
@@ -174,6 +222,9 @@ struct SlurmArgs {
     /// Write the scripts but do not submit.
     #[arg(long)]
     dry_run: bool,
+    /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+    #[arg(long)]
+    yes: bool,
 }
 
 #[derive(Args)]
@@ -211,6 +262,16 @@ fn parse_assignment(s: &str) -> Result<(String, String), String> {
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
     Ok((name.trim().to_owned(), value.to_owned()))
+}
+
+/// `NAME=NUMBER`.
+fn parse_number_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = parse_assignment(s)?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("value of {name}: {e}"))?;
+    Ok((name, v))
 }
 
 fn main() -> ExitCode {
@@ -255,8 +316,14 @@ fn causes(e: &anyhow::Error) -> String {
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Run(args) => run(args),
-        Command::Plan { study, shards, out } => {
+        Command::Plan {
+            study,
+            shards,
+            out,
+            yes,
+        } => {
             let s = Study::load(&study)?;
+            check_plan_size(&s, &out, yes)?;
             let p = shard::plan(&s, shards, &out)?;
             println!(
                 "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
@@ -310,7 +377,37 @@ fn dispatch(cmd: Command) -> Result<()> {
         }
         Command::Inspect { fmu } => inspect(&fmu),
         Command::Simulate(args) => simulate(args),
+        Command::Surrogate(cmd) => surrogate(cmd),
         Command::Worker => unreachable!("handled in main"),
+    }
+}
+
+/// Writes `text` to `out`, or to standard output.
+fn emit(text: &str, out: Option<&Path>) -> Result<()> {
+    match out {
+        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display())),
+        None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
+    }
+}
+
+/// `uq-driver surrogate eval|sample`.
+fn surrogate(cmd: SurrogateCommand) -> Result<()> {
+    match cmd {
+        SurrogateCommand::Eval { dir, at, out } => {
+            let s = Surrogate::load(&dir)?;
+            let x = s.point(&at)?;
+            emit(&s.eval_csv(&x), out.as_deref())
+        }
+        SurrogateCommand::Sample {
+            dir,
+            n,
+            seed,
+            times,
+            out,
+        } => {
+            let s = Surrogate::load(&dir)?;
+            emit(&s.sample_csv(n, seed, &times), out.as_deref())
+        }
     }
 }
 
@@ -323,6 +420,7 @@ fn run(a: RunArgs) -> Result<()> {
         allow_failures: a.allow_failures,
         fresh: a.fresh,
         max_new_points: a.max_points,
+        yes: a.yes,
         ..RunOptions::default()
     };
     a.safety.apply(&mut opts)?;
@@ -331,6 +429,16 @@ fn run(a: RunArgs) -> Result<()> {
         Outcome::Study(r) => print_study(&r, &a.out),
         Outcome::Suite(r) => print_suite(&r, &a.out),
     }
+    Ok(())
+}
+
+/// The size checks of `run` for a plan (whose shards run with the default thread count).
+fn check_plan_size(s: &Study, dir: &Path, yes: bool) -> Result<()> {
+    let opts = RunOptions {
+        yes,
+        ..RunOptions::default()
+    };
+    size::check(s, dir, &opts).with_context(|| format!("study {}", s.origin))?;
     Ok(())
 }
 
@@ -367,6 +475,7 @@ fn run_shard(
 /// `uq-driver slurm`: plan, write the batch scripts and (unless --dry-run) submit them.
 fn slurm(a: SlurmArgs) -> Result<()> {
     let s = Study::load(&a.study)?;
+    check_plan_size(&s, &a.out, a.yes)?;
     shard::plan(&s, a.shards, &a.out)?;
     let driver = std::env::current_exe().context("locating the uq-driver executable")?;
     let o = shard::SlurmOptions {
@@ -487,6 +596,12 @@ fn simulate(a: SimulateArgs) -> Result<()> {
         ),
         other => other.into(),
     })?;
+    let series = if a.outputs.is_empty() {
+        fmu.description().output_variables().count()
+    } else {
+        a.outputs.len()
+    };
+    size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
     let params: Vec<(String, FixedValue)> = a
         .set

@@ -10,7 +10,8 @@ use serde::Serialize;
 
 use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::method::{Draws, MethodSummary, Sobol};
+use crate::uq::method::{ChaosError, Draws, MethodSummary, Sobol};
+use crate::uq::random_inputs::Correlation;
 
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
@@ -31,6 +32,8 @@ pub struct OutputStats {
     pub quantiles: Vec<(f64, Vec<f64>)>,
     /// Std of the chaos surrogate where it differs from `std` (collocation).
     pub std_pce: Option<Vec<f64>>,
+    /// Standard error of the mean over time, where the method estimates it (sampling).
+    pub std_error_mean: Option<Vec<f64>>,
     /// First-order and total Sobol' indices over time.
     pub sobol: Option<Sobol>,
     /// PDF evolution: times of the columns.
@@ -41,6 +44,9 @@ pub struct OutputStats {
     pub pdf: Vec<Vec<f64>>,
     /// Where the quantiles and densities come from.
     pub draws: Draws,
+    /// The chaos's estimated truncation error over time (a column of `<V>.csv` named after
+    /// its kind: `loo`, `level_difference` or `order_difference`).
+    pub chaos_error: Option<ChaosError>,
 }
 
 impl OutputStats {
@@ -92,9 +98,73 @@ pub struct ScalarStats {
     pub sobol_first: Option<Vec<f64>>,
     /// Total Sobol' indices per parameter.
     pub sobol_total: Option<Vec<f64>>,
+    /// The Sobol' indices labelled by parameter name, with their confidence intervals where
+    /// the method gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sobol: Option<SobolSummary>,
     /// Where the quantiles and the PDF come from.
     #[serde(skip)]
     pub draws: Draws,
+    /// The chaos's estimated relative truncation error (chaos methods).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chaos_error: Option<ScalarChaosError>,
+}
+
+/// A scalar quantity's chaos truncation error in `summary.json`:
+/// `{"kind": "loo" | "level_difference" | "order_difference", "value": ...}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScalarChaosError {
+    /// How it was estimated.
+    pub kind: &'static str,
+    /// The relative error.
+    pub value: f64,
+}
+
+/// Sobol' indices of a scalar quantity by parameter name (`quantities.NAME.sobol` in
+/// `summary.json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SobolSummary {
+    /// First-order index of each parameter.
+    pub first: BTreeMap<String, f64>,
+    /// Total index of each parameter.
+    pub total: BTreeMap<String, f64>,
+    /// `[low, high]` interval of each first-order index, where estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_ci: Option<BTreeMap<String, [f64; 2]>>,
+    /// `[low, high]` interval of each total index, where estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub total_ci: Option<BTreeMap<String, [f64; 2]>>,
+    /// Confidence level of the intervals.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ci_level: Option<f64>,
+}
+
+impl SobolSummary {
+    /// Column `col` of `sobol`, labelled by `names` (the parameters, in study order).
+    pub fn of(sobol: &Sobol, col: usize, names: &[&str]) -> SobolSummary {
+        let label = |v: &[f64]| -> BTreeMap<String, f64> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().copied())
+                .collect()
+        };
+        let label_ci = |v: &[(f64, f64)]| -> BTreeMap<String, [f64; 2]> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().map(|&(lo, hi)| [lo, hi]))
+                .collect()
+        };
+        let ci = sobol.intervals.as_ref();
+        SobolSummary {
+            first: label(&sobol.first[col]),
+            total: label(&sobol.total[col]),
+            first_ci: ci.map(|c| label_ci(&c.first[col])),
+            total_ci: ci.map(|c| label_ci(&c.total[col])),
+            ci_level: ci.map(|c| c.level),
+        }
+    }
 }
 
 /// Outcome of one point of a design.
@@ -206,6 +276,10 @@ pub struct Summary {
     pub experiment: Experiment,
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
+    /// Their correlation: the requested pairs and the normal-space matrix of the Gaussian
+    /// copula (absent when the inputs are independent).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation: Option<Correlation>,
     /// Deterministic values.
     pub fixed: BTreeMap<String, FixedValue>,
     /// The FMU (null for intrusive methods).

@@ -442,6 +442,7 @@ fn integral_design_values_set_an_integer_random_parameter() {
         values,
         weights: None,
         warnings: Vec::new(),
+        inputs: study.random_inputs(),
     };
     let dir = tempfile::tempdir().unwrap();
     let outcome =

@@ -123,6 +123,14 @@ fn write_output_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
         header.push("std_pce".into());
         cols.push(sp);
     }
+    if let Some(se) = &s.std_error_mean {
+        header.push("std_error_mean".into());
+        cols.push(se);
+    }
+    if let Some(e) = &s.chaos_error {
+        header.push(e.kind.name().into());
+        cols.push(&e.values);
+    }
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(&dir.join(format!("{}.csv", s.name)), &hdr, &cols)
 }
@@ -132,18 +140,34 @@ fn column(rows: &[Vec<f64>], j: usize) -> Vec<f64> {
     rows.iter().map(|r| r[j]).collect()
 }
 
-/// `<V>_sobol.csv`: `time,S_<p>...,ST_<p>...`.
+/// `<V>_sobol.csv`: `time,S_<p>...,ST_<p>...`, then, where the method gives confidence
+/// intervals, `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...`.
 fn write_sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), ReportError> {
-    let Some(Sobol { first, total }) = &s.sobol else {
+    let Some(Sobol {
+        first,
+        total,
+        intervals,
+    }) = &s.sobol
+    else {
         return Ok(());
     };
     let mut header = vec!["time".to_string()];
     header.extend(names.iter().map(|n| format!("S_{n}")));
     header.extend(names.iter().map(|n| format!("ST_{n}")));
-    let data: Vec<Vec<f64>> = (0..names.len())
+    let mut data: Vec<Vec<f64>> = (0..names.len())
         .map(|j| column(first, j))
         .chain((0..names.len()).map(|j| column(total, j)))
         .collect();
+    if let Some(ci) = intervals {
+        for (label, rows) in [("S", &ci.first), ("ST", &ci.total)] {
+            for (j, n) in names.iter().enumerate() {
+                header.push(format!("{label}_{n}_lo"));
+                header.push(format!("{label}_{n}_hi"));
+                data.push(rows.iter().map(|r| r[j].0).collect());
+                data.push(rows.iter().map(|r| r[j].1).collect());
+            }
+        }
+    }
     let mut cols: Vec<&[f64]> = vec![&s.times];
     cols.extend(data.iter().map(Vec::as_slice));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
@@ -152,7 +176,7 @@ fn write_sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), Re
 
 /// `<V>_sobol.svg`: first-order (solid) and total (dashed) indices over time.
 fn write_sobol_plot(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), ReportError> {
-    let Some(Sobol { first, total }) = &s.sobol else {
+    let Some(Sobol { first, total, .. }) = &s.sobol else {
         return Ok(());
     };
     let v = &s.name;
@@ -325,6 +349,20 @@ fn scalar_section(q: &ScalarStats) -> Section {
             format!("{p:.5} ± {se:.1e}"),
         ]);
     }
+    if let Some(sobol) = &q.sobol {
+        for (label, values, ci) in [
+            ("first-order Sobol' index", &sobol.first, &sobol.first_ci),
+            ("total Sobol' index", &sobol.total, &sobol.total_ci),
+        ] {
+            for (p, v) in values {
+                let interval = ci
+                    .as_ref()
+                    .and_then(|c| c.get(p))
+                    .map_or(String::new(), |[lo, hi]| format!(" [{lo:.4}, {hi:.4}]"));
+                rows.push(vec![format!("{label} of {p}"), format!("{v:.4}{interval}")]);
+            }
+        }
+    }
     Section {
         heading: format!("Quantity {name}"),
         text: format!(
@@ -447,6 +485,16 @@ fn head_sections(r: &StudyReport) -> Vec<Section> {
                 .collect(),
         }),
     }];
+    if let Some(se) = s
+        .method
+        .details
+        .get("standard_error")
+        .and_then(|v| v.as_str())
+    {
+        head[0]
+            .text
+            .push_str(&format!("\n\nStandard error of the mean: {se}."));
+    }
     if !s.warnings.is_empty() {
         head.push(Section {
             heading: "Warnings".into(),

@@ -18,7 +18,20 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/wheel-lhs-50000.toml"),
     ),
     ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
+    ("wheel-qmc", include_str!("../../studies/wheel-qmc.toml")),
+    (
+        "wheel-sobol-sampling",
+        include_str!("../../studies/wheel-sobol-sampling.toml"),
+    ),
     ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
+    (
+        "wheel-sparse",
+        include_str!("../../studies/wheel-sparse.toml"),
+    ),
+    (
+        "wheel-pce-lars",
+        include_str!("../../studies/wheel-pce-lars.toml"),
+    ),
     (
         "paper-wheel",
         include_str!("../../studies/paper-wheel.toml"),
@@ -59,6 +72,14 @@ pub const BUILTINS: &[(&str, &str)] = &[
     (
         "vehicle-track-defect",
         include_str!("../../studies/vehicle-track-defect.toml"),
+    ),
+    (
+        "vehicle-track-8d-pce",
+        include_str!("../../studies/vehicle-track-8d-pce.toml"),
+    ),
+    (
+        "vehicle-track-8d-lhs",
+        include_str!("../../studies/vehicle-track-8d-lhs.toml"),
     ),
     (
         "paper-vehicle-track",

@@ -11,6 +11,10 @@ use crate::qoi::QoiSpec;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::MethodSpec;
 
+/// Most communication points of one run (the limit of [`Experiment::check`]): 10^8 points
+/// hold 800 MB per recorded variable.
+pub const MAX_TIME_POINTS: f64 = 1e8;
+
 /// Start, stop and communication step (s).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -69,7 +73,8 @@ impl Experiment {
         t
     }
 
-    /// Checks that start < stop and step > 0, all finite.
+    /// Checks that start < stop and step > 0, all finite, and that the grid has at most
+    /// [`MAX_TIME_POINTS`] points (before anything allocates it).
     pub fn check(&self) -> Result<(), InvalidExperiment> {
         if self.step == 0.0 {
             return Err(InvalidExperiment::ZeroStep);
@@ -79,6 +84,14 @@ impl Experiment {
             return Err(InvalidExperiment::Range {
                 start: self.start,
                 stop: self.stop,
+                step: self.step,
+            });
+        }
+        // t_0 … t_n with n = ceil((stop − start) / step) at most (a shorter last step).
+        let points = ((self.stop - self.start) / self.step).ceil() + 1.0;
+        if points.is_nan() || points > MAX_TIME_POINTS {
+            return Err(InvalidExperiment::TooManyPoints {
+                points,
                 step: self.step,
             });
         }
@@ -101,6 +114,19 @@ pub enum InvalidExperiment {
         start: f64,
         /// Stop (s).
         stop: f64,
+        /// Step (s).
+        step: f64,
+    },
+    /// More communication points than [`MAX_TIME_POINTS`].
+    #[error(
+        "experiment: {points:.3e} communication points (step {step:e} s), more than the limit of \
+         1e8 per run (each recorded variable would take {:.1e} bytes of memory); use a \
+         coarser step or a shorter experiment",
+        8.0 * points
+    )]
+    TooManyPoints {
+        /// Communication points (t_0 … t_n).
+        points: f64,
         /// Step (s).
         step: f64,
     },
@@ -176,6 +202,9 @@ pub struct StudyFile {
     pub method: Spanned<MethodSpec>,
     /// Random parameters.
     pub parameters: Vec<Spanned<ParameterSpec>>,
+    /// Correlations between random parameters (a Gaussian copula).
+    #[serde(default)]
+    pub correlation: Vec<Spanned<CorrelationSpec>>,
     /// Deterministic parameter values set before every run (numbers, Booleans or texts).
     #[serde(default)]
     pub fixed: BTreeMap<String, FixedValue>,
@@ -204,6 +233,16 @@ pub struct StudyFile {
 
 fn default_seed() -> u64 {
     42
+}
+
+/// `[[correlation]]`: the Pearson correlation `rho` of two random parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CorrelationSpec {
+    /// The two parameters, by name.
+    pub between: [String; 2],
+    /// Their correlation, in (-1, 1).
+    pub rho: f64,
 }
 
 /// A published value: `statistic` ("mean", "std", or "p>LIMIT") of `quantity` in `variant`.

@@ -14,6 +14,7 @@ use super::study::{Study, Suite};
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::Evaluation;
+use crate::uq::random_inputs::{Correlation, CorrelationPair};
 
 impl Study {
     /// Loads `builtin:NAME` or a TOML file.
@@ -92,6 +93,7 @@ fn study(
         .map(|p| (p.span(), p.get_ref()))
         .collect();
     let parameters = parameters(&cx, &params, &file)?;
+    let correlation = correlation(&cx, &parameters, &file)?;
     check_fixed(&cx, &file)?;
     check_quantities(&cx, &file)?;
     check_analysis(&cx, &file.analysis)?;
@@ -106,6 +108,7 @@ fn study(
         experiment: e.get_ref().clone(),
         method: file.method.get_ref().clone(),
         parameters,
+        correlation,
         fixed: file.fixed.clone(),
         inputs: file
             .inputs
@@ -117,7 +120,7 @@ fn study(
         system: file.system.clone(),
         suite: None,
     };
-    check_method(&cx, &study, file.method.span())?;
+    check_method(&cx, &mut study, file.method.span())?;
     if let Evaluation::Sampling(_) = study.method().evaluation() {
         let fmu = file
             .fmu
@@ -158,6 +161,25 @@ fn parameters(
         out.push(param);
     }
     Ok(out)
+}
+
+/// The `[[correlation]]` pairs, their Gaussian copula checked (positive definite,
+/// attainable with the marginals).
+fn correlation(
+    cx: &Context,
+    parameters: &[RandomParameter],
+    file: &StudyFile,
+) -> Result<Option<Correlation>, StudyError> {
+    let pairs = file
+        .correlation
+        .iter()
+        .map(|c| CorrelationPair {
+            between: c.get_ref().between.clone(),
+            rho: c.get_ref().rho,
+        })
+        .collect();
+    let at = file.correlation.first().map(|c| c.span());
+    Correlation::new(parameters, pairs).map_err(|e| cx.invalid(at, format!("[[correlation]]: {e}")))
 }
 
 fn check_fixed(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
@@ -207,7 +229,13 @@ fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
     Ok(())
 }
 
-fn check_method(cx: &Context, study: &Study, span: Range<usize>) -> Result<(), StudyError> {
+fn check_method(cx: &Context, study: &mut Study, span: Range<usize>) -> Result<(), StudyError> {
+    let kind = study.method().kind();
+    let base = study.base.clone();
+    study
+        .method
+        .resolve_files(base.as_deref())
+        .map_err(|e| cx.invalid(Some(span.clone()), format!("method {kind}: {e}")))?;
     let times = study.times();
     study
         .method()

@@ -14,7 +14,8 @@
 //! order = 5                    # SCM: total order of the Hermite chaos (default nodes − 1)
 //! [[parameters]]
 //! name = "K"
-//! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal"
+//! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal" |
+//!                              # "beta" | "gamma" | "weibull" | "integer_uniform"
 //! mean = 100.0
 //! std = 10.0                   # or cov = 0.1
 //! [fixed]                      # deterministic values: numbers, true/false, "texts"
@@ -41,7 +42,8 @@ mod value;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{
-    Analysis, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue, StudyFile, Variant,
+    Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue,
+    StudyFile, Variant,
 };
 pub use load::fmu_search_path;
 pub use parameter::{DistributionSpec, InvalidParameter, ParameterSpec};

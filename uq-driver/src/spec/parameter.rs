@@ -68,6 +68,39 @@ pub enum DistributionSpec {
         /// Upper bound.
         high: f64,
     },
+    /// `distribution = "beta"`: Beta(`alpha`, `beta`) scaled to `[low, high]`.
+    Beta {
+        /// First shape (> 0).
+        alpha: f64,
+        /// Second shape (> 0).
+        beta: f64,
+        /// Lower end.
+        low: f64,
+        /// Upper end.
+        high: f64,
+    },
+    /// `distribution = "gamma"`: `shape` and `scale` (mean `shape · scale`).
+    Gamma {
+        /// Shape (> 0).
+        shape: f64,
+        /// Scale (> 0, units of the parameter).
+        scale: f64,
+    },
+    /// `distribution = "weibull"`: CDF `1 - exp(-(x/scale)^shape)`.
+    Weibull {
+        /// Shape (> 0).
+        shape: f64,
+        /// Scale (> 0, units of the parameter).
+        scale: f64,
+    },
+    /// `distribution = "integer_uniform"`: the integers `low..=high`, equally likely
+    /// (sampling methods only).
+    IntegerUniform {
+        /// Smallest value.
+        low: i64,
+        /// Largest value (included).
+        high: i64,
+    },
 }
 
 /// Why a parameter's distribution is refused.
@@ -146,6 +179,17 @@ impl DistributionSpec {
                 low,
                 high,
             } => Distribution::truncated_normal(mean, spread(mean, std, cov)?, low, high)?,
+            DistributionSpec::Beta {
+                alpha,
+                beta,
+                low,
+                high,
+            } => Distribution::beta(alpha, beta, low, high)?,
+            DistributionSpec::Gamma { shape, scale } => Distribution::gamma(shape, scale)?,
+            DistributionSpec::Weibull { shape, scale } => Distribution::weibull(shape, scale)?,
+            DistributionSpec::IntegerUniform { low, high } => {
+                Distribution::integer_uniform(low, high)?
+            }
         })
     }
 }
@@ -201,6 +245,32 @@ mod tests {
         )
         .unwrap();
         assert!(p.to_parameter().is_ok());
+        for (text, want) in [
+            (
+                "distribution = \"beta\"\nalpha = 2\nbeta = 5\nlow = 1\nhigh = 3",
+                Distribution::beta(2.0, 5.0, 1.0, 3.0).unwrap(),
+            ),
+            (
+                "distribution = \"gamma\"\nshape = 2.5\nscale = 4e3",
+                Distribution::gamma(2.5, 4e3).unwrap(),
+            ),
+            (
+                "distribution = \"weibull\"\nshape = 1.5\nscale = 2",
+                Distribution::weibull(1.5, 2.0).unwrap(),
+            ),
+            (
+                "distribution = \"integer_uniform\"\nlow = 1\nhigh = 16",
+                Distribution::integer_uniform(1, 16).unwrap(),
+            ),
+        ] {
+            let p = parse(&format!("name = \"K\"\n{text}")).unwrap();
+            assert_eq!(p.to_parameter().unwrap().distribution, want, "{text}");
+        }
+        let bad = parse("name = \"K\"\ndistribution = \"gamma\"\nshape = -1\nscale = 1").unwrap();
+        assert!(bad.to_parameter().is_err());
+        let bad =
+            parse("name = \"K\"\ndistribution = \"integer_uniform\"\nlow = 5\nhigh = 1").unwrap();
+        assert!(bad.to_parameter().is_err());
     }
 
     #[test]
@@ -209,7 +279,9 @@ mod tests {
         assert!(e.to_string().contains("unknown field `low`"), "{e}");
         assert!(e.to_string().contains("parameter 'K'"), "{e}");
         let e = parse("name = \"K\"\ndistribution = \"gamma\"\nmean = 1.0").unwrap_err();
-        assert!(e.to_string().contains("unknown variant `gamma`"), "{e}");
+        assert!(e.to_string().contains("unknown field `mean`"), "{e}");
+        let e = parse("name = \"K\"\ndistribution = \"cauchy\"\nmean = 1.0").unwrap_err();
+        assert!(e.to_string().contains("unknown variant `cauchy`"), "{e}");
         assert!(parse("mean = 1.0\nstd = 0.1").is_err());
         let both = parse("name = \"K\"\nmean = 1.0\nstd = 0.1\ncov = 0.1").unwrap();
         assert_eq!(both.to_parameter(), Err(InvalidParameter::BothSpreads));

@@ -9,6 +9,7 @@ use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::{Method, MethodSpec, Problem};
+use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// A validated study, ready to run.
 #[derive(Clone, Debug)]
@@ -33,6 +34,8 @@ pub struct Study {
     pub method: MethodSpec,
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
+    /// Their correlation (`[[correlation]]`), if any.
+    pub correlation: Option<Correlation>,
     /// Deterministic values.
     pub fixed: BTreeMap<String, FixedValue>,
     /// Time-varying inputs: the CSV file, resolved against the study's folder.
@@ -71,6 +74,14 @@ impl Study {
         self.method.method()
     }
 
+    /// The random inputs: parameters and correlation, as designs map to them.
+    pub fn random_inputs(&self) -> RandomInputs {
+        RandomInputs {
+            parameters: self.parameters.clone(),
+            correlation: self.correlation.clone(),
+        }
+    }
+
     /// The communication points (s).
     pub fn times(&self) -> Vec<f64> {
         self.experiment.times()
@@ -80,6 +91,7 @@ impl Study {
     pub fn problem<'a>(&'a self, times: &'a [f64]) -> Problem<'a> {
         Problem {
             parameters: &self.parameters,
+            correlation: self.correlation.as_ref(),
             outputs: &self.outputs,
             quantities: self.qoi.iter().map(|q| q.quantity_names().len()).sum(),
             times,

@@ -112,6 +112,64 @@ fn times_do_not_drift() {
 }
 
 #[test]
+fn correlations_are_checked_where_they_are_written() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let with = |extra: &str| format!("{base}\n{extra}");
+    let ok = Study::parse(
+        &with("[[correlation]]\nbetween = [\"K\", \"C\"]\nrho = 0.5"),
+        "t.toml",
+        None,
+    )
+    .unwrap();
+    let c = ok.correlation.as_ref().unwrap();
+    // Two normal inputs: the normal-space correlation is the requested one.
+    assert!((c.normal_correlation[(0, 1)] - 0.5).abs() < 1e-12);
+    assert_eq!(ok.random_inputs().correlation.as_ref(), Some(c));
+    for (extra, needle) in [
+        (
+            "[[correlation]]\nbetween = [\"K\", \"X\"]\nrho = 0.5",
+            "'X' is not a random parameter",
+        ),
+        (
+            "[[correlation]]\nbetween = [\"K\", \"C\"]\nrho = 1.5",
+            "strictly between -1 and 1",
+        ),
+        (
+            "[[correlation]]\nbetween = [\"K\", \"C\"]\nrho = 0.5\ncolour = 1",
+            "unknown field",
+        ),
+    ] {
+        let err = Study::parse(&with(extra), "t.toml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(needle), "{err} should mention {needle}");
+        assert!(err.starts_with("t.toml:"), "{err}");
+    }
+    // Three inputs whose pairwise correlations cannot coexist.
+    let three = base.replace(
+        "[outputs]",
+        "[[parameters]]\nname = \"m\"\nmean = 10.0\nstd = 1.0\n\n[outputs]",
+    );
+    let text = format!(
+        "{three}\n[[correlation]]\nbetween = [\"K\", \"C\"]\nrho = 0.9\n\
+         [[correlation]]\nbetween = [\"C\", \"m\"]\nrho = 0.9\n\
+         [[correlation]]\nbetween = [\"K\", \"m\"]\nrho = -0.9"
+    );
+    let err = Study::parse(&text, "t.toml", None).unwrap_err().to_string();
+    assert!(err.contains("not positive definite"), "{err}");
+    // SGM refuses correlated inputs.
+    let sgm = include_str!("../../studies/wheel-sgm.toml");
+    let err = Study::parse(
+        &format!("{sgm}\n[[correlation]]\nbetween = [\"K\", \"C\"]\nrho = 0.3"),
+        "t.toml",
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("independent Gaussian"), "{err}");
+}
+
+#[test]
 fn a_stop_time_off_the_grid_gets_a_shorter_last_step_not_an_error() {
     // Issue 13: stop − start not a whole number of steps was refused; fmpy ends with a
     // shorter step.

@@ -10,10 +10,12 @@ use nalgebra::DMatrix;
 use super::store::Record;
 use crate::qoi::scalar::Code;
 use crate::qoi::{kde, QoiSpec};
-use crate::results::{OutputStats, ScalarStats};
+use crate::results::{OutputStats, ScalarChaosError, ScalarStats, SobolSummary};
 use crate::spec::{Analysis, Study};
+use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
 use crate::uq::moments;
+use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
 const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
@@ -97,6 +99,8 @@ pub struct Settings<'a> {
     pub analysis: &'a Analysis,
     /// The study's seed.
     pub seed: u64,
+    /// The names of the random parameters, in study order (labels of Sobol' indices).
+    pub parameters: &'a [RandomParameter],
 }
 
 impl<'a> Settings<'a> {
@@ -105,6 +109,7 @@ impl<'a> Settings<'a> {
         Settings {
             analysis: &study.analysis,
             seed: study.seed,
+            parameters: &study.parameters,
         }
     }
 
@@ -184,11 +189,13 @@ pub fn output_stats(
         upper_3sigma,
         quantiles,
         std_pce: estimate.std_chaos.clone(),
+        std_error_mean: estimate.std_error_mean.clone(),
         sobol: estimate.sobol.clone(),
         pdf_times: picked.iter().map(|&k| times[k]).collect(),
         pdf_grid: grid,
         pdf,
         draws: estimate.draws,
+        chaos_error: estimate.chaos_error.clone(),
     })
 }
 
@@ -256,7 +263,19 @@ fn scalar_stats(
         density_samples,
         sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
         sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
+        sobol: estimate.sobol.as_ref().map(|s| {
+            let names: Vec<&str> = settings
+                .parameters
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect();
+            SobolSummary::of(s, 0, &names)
+        }),
         draws: estimate.draws,
+        chaos_error: estimate.chaos_error.as_ref().map(|e| ScalarChaosError {
+            kind: e.kind.name(),
+            value: e.values[0],
+        }),
     })
 }
 
@@ -307,14 +326,27 @@ impl<'a> Runs<'a> {
     }
 }
 
+/// What [`analyse_runs`] finds.
+#[derive(Clone, Debug)]
+pub struct Analysed {
+    /// Per output.
+    pub outputs: Vec<OutputStats>,
+    /// Per scalar quantity.
+    pub quantities: Vec<ScalarStats>,
+    /// The chaos of each output that has one (chaos methods).
+    pub output_chaos: Vec<NamedChaos>,
+    /// The chaos of each quantity that has one.
+    pub quantity_chaos: Vec<NamedChaos>,
+}
+
 /// Statistics of every output and quantity of a study whose points have all been run
-/// (`records` holds one record per point of `design`).
+/// (`records` holds one record per point of `design`), and the chaoses of a chaos method.
 pub fn analyse_runs(
     study: &Study,
     method: &dyn Sampling,
     design: &Design,
     records: &[Option<Record>],
-) -> Result<(Vec<OutputStats>, Vec<ScalarStats>), AnalysisError> {
+) -> Result<Analysed, AnalysisError> {
     let settings = Settings::of(study);
     let times = study.times();
     let nt = times.len();
@@ -325,6 +357,7 @@ pub fn analyse_runs(
         });
     }
     let mut outputs = Vec::new();
+    let mut output_chaos = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
         let data = runs.output(o, nt);
         let estimate = method
@@ -340,9 +373,18 @@ pub fn analyse_runs(
             Some(&data),
             &settings,
         )?);
+        if let Some(pce) = estimate.chaos {
+            output_chaos.push(NamedChaos {
+                name: name.clone(),
+                times: Some(times.clone()),
+                pce,
+                error: estimate.chaos_error,
+            });
+        }
     }
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
+    let mut quantity_chaos = Vec::new();
     let scalars = study
         .qoi
         .iter()
@@ -383,8 +425,21 @@ pub fn analyse_runs(
                 })
         })?;
         quantities.push(scalar_stats(&name, q.limits(), &estimate, qr, &settings)?);
+        if let Some(pce) = estimate.chaos {
+            quantity_chaos.push(NamedChaos {
+                name: name.clone(),
+                times: None,
+                pce,
+                error: estimate.chaos_error,
+            });
+        }
     }
-    Ok((outputs, quantities))
+    Ok(Analysed {
+        outputs,
+        quantities,
+        output_chaos,
+        quantity_chaos,
+    })
 }
 
 /// Statistics of every output of an intrusive method's solution.

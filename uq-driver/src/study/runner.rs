@@ -41,6 +41,8 @@ pub struct RunOptions {
     /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point; in-process
     /// the study stops with a message naming the point (an FMU call cannot be interrupted).
     pub timeout_per_run: Option<Duration>,
+    /// Start a large study without asking (`--yes`; see [`super::size`]).
+    pub yes: bool,
 }
 
 impl RunOptions {
@@ -178,6 +180,10 @@ pub fn study_hash(study: &Study) -> String {
             .map(|b| format!("{:x}", Sha256::digest(&b)))
             .unwrap_or_default();
         key["inputs"] = serde_json::json!(content);
+    }
+    // Likewise the correlation: studies without one keep their hash.
+    if let Some(c) = &study.correlation {
+        key["correlation"] = serde_json::json!(c.pairs);
     }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }

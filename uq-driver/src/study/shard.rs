@@ -112,7 +112,7 @@ fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
 
 /// The study's design.
 fn design(study: &Study) -> Result<Design, ShardError> {
-    let d = sampling(study)?.design(&study.parameters, study.seed);
+    let d = sampling(study)?.design(&study.random_inputs(), study.seed);
     Ok(d.map_err(RunError::from)?)
 }
 

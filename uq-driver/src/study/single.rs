@@ -8,6 +8,7 @@ use std::time::Instant;
 use super::analysis;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::size;
 use super::store::Record;
 use crate::fmu::Fmu;
 use crate::report::{self, ReportError, StudyReport};
@@ -15,7 +16,10 @@ use crate::results::{
     FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, ScalarStats, Summary, Versions,
 };
 use crate::spec::Study;
+use crate::uq::distributions::Germ;
 use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
+use crate::uq::random_inputs::RandomInputs;
+use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
 /// Runs a study that is not a suite.
 pub(crate) fn run_single(
@@ -31,7 +35,17 @@ pub(crate) fn run_single(
         Evaluation::Intrusive(method) => solve(study, method, out_dir),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
-            let design = method.design(&study.parameters, study.seed)?;
+            let design = method.design(&study.random_inputs(), study.seed)?;
+            if method.planned_runs(study.parameters.len()).is_none() {
+                // Only the design knew its size: check it before it runs.
+                size::check_runs(study, design.len(), opts)?;
+            }
+            eprintln!(
+                "{}: {} with {} model runs",
+                study.name,
+                study.method().label(study.parameters.len()),
+                design.len()
+            );
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
             finish(study, method, &fmu, &design, outcome, out_dir, opts)
         }
@@ -71,6 +85,7 @@ fn summary(
         seed: study.seed,
         experiment: study.experiment.clone(),
         parameters: study.parameters.clone(),
+        correlation: study.correlation.clone(),
         fixed: study.fixed.clone(),
         fmu: facts.fmu,
         model_runs: facts.model_runs,
@@ -111,7 +126,8 @@ pub(crate) fn finish(
             total: design.len(),
         });
     }
-    let (outputs, quantities) = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let analysed = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let (outputs, quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let facts = RunFacts {
         fmu: Some(FmuInfo {
@@ -137,6 +153,14 @@ pub(crate) fn finish(
         &outputs,
         &quantities,
     );
+    write_surrogate(
+        study,
+        design.germ,
+        &design.inputs,
+        &analysed.output_chaos,
+        &analysed.quantity_chaos,
+        out_dir,
+    )?;
     let points = point_table(study, design, &outcome.records);
     report::study::write(
         out_dir,
@@ -166,6 +190,27 @@ fn solve(
     let solution = method.solve(&study.problem(&times))?;
     let wall_time = started.elapsed().as_secs_f64();
     let outputs = analysis::analyse_solution(study, &solution)?;
+    let chaos: Vec<NamedChaos> = study
+        .outputs
+        .iter()
+        .zip(&solution.outputs)
+        .filter_map(|(name, e)| {
+            e.chaos.as_ref().map(|pce| NamedChaos {
+                name: name.clone(),
+                times: Some(times.clone()),
+                pce: pce.clone(),
+                error: e.chaos_error.clone(),
+            })
+        })
+        .collect();
+    write_surrogate(
+        study,
+        Germ::Normal,
+        &study.random_inputs(),
+        &chaos,
+        &[],
+        out_dir,
+    )?;
     let mut method_summary = study.method().summary(study.parameters.len());
     method_summary.details.extend(solution.details);
     let facts = RunFacts {
@@ -200,6 +245,32 @@ fn solve(
         outputs,
         quantities: Vec::new(),
     })
+}
+
+/// Writes `surrogate.json` when the method gave a chaos (and removes a stale one otherwise).
+fn write_surrogate(
+    study: &Study,
+    germ: Germ,
+    inputs: &RandomInputs,
+    outputs: &[NamedChaos],
+    quantities: &[NamedChaos],
+    out_dir: &Path,
+) -> Result<(), ReportError> {
+    let path = out_dir.join("surrogate.json");
+    if outputs.is_empty() && quantities.is_empty() {
+        let _ = std::fs::remove_file(&path);
+        return Ok(());
+    }
+    let file = SurrogateFile::new(
+        &study.name,
+        study.method().kind(),
+        germ,
+        inputs,
+        outputs,
+        quantities,
+    );
+    let text = serde_json::to_string(&file).expect("surrogates serialize");
+    std::fs::write(&path, text).map_err(|source| ReportError::Io { path, source })
 }
 
 /// The design with the status of each point.

@@ -1,19 +1,31 @@
 //! Probability distributions of uncertain inputs and their isoprobabilistic
-//! maps from the unit interval (sampling) and from the standard normal
-//! (collocation).
+//! maps from the unit interval (sampling), from the standard normal
+//! (collocation) and from the germs of the Askey scheme (polynomial chaos).
+//!
+//! One type, [`Distribution`], for every input family: normal, log-normal,
+//! uniform, truncated normal, Beta, Gamma, Weibull and the integer uniform.
+//! `functions.rs` holds the density, CDF, survival function and quantile of
+//! each, `maps.rs` the maps to and from the standard spaces ([`Germ`]),
+//! `shapes.rs` the numerics of the Beta, Gamma and Weibull shapes and
+//! `truncated.rs` those of the truncated normal.
 //!
 //! Tails are handled with complementary probabilities: for an upper-tail
 //! point, `1 - u` is carried explicitly instead of being recomputed from `u`,
 //! so that Gauss–Hermite nodes at 10 sigma still map to distinct,
 //! correctly ordered physical values.
 
+mod functions;
+mod maps;
+mod shapes;
+#[cfg(test)]
+mod shapes_tests;
 #[cfg(test)]
 mod tests;
 mod truncated;
 
 use serde::{Deserialize, Serialize};
 
-use crate::uq::special::{norm_cdf, norm_isf, norm_pdf, norm_ppf, norm_sf};
+pub use shapes::gamma_pq;
 use truncated::Trunc;
 
 /// Errors of the distribution constructors and of [`Distribution::validate`].
@@ -64,12 +76,23 @@ pub enum DistributionError {
     /// The mean or standard deviation of the distribution overflows.
     #[error("the mean or standard deviation of the distribution is not finite")]
     MomentsNotFinite,
+    /// Integer bounds out of order, or beyond the integers a double represents exactly.
+    #[error(
+        "integer_uniform needs low <= high, both within ±2^53 (got low = {low}, high = {high})"
+    )]
+    IntegerRange {
+        /// Smallest value.
+        low: i64,
+        /// Largest value.
+        high: i64,
+    },
 }
 
 /// A one-dimensional input distribution.
 ///
 /// Serialized with a `kind` tag, e.g. `{"kind": "normal", "mean": 1.0, "std": 0.1}`;
-/// the log-normal kind is `log_normal` (`lognormal` is accepted on input).
+/// the log-normal kind is `log_normal` (`lognormal` is accepted on input); the others are
+/// `uniform`, `truncated_normal`, `beta`, `gamma`, `weibull` and `integer_uniform`.
 /// Deserialization does not validate: call [`Distribution::validate`] on
 /// deserialized values (the constructors validate).
 /// Infinite truncation bounds are allowed but cannot be written as JSON
@@ -111,6 +134,41 @@ pub enum Distribution {
         low: f64,
         /// Upper bound (may be `+inf`, > low).
         high: f64,
+    },
+    /// Beta(alpha, beta) scaled to `[low, high]`: density proportional to
+    /// `u^(alpha-1) (1-u)^(beta-1)`, `u = (x - low) / (high - low)`.
+    Beta {
+        /// First shape (> 0).
+        alpha: f64,
+        /// Second shape (> 0).
+        beta: f64,
+        /// Lower end.
+        low: f64,
+        /// Upper end (> low).
+        high: f64,
+    },
+    /// Gamma: density `x^(shape-1) e^(-x/scale) / (Gamma(shape) scale^shape)` on `[0, inf)`
+    /// (mean `shape · scale`).
+    Gamma {
+        /// Shape `k` (> 0).
+        shape: f64,
+        /// Scale `theta` (> 0, units of the input).
+        scale: f64,
+    },
+    /// Weibull: CDF `1 - exp(-(x/scale)^shape)` on `[0, inf)`.
+    Weibull {
+        /// Shape `k` (> 0).
+        shape: f64,
+        /// Scale `lambda` (> 0, units of the input).
+        scale: f64,
+    },
+    /// Uniform on the integers `low..=high` (both included): a discrete input, for
+    /// sampling designs (MC, LHS, QMC); polynomial chaos methods refuse it.
+    IntegerUniform {
+        /// Smallest value.
+        low: i64,
+        /// Largest value.
+        high: i64,
     },
 }
 
@@ -187,6 +245,32 @@ impl Distribution {
         .checked()
     }
 
+    /// Beta(alpha, beta) on `[low, high]` (shapes finite and positive, finite `low < high`).
+    pub fn beta(alpha: f64, beta: f64, low: f64, high: f64) -> Result<Self, DistributionError> {
+        Distribution::Beta {
+            alpha,
+            beta,
+            low,
+            high,
+        }
+        .checked()
+    }
+
+    /// Gamma(shape, scale), both finite and positive.
+    pub fn gamma(shape: f64, scale: f64) -> Result<Self, DistributionError> {
+        Distribution::Gamma { shape, scale }.checked()
+    }
+
+    /// Weibull(shape, scale), both finite and positive.
+    pub fn weibull(shape: f64, scale: f64) -> Result<Self, DistributionError> {
+        Distribution::Weibull { shape, scale }.checked()
+    }
+
+    /// Uniform on the integers `low..=high` (`low <= high`, both within ±2^53).
+    pub fn integer_uniform(low: i64, high: i64) -> Result<Self, DistributionError> {
+        Distribution::IntegerUniform { low, high }.checked()
+    }
+
     /// `self` if its parameters are valid.
     fn checked(self) -> Result<Self, DistributionError> {
         self.validate()?;
@@ -233,6 +317,30 @@ impl Distribution {
                     });
                 }
             }
+            Distribution::Beta {
+                alpha,
+                beta,
+                low,
+                high,
+            } => {
+                positive("alpha", alpha)?;
+                positive("beta", beta)?;
+                finite("low", low)?;
+                finite("high", high)?;
+                if low >= high || !(high - low).is_finite() {
+                    return Err(DistributionError::EmptyInterval { low, high });
+                }
+            }
+            Distribution::Gamma { shape, scale } | Distribution::Weibull { shape, scale } => {
+                positive("shape", shape)?;
+                positive("scale", scale)?;
+            }
+            Distribution::IntegerUniform { low, high } => {
+                const EXACT: i64 = 1 << 53;
+                if low > high || low < -EXACT || high > EXACT {
+                    return Err(DistributionError::IntegerRange { low, high });
+                }
+            }
         }
         if !self.mean().is_finite() || !self.std().is_finite() {
             return Err(DistributionError::MomentsNotFinite);
@@ -246,232 +354,39 @@ impl Distribution {
         matches!(self, Distribution::Normal { .. })
     }
 
-    /// Support `(lower, upper)` (possibly infinite).
-    pub fn support(&self) -> (f64, f64) {
+    /// Whether the input takes discrete values (the integer uniform).
+    pub fn is_discrete(&self) -> bool {
+        matches!(self, Distribution::IntegerUniform { .. })
+    }
+
+    /// The value a deterministic run uses: the mean, or for a discrete input the value of
+    /// the support nearest to it (the lower one of two).
+    pub fn nominal(&self) -> f64 {
         match *self {
-            Distribution::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
-            Distribution::LogNormal { .. } => (0.0, f64::INFINITY),
-            Distribution::Uniform { low, high }
-            | Distribution::TruncatedNormal { low, high, .. } => (low, high),
-        }
-    }
-
-    /// Mean of the distribution.
-    pub fn mean(&self) -> f64 {
-        match *self {
-            Distribution::Normal { mean, .. } => mean,
-            Distribution::LogNormal { mu, sigma } => (mu + 0.5 * sigma * sigma).exp(),
-            Distribution::Uniform { low, high } => 0.5 * (low + high),
-            Distribution::TruncatedNormal {
-                mean,
-                std,
-                low,
-                high,
-            } => mean + std * Trunc::new(mean, std, low, high).moments().0,
-        }
-    }
-
-    /// Standard deviation of the distribution.
-    pub fn std(&self) -> f64 {
-        match *self {
-            Distribution::Normal { std, .. } => std,
-            Distribution::LogNormal { mu, sigma } => {
-                let s2 = sigma * sigma;
-                s2.exp_m1().sqrt() * (mu + 0.5 * s2).exp()
+            Distribution::IntegerUniform { low, high } => {
+                // floor((low + high) / 2) without overflow.
+                (low + (high - low) / 2) as f64
             }
-            Distribution::Uniform { low, high } => (high - low) / 12f64.sqrt(),
-            Distribution::TruncatedNormal {
-                mean,
-                std,
-                low,
-                high,
-            } => std * Trunc::new(mean, std, low, high).moments().1,
-        }
-    }
-
-    /// Probability density at `x`.
-    pub fn pdf(&self, x: f64) -> f64 {
-        if x.is_nan() {
-            return f64::NAN;
-        }
-        match *self {
-            Distribution::Normal { mean, std } => norm_pdf((x - mean) / std) / std,
-            Distribution::LogNormal { mu, sigma } => {
-                if x <= 0.0 || x.is_infinite() {
-                    0.0
-                } else {
-                    norm_pdf((x.ln() - mu) / sigma) / (sigma * x)
-                }
-            }
-            Distribution::Uniform { low, high } => {
-                if (low..=high).contains(&x) {
-                    1.0 / (high - low)
-                } else {
-                    0.0
-                }
-            }
-            Distribution::TruncatedNormal {
-                mean,
-                std,
-                low,
-                high,
-            } => {
-                if (low..=high).contains(&x) {
-                    let t = Trunc::new(mean, std, low, high);
-                    norm_pdf((x - mean) / std) / (std * t.mass)
-                } else {
-                    0.0
-                }
-            }
-        }
-    }
-
-    /// Cumulative distribution function `P(X <= x)`, accurate in relative
-    /// terms in the lower tail.
-    pub fn cdf(&self, x: f64) -> f64 {
-        self.tail(x, false)
-    }
-
-    /// Survival function `P(X > x)`, accurate in relative terms in the upper
-    /// tail (use it for small exceedance probabilities).
-    pub fn sf(&self, x: f64) -> f64 {
-        self.tail(x, true)
-    }
-
-    /// `P(X > x)` if `upper`, else `P(X <= x)`, each computed directly (not as one minus
-    /// the other).
-    fn tail(&self, x: f64, upper: bool) -> f64 {
-        if x.is_nan() {
-            return f64::NAN;
-        }
-        let phi = if upper { norm_sf } else { norm_cdf };
-        match *self {
-            Distribution::Normal { mean, std } => phi((x - mean) / std),
-            Distribution::LogNormal { mu, sigma } => {
-                if x <= 0.0 {
-                    f64::from(u8::from(upper))
-                } else {
-                    phi((x.ln() - mu) / sigma)
-                }
-            }
-            Distribution::Uniform { low, high } => {
-                let inside = if upper { high - x } else { x - low };
-                (inside / (high - low)).clamp(0.0, 1.0)
-            }
-            Distribution::TruncatedNormal {
-                mean,
-                std,
-                low,
-                high,
-            } => {
-                let t = Trunc::new(mean, std, low, high);
-                let z = (x - mean) / std;
-                if upper {
-                    t.sf(z)
-                } else {
-                    t.cdf(z)
-                }
-            }
-        }
-    }
-
-    /// Quantile (inverse CDF) at probability `u` in `[0, 1]` (NaN outside).
-    /// `u = 0` and `u = 1` give the ends of the support.
-    pub fn inverse_cdf(&self, u: f64) -> f64 {
-        if u.is_nan() || !(0.0..=1.0).contains(&u) {
-            return f64::NAN;
-        }
-        // 1 - u is exact for u >= 1/2, where it is used.
-        self.quantile(u, 1.0 - u)
-    }
-
-    /// Quantile from `u` and `v = 1 - u`, using whichever is accurate.
-    fn quantile(&self, u: f64, v: f64) -> f64 {
-        if u == 0.0 {
-            return self.support().0;
-        }
-        if v == 0.0 {
-            return self.support().1;
-        }
-        let z_of = |u: f64, v: f64| if u <= 0.5 { norm_ppf(u) } else { norm_isf(v) };
-        match *self {
-            Distribution::Normal { mean, std } => mean + std * z_of(u, v),
-            Distribution::LogNormal { mu, sigma } => (mu + sigma * z_of(u, v)).exp(),
-            Distribution::Uniform { low, high } => {
-                let x = if u <= 0.5 {
-                    low + u * (high - low)
-                } else {
-                    high - v * (high - low)
-                };
-                x.clamp(low, high)
-            }
-            Distribution::TruncatedNormal {
-                mean,
-                std,
-                low,
-                high,
-            } => {
-                let z = Trunc::new(mean, std, low, high).quantile(u, v);
-                (mean + std * z).clamp(low, high)
-            }
-        }
-    }
-
-    /// Isoprobabilistic map from the standard-normal germ `z` to this
-    /// distribution, `F^{-1}(Phi(z))`, as used by stochastic collocation.
-    ///
-    /// Normal: `mean + std z`; log-normal: `exp(mu + sigma z)` (both exact);
-    /// others through the quantile with `Phi(z)` and `1 - Phi(z) = Phi(-z)`
-    /// both computed in relative precision, so nodes far in either tail map
-    /// to distinct points inside the support.
-    pub fn from_standard_normal(&self, z: f64) -> f64 {
-        if z.is_nan() {
-            return f64::NAN;
-        }
-        match *self {
-            Distribution::Normal { mean, std } => mean + std * z,
-            Distribution::LogNormal { mu, sigma } => (mu + sigma * z).exp(),
-            _ => self.quantile(norm_cdf(z), norm_sf(z)),
-        }
-    }
-
-    /// The value of this input at the germ coordinate `x` of a design built in the
-    /// standard space `germ` (the isoprobabilistic map `F^{-1}(G(x))`, `G` the germ's CDF).
-    pub fn from_germ(&self, germ: Germ, x: f64) -> f64 {
-        match germ {
-            Germ::Normal => self.from_standard_normal(x),
-            Germ::Uniform => self.inverse_cdf(x),
-        }
-    }
-
-    /// The germ coordinate of `value` in the standard space `germ`, the inverse of
-    /// [`Distribution::from_germ`] (`G^{-1}(F(value))`); tails keep their relative precision.
-    pub fn to_germ(&self, germ: Germ, value: f64) -> f64 {
-        match (germ, self) {
-            (Germ::Uniform, _) => self.cdf(value),
-            (Germ::Normal, &Distribution::Normal { mean, std }) => (value - mean) / std,
-            (Germ::Normal, &Distribution::LogNormal { mu, sigma }) => (value.ln() - mu) / sigma,
-            (Germ::Normal, _) => {
-                let u = self.cdf(value);
-                if u <= 0.5 {
-                    norm_ppf(u)
-                } else {
-                    norm_isf(self.sf(value))
-                }
-            }
+            _ => self.mean(),
         }
     }
 }
 
-/// A standard space in which designs are built: independent germs, each mapped to its
-/// input by [`Distribution::from_germ`].
+/// A standard space in which designs are built: independent germs, one per input, each
+/// mapped to its input by [`Distribution::from_germ`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Germ {
-    /// Standard normal N(0, 1) (Gauss–Hermite rules, Hermite chaos).
+    /// Standard normal N(0, 1) for every input (Gauss–Hermite rules, Hermite chaos), each
+    /// input by its isoprobabilistic map `F^-1(Phi(z))`.
     Normal,
-    /// Uniform on (0, 1) (Monte Carlo and Latin hypercube designs).
+    /// Uniform on (0, 1) (Monte Carlo and Latin hypercube designs): `F^-1(u)`.
     Uniform,
+    /// Each input's own germ of the Askey scheme, mapped affinely
+    /// ([`Distribution::askey_affine`]): N(0, 1) for a normal input, U(-1, 1) for a uniform
+    /// one, Beta(alpha, beta) on [-1, 1] for a Beta input, Gamma(shape, 1) for a Gamma input;
+    /// inputs without an Askey family take N(0, 1) and the normal map, as for `Normal`.
+    Askey,
 }
 
 /// A named random input of a study (an FMU parameter).

@@ -1,6 +1,7 @@
 //! Tests of the distributions: constructors, moments, CDF/quantile round trips, tails.
 
 use super::*;
+use crate::uq::special::{norm_cdf, norm_pdf, norm_sf};
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * b.abs().max(1e-300)
@@ -15,6 +16,9 @@ fn all() -> Vec<Distribution> {
         Distribution::truncated_normal(0.0, 1.0, 0.0, f64::INFINITY).unwrap(),
         Distribution::truncated_normal(0.0, 1.0, f64::NEG_INFINITY, -4.0).unwrap(),
         Distribution::truncated_normal(10.0, 1.0, 9.7, 9.9).unwrap(),
+        Distribution::beta(2.0, 5.0, 1.0, 3.0).unwrap(),
+        Distribution::gamma(3.0, 0.7).unwrap(),
+        Distribution::weibull(1.5, 2.0).unwrap(),
     ]
 }
 
@@ -274,10 +278,15 @@ fn far_tail_nodes_map_inside_the_support_and_stay_ordered() {
 #[test]
 fn germ_maps_round_trip() {
     for d in all() {
-        for germ in [Germ::Normal, Germ::Uniform] {
-            let xs: &[f64] = match germ {
-                Germ::Normal => &[-3.0, -0.5, 0.0, 0.7, 3.0],
-                Germ::Uniform => &[1e-3, 0.3, 0.5, 0.9, 0.999],
+        for germ in [Germ::Normal, Germ::Uniform, Germ::Askey] {
+            let xs: &[f64] = match (germ, d.askey_affine()) {
+                (Germ::Uniform, _) => &[1e-3, 0.3, 0.5, 0.9, 0.999],
+                (Germ::Askey, Some(_)) => match d {
+                    Distribution::Normal { .. } => &[-3.0, -0.5, 0.0, 0.7, 3.0],
+                    Distribution::Gamma { .. } => &[0.01, 0.5, 2.0, 7.0],
+                    _ => &[-0.999, -0.3, 0.0, 0.4, 0.98],
+                },
+                _ => &[-3.0, -0.5, 0.0, 0.7, 3.0],
             };
             for &x in xs {
                 let v = d.from_germ(germ, x);
@@ -296,4 +305,50 @@ fn germ_maps_round_trip() {
         l.from_germ(Germ::Normal, -2.0),
         l.from_standard_normal(-2.0)
     );
+    // Askey germs are affine; inputs without an Askey family use the normal map.
+    let b = Distribution::beta(2.0, 3.0, 1.0, 5.0).unwrap();
+    assert_eq!(b.from_germ(Germ::Askey, -1.0), 1.0);
+    assert_eq!(b.from_germ(Germ::Askey, 0.5), 4.0);
+    assert_eq!(l.from_germ(Germ::Askey, 1.5), l.from_standard_normal(1.5));
+    let g = Distribution::gamma(2.5, 4.0).unwrap();
+    assert_eq!(g.from_germ(Germ::Askey, 0.25), 1.0);
+}
+
+#[test]
+fn normal_scores_of_every_germ_agree() {
+    // The standard-normal score of the same physical value, from any germ.
+    for d in all() {
+        let z: f64 = 0.8;
+        let x = d.from_standard_normal(z);
+        for germ in [Germ::Normal, Germ::Uniform, Germ::Askey] {
+            let t = d.to_germ(germ, x);
+            let s = d.normal_score(germ, t);
+            assert!((s - z).abs() < 1e-8, "{d:?} {germ:?}: {s}");
+        }
+    }
+}
+
+#[test]
+fn serde_of_the_new_families() {
+    for (d, text) in [
+        (
+            Distribution::beta(2.0, 5.0, 0.0, 1.0).unwrap(),
+            r#"{"kind":"beta","alpha":2.0,"beta":5.0,"low":0.0,"high":1.0}"#,
+        ),
+        (
+            Distribution::gamma(2.0, 3.0).unwrap(),
+            r#"{"kind":"gamma","shape":2.0,"scale":3.0}"#,
+        ),
+        (
+            Distribution::weibull(1.5, 3.0).unwrap(),
+            r#"{"kind":"weibull","shape":1.5,"scale":3.0}"#,
+        ),
+        (
+            Distribution::integer_uniform(1, 6).unwrap(),
+            r#"{"kind":"integer_uniform","low":1,"high":6}"#,
+        ),
+    ] {
+        assert_eq!(serde_json::to_string(&d).unwrap(), text);
+        assert_eq!(serde_json::from_str::<Distribution>(text).unwrap(), d);
+    }
 }

@@ -226,7 +226,8 @@ impl GalerkinSystem {
                 "force vectors must have {n} entries"
             )));
         }
-        let basis = MultiIndexSet::total_order(sys.n_germs, order);
+        let basis = MultiIndexSet::total_degree(sys.n_germs, order)
+            .map_err(|e| GalerkinError::Shape(e.to_string()))?;
         let p = basis.len();
         let g0 = germ_matrix(&basis, None);
         let gl: Vec<DMatrix<f64>> = (0..sys.n_germs)
@@ -399,12 +400,12 @@ impl GalerkinSystem {
         Ok(out)
     }
 
-    /// The chaos of one DOF's displacement over time, from [`GalerkinSystem::solve`] output.
+    /// The chaos of one DOF's displacement over time, from [`GalerkinSystem::solve`] output
+    /// (coefficients in the unnormalized basis `prod He_k`, rescaled by the exact norms to
+    /// the orthonormal Hermite chaos).
     pub fn pce(&self, coeffs: DMatrix<f64>) -> Pce {
-        Pce {
-            basis: self.basis.clone(),
-            coeffs,
-        }
+        Pce::from_hermite_he(self.basis.clone(), coeffs)
+            .expect("a Hermite basis of the set's own dimension, one row per term")
     }
 }
 

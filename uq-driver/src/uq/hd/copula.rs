@@ -16,10 +16,8 @@
 
 use nalgebra::{Cholesky, DMatrix, DVector};
 
-use super::askey::Family;
-use super::marginals::Marginal;
-use crate::uq::distributions::Distribution;
-use crate::uq::special::{norm_isf, norm_ppf};
+use crate::uq::distributions::{Distribution, Germ};
+use crate::uq::pce::askey::Family;
 
 /// Number of Gauss–Hermite nodes for the Mehler coefficients.
 const GH_NODES: usize = 160;
@@ -34,26 +32,12 @@ pub trait NormalMapped: Send + Sync {
     fn normal(&self, x: f64) -> f64;
 }
 
-impl NormalMapped for Marginal {
-    fn physical(&self, z: f64) -> f64 {
-        Marginal::from_standard_normal(self, z)
-    }
-    fn normal(&self, x: f64) -> f64 {
-        Marginal::to_standard_normal(self, x)
-    }
-}
-
 impl NormalMapped for Distribution {
     fn physical(&self, z: f64) -> f64 {
         Distribution::from_standard_normal(self, z)
     }
     fn normal(&self, x: f64) -> f64 {
-        let p = self.cdf(x);
-        if p <= 0.5 {
-            norm_ppf(p)
-        } else {
-            norm_isf(self.sf(x))
-        }
+        self.to_germ(Germ::Normal, x)
     }
 }
 
@@ -199,27 +183,16 @@ fn print_matrix(m: &DMatrix<f64>) -> String {
 }
 
 /// A Gaussian copula over given marginals.
+#[derive(Clone, Debug, PartialEq)]
 pub struct GaussianCopula {
-    marginals: Vec<Box<dyn NormalMapped>>,
+    marginals: Vec<Distribution>,
     normal_corr: DMatrix<f64>,
     chol: DMatrix<f64>,
 }
 
-impl std::fmt::Debug for GaussianCopula {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GaussianCopula")
-            .field("dim", &self.marginals.len())
-            .field("normal_corr", &self.normal_corr)
-            .finish()
-    }
-}
-
 impl GaussianCopula {
     /// The copula of `marginals` with requested Pearson correlation matrix `target`.
-    pub fn new(
-        marginals: Vec<Box<dyn NormalMapped>>,
-        target: &DMatrix<f64>,
-    ) -> Result<Self, CopulaError> {
+    pub fn new(marginals: Vec<Distribution>, target: &DMatrix<f64>) -> Result<Self, CopulaError> {
         let d = marginals.len();
         let bad = || CopulaError::NotACorrelation {
             dim: d,
@@ -256,7 +229,7 @@ impl GaussianCopula {
                 }
                 for k in [i, j] {
                     if me[k].is_none() {
-                        let m = mehler(marginals[k].as_ref(), &nodes);
+                        let m = mehler(&marginals[k], &nodes);
                         if !(m.sd > 0.0 && m.sd.is_finite()) {
                             return Err(CopulaError::Degenerate(k));
                         }
@@ -323,6 +296,7 @@ impl GaussianCopula {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::uq::distributions::Distribution as Marginal;
     use crate::uq::quadrature::gauss_hermite;
     use crate::uq::rng::{standard_normal, stream};
 
@@ -418,10 +392,10 @@ mod tests {
 
     #[test]
     fn draws_reproduce_the_target_correlation_within_its_standard_error() {
-        let margs: Vec<Box<dyn NormalMapped>> = vec![
-            Box::new(Marginal::gamma(2.0, 1.5).unwrap()),
-            Box::new(Marginal::beta(2.0, 5.0, 1.0, 2.0).unwrap()),
-            Box::new(Marginal::weibull(1.3, 2.0).unwrap()),
+        let margs = vec![
+            Marginal::gamma(2.0, 1.5).unwrap(),
+            Marginal::beta(2.0, 5.0, 1.0, 2.0).unwrap(),
+            Marginal::weibull(1.3, 2.0).unwrap(),
         ];
         let target =
             DMatrix::from_row_slice(3, 3, &[1.0, 0.5, -0.3, 0.5, 1.0, 0.2, -0.3, 0.2, 1.0]);
@@ -457,11 +431,7 @@ mod tests {
 
     #[test]
     fn bad_matrices_are_refused_with_the_matrix_named() {
-        let margs = || -> Vec<Box<dyn NormalMapped>> {
-            (0..3)
-                .map(|_| Box::new(Distribution::normal(0.0, 1.0).unwrap()) as Box<dyn NormalMapped>)
-                .collect()
-        };
+        let margs = || vec![Distribution::normal(0.0, 1.0).unwrap(); 3];
         let not_pd =
             DMatrix::from_row_slice(3, 3, &[1.0, 0.9, -0.9, 0.9, 1.0, 0.9, -0.9, 0.9, 1.0]);
         let err = GaussianCopula::new(margs(), &not_pd).unwrap_err();

@@ -246,6 +246,7 @@ pub fn omp_path(
 pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<f64> {
     let n = psi.nrows();
     let var = super::regression::sample_variance(y);
+    let negligible = super::regression::negligible_variance(y);
     let mut qs: Vec<DVector<f64>> = Vec::new();
     let mut rinv: Vec<Vec<f64>> = Vec::new(); // columns of R^-1 (upper triangular)
     let mut rcols: Vec<Vec<f64>> = Vec::new(); // columns of R
@@ -305,13 +306,7 @@ pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<
                 .sum::<f64>()
                 / n as f64;
             let t = n as f64 / (n - p) as f64 * (1.0 + tr);
-            if var > 0.0 {
-                t * loo / var
-            } else if loo == 0.0 {
-                0.0
-            } else {
-                f64::INFINITY
-            }
+            super::regression::relative(t * loo, var, negligible)
         } else {
             f64::INFINITY
         };
@@ -392,8 +387,8 @@ pub fn sparse_regression(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::hd::askey::Family;
-    use crate::uq::hd::basis::{Basis, MultiIndexSet};
+    use crate::uq::pce::askey::Family;
+    use crate::uq::pce::basis::{Basis, MultiIndexSet};
     use crate::uq::rng::{standard_normal, stream, uniform_open01};
 
     #[test]

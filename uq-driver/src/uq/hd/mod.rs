@@ -1,15 +1,11 @@
 //! High-dimensional UQ building blocks (issue 11): pure numerics, no FMU.
 //!
-//! One concept per module:
-//! - [`askey`]: orthonormal polynomial families of the Askey scheme (Hermite,
-//!   Legendre, Laguerre, Jacobi) by three-term recurrences, and their Gauss rules;
-//! - [`basis`]: multi-index sets (total degree, hyperbolic q-norm, downward closed)
-//!   and the multivariate orthonormal basis over them;
+//! One concept per module (the Askey families and the orthonormal bases over multi-index
+//! sets are in [`crate::uq::pce`]; the input families in [`crate::uq::distributions`]):
 //! - [`rules`]: nested and non-nested one-dimensional rules by level (Genz–Keister,
 //!   Clenshaw–Curtis, Gauss–Patterson, Gauss–Legendre, Gauss–Hermite);
 //! - [`smolyak`]: admissible level sets, combination coefficients, sparse grids;
 //! - [`pseudo_spectral`]: the sparse pseudo-spectral projection (Conrad & Marzouk 2013);
-//! - [`marginals`]: Beta, Gamma, Weibull and integer-uniform inputs with their germ maps;
 //! - [`copula`]: the Gaussian (Nataf) copula for correlated inputs;
 //! - [`sobol_seq`]: Sobol' points (Joe–Kuo direction numbers) with Owen scrambling;
 //! - [`regression`]: least squares with the closed-form leave-one-out error;
@@ -24,11 +20,8 @@
 //! Quadrature weights always sum to 1 (they integrate against the germ's probability
 //! measure) and polynomial bases are orthonormal for that measure.
 
-pub mod askey;
-pub mod basis;
 pub mod copula;
 pub mod lars;
-pub mod marginals;
 pub mod pseudo_spectral;
 pub mod regression;
 pub mod rules;

@@ -52,6 +52,9 @@ pub struct LeastSquaresFit {
     pub correction: f64,
     /// Empirical variance of the responses (denominator N - 1).
     pub response_var: f64,
+    /// A variance at or below this is rounding noise of constant responses
+    /// ([`negligible_variance`]).
+    pub negligible_var: f64,
     /// Leverages `h_i` (hat matrix diagonal).
     pub leverage: Vec<f64>,
 }
@@ -60,23 +63,36 @@ impl LeastSquaresFit {
     /// Relative LOO error `loo_mse / Var(y)` (infinite when `Var(y) = 0` and the
     /// error is not).
     pub fn relative_loo(&self) -> f64 {
-        relative(self.loo_mse, self.response_var)
+        relative(self.loo_mse, self.response_var, self.negligible_var)
     }
 
     /// Corrected relative LOO error `T(P, N) loo_mse / Var(y)`.
     pub fn corrected_relative_loo(&self) -> f64 {
-        relative(self.correction * self.loo_mse, self.response_var)
+        relative(
+            self.correction * self.loo_mse,
+            self.response_var,
+            self.negligible_var,
+        )
     }
 }
 
-fn relative(err: f64, var: f64) -> f64 {
-    if var > 0.0 {
+/// `err / var`; responses whose variance is rounding noise (`<= negligible`) count as
+/// constant: relative error 0 when `err` is noise too, infinite otherwise.
+pub(crate) fn relative(err: f64, var: f64, negligible: f64) -> f64 {
+    if var > negligible {
         err / var
-    } else if err == 0.0 {
+    } else if err <= negligible {
         0.0
     } else {
         f64::INFINITY
     }
+}
+
+/// The variance below which responses count as constant: `(64 eps max|y|)^2`, the rounding
+/// noise of values of that size.
+pub fn negligible_variance(y: &[f64]) -> f64 {
+    let m = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    (64.0 * f64::EPSILON * m).powi(2)
 }
 
 /// Empirical variance (denominator `N - 1`; 0 for fewer than 2 values).
@@ -91,67 +107,102 @@ pub fn sample_variance(y: &[f64]) -> f64 {
 
 /// Least-squares fit of `y` on the columns of `psi` with LOO errors.
 pub fn least_squares(psi: &DMatrix<f64>, y: &[f64]) -> Result<LeastSquaresFit, RegressionError> {
-    let (n, p) = psi.shape();
-    if y.len() != n {
-        return Err(RegressionError::Shape {
-            rows: n,
-            responses: y.len(),
-        });
-    }
-    if n < p || p == 0 {
-        return Err(RegressionError::Underdetermined {
-            samples: n,
-            terms: p,
-        });
-    }
-    let qr = psi.clone().qr();
-    let r = qr.r();
-    let rmax = (0..p).map(|k| r[(k, k)].abs()).fold(0.0, f64::max);
-    if let Some(column) = (0..p).find(|&k| r[(k, k)].abs() <= 1e-11 * rmax.max(f64::MIN_POSITIVE)) {
-        return Err(RegressionError::RankDeficient { column });
-    }
-    let q = qr.q();
-    let yv = DVector::from_column_slice(y);
-    let qty = q.transpose() * &yv;
-    let c = r
-        .solve_upper_triangular(&qty)
-        .ok_or(RegressionError::RankDeficient { column: 0 })?;
-    let fitted = psi * &c;
-    let leverage: Vec<f64> = (0..n).map(|i| q.row(i).norm_squared()).collect();
-    let loo_mse = (0..n)
-        .map(|i| {
-            let h = leverage[i];
-            let res = y[i] - fitted[i];
-            if h >= 1.0 - 1e-12 {
-                if res == 0.0 {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            } else {
-                (res / (1.0 - h)).powi(2)
-            }
+    LeastSquares::new(psi)?.fit(y)
+}
+
+/// The QR factorisation of a design, with what the LOO error needs (leverages and the
+/// correction factor): fits any number of responses on the same design, one factorisation.
+#[derive(Clone, Debug)]
+pub struct LeastSquares {
+    psi: DMatrix<f64>,
+    q: DMatrix<f64>,
+    r: DMatrix<f64>,
+    leverage: Vec<f64>,
+    correction: f64,
+}
+
+impl LeastSquares {
+    /// Factors `psi` (N rows, P columns): refused when `N < P` or the columns are
+    /// (numerically) dependent.
+    pub fn new(psi: &DMatrix<f64>) -> Result<LeastSquares, RegressionError> {
+        let (n, p) = psi.shape();
+        if n < p || p == 0 {
+            return Err(RegressionError::Underdetermined {
+                samples: n,
+                terms: p,
+            });
+        }
+        let qr = psi.clone().qr();
+        let r = qr.r();
+        let rmax = (0..p).map(|k| r[(k, k)].abs()).fold(0.0, f64::max);
+        if let Some(column) =
+            (0..p).find(|&k| r[(k, k)].abs() <= 1e-11 * rmax.max(f64::MIN_POSITIVE))
+        {
+            return Err(RegressionError::RankDeficient { column });
+        }
+        let q = qr.q();
+        let leverage: Vec<f64> = (0..n).map(|i| q.row(i).norm_squared()).collect();
+        // tr(C^-1) = N tr((Psi^T Psi)^-1) = N |R^-1|_F^2.
+        let correction = if n > p {
+            let rinv = r
+                .clone()
+                .try_inverse()
+                .ok_or(RegressionError::RankDeficient { column: 0 })?;
+            let tr = n as f64 * rinv.norm_squared();
+            n as f64 / (n - p) as f64 * (1.0 + tr / n as f64)
+        } else {
+            f64::INFINITY
+        };
+        Ok(LeastSquares {
+            psi: psi.clone(),
+            q,
+            r,
+            leverage,
+            correction,
         })
-        .sum::<f64>()
-        / n as f64;
-    // tr(C^-1) = N tr((Psi^T Psi)^-1) = N |R^-1|_F^2.
-    let correction = if n > p {
-        let rinv = r
-            .clone()
-            .try_inverse()
+    }
+
+    /// The fit of the response `y` (one value per row of the design).
+    pub fn fit(&self, y: &[f64]) -> Result<LeastSquaresFit, RegressionError> {
+        let n = self.psi.nrows();
+        if y.len() != n {
+            return Err(RegressionError::Shape {
+                rows: n,
+                responses: y.len(),
+            });
+        }
+        let yv = DVector::from_column_slice(y);
+        let qty = self.q.transpose() * &yv;
+        let c = self
+            .r
+            .solve_upper_triangular(&qty)
             .ok_or(RegressionError::RankDeficient { column: 0 })?;
-        let tr = n as f64 * rinv.norm_squared();
-        n as f64 / (n - p) as f64 * (1.0 + tr / n as f64)
-    } else {
-        f64::INFINITY
-    };
-    Ok(LeastSquaresFit {
-        coeffs: c.iter().copied().collect(),
-        loo_mse,
-        correction,
-        response_var: sample_variance(y),
-        leverage,
-    })
+        let fitted = &self.psi * &c;
+        let loo_mse = (0..n)
+            .map(|i| {
+                let h = self.leverage[i];
+                let res = y[i] - fitted[i];
+                if h >= 1.0 - 1e-12 {
+                    if res == 0.0 {
+                        0.0
+                    } else {
+                        f64::INFINITY
+                    }
+                } else {
+                    (res / (1.0 - h)).powi(2)
+                }
+            })
+            .sum::<f64>()
+            / n as f64;
+        Ok(LeastSquaresFit {
+            coeffs: c.iter().copied().collect(),
+            loo_mse,
+            correction: self.correction,
+            response_var: sample_variance(y),
+            negligible_var: negligible_variance(y),
+            leverage: self.leverage.clone(),
+        })
+    }
 }
 
 /// The sub-matrix of the given columns.

@@ -12,6 +12,7 @@
 //! | Gauss–Patterson | yes | 1, 3, 7, 15, 31, 63 | 1, 5, 11, 23, 47, 95 (`3 * 2^l - 1`) |
 //! | Gauss–Legendre | no | `l + 1` | `2l + 1` |
 //! | Gauss–Hermite | no | `l + 1` | `2l + 1` |
+//! | Gauss rule of an Askey family (Laguerre, Jacobi germs) | no | `l + 1` | `2l + 1` |
 //!
 //! Genz–Keister (J. Comput. Appl. Math. 71, 1996; generators 1+2+6+10+16) and
 //! Gauss–Patterson (Math. Comp. 22, 1968) rules are Kronrod–Patterson extensions:
@@ -32,7 +33,7 @@ use std::sync::OnceLock;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::askey::Family;
+use crate::uq::pce::askey::Family;
 
 /// Errors of the rule constructors.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -82,7 +83,7 @@ pub struct LevelInfo {
 }
 
 /// The one-dimensional rules available for sparse grids.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RuleKind {
     /// Nested rule for the N(0, 1) germ (Genz–Keister 1+2+6+10+16).
     GenzKeister,
@@ -94,6 +95,9 @@ pub enum RuleKind {
     GaussLegendre,
     /// Probabilists' Gauss–Hermite, `level + 1` points (not nested).
     GaussHermite,
+    /// The Gauss rule of an Askey family's germ (e.g. Gauss–Laguerre for a Gamma germ,
+    /// Gauss–Jacobi for a Beta germ), `level + 1` points (not nested).
+    Gauss(Family),
 }
 
 /// Genz–Keister points per level.
@@ -116,13 +120,19 @@ impl RuleKind {
             RuleKind::GaussPatterson => "Gauss-Patterson",
             RuleKind::GaussLegendre => "Gauss-Legendre",
             RuleKind::GaussHermite => "Gauss-Hermite",
+            RuleKind::Gauss(Family::Laguerre { .. }) => "Gauss-Laguerre",
+            RuleKind::Gauss(Family::Jacobi { .. }) => "Gauss-Jacobi",
+            RuleKind::Gauss(Family::Hermite) => "Gauss-Hermite",
+            RuleKind::Gauss(Family::Legendre) => "Gauss-Legendre",
         }
     }
 
-    /// The germ's orthonormal family: Hermite (normal germ) or Legendre (uniform germ).
+    /// The germ's orthonormal family: Hermite (normal germ), Legendre (uniform germ) or the
+    /// family of a [`RuleKind::Gauss`] rule.
     pub fn family(&self) -> Family {
         match self {
             RuleKind::GenzKeister | RuleKind::GaussHermite => Family::Hermite,
+            RuleKind::Gauss(f) => *f,
             _ => Family::Legendre,
         }
     }
@@ -141,7 +151,9 @@ impl RuleKind {
             RuleKind::GenzKeister => GK_POINTS.len() - 1,
             RuleKind::ClenshawCurtis => CC_MAX_LEVEL,
             RuleKind::GaussPatterson => GP_MAX_LEVEL,
-            RuleKind::GaussLegendre | RuleKind::GaussHermite => GAUSS_MAX_LEVEL,
+            RuleKind::GaussLegendre | RuleKind::GaussHermite | RuleKind::Gauss(_) => {
+                GAUSS_MAX_LEVEL
+            }
         }
     }
 
@@ -170,7 +182,7 @@ impl RuleKind {
                 }
             }
             RuleKind::GaussPatterson => (1 << (level + 1)) - 1,
-            RuleKind::GaussLegendre | RuleKind::GaussHermite => level + 1,
+            RuleKind::GaussLegendre | RuleKind::GaussHermite | RuleKind::Gauss(_) => level + 1,
         })
     }
 
@@ -187,7 +199,7 @@ impl RuleKind {
                     3 * (1 << level) - 1
                 }
             }
-            RuleKind::GaussLegendre | RuleKind::GaussHermite => 2 * level + 1,
+            RuleKind::GaussLegendre | RuleKind::GaussHermite | RuleKind::Gauss(_) => 2 * level + 1,
         })
     }
 
@@ -213,7 +225,7 @@ impl RuleKind {
                 nested_cache(&GP_CACHE, Family::Legendre, &pts)?[level].clone()
             }
             RuleKind::ClenshawCurtis => clenshaw_curtis(self.points(level)?),
-            RuleKind::GaussLegendre | RuleKind::GaussHermite => self
+            RuleKind::GaussLegendre | RuleKind::GaussHermite | RuleKind::Gauss(_) => self
                 .family()
                 .gauss(level + 1)
                 .map_err(|e| RuleError::Extension {

@@ -306,7 +306,7 @@ pub fn sparse_grid_size(rule: RuleKind, dim: usize, level: usize) -> Result<usiz
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::hd::askey::Family;
+    use crate::uq::pce::askey::Family;
     use std::collections::HashSet;
 
     /// Exact E[prod t_i^{m_i}] for the germ of each rule.

@@ -4,17 +4,18 @@
 //! leave-one-out error is kept (as UQLab and OpenTURNS do). Scanning stops after two
 //! degrees in a row without improvement.
 //!
-//! Points are given in germ space (see [`super::askey`]): one coordinate per input, in
+//! Points are given in germ space (see [`crate::uq::pce::askey`]): one coordinate per input, in
 //! the germ of that input's family.
 
 use std::ops::RangeInclusive;
 
 use nalgebra::DMatrix;
 
-use super::askey::Family;
-use super::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
 use super::lars::{sparse_regression, PathKind};
 use super::regression::{least_squares, RegressionError};
+use crate::uq::pce::askey::Family;
+use crate::uq::pce::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
+use crate::uq::pce::{Pce, PceError};
 
 /// Errors of the chaos fit.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -25,6 +26,9 @@ pub enum ChaosFitError {
     /// Every degree failed; the error of the lowest degree.
     #[error(transparent)]
     Regression(#[from] RegressionError),
+    /// The fitted coefficients do not match the basis.
+    #[error(transparent)]
+    Chaos(#[from] PceError),
     /// Empty degree range or no points.
     #[error("a chaos fit needs points and a non-empty degree range")]
     Empty,
@@ -42,10 +46,9 @@ pub enum FitKind {
 /// A fitted chaos.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChaosFit {
-    /// The selected basis (only the retained terms for a sparse fit).
-    pub basis: Basis,
-    /// Coefficients, one per basis term.
-    pub coeffs: Vec<f64>,
+    /// The chaos (one column), on the selected basis (only the retained terms for a sparse
+    /// fit).
+    pub pce: Pce,
     /// Corrected relative leave-one-out error of the selected model.
     pub loo: f64,
     /// Selected total degree.
@@ -57,14 +60,12 @@ pub struct ChaosFit {
 impl ChaosFit {
     /// Mean, variance and Sobol' indices.
     pub fn stats(&self) -> ChaosStats {
-        ChaosStats::new(self.basis.set(), &self.coeffs)
+        self.pce.stats(0)
     }
 
     /// Evaluates the chaos at a germ point.
     pub fn eval(&self, t: &[f64]) -> f64 {
-        let mut v = vec![0.0; self.basis.len()];
-        self.basis.eval(t, &mut v);
-        v.iter().zip(&self.coeffs).map(|(a, b)| a * b).sum()
+        self.pce.eval_column(0, t)
     }
 }
 
@@ -77,64 +78,101 @@ pub fn fit_chaos(
     q: f64,
     kind: FitKind,
 ) -> Result<ChaosFit, ChaosFitError> {
-    if points.is_empty() || degrees.is_empty() {
-        return Err(ChaosFitError::Empty);
+    Candidates::new(families, points, degrees, q)?.fit(y, kind)
+}
+
+/// The candidate bases of a degree-adaptive fit with their design matrices, built once for
+/// any number of responses at the same points.
+#[derive(Clone, Debug)]
+pub struct Candidates {
+    /// `(degree, basis, design matrix)` by increasing degree.
+    levels: Vec<(usize, Basis, DMatrix<f64>)>,
+    families: Vec<Family>,
+}
+
+impl Candidates {
+    /// The hyperbolic (q-norm) bases of every degree in `degrees` at `points`.
+    pub fn new(
+        families: &[Family],
+        points: &[Vec<f64>],
+        degrees: RangeInclusive<usize>,
+        q: f64,
+    ) -> Result<Candidates, ChaosFitError> {
+        if points.is_empty() || degrees.is_empty() {
+            return Err(ChaosFitError::Empty);
+        }
+        let d = families.len();
+        let levels = degrees
+            .map(|p| {
+                let set = MultiIndexSet::hyperbolic(d, p, q)?;
+                let basis = Basis::new(families.to_vec(), set)?;
+                let psi = basis.design_matrix(points);
+                Ok((p, basis, psi))
+            })
+            .collect::<Result<_, ChaosFitError>>()?;
+        Ok(Candidates {
+            levels,
+            families: families.to_vec(),
+        })
     }
-    let d = families.len();
-    let mut best: Option<ChaosFit> = None;
-    let mut tried = Vec::new();
-    let mut first_err = None;
-    let mut worse = 0;
-    for p in degrees {
-        let set = MultiIndexSet::hyperbolic(d, p, q)?;
-        let basis = Basis::new(families.to_vec(), set)?;
-        let psi: DMatrix<f64> = basis.design_matrix(points);
-        let result = match kind {
-            FitKind::Full => least_squares(&psi, y).map(|f| {
-                let loo = f.corrected_relative_loo();
-                (basis.clone(), f.coeffs, loo)
-            }),
-            FitKind::Sparse(path) => sparse_regression(&psi, y, Some(0), path).map(|f| {
-                let loo = f.fit.corrected_relative_loo();
-                let sub = basis.set().select(&f.columns).expect("distinct columns");
-                let b = Basis::new(families.to_vec(), sub).expect("same families");
-                (b, f.fit.coeffs, loo)
-            }),
-        };
-        let (b, coeffs, loo) = match result {
-            Ok(r) => r,
-            Err(e) => {
-                first_err.get_or_insert(e);
-                break;
-            }
-        };
-        tried.push((p, loo));
-        let improves = match &best {
-            None => true,
-            Some(b) => loo < b.loo,
-        };
-        if improves {
-            best = Some(ChaosFit {
-                basis: b,
-                coeffs,
-                loo,
-                degree: p,
-                tried: vec![],
-            });
-            worse = 0;
-        } else {
-            worse += 1;
-            if worse >= 2 {
-                break;
+
+    /// Fits `y` (one value per point): each degree in turn, keeping the smallest corrected
+    /// relative LOO error; stops after two degrees in a row without improvement, or at the
+    /// first degree a full fit cannot determine (the error of the first degree is returned
+    /// when none fits).
+    pub fn fit(&self, y: &[f64], kind: FitKind) -> Result<ChaosFit, ChaosFitError> {
+        let mut best: Option<ChaosFit> = None;
+        let mut tried = Vec::new();
+        let mut first_err = None;
+        let mut worse = 0;
+        for (p, basis, psi) in &self.levels {
+            let result = match kind {
+                FitKind::Full => least_squares(psi, y).map(|f| {
+                    let loo = f.corrected_relative_loo();
+                    (basis.clone(), f.coeffs, loo)
+                }),
+                FitKind::Sparse(path) => sparse_regression(psi, y, Some(0), path).map(|f| {
+                    let loo = f.fit.corrected_relative_loo();
+                    let sub = basis.set().select(&f.columns).expect("distinct columns");
+                    let b = Basis::new(self.families.clone(), sub).expect("same families");
+                    (b, f.fit.coeffs, loo)
+                }),
+            };
+            let (b, coeffs, loo) = match result {
+                Ok(r) => r,
+                Err(e) => {
+                    first_err.get_or_insert(e);
+                    break;
+                }
+            };
+            tried.push((*p, loo));
+            let improves = match &best {
+                None => true,
+                Some(b) => loo < b.loo,
+            };
+            if improves {
+                let n = coeffs.len();
+                best = Some(ChaosFit {
+                    pce: Pce::new(b, DMatrix::from_vec(n, 1, coeffs))?,
+                    loo,
+                    degree: *p,
+                    tried: vec![],
+                });
+                worse = 0;
+            } else {
+                worse += 1;
+                if worse >= 2 {
+                    break;
+                }
             }
         }
-    }
-    match best {
-        Some(mut b) => {
-            b.tried = tried;
-            Ok(b)
+        match best {
+            Some(mut b) => {
+                b.tried = tried;
+                Ok(b)
+            }
+            None => Err(first_err.map_or(ChaosFitError::Empty, ChaosFitError::Regression)),
         }
-        None => Err(first_err.map_or(ChaosFitError::Empty, ChaosFitError::Regression)),
     }
 }
 

@@ -4,12 +4,14 @@
 use serde::Serialize;
 
 use super::error::MethodError;
-use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::distributions::Germ;
+use crate::uq::pce::Family;
+use crate::uq::random_inputs::RandomInputs;
 
 /// Where a [`Sampling`](super::Sampling) method runs the model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Design {
-    /// The standard space of `points`.
+    /// The (independent) standard space of `points`.
     pub germ: Germ,
     /// Coordinates of each point in the standard space, one per random parameter.
     pub points: Vec<Vec<f64>>,
@@ -20,36 +22,48 @@ pub struct Design {
     pub weights: Option<Vec<f64>>,
     /// Notes for the user (e.g. points where a Gaussian stiffness is negative).
     pub warnings: Vec<String>,
+    /// The inputs `points` are mapped to ([`RandomInputs::to_physical`]): marginals and copula.
+    pub inputs: RandomInputs,
 }
 
 impl Design {
-    /// A design whose values are the images of `points` under each parameter's
-    /// isoprobabilistic map from `germ` ([`Distribution::from_germ`](crate::uq::Distribution::from_germ)),
-    /// with a warning per parameter that reaches non-positive values although its mean is positive.
+    /// A design whose values are the images of `points` under the inputs' map from `germ`
+    /// ([`RandomInputs::to_physical`]: each input's isoprobabilistic map, correlated through the
+    /// copula where the study correlates inputs), with a warning per parameter that reaches
+    /// non-positive values although its mean is positive.
     pub fn mapped(
         germ: Germ,
         points: Vec<Vec<f64>>,
         weights: Option<Vec<f64>>,
-        parameters: &[RandomParameter],
+        inputs: &RandomInputs,
     ) -> Design {
-        let values = points
-            .iter()
-            .map(|g| {
-                g.iter()
-                    .zip(parameters)
-                    .map(|(&x, p)| p.distribution.from_germ(germ, x))
-                    .collect()
-            })
-            .collect();
+        let values = points.iter().map(|t| inputs.to_physical(germ, t)).collect();
         let mut design = Design {
             germ,
             points,
             values,
             weights,
             warnings: Vec::new(),
+            inputs: inputs.clone(),
         };
-        design.warnings = design.sign_warnings(parameters);
+        design.warnings = design.sign_warnings();
         design
+    }
+
+    /// The orthonormal family of each coordinate of the standard space (Hermite for a
+    /// normal germ, the input's Askey family or Hermite for Askey germs); `None` for the
+    /// unit cube of sampling designs.
+    pub fn families(&self) -> Option<Vec<Family>> {
+        match self.germ {
+            Germ::Normal => Some(vec![Family::Hermite; self.inputs.len()]),
+            Germ::Askey => Some(
+                self.inputs
+                    .iter()
+                    .map(|p| Family::of(&p.distribution).unwrap_or(Family::Hermite))
+                    .collect(),
+            ),
+            Germ::Uniform => None,
+        }
     }
 
     /// Number of points.
@@ -81,9 +95,9 @@ impl Design {
 
     /// One warning per positive-mean parameter that some points set to a value <= 0, with the
     /// probability weight of those points.
-    fn sign_warnings(&self, parameters: &[RandomParameter]) -> Vec<String> {
+    fn sign_warnings(&self) -> Vec<String> {
         let mut warnings = Vec::new();
-        for (j, p) in parameters.iter().enumerate() {
+        for (j, p) in self.inputs.iter().enumerate() {
             if p.distribution.mean() <= 0.0 {
                 continue;
             }
@@ -113,14 +127,14 @@ impl Design {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::Distribution;
+    use crate::uq::{Distribution, RandomParameter};
 
     #[test]
     fn negative_values_of_a_positive_parameter_are_reported_with_their_weight() {
-        let params = [RandomParameter {
+        let params = RandomInputs::independent(vec![RandomParameter {
             name: "k".into(),
             distribution: Distribution::normal(1.0, 1.0).unwrap(),
-        }];
+        }]);
         // z = -2 maps to k = -1; weight 0.25.
         let d = Design::mapped(
             Germ::Normal,

@@ -31,6 +31,7 @@
 //! - a nested study: the product of an outer and an inner design, and for every outer sample
 //!   the inner method's own [`Sampling::estimate`] on that sample's rows.
 
+mod chaos;
 mod design;
 mod error;
 mod estimate;
@@ -39,9 +40,10 @@ mod traits;
 
 use serde::{Deserialize, Serialize};
 
+pub use chaos::ChaosBasis;
 pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
-pub use estimate::{Draws, Estimate, Sobol};
+pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
     details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
 };
@@ -76,9 +78,24 @@ macro_rules! methods {
 methods! {
     mc::Mc,
     lhs::Lhs,
+    qmc::Qmc,
+    sobol_sampling::SobolSampling,
     scm::Scm,
     sgm::Sgm,
     nominal::Nominal,
+    sparse_grid::SparseGrid,
+    pce_regression::PceRegression,
+}
+
+impl MethodSpec {
+    /// Resolves the files a method's settings name (e.g. a points file) against `base`,
+    /// the study file's folder, and records what must enter the study's hash.
+    pub fn resolve_files(&mut self, base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
+        match self {
+            MethodSpec::PceRegression(m) => m.resolve_points(base),
+            _ => Ok(()),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -87,6 +104,7 @@ mod tests {
 
     use super::*;
     use crate::uq::distributions::RandomParameter;
+    use crate::uq::random_inputs::RandomInputs;
 
     #[test]
     fn kinds_are_the_snake_case_variant_names() {
@@ -94,9 +112,17 @@ mod tests {
         for (text, kind) in [
             ("kind = \"mc\"\nsamples = 10", "mc"),
             ("kind = \"lhs\"\nsamples = 10", "lhs"),
+            ("kind = \"lhs\"\nsamples = 10\nreplicates = 4", "lhs"),
+            ("kind = \"qmc\"\nsamples = 16", "qmc"),
+            ("kind = \"sobol_sampling\"\nsamples = 16", "sobol_sampling"),
             ("kind = \"scm\"\nnodes = 3", "scm"),
             ("kind = \"sgm\"\norder = 2", "sgm"),
             ("kind = \"nominal\"", "nominal"),
+            ("kind = \"sparse_grid\"\nlevel = 2", "sparse_grid"),
+            (
+                "kind = \"pce_regression\"\nsamples = 10\norder = 2",
+                "pce_regression",
+            ),
         ] {
             let m = toml_kind(text);
             assert_eq!(m.method().kind(), kind);
@@ -113,6 +139,8 @@ mod tests {
             "kind = \"scm\"\nsamples = 10\nnodes = 3",
             "kind = \"nominal\"\norder = 1",
             "kind = \"mc\"",
+            "kind = \"mc\"\nsamples = 10\nreplicates = 4",
+            "kind = \"qmc\"\nnodes = 3",
         ] {
             let r: Result<MethodSpec, _> = toml::from_str(text);
             assert!(r.is_err(), "{text}");
@@ -125,7 +153,7 @@ mod tests {
     #[test]
     fn every_sampling_method_estimates_the_analytic_fixture() {
         let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
-        let params = [
+        let params = RandomInputs::independent(vec![
             RandomParameter {
                 name: "K".into(),
                 distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
@@ -134,7 +162,7 @@ mod tests {
                 name: "C".into(),
                 distribution: crate::uq::Distribution::normal(b, t).unwrap(),
             },
-        ];
+        ]);
         let f = |v: &[f64]| v[0] + v[0] * v[1] + v[1] * v[1];
         let mean = a + a * b + b * b + t * t;
         let parts = [
@@ -146,8 +174,14 @@ mod tests {
         for text in [
             "kind = \"mc\"\nsamples = 20000",
             "kind = \"lhs\"\nsamples = 20000",
+            "kind = \"lhs\"\nsamples = 2000\nreplicates = 10",
+            "kind = \"qmc\"\nsamples = 4096\nreplicates = 8",
+            "kind = \"sobol_sampling\"\nsamples = 8192",
             "kind = \"scm\"\nnodes = 3",
             "kind = \"nominal\"",
+            "kind = \"sparse_grid\"\nlevel = 2",
+            "kind = \"pce_regression\"\nsamples = 20\norder = 2",
+            "kind = \"pce_regression\"\nsamples = 20\norder = 4\nsparse = true\ndesign = \"qmc\"",
         ] {
             let spec: MethodSpec = toml::from_str(text).unwrap();
             let Evaluation::Sampling(m) = spec.method().evaluation() else {
@@ -174,9 +208,42 @@ mod tests {
                     assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-12);
                     assert_eq!(e.draws, Draws::Chaos);
                 }
+                "sobol_sampling" => {
+                    // Pick-freeze indices of the same fixture, within sampling error.
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][0] - parts[0] / var).abs() < 0.03);
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 0.03);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 0.03);
+                    assert!(sobol.intervals.is_some());
+                    assert!((e.mean[0] - mean).abs() < 4.0 * e.std_error_mean.unwrap()[0]);
+                    assert!((e.std[0] / var.sqrt() - 1.0).abs() < 0.03);
+                }
+                kind @ ("sparse_grid" | "pce_regression") => {
+                    // A polynomial of degree 2 in the chaos space: exact, with a vanishing
+                    // error estimate.
+                    assert!((e.mean[0] - mean).abs() < 1e-11, "{text}: {}", e.mean[0]);
+                    assert!(
+                        (e.std[0] - var.sqrt()).abs() < 1e-11,
+                        "{text}: {}",
+                        e.std[0]
+                    );
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 1e-11);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-11);
+                    let err = e.chaos_error.unwrap().values[0];
+                    if kind == "sparse_grid" {
+                        // Level 1 misses exactly the K C interaction: its variance share.
+                        assert!((err - parts[2] / var).abs() < 1e-12, "{err}");
+                    } else {
+                        assert!(err < 1e-20, "{text}: {err}");
+                    }
+                    assert_eq!(e.draws, Draws::Chaos);
+                }
                 kind => {
                     let se = e.std_error_mean.as_ref().unwrap()[0];
-                    assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    if !text.contains("replicates") {
+                        assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    }
                     assert!((e.mean[0] - mean).abs() < 4.0 * se, "{kind}: {}", e.mean[0]);
                     assert!(
                         (e.std[0] / var.sqrt() - 1.0).abs() < 0.03,
@@ -195,10 +262,10 @@ mod tests {
         let Evaluation::Sampling(m) = spec.method().evaluation() else {
             panic!("scm runs a design");
         };
-        let params = [RandomParameter {
+        let params = RandomInputs::independent(vec![RandomParameter {
             name: "K".into(),
             distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
-        }];
+        }]);
         let design = m.design(&params, 0).unwrap();
         let data = DMatrix::from_element(1, 3, 1.0);
         let e = m.estimate(&design, &[1], &data).unwrap_err();

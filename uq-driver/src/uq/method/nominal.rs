@@ -7,7 +7,8 @@ use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::distributions::Germ;
+use crate::uq::random_inputs::RandomInputs;
 
 /// `kind = "nominal"` (no settings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -42,14 +43,16 @@ impl Method for Nominal {
 }
 
 impl Sampling for Nominal {
-    /// One point of weight 1 at the parameters' means.
-    fn design(&self, parameters: &[RandomParameter], _seed: u64) -> Result<Design, MethodError> {
+    /// One point of weight 1 at the parameters' means (a discrete input at the value of
+    /// its support nearest to its mean, [`crate::uq::Distribution::nominal`]).
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         Ok(Design {
             germ: Germ::Normal,
-            points: vec![vec![0.0; parameters.len()]],
-            values: vec![parameters.iter().map(|p| p.distribution.mean()).collect()],
+            points: vec![vec![0.0; inputs.len()]],
+            values: vec![inputs.iter().map(|p| p.distribution.nominal()).collect()],
             weights: Some(vec![1.0]),
             warnings: Vec::new(),
+            inputs: inputs.clone(),
         })
     }
 
@@ -68,5 +71,13 @@ impl Sampling for Nominal {
 
     fn min_runs(&self) -> usize {
         1
+    }
+
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn draws_from_chaos(&self) -> bool {
+        false
     }
 }

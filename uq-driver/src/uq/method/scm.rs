@@ -6,12 +6,14 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use super::chaos::{continuous_inputs, order_difference};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::{Germ, RandomParameter};
-use crate::uq::pce::{MultiIndexSet, Pce};
+use crate::uq::distributions::Germ;
+use crate::uq::random_inputs::RandomInputs;
+use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
 
 /// Most nodes per dimension.
@@ -60,10 +62,14 @@ impl Method for Scm {
                  the quadrature cannot integrate the basis norms exactly otherwise"
             )));
         }
+        continuous_inputs(problem, "scm")?;
         let dim = problem.parameters.len();
         if (nodes as f64).powi(dim as i32) > MAX_POINTS {
             return Err(InvalidSettings(format!(
-                "tensor grid of {nodes}^{dim} points is too large"
+                "tensor grid of {nodes}^{dim} = {:.3e} points is too large (at most {MAX_POINTS:.0e}); \
+                 in {dim} dimensions use `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`, \
+                 which need far fewer runs",
+                (nodes as f64).powi(dim as i32)
             )));
         }
         Ok(())
@@ -85,14 +91,18 @@ impl Method for Scm {
 
 impl Sampling for Scm {
     /// The tensor grid, last parameter varying fastest; weights sum to one.
-    fn design(&self, parameters: &[RandomParameter], _seed: u64) -> Result<Design, MethodError> {
-        let grid = quadrature::tensor_grid(&vec![self.nodes; parameters.len()])?;
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        let grid = quadrature::tensor_grid(&vec![self.nodes; inputs.len()])?;
         Ok(Design::mapped(
             Germ::Normal,
             grid.points,
             Some(grid.weights),
-            parameters,
+            inputs,
         ))
+    }
+
+    fn planned_runs(&self, dim: usize) -> Option<f64> {
+        Some((self.nodes as f64).powi(dim as i32))
     }
 
     /// Needs every node: a missing weighted node would bias every moment.
@@ -104,7 +114,8 @@ impl Sampling for Scm {
     ) -> Result<Estimate, MethodError> {
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
-        let basis = MultiIndexSet::total_order(dim, self.order());
+        let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
+        let basis = Basis::new(vec![Family::Hermite; dim], set).map_err(PceError::from)?;
         let pce = Pce::project(
             basis,
             &design.points,
@@ -114,6 +125,7 @@ impl Sampling for Scm {
         )?;
         let mut estimate = Estimate::from_quadrature(data, weights);
         estimate.std_chaos = Some(pce.std());
+        estimate.chaos_error = order_difference(&pce);
         estimate.sobol = Some(Sobol::from_chaos(&pce));
         estimate.chaos = Some(pce);
         estimate.draws = Draws::Chaos;

@@ -69,6 +69,13 @@ impl Method for Sgm {
                 p.name
             )));
         }
+        if problem.correlation.is_some() {
+            return Err(InvalidSettings(
+                "SGM needs independent Gaussian parameters; this study correlates some \
+                 ([[correlation]]): use scm, sparse_grid or pce_regression"
+                    .into(),
+            ));
+        }
         let sys = system(problem)?;
         linear_system(sys, problem.parameters)?;
         output_dofs(sys, problem.outputs)?;

@@ -9,12 +9,15 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
+use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// What a method knows of the study it belongs to.
 #[derive(Clone, Copy, Debug)]
 pub struct Problem<'a> {
     /// The random parameters, in study order.
     pub parameters: &'a [RandomParameter],
+    /// Their correlation, if the study correlates some.
+    pub correlation: Option<&'a Correlation>,
     /// The output variables analysed over time.
     pub outputs: &'a [String],
     /// Number of scalar quantities of interest.
@@ -93,8 +96,10 @@ pub trait Method: std::fmt::Debug + Send + Sync {
 
 /// A method that runs the model at the points of a design.
 pub trait Sampling {
-    /// The design for `parameters` (deterministic in `seed`).
-    fn design(&self, parameters: &[RandomParameter], seed: u64) -> Result<Design, MethodError>;
+    /// The design for `inputs` (deterministic in `seed`): points in an independent standard
+    /// space mapped to physical values by [`Design::mapped`], which honours the inputs'
+    /// correlation.
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError>;
 
     /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
     /// the points that gave a value; one column per time step or quantity).
@@ -108,6 +113,21 @@ pub trait Sampling {
     /// The fewest successful runs the estimator can work with.
     fn min_runs(&self) -> usize {
         2
+    }
+
+    /// The number of model runs of the design for `dim` random parameters, computed without
+    /// building it (as a float: it may be far beyond any integer type), or `None` when only
+    /// the design knows. The study checks it before anything is allocated (`study::size`):
+    /// every method should give it.
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        None
+    }
+
+    /// Whether the estimates may draw their quantiles and densities from a chaos surrogate
+    /// (`[analysis] surrogate_samples` draws of every output time): counted in the memory
+    /// estimate of `study::size`. `true` unless the method never builds a chaos.
+    fn draws_from_chaos(&self) -> bool {
+        true
     }
 }
 

@@ -1,27 +1,36 @@
-//! Probabilists' Hermite polynomial chaos in independent standard-normal
-//! germs `z = (z_1, ..., z_d)`.
+//! Polynomial chaos in independent germs, one orthonormal family of the Askey scheme per
+//! dimension: the chaos type of every method (SCM, SGM, sparse grids, regression).
 //!
-//! Basis: `Psi_k(z) = prod_i He_{k_i}(z_i)` with the probabilists' Hermite
-//! polynomials `He_{n+1}(x) = x He_n(x) - n He_{n-1}(x)`, orthogonal with
-//! `E[He_m He_n] = n! delta_mn`, so `||Psi_k||^2 = prod_i k_i!`.
+//! - [`askey`]: the families (Hermite, Legendre, Laguerre, Jacobi) by three-term
+//!   recurrences, their Gauss rules and the family of each input distribution;
+//! - [`basis`]: multi-index sets (total degree, hyperbolic) and the multivariate basis
+//!   `Psi_k(t) = prod_i p^(i)_{k_i}(t_i)` over them, orthonormal for the product germ law;
+//! - [`hermite`]: probabilists' Hermite polynomials `He_n` with their exact norms `n!` and
+//!   triple products (the stochastic Galerkin method assembles in that basis and hands its
+//!   chaos over through [`Pce::from_hermite_he`]).
 //!
-//! The coefficients are computed by pseudo-spectral projection on a
-//! Gauss–Hermite tensor grid, always dividing by these EXACT norms. Dividing
-//! by norms computed with the same quadrature is a known trap: with `n` nodes
-//! a degree-`n` polynomial vanishes at every node, its quadrature norm is
-//! rounding noise (~1e-14) and the coefficient explodes. [`Pce::project`]
-//! therefore refuses bases whose degree in some dimension is not below the
-//! number of nodes in that dimension.
+//! A [`Pce`] holds one basis and one column of coefficients per output (e.g. per time
+//! step). The basis is orthonormal, so the mean is the constant coefficient, the variance
+//! the sum of the other squared coefficients and the Sobol' indices sums of squares over
+//! index subsets. The norms are exact by construction (the recurrences have exact
+//! coefficients): the projection never divides by norms computed with the quadrature it
+//! projects with — a known trap, since with `n` nodes a degree-`n` polynomial vanishes at
+//! every node and its quadrature norm is rounding noise. [`Pce::project`] refuses bases
+//! whose degree in some dimension is not below the number of nodes there.
 
+pub mod askey;
+pub mod basis;
 mod hermite;
-mod multi_index;
 #[cfg(test)]
 mod tests;
 
 use nalgebra::DMatrix;
 
+pub use askey::Family;
+pub use basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
 pub use hermite::{hermite_all, hermite_he, hermite_norm_sq, hermite_triple};
-pub use multi_index::MultiIndexSet;
+
+use crate::uq::rng;
 
 /// Errors of the polynomial-chaos construction.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -45,9 +54,9 @@ pub enum PceError {
     /// Inconsistent sizes of points, weights, values or basis.
     #[error("shape mismatch: {0}")]
     Shape(String),
-    /// The basis is not a valid set of distinct multi-indices.
-    #[error("invalid multi-index set: {0}")]
-    InvalidBasis(String),
+    /// The basis is not valid.
+    #[error("invalid chaos basis: {0}")]
+    InvalidBasis(#[from] BasisError),
     /// An ensemble value or weight is NaN or infinite.
     #[error("non-finite {what} at point {point}")]
     NotFinite {
@@ -58,30 +67,82 @@ pub enum PceError {
     },
 }
 
-/// A polynomial-chaos expansion of several outputs (e.g. the time steps of a
-/// response) on a common basis.
+/// A polynomial-chaos expansion of several outputs (e.g. the time steps of a response) on a
+/// common orthonormal basis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pce {
-    /// The basis.
-    pub basis: MultiIndexSet,
+    /// The basis: one family per germ dimension, the multi-indices.
+    pub basis: Basis,
     /// Coefficients: one row per basis term, one column per output.
     pub coeffs: DMatrix<f64>,
 }
 
 impl Pce {
-    /// Pseudo-spectral projection
-    /// `c_k = sum_q w_q f(z_q) Psi_k(z_q) / ||Psi_k||^2` with the exact norms.
+    /// A chaos from coefficients in the orthonormal basis `basis`.
+    pub fn new(basis: Basis, coeffs: DMatrix<f64>) -> Result<Pce, PceError> {
+        if coeffs.nrows() != basis.len() {
+            return Err(PceError::Shape(format!(
+                "{} coefficient rows for {} basis terms",
+                coeffs.nrows(),
+                basis.len()
+            )));
+        }
+        Ok(Pce { basis, coeffs })
+    }
+
+    /// The Hermite chaos (standard-normal germs) of coefficients `he` given in the
+    /// *unnormalized* basis `prod_i He_{k_i}(z_i)`: each row is scaled by the exact norm
+    /// `sqrt(prod_i k_i!)`.
+    pub fn from_hermite_he(set: MultiIndexSet, he: DMatrix<f64>) -> Result<Pce, PceError> {
+        let mut coeffs = he;
+        for (t, k) in set.indices().iter().enumerate() {
+            let norm: f64 = k
+                .iter()
+                .map(|&n| hermite_norm_sq(n))
+                .product::<f64>()
+                .sqrt();
+            coeffs.row_mut(t).scale_mut(norm);
+        }
+        let basis = Basis::new(vec![Family::Hermite; set.dim()], set)?;
+        Pce::new(basis, coeffs)
+    }
+
+    /// One chaos over the union of per-column multi-index sets (each column's coefficients
+    /// placed at its own indices, zeros elsewhere), as regression fits of separate outputs
+    /// give; the union is in graded order (total degree, then lexicographically
+    /// decreasing).
+    pub fn from_columns(
+        families: Vec<Family>,
+        columns: &[(Vec<Vec<usize>>, Vec<f64>)],
+    ) -> Result<Pce, PceError> {
+        let mut union: Vec<Vec<usize>> = columns.iter().flat_map(|c| c.0.clone()).collect();
+        union.sort_by(|a, b| {
+            let (sa, sb): (usize, usize) = (a.iter().sum(), b.iter().sum());
+            sa.cmp(&sb).then_with(|| b.cmp(a))
+        });
+        union.dedup();
+        let set = MultiIndexSet::from_indices(families.len(), union)?;
+        let mut coeffs = DMatrix::<f64>::zeros(set.len(), columns.len());
+        for (col, (indices, c)) in columns.iter().enumerate() {
+            for (k, v) in indices.iter().zip(c) {
+                let row = set.position(k).expect("in the union");
+                coeffs[(row, col)] = *v;
+            }
+        }
+        Pce::new(Basis::new(families, set)?, coeffs)
+    }
+
+    /// Pseudo-spectral projection `c_k = sum_q w_q f(t_q) Psi_k(t_q)` of `values` (one
+    /// row per point, one column per output) with a tensor quadrature rule of the germ law
+    /// (`points`, `weights` summing to 1; `nodes_per_dim` nodes of a Gauss rule in each
+    /// dimension). The basis is orthonormal with exact norms: nothing is divided by a
+    /// quadrature norm.
     ///
-    /// `points` and `weights`: a quadrature rule in standard-normal space
-    /// (e.g. [`tensor_grid`](crate::uq::quadrature::tensor_grid)), `values`:
-    /// one row per point, one column per output; `nodes_per_dim`: the number
-    /// of Gauss–Hermite nodes of the rule in each dimension.
-    ///
-    /// Errors: sizes inconsistent, non-finite data, invalid basis, or a basis
-    /// degree not below the number of nodes in some dimension
-    /// ([`PceError::OrderNotBelowNodes`]; see [`Pce::project_lenient`]).
+    /// Errors: sizes inconsistent, non-finite data, or a basis degree not below the number
+    /// of nodes in some dimension ([`PceError::OrderNotBelowNodes`]; see
+    /// [`Pce::project_lenient`]).
     pub fn project(
-        basis: MultiIndexSet,
+        basis: Basis,
         points: &[Vec<f64>],
         weights: &[f64],
         values: &DMatrix<f64>,
@@ -94,12 +155,11 @@ impl Pce {
         Ok(project_unchecked(basis, points, weights, values))
     }
 
-    /// Like [`Pce::project`] but accepts a basis degree that reaches the
-    /// number of nodes, returning one warning per offending dimension. The
-    /// highest-degree coefficients are then aliased (wrong, typically
-    /// zero); the exact norms keep them from exploding.
+    /// Like [`Pce::project`] but accepts a basis degree that reaches the number of nodes,
+    /// returning one warning per offending dimension. The highest-degree coefficients are
+    /// then aliased (wrong, typically zero); the exact norms keep them from exploding.
     pub fn project_lenient(
-        basis: MultiIndexSet,
+        basis: Basis,
         points: &[Vec<f64>],
         weights: &[f64],
         values: &DMatrix<f64>,
@@ -113,27 +173,42 @@ impl Pce {
         Ok((project_unchecked(basis, points, weights, values), warnings))
     }
 
+    /// Number of germ dimensions.
+    pub fn dim(&self) -> usize {
+        self.basis.set().dim()
+    }
+
     /// Number of outputs (columns).
     pub fn outputs(&self) -> usize {
         self.coeffs.ncols()
     }
 
+    /// The multi-index set.
+    pub fn set(&self) -> &MultiIndexSet {
+        self.basis.set()
+    }
+
+    /// Position of the constant term, if present.
+    fn constant_term(&self) -> Option<usize> {
+        self.set().position(&vec![0; self.dim()])
+    }
+
     /// Mean of every output: the coefficient of the constant term.
     pub fn mean(&self) -> Vec<f64> {
-        match self.basis.constant_term() {
+        match self.constant_term() {
             Some(t) => self.coeffs.row(t).iter().copied().collect(),
             None => vec![0.0; self.outputs()],
         }
     }
 
-    /// Variance of every output: `sum_{k != 0} c_k^2 ||Psi_k||^2`.
+    /// Variance of every output: `sum_{k != 0} c_k^2`.
     pub fn variance(&self) -> Vec<f64> {
-        let c0 = self.basis.constant_term();
+        let c0 = self.constant_term();
         (0..self.outputs())
             .map(|col| {
                 (0..self.basis.len())
                     .filter(|&t| Some(t) != c0)
-                    .map(|t| self.coeffs[(t, col)].powi(2) * self.basis.norm_sq(t))
+                    .map(|t| self.coeffs[(t, col)].powi(2))
                     .sum()
             })
             .collect()
@@ -144,39 +219,55 @@ impl Pce {
         self.variance().into_iter().map(f64::sqrt).collect()
     }
 
-    /// The surrogate of every output at the germ point `z`.
+    /// Mean, variance and Sobol' indices of output `col` (NaN indices for zero variance).
+    pub fn stats(&self, col: usize) -> ChaosStats {
+        ChaosStats::new(self.set(), self.coeffs.column(col).as_slice())
+    }
+
+    /// The surrogate of every output at the germ point `t`.
     ///
     /// # Panics
-    /// If `z.len() != self.basis.dim`.
-    pub fn eval(&self, z: &[f64]) -> Vec<f64> {
+    /// If `t.len() != self.dim()`.
+    pub fn eval(&self, t: &[f64]) -> Vec<f64> {
+        assert_eq!(
+            t.len(),
+            self.dim(),
+            "point dimension differs from the basis"
+        );
         let mut psi = vec![0.0; self.basis.len()];
-        self.basis.eval(z, &mut psi);
+        self.basis.eval(t, &mut psi);
         (0..self.outputs())
             .map(|col| dot_column(&self.coeffs, col, &psi))
             .collect()
     }
 
-    /// The surrogate of output `col` at the germ point `z`.
+    /// The surrogate of output `col` at the germ point `t`.
     ///
     /// # Panics
-    /// If `col >= self.outputs()` or `z.len() != self.basis.dim`.
-    pub fn eval_column(&self, col: usize, z: &[f64]) -> f64 {
+    /// If `col >= self.outputs()` or `t.len() != self.dim()`.
+    pub fn eval_column(&self, col: usize, t: &[f64]) -> f64 {
         assert!(col < self.outputs(), "column {col} out of range");
+        assert_eq!(
+            t.len(),
+            self.dim(),
+            "point dimension differs from the basis"
+        );
         let mut psi = vec![0.0; self.basis.len()];
-        self.basis.eval(z, &mut psi);
+        self.basis.eval(t, &mut psi);
         dot_column(&self.coeffs, col, &psi)
     }
 
     /// `n` draws of every output of the surrogate, one row per draw: row `i` is the chaos at
-    /// the standard normals of [`MultiIndexSet::draws`] (a function of `(seed, i)` only).
+    /// point `i` of [`germ_draws`] (a function of `(seed, i)` only).
     pub fn sample(&self, n: usize, seed: u64) -> DMatrix<f64> {
-        self.basis.draws(n, seed) * &self.coeffs
+        self.basis
+            .design_matrix(&germ_draws(self.basis.families(), n, seed))
+            * &self.coeffs
     }
 
-    /// First-order Sobol' indices of output `col`, one per germ dimension:
-    /// the variance share of the terms depending on that dimension only.
-    /// All zeros when the variance vanishes (or is at the rounding level of
-    /// the mean, as for a constant output).
+    /// First-order Sobol' indices of output `col`, one per germ dimension: the variance
+    /// share of the terms depending on that dimension only. All zeros when the variance
+    /// vanishes (or is at the rounding level of the mean, as for a constant output).
     ///
     /// # Panics
     /// If `col >= self.outputs()`.
@@ -186,9 +277,8 @@ impl Pce {
         })
     }
 
-    /// Total Sobol' indices of output `col`, one per germ dimension: the
-    /// variance share of all terms involving that dimension.
-    /// All zeros when the variance vanishes.
+    /// Total Sobol' indices of output `col`, one per germ dimension: the variance share of
+    /// all terms involving that dimension. All zeros when the variance vanishes.
     ///
     /// # Panics
     /// If `col >= self.outputs()`.
@@ -199,9 +289,9 @@ impl Pce {
     fn sobol(&self, col: usize, selects: impl Fn(&[usize], usize) -> bool) -> Vec<f64> {
         assert!(col < self.outputs(), "column {col} out of range");
         let parts: Vec<f64> = (0..self.basis.len())
-            .map(|t| self.coeffs[(t, col)].powi(2) * self.basis.norm_sq(t))
+            .map(|t| self.coeffs[(t, col)].powi(2))
             .collect();
-        let c0 = self.basis.constant_term();
+        let c0 = self.constant_term();
         let var: f64 = parts
             .iter()
             .enumerate()
@@ -211,23 +301,44 @@ impl Pce {
         // Variance at rounding level of the mean (a constant output) counts as zero.
         let c0_abs = c0.map_or(0.0, |t| self.coeffs[(t, col)].abs());
         let negligible = (64.0 * f64::EPSILON * c0_abs).powi(2);
-        (0..self.basis.dim)
+        (0..self.dim())
             .map(|i| {
                 if var.is_nan() || var <= negligible {
                     return 0.0;
                 }
                 let s: f64 = self
-                    .basis
-                    .indices
+                    .set()
+                    .indices()
                     .iter()
                     .zip(&parts)
                     .filter(|(k, _)| selects(k, i))
                     .map(|(_, v)| v)
                     .sum();
-                s / var
+                // + 0.0: an empty sum is -0.0.
+                s / var + 0.0
             })
             .collect()
     }
+}
+
+/// `n` random points of the germs of `families`: point `i` takes one uniform per dimension
+/// from `rng::stream(seed, i)` and maps it through the germ law's quantile (a Hermite germ is
+/// [`rng::standard_normal`]), so the points depend on `(seed, i)` only.
+pub fn germ_draws(families: &[Family], n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let laws: Vec<_> = families.iter().map(Family::law).collect();
+    (0..n)
+        .map(|i| {
+            let mut r = rng::stream(seed, i as u64);
+            families
+                .iter()
+                .zip(&laws)
+                .map(|(f, law)| match f {
+                    Family::Hermite => rng::standard_normal(&mut r),
+                    _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
+                })
+                .collect()
+        })
+        .collect()
 }
 
 fn dot_column(c: &DMatrix<f64>, col: usize, psi: &[f64]) -> f64 {
@@ -235,13 +346,13 @@ fn dot_column(c: &DMatrix<f64>, col: usize, psi: &[f64]) -> f64 {
 }
 
 fn check_inputs(
-    basis: &MultiIndexSet,
+    basis: &Basis,
     points: &[Vec<f64>],
     weights: &[f64],
     values: &DMatrix<f64>,
     nodes_per_dim: &[usize],
 ) -> Result<(), PceError> {
-    basis.validate()?;
+    let dim = basis.set().dim();
     if points.len() != weights.len() || points.len() != values.nrows() {
         return Err(PceError::Shape(format!(
             "{} points, {} weights, {} value rows",
@@ -250,19 +361,17 @@ fn check_inputs(
             values.nrows()
         )));
     }
-    if nodes_per_dim.len() != basis.dim {
+    if nodes_per_dim.len() != dim {
         return Err(PceError::Shape(format!(
-            "nodes given for {} dimensions, basis has {}",
+            "nodes given for {} dimensions, basis has {dim}",
             nodes_per_dim.len(),
-            basis.dim
         )));
     }
     for (q, p) in points.iter().enumerate() {
-        if p.len() != basis.dim {
+        if p.len() != dim {
             return Err(PceError::Shape(format!(
-                "point {q} has {} coordinates, basis has {} dimensions",
+                "point {q} has {} coordinates, basis has {dim} dimensions",
                 p.len(),
-                basis.dim
             )));
         }
         if p.iter().any(|x| !x.is_finite()) {
@@ -288,9 +397,10 @@ fn check_inputs(
 }
 
 /// One error per dimension whose basis degree is not below its node count.
-fn aliasing(basis: &MultiIndexSet, nodes_per_dim: &[usize]) -> Vec<PceError> {
+fn aliasing(basis: &Basis, nodes_per_dim: &[usize]) -> Vec<PceError> {
     basis
-        .max_degree_per_dim()
+        .set()
+        .max_per_dim()
         .into_iter()
         .zip(nodes_per_dim)
         .enumerate()
@@ -300,22 +410,15 @@ fn aliasing(basis: &MultiIndexSet, nodes_per_dim: &[usize]) -> Vec<PceError> {
 }
 
 fn project_unchecked(
-    basis: MultiIndexSet,
+    basis: Basis,
     points: &[Vec<f64>],
     weights: &[f64],
     values: &DMatrix<f64>,
 ) -> Pce {
-    let p = basis.len();
-    // a[(t, q)] = w_q Psi_t(z_q) / ||Psi_t||^2
-    let mut a = DMatrix::<f64>::zeros(p, points.len());
-    let inv_norms: Vec<f64> = (0..p).map(|t| 1.0 / basis.norm_sq(t)).collect();
-    let mut psi = vec![0.0; p];
-    let mut scratch = Vec::new();
-    for (q, (z, &w)) in points.iter().zip(weights).enumerate() {
-        basis.eval_with(z, &mut psi, &mut scratch);
-        for t in 0..p {
-            a[(t, q)] = w * psi[t] * inv_norms[t];
-        }
+    // a[(t, q)] = w_q Psi_t(t_q)
+    let mut a = basis.design_matrix(points).transpose();
+    for (q, &w) in weights.iter().enumerate() {
+        a.column_mut(q).scale_mut(w);
     }
     let coeffs = a * values;
     Pce { basis, coeffs }

@@ -115,9 +115,18 @@ fn triple_products_match_quadrature() {
     }
 }
 
+/// The Hermite basis of total order `p` in `d` germs.
+fn hermite(d: usize, p: usize) -> Basis {
+    Basis::new(
+        vec![Family::Hermite; d],
+        MultiIndexSet::total_degree(d, p).unwrap(),
+    )
+    .unwrap()
+}
+
 #[test]
 fn total_order_sets() {
-    let s = MultiIndexSet::total_order(2, 2);
+    let s = MultiIndexSet::total_degree(2, 2).unwrap();
     let expect: Vec<Vec<usize>> = vec![
         vec![0, 0],
         vec![1, 0],
@@ -126,14 +135,14 @@ fn total_order_sets() {
         vec![1, 1],
         vec![0, 2],
     ];
-    assert_eq!(s.indices, expect);
-    assert_eq!(MultiIndexSet::total_order(2, 6).len(), 28);
-    assert_eq!(MultiIndexSet::total_order(3, 4).len(), 35);
-    assert_eq!(MultiIndexSet::total_order(5, 3).len(), 56);
-    assert_eq!(MultiIndexSet::total_order(1, 7).len(), 8);
-    let s3 = MultiIndexSet::total_order(3, 2);
+    assert_eq!(s.indices(), expect.as_slice());
+    assert_eq!(MultiIndexSet::total_degree(2, 6).unwrap().len(), 28);
+    assert_eq!(MultiIndexSet::total_degree(3, 4).unwrap().len(), 35);
+    assert_eq!(MultiIndexSet::total_degree(5, 3).unwrap().len(), 56);
+    assert_eq!(MultiIndexSet::total_degree(1, 7).unwrap().len(), 8);
+    let s3 = MultiIndexSet::total_degree(3, 2).unwrap();
     assert_eq!(
-        s3.indices[4..10],
+        s3.indices()[4..10],
         [
             vec![2, 0, 0],
             vec![1, 1, 0],
@@ -143,41 +152,65 @@ fn total_order_sets() {
             vec![0, 0, 2]
         ]
     );
-    assert!(s3.validate().is_ok());
     assert_eq!(s3.position(&[1, 0, 1]), Some(6));
     assert_eq!(s3.position(&[3, 0, 0]), None);
-    assert_eq!((s3.dim(), s3.order(), s3.indices().len()), (3, 2, 10));
-    let zero = MultiIndexSet::total_order(0, 3);
+    assert_eq!((s3.dim(), s3.order(), s3.len()), (3, 2, 10));
+    let zero = MultiIndexSet::total_degree(0, 3).unwrap();
     assert_eq!(zero.len(), 1);
-    assert_eq!(zero.constant_term(), Some(0));
-    let s = MultiIndexSet::total_order(3, 3);
     assert_eq!(
-        s.norm_sq(s.indices.iter().position(|k| k == &[2, 0, 1]).unwrap()),
-        2.0
+        MultiIndexSet::total_degree(3, 3).unwrap().max_per_dim(),
+        vec![3, 3, 3]
     );
-    assert_eq!(s.max_degree_per_dim(), vec![3, 3, 3]);
 }
 
 #[test]
-fn invalid_sets_are_rejected() {
-    let mut s = MultiIndexSet::total_order(2, 2);
-    s.indices.push(vec![1, 1]);
-    assert!(matches!(s.validate(), Err(PceError::InvalidBasis(_))));
-    let mut s = MultiIndexSet::total_order(2, 2);
-    s.indices[3] = vec![2];
-    assert!(matches!(s.validate(), Err(PceError::InvalidBasis(_))));
-}
-
-#[test]
-fn basis_eval_is_the_product_of_hermites() {
-    let s = MultiIndexSet::total_order(3, 4);
+fn hermite_basis_is_the_normalized_product_of_hermites() {
+    let b = hermite(3, 4);
     let z = [0.3, -1.2, 2.1];
-    let mut out = vec![0.0; s.len()];
-    s.eval(&z, &mut out);
-    for (t, k) in s.indices.iter().enumerate() {
-        let want: f64 = k.iter().zip(&z).map(|(&n, &x)| hermite_he(n, x)).product();
+    let mut out = vec![0.0; b.len()];
+    b.eval(&z, &mut out);
+    for (t, k) in b.set().indices().iter().enumerate() {
+        let want: f64 = k
+            .iter()
+            .zip(&z)
+            .map(|(&n, &x)| hermite_he(n, x) / hermite_norm_sq(n).sqrt())
+            .product();
         assert!((out[t] - want).abs() < 1e-13 * want.abs().max(1.0));
     }
+}
+
+#[test]
+fn galerkin_coefficients_convert_by_the_exact_norms() {
+    // 1 + 2 He1(z1) + 3 He2(z2) + He1 He2: orthonormal 1, 2, 3 sqrt 2, sqrt 2.
+    let set = MultiIndexSet::total_degree(2, 3).unwrap();
+    let mut he = DMatrix::zeros(set.len(), 1);
+    for (k, c) in [([0, 0], 1.0), ([1, 0], 2.0), ([0, 2], 3.0), ([1, 2], 1.0)] {
+        he[(set.position(&k).unwrap(), 0)] = c;
+    }
+    let pce = Pce::from_hermite_he(set.clone(), he).unwrap();
+    let at = |k: [usize; 2]| pce.coeffs[(set.position(&k).unwrap(), 0)];
+    assert_eq!(at([0, 0]), 1.0);
+    assert_eq!(at([1, 0]), 2.0);
+    assert!((at([0, 2]) - 3.0 * 2f64.sqrt()).abs() < 1e-15);
+    assert!((at([1, 2]) - 2f64.sqrt()).abs() < 1e-15);
+    // Var = 4 + 9 * 2 + 2 = 24.
+    assert!((pce.variance()[0] - 24.0).abs() < 1e-13);
+    let z = [0.4, -1.3];
+    let direct = 1.0 + 2.0 * z[0] + (3.0 + z[0]) * (z[1] * z[1] - 1.0);
+    assert!((pce.eval(&z)[0] - direct).abs() < 1e-13);
+}
+
+#[test]
+fn union_of_column_sets_keeps_each_column() {
+    let fams = vec![Family::Legendre, Family::Hermite];
+    let cols = vec![
+        (vec![vec![0, 0], vec![2, 0]], vec![1.0, 0.5]),
+        (vec![vec![0, 1], vec![0, 0]], vec![-2.0, 3.0]),
+    ];
+    let pce = Pce::from_columns(fams, &cols).unwrap();
+    assert_eq!(pce.set().indices(), &[vec![0, 0], vec![0, 1], vec![2, 0]]);
+    assert_eq!(pce.mean(), vec![1.0, 3.0]);
+    assert_eq!(pce.variance(), vec![0.25, 4.0]);
 }
 
 type Fun<'a> = &'a dyn Fn(&[f64]) -> f64;
@@ -199,24 +232,26 @@ fn projection_of_a_polynomial_is_exact() {
     let npd = [4, 4];
     let grid = tensor_grid(&npd).unwrap();
     let vals = grid_values(&grid.points, &[&f, &g]);
-    let basis = MultiIndexSet::total_order(2, 3);
+    let basis = hermite(2, 3);
     let pce = Pce::project(basis.clone(), &grid.points, &grid.weights, &vals, &npd).unwrap();
-    let pos = |k: [usize; 2]| basis.indices.iter().position(|b| b == &k).unwrap();
-    for t in 0..basis.len() {
-        let want = match basis.indices[t].as_slice() {
+    let idx = basis.set().indices();
+    let pos = |k: [usize; 2]| idx.iter().position(|b| b == &k).unwrap();
+    // Orthonormal coefficients: the He coefficients times sqrt(prod k_i!).
+    for (t, k) in idx.iter().enumerate() {
+        let want = match k.as_slice() {
             [0, 0] => 1.0,
             [1, 0] => 2.0,
-            [1, 2] => 3.0,
-            [0, 3] => 0.5,
+            [1, 2] => 3.0 * 2f64.sqrt(),
+            [0, 3] => 0.5 * 6f64.sqrt(),
             _ => 0.0,
         };
         assert!(
             (pce.coeffs[(t, 0)] - want).abs() < 1e-13,
             "term {:?}",
-            basis.indices[t]
+            idx[t]
         );
     }
-    assert!((pce.coeffs[(pos([2, 0]), 1)] - 1.0).abs() < 1e-13);
+    assert!((pce.coeffs[(pos([2, 0]), 1)] - 2f64.sqrt()).abs() < 1e-13);
     assert!((pce.mean()[0] - 1.0).abs() < 1e-13);
     assert!((pce.mean()[1] - 1.0).abs() < 1e-13);
     // Var f = 4 * 1 + 9 * 1! 2! + 0.25 * 3! = 23.5; Var z1^2 = 2.
@@ -239,7 +274,7 @@ fn lognormal_fixture_mean_and_variance() {
     let grid = tensor_grid(&[nodes]).unwrap();
     let vals = grid_values(&grid.points, &[&|z: &[f64]| (a * z[0]).exp()]);
     let pce = Pce::project(
-        MultiIndexSet::total_order(1, order),
+        hermite(1, order),
         &grid.points,
         &grid.weights,
         &vals,
@@ -253,11 +288,27 @@ fn lognormal_fixture_mean_and_variance() {
     assert!((pce.variance()[0] - exact_var).abs() < 1e-12);
     // Exact up to the aliasing of the neglected degrees (largest for n = order).
     for n in 0..=order {
-        let c = m * a.powi(n as i32) / hermite_norm_sq(n);
-        assert!((pce.coeffs[(n, 0)] - c).abs() < 1e-11 * m, "n={n}");
+        // Orthonormal: the He coefficient m a^n / n! times sqrt(n!) (and so is the error).
+        let norm = hermite_norm_sq(n).sqrt();
+        let c = m * a.powi(n as i32) / norm;
+        assert!((pce.coeffs[(n, 0)] - c).abs() < 1e-11 * m * norm, "n={n}");
     }
     // Sampling the surrogate reproduces the moments.
     let s = pce.sample(40_000, 5);
+    // Draws of a Legendre germ are uniform on (-1, 1), reproducibly.
+    let leg = Pce::new(
+        Basis::new(
+            vec![Family::Legendre],
+            MultiIndexSet::total_degree(1, 1).unwrap(),
+        )
+        .unwrap(),
+        DMatrix::from_column_slice(2, 1, &[0.0, 1.0 / 3f64.sqrt()]),
+    )
+    .unwrap();
+    let u = leg.sample(20_000, 9);
+    assert!(u.iter().all(|v| v.abs() < 1.0));
+    assert!((u.column(0).mean()).abs() < 5.0 / (3.0 * 20_000f64).sqrt());
+    assert_eq!(u, leg.sample(20_000, 9));
     let mean = s.column(0).mean();
     let sd = exact_var.sqrt();
     assert!((mean - m).abs() < 5.0 * sd / 200.0);
@@ -281,14 +332,7 @@ fn sobol_indices_of_additive_and_interacting_functions() {
             &|_: &[f64]| 3.0,
         ],
     );
-    let pce = Pce::project(
-        MultiIndexSet::total_order(2, 2),
-        &grid.points,
-        &grid.weights,
-        &vals,
-        &npd,
-    )
-    .unwrap();
+    let pce = Pce::project(hermite(2, 2), &grid.points, &grid.weights, &vals, &npd).unwrap();
     let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-13);
     assert!(close(&pce.sobol_first(0), &[0.2, 0.8]));
     assert!(close(&pce.sobol_total(0), &[0.2, 0.8]));
@@ -314,14 +358,7 @@ fn order_not_below_nodes_is_refused() {
         .sum();
     assert!(quad_norm < 1e-10, "{quad_norm}");
     let vals = grid_values(&grid.points, &[&|z: &[f64]| hermite_he(6, z[0]) + z[0]]);
-    let err = Pce::project(
-        MultiIndexSet::total_order(1, 6),
-        &grid.points,
-        &grid.weights,
-        &vals,
-        &npd,
-    )
-    .unwrap_err();
+    let err = Pce::project(hermite(1, 6), &grid.points, &grid.weights, &vals, &npd).unwrap_err();
     assert_eq!(
         err,
         PceError::OrderNotBelowNodes {
@@ -334,33 +371,20 @@ fn order_not_below_nodes_is_refused() {
         .to_string()
         .contains("order must be below the nodes per dimension"));
     // Lenient: a warning, aliased (zero) top coefficient, no explosion.
-    let (pce, warnings) = Pce::project_lenient(
-        MultiIndexSet::total_order(1, 6),
-        &grid.points,
-        &grid.weights,
-        &vals,
-        &npd,
-    )
-    .unwrap();
+    let (pce, warnings) =
+        Pce::project_lenient(hermite(1, 6), &grid.points, &grid.weights, &vals, &npd).unwrap();
     assert_eq!(warnings.len(), 1);
     assert!(pce.coeffs[(6, 0)].abs() < 1e-12);
     assert!((pce.std()[0] - 1.0).abs() < 1e-12);
     // Order 5 with 6 nodes is fine.
-    assert!(Pce::project(
-        MultiIndexSet::total_order(1, 5),
-        &grid.points,
-        &grid.weights,
-        &vals,
-        &npd
-    )
-    .is_ok());
+    assert!(Pce::project(hermite(1, 5), &grid.points, &grid.weights, &vals, &npd).is_ok());
 }
 
 #[test]
 fn bad_shapes_and_values_are_errors() {
     let npd = [2, 2];
     let grid = tensor_grid(&npd).unwrap();
-    let basis = MultiIndexSet::total_order(2, 1);
+    let basis = hermite(2, 1);
     let vals = DMatrix::from_element(4, 3, 1.0);
     let ok = Pce::project(basis.clone(), &grid.points, &grid.weights, &vals, &npd);
     assert!(ok.is_ok());

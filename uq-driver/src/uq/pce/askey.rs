@@ -16,6 +16,9 @@
 //! `sqrt(beta_{n+1}) p_{n+1} = (t - alpha_n) p_n - sqrt(beta_n) p_{n-1}`.
 
 use nalgebra::{DMatrix, SymmetricEigen};
+use serde::{Deserialize, Serialize};
+
+use crate::uq::distributions::Distribution;
 
 /// Largest number of nodes of a Gauss rule from [`Family::gauss`].
 pub const MAX_GAUSS_NODES: usize = 200;
@@ -39,7 +42,10 @@ pub enum AskeyError {
 }
 
 /// An orthonormal polynomial family (see the module docs for the germs).
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Serialized with a `family` tag, e.g. `{"family": "jacobi", "a": 2.0, "b": 5.0}`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "family", rename_all = "snake_case")]
 pub enum Family {
     /// Probabilists' Hermite, germ N(0, 1).
     Hermite,
@@ -72,6 +78,51 @@ fn check_shape(family: &'static str, name: &'static str, value: f64) -> Result<(
 }
 
 impl Family {
+    /// The family of `d`'s germ in the Askey scheme (normal: Hermite, uniform: Legendre,
+    /// Beta: Jacobi, Gamma: Laguerre), `None` for the others. The germ is mapped to `d` by
+    /// [`Distribution::askey_affine`].
+    pub fn of(d: &Distribution) -> Option<Family> {
+        match *d {
+            Distribution::Normal { .. } => Some(Family::Hermite),
+            Distribution::Uniform { .. } => Some(Family::Legendre),
+            Distribution::Beta { alpha, beta, .. } => Some(Family::Jacobi { a: alpha, b: beta }),
+            Distribution::Gamma { shape, .. } => Some(Family::Laguerre { shape }),
+            _ => None,
+        }
+    }
+
+    /// The germ's law as a distribution: N(0, 1), U(-1, 1), Gamma(shape, 1) or
+    /// Beta(a, b) on [-1, 1].
+    pub fn law(&self) -> Distribution {
+        match *self {
+            Family::Hermite => Distribution::Normal {
+                mean: 0.0,
+                std: 1.0,
+            },
+            Family::Legendre => Distribution::Uniform {
+                low: -1.0,
+                high: 1.0,
+            },
+            Family::Laguerre { shape } => Distribution::Gamma { shape, scale: 1.0 },
+            Family::Jacobi { a, b } => Distribution::Beta {
+                alpha: a,
+                beta: b,
+                low: -1.0,
+                high: 1.0,
+            },
+        }
+    }
+
+    /// Lower-case name (`hermite`, `legendre`, `laguerre`, `jacobi`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Family::Hermite => "hermite",
+            Family::Legendre => "legendre",
+            Family::Laguerre { .. } => "laguerre",
+            Family::Jacobi { .. } => "jacobi",
+        }
+    }
+
     /// Checks the shape parameters.
     pub fn validate(&self) -> Result<(), AskeyError> {
         match *self {
@@ -445,6 +496,83 @@ mod tests {
             let (_, d) = fam.value_and_derivative(5, t);
             let fd = (fam.eval(5, t + h) - fam.eval(5, t - h)) / (2.0 * h);
             assert!((d - fd).abs() < 1e-6 * d.abs().max(1.0), "{fam:?}");
+        }
+    }
+
+    #[test]
+    fn askey_bases_are_orthonormal_for_the_physical_distributions() {
+        // p_i(germ(X)) orthonormal under the physical density (written here), with the
+        // germ from Distribution::askey_affine and the family from Family::of.
+        let cases = [
+            Distribution::gamma(2.5, 3.0).unwrap(),
+            Distribution::gamma(1.0, 0.5).unwrap(),
+            Distribution::beta(2.0, 3.0, 5.0, 9.0).unwrap(),
+            Distribution::beta(1.5, 1.5, -1.0, 2.0).unwrap(),
+            Distribution::uniform(-2.0, 6.0).unwrap(),
+            Distribution::normal(3.0, 0.5).unwrap(),
+        ];
+        for m in cases {
+            let fam = Family::of(&m).unwrap();
+            let (offset, scale) = m.askey_affine().unwrap();
+            let (lo, hi) = match m {
+                Distribution::Gamma { scale, .. } => (0.0, 60.0 * scale),
+                Distribution::Normal { mean, std } => (mean - 14.0 * std, mean + 14.0 * std),
+                _ => m.support(),
+            };
+            let dens = |x: f64| -> f64 {
+                match m {
+                    Distribution::Gamma { shape, scale } => {
+                        x.powf(shape - 1.0) * (-x / scale).exp()
+                            / (ln_gamma(shape).exp() * scale.powf(shape))
+                    }
+                    Distribution::Beta {
+                        alpha,
+                        beta,
+                        low,
+                        high,
+                    } => {
+                        let u = (x - low) / (high - low);
+                        let lb = ln_gamma(alpha) + ln_gamma(beta) - ln_gamma(alpha + beta);
+                        u.powf(alpha - 1.0) * (1.0 - u).powf(beta - 1.0) / (lb.exp() * (high - low))
+                    }
+                    Distribution::Uniform { low, high } => 1.0 / (high - low),
+                    Distribution::Normal { mean, std } => {
+                        let z = (x - mean) / std;
+                        (-0.5 * z * z).exp() / (std * (2.0 * std::f64::consts::PI).sqrt())
+                    }
+                    _ => unreachable!(),
+                }
+            };
+            for i in 0..6 {
+                for j in 0..=i {
+                    let g = integrate(
+                        |x| {
+                            let t = (x - offset) / scale;
+                            dens(x) * fam.eval(i, t) * fam.eval(j, t)
+                        },
+                        lo,
+                        hi,
+                        2000,
+                    );
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!((g - want).abs() < 1e-6, "{m:?} <{i},{j}> = {g}");
+                }
+            }
+            // The germ law pushed through the affine map has the input's moments.
+            let law = fam.law();
+            assert!((offset + scale * law.mean() - m.mean()).abs() < 1e-12 * m.std());
+            assert!((scale * law.std() / m.std() - 1.0).abs() < 1e-12);
+        }
+        for d in [
+            Distribution::weibull(2.0, 1.0).unwrap(),
+            Distribution::lognormal(0.0, 1.0).unwrap(),
+            Distribution::integer_uniform(1, 3).unwrap(),
+            Distribution::truncated_normal(0.0, 1.0, -1.0, 2.0).unwrap(),
+        ] {
+            assert!(
+                Family::of(&d).is_none() && d.askey_affine().is_none(),
+                "{d:?}"
+            );
         }
     }
 

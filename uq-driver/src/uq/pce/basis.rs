@@ -157,6 +157,15 @@ impl MultiIndexSet {
         })
     }
 
+    /// Largest total degree `|alpha|_1` of a member (0 for an empty set).
+    pub fn order(&self) -> usize {
+        self.indices
+            .iter()
+            .map(|a| a.iter().sum::<usize>())
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Largest entry per dimension.
     pub fn max_per_dim(&self) -> Vec<usize> {
         let mut m = vec![0; self.dim];

@@ -1,0 +1,336 @@
+//! Smolyak sparse grids: the isotropic level-`L` grid `{l : l_1 + ... + l_d <= L}` of
+//! nested one-dimensional rules in each input's germ, the chaos by the sparse
+//! pseudo-spectral construction (the combination technique applied to full-tensor
+//! projections, each exact on its own space — Conrad & Marzouk 2013 — not a projection
+//! with the Smolyak weights, which aliases), and the truncation error from the difference
+//! between the chaoses of levels `L` and `L - 1` (no extra runs with nested rules).
+//!
+//! Rules per input germ (`rule` overrides the default of the germs it fits):
+//!
+//! | germ (family) | default | also |
+//! | --- | --- | --- |
+//! | N(0, 1) (Hermite: normal inputs, inputs mapped through the normal) | Genz–Keister (nested, levels 0–4) | `gauss_hermite` |
+//! | U(-1, 1) (Legendre: uniform inputs) | Gauss–Patterson (nested, levels 0–5) | `clenshaw_curtis`, `gauss_legendre` |
+//! | Beta on [-1, 1] (Jacobi), Gamma(k, 1) (Laguerre) | their Gauss rule (not nested) | |
+//!
+//! Mean, Std, Sobol' indices, quantiles and densities all come from the chaos: the sparse
+//! rule's weights can be negative, so its own variance can be too.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::chaos::{continuous_inputs, ChaosBasis};
+use super::design::Design;
+use super::error::{InvalidSettings, MethodError};
+use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
+use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
+use crate::uq::distributions::RandomParameter;
+use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
+use crate::uq::hd::rules::RuleKind;
+use crate::uq::hd::smolyak::{LevelSet, SparseGrid as Grid};
+use crate::uq::random_inputs::RandomInputs;
+use crate::uq::pce::Family;
+
+/// Most points of a sparse grid accepted here.
+const MAX_POINTS: usize = 1_000_000;
+
+/// A one-dimensional rule named in a study file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RuleName {
+    /// Genz–Keister (normal germs, nested).
+    GenzKeister,
+    /// Gauss–Hermite (normal germs, not nested).
+    GaussHermite,
+    /// Gauss–Patterson (uniform germs, nested).
+    GaussPatterson,
+    /// Clenshaw–Curtis (uniform germs, nested).
+    ClenshawCurtis,
+    /// Gauss–Legendre (uniform germs, not nested).
+    GaussLegendre,
+}
+
+impl RuleName {
+    fn kind(self) -> RuleKind {
+        match self {
+            RuleName::GenzKeister => RuleKind::GenzKeister,
+            RuleName::GaussHermite => RuleKind::GaussHermite,
+            RuleName::GaussPatterson => RuleKind::GaussPatterson,
+            RuleName::ClenshawCurtis => RuleKind::ClenshawCurtis,
+            RuleName::GaussLegendre => RuleKind::GaussLegendre,
+        }
+    }
+}
+
+/// `kind = "sparse_grid"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SparseGrid {
+    /// Smolyak level `L` (0: the centre point only).
+    pub level: usize,
+    /// The rule of the germs it fits (default: Genz–Keister for normal germs,
+    /// Gauss–Patterson for uniform ones).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rule: Option<RuleName>,
+    /// The chaos basis (`askey`, default, or `hermite`).
+    #[serde(default)]
+    pub chaos: ChaosBasis,
+}
+
+impl SparseGrid {
+    /// The family of each input's germ.
+    fn families(&self, parameters: &[RandomParameter]) -> Vec<Family> {
+        parameters
+            .iter()
+            .map(|p| match self.chaos {
+                ChaosBasis::Hermite => Family::Hermite,
+                ChaosBasis::Askey => Family::of(&p.distribution).unwrap_or(Family::Hermite),
+            })
+            .collect()
+    }
+
+    /// The rule of each dimension, from its germ's family.
+    fn rules(&self, families: &[Family]) -> Vec<RuleKind> {
+        families
+            .iter()
+            .map(|&f| {
+                let named = self.rule.map(RuleName::kind).filter(|k| k.family() == f);
+                match (named, f) {
+                    (Some(k), _) => k,
+                    (None, Family::Hermite) => RuleKind::GenzKeister,
+                    (None, Family::Legendre) => RuleKind::GaussPatterson,
+                    (None, other) => RuleKind::Gauss(other),
+                }
+            })
+            .collect()
+    }
+
+    /// The grid of `families`' germs.
+    fn grid(&self, families: &[Family]) -> Result<Grid, MethodError> {
+        let set = LevelSet::total(families.len(), self.level).map_err(grid_error)?;
+        Grid::new(&self.rules(families), &set).map_err(grid_error)
+    }
+}
+
+fn grid_error(e: impl std::fmt::Display) -> MethodError {
+    MethodError::Invalid(InvalidSettings(format!("sparse grid: {e}")))
+}
+
+impl Method for SparseGrid {
+    fn kind(&self) -> &'static str {
+        "sparse_grid"
+    }
+
+    fn label(&self, _dim: usize) -> String {
+        format!("sparse grid level {}", self.level)
+    }
+
+    fn validate(&self, problem: &Problem) -> Result<(), InvalidSettings> {
+        continuous_inputs(problem, "sparse_grid")?;
+        let families = self.families(problem.parameters);
+        let rules = self.rules(&families);
+        if let Some(named) = self.rule {
+            if !rules.contains(&named.kind()) {
+                return Err(InvalidSettings(format!(
+                    "rule {:?} fits none of the inputs' germs (normal germs: genz_keister, \
+                     gauss_hermite; uniform germs: gauss_patterson, clenshaw_curtis, gauss_legendre)",
+                    named
+                )));
+            }
+        }
+        for (r, p) in rules.iter().zip(problem.parameters) {
+            if self.level > r.max_level() {
+                return Err(InvalidSettings(format!(
+                    "level {} is above the highest level of {} ({}), the rule of '{}'; lower \
+                     the level or choose another rule",
+                    self.level,
+                    r.name(),
+                    r.max_level(),
+                    p.name
+                )));
+            }
+        }
+        let n = self
+            .grid(&families)
+            .map_err(|e| InvalidSettings(e.to_string()))?
+            .len();
+        if n > MAX_POINTS {
+            return Err(InvalidSettings(format!(
+                "the level-{} sparse grid has {n} points (more than {MAX_POINTS}); lower the \
+                 level or use pce_regression",
+                self.level
+            )));
+        }
+        Ok(())
+    }
+
+    fn summary(&self, _dim: usize) -> MethodSummary {
+        MethodSummary::new(self.kind(), self)
+    }
+
+    fn evaluation(&self) -> Evaluation<'_> {
+        Evaluation::Sampling(self)
+    }
+}
+
+impl Sampling for SparseGrid {
+    /// The merged nodes of the sparse grid in the inputs' germs, with the (possibly
+    /// negative) combined weights.
+    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        let families = self.families(inputs);
+        let grid = self.grid(&families)?;
+        let germ = self.chaos.germ();
+        // Nodes far in the tails (Genz–Keister: |z| up to 9 at level 4) that give a
+        // positive-mean input a value <= 0 are reported by `Design::mapped`, with their weight.
+        Ok(Design::mapped(germ, grid.points, Some(grid.weights), inputs))
+    }
+
+    /// Needs every node (weighted design). The chaos of every column by the sparse
+    /// pseudo-spectral projection; the level difference when the rules are nested.
+    fn estimate(
+        &self,
+        design: &Design,
+        rows: &[usize],
+        data: &DMatrix<f64>,
+    ) -> Result<Estimate, MethodError> {
+        design.complete_weights(rows)?;
+        let families = design.families().ok_or_else(|| {
+            MethodError::Invalid(InvalidSettings("a sparse grid needs a chaos germ".into()))
+        })?;
+        let grid = self.grid(&families)?;
+        if grid.len() != design.len() {
+            return Err(grid_error(format!(
+                "the grid has {} points, the design {}",
+                grid.len(),
+                design.len()
+            )));
+        }
+        let pce = sparse_pseudo_spectral(&grid, data).map_err(grid_error)?;
+        let nested = grid.rules.iter().all(RuleKind::is_nested);
+        let chaos_error = if self.level >= 1 && nested {
+            let coarse = LevelSet::total(families.len(), self.level - 1).map_err(grid_error)?;
+            let values = level_difference_from(&pce, &grid, data, &coarse).map_err(grid_error)?;
+            Some(ChaosError {
+                kind: ChaosErrorKind::LevelDifference,
+                values,
+            })
+        } else {
+            None
+        };
+        let mut estimate = Estimate::from_chaos(pce);
+        estimate.chaos_error = chaos_error;
+        Ok(estimate)
+    }
+
+    fn min_runs(&self) -> usize {
+        1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::Distribution;
+
+    fn inputs(ds: Vec<Distribution>) -> RandomInputs {
+        RandomInputs::independent(
+            ds.into_iter()
+                .enumerate()
+                .map(|(i, d)| RandomParameter {
+                    name: format!("x{i}"),
+                    distribution: d,
+                })
+                .collect(),
+        )
+    }
+
+    fn method(text: &str) -> SparseGrid {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn rules_follow_the_germs_and_the_rule_key() {
+        let m = method("level = 2");
+        let fams = m.families(&inputs(vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::uniform(0.0, 1.0).unwrap(),
+            Distribution::gamma(2.0, 1.0).unwrap(),
+            Distribution::weibull(2.0, 1.0).unwrap(),
+        ]));
+        assert_eq!(
+            m.rules(&fams),
+            vec![
+                RuleKind::GenzKeister,
+                RuleKind::GaussPatterson,
+                RuleKind::Gauss(Family::Laguerre { shape: 2.0 }),
+                RuleKind::GenzKeister,
+            ]
+        );
+        let cc = method("level = 2\nrule = \"clenshaw_curtis\"");
+        assert_eq!(cc.rules(&fams)[1], RuleKind::ClenshawCurtis);
+        assert_eq!(cc.rules(&fams)[0], RuleKind::GenzKeister);
+        let h = method("level = 2\nchaos = \"hermite\"");
+        assert!(h.rules(&h.families(&inputs(vec![Distribution::uniform(0.0, 1.0).unwrap()])))
+            == vec![RuleKind::GenzKeister]);
+    }
+
+    #[test]
+    fn a_polynomial_in_mixed_inputs_is_recovered_with_its_moments() {
+        // f = a + b² + a b with a ~ N(1, 0.5²), b ~ U(0, 2): E f = 1 + 4/3 + 1 = 10/3,
+        // Var f from a = 1 + 0.5 z, b = 1 + u (u ~ U(-1, 1)):
+        // f = 1 + 0.5z + 1 + 2u + u² + 1 + u + 0.5z + 0.5zu = 3 + z + 3u + u² + 0.5 z u;
+        // Var = 1 + 9/3 + Var(u²) + 0.25/3 = 1 + 3 + 4/45 + 1/12.
+        let ins = inputs(vec![
+            Distribution::normal(1.0, 0.5).unwrap(),
+            Distribution::uniform(0.0, 2.0).unwrap(),
+        ]);
+        let m = method("level = 3");
+        let d = m.design(&ins, 0).unwrap();
+        let vals: Vec<f64> = d
+            .values
+            .iter()
+            .map(|v| v[0] + v[1] * v[1] + v[0] * v[1])
+            .collect();
+        let data = DMatrix::from_column_slice(vals.len(), 1, &vals);
+        let rows: Vec<usize> = (0..d.len()).collect();
+        let e = m.estimate(&d, &rows, &data).unwrap();
+        assert!((e.mean[0] - 10.0 / 3.0).abs() < 1e-12, "{}", e.mean[0]);
+        let var: f64 = 1.0 + 3.0 + 4.0 / 45.0 + 1.0 / 12.0;
+        assert!((e.std[0] - var.sqrt()).abs() < 1e-12, "{}", e.std[0]);
+        // A polynomial already in the level-2 space: the level difference vanishes.
+        let err = e.chaos_error.unwrap();
+        assert_eq!(err.kind, ChaosErrorKind::LevelDifference);
+        assert!(err.values[0] < 1e-24, "{:?}", err.values);
+        assert!(m.estimate(&d, &rows[1..], &data.rows(1, d.len() - 1).into_owned()).is_err());
+    }
+
+    #[test]
+    fn settings_that_do_not_fit_the_inputs_are_refused() {
+        let ins = inputs(vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::normal(2.0, 0.1).unwrap(),
+        ]);
+        fn problem(p: &RandomInputs) -> Problem<'_> {
+            Problem {
+                parameters: &p.parameters,
+                correlation: None,
+                outputs: &[],
+                quantities: 0,
+                times: &[0.0],
+                system: None,
+            }
+        }
+        let p = problem(&ins);
+        let e = method("level = 2\nrule = \"clenshaw_curtis\"")
+            .validate(&p)
+            .unwrap_err();
+        assert!(e.0.contains("fits none of the inputs"), "{e}");
+        let e = method("level = 5").validate(&p).unwrap_err();
+        assert!(e.0.contains("highest level of Genz-Keister (4)"), "{e}");
+        assert!(method("level = 5\nrule = \"gauss_hermite\"")
+            .validate(&p)
+            .is_ok());
+        let int = inputs(vec![Distribution::integer_uniform(1, 3).unwrap()]);
+        assert!(method("level = 1").validate(&problem(&int)).is_err());
+    }
+}

@@ -1,0 +1,529 @@
+//! The exported chaos surrogate of a study (`DIR/surrogate.json`): the inputs and their maps,
+//! the correlation, and for every output (per time) and scalar quantity the multi-indices,
+//! the coefficients and the estimated truncation error. [`Surrogate`] reads it back,
+//! evaluates it at physical parameter values and samples it.
+//!
+//! The format (version 1) is documented in the README ("The surrogate"). A chaos term is
+//! `prod_i p^(i)_{k_i}(t_i)`, `p^(i)` the orthonormal polynomial of input `i`'s family on
+//! its germ `t_i`; an input's value is `offset + scale t_i` (`map = "affine"`) or
+//! `F_i^-1(Phi(t_i))` (`map = "normal"`), correlated inputs through the Gaussian copula.
+
+use std::path::Path;
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::uq::distributions::{Distribution, Germ, RandomParameter};
+use crate::uq::method::ChaosError;
+use crate::uq::pce::{germ_draws, Basis, Family, MultiIndexSet, Pce};
+use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
+
+/// `format` of the file.
+pub const FORMAT: &str = "railuq-surrogate";
+/// `version` of the file.
+pub const VERSION: u32 = 1;
+
+/// Errors of reading and using a surrogate.
+#[derive(Debug, thiserror::Error)]
+pub enum SurrogateError {
+    /// The file cannot be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Not a surrogate file of a known version, or inconsistent.
+    #[error("{0}")]
+    Invalid(String),
+    /// A parameter given that the surrogate does not have, or a bad value.
+    #[error("{0}")]
+    Input(String),
+}
+
+/// How an input's value follows from its germ coordinate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "map", rename_all = "snake_case")]
+pub enum InputMap {
+    /// `x = offset + scale · t`.
+    Affine {
+        /// Offset (units of the input).
+        offset: f64,
+        /// Scale (units of the input).
+        scale: f64,
+    },
+    /// `x = F^-1(Phi(t))`, `t` standard normal.
+    Normal,
+}
+
+/// An input of the surrogate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurrogateInput {
+    /// FMU variable name.
+    pub name: String,
+    /// Its distribution.
+    pub distribution: Distribution,
+    /// The orthonormal family of its germ (`{"family": "hermite"}`, ...).
+    pub family: Family,
+    /// How the germ maps to the input (before the copula, for a correlated input).
+    #[serde(flatten)]
+    pub map: InputMap,
+}
+
+/// The correlation of the inputs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurrogateCorrelation {
+    /// The requested pairs (Pearson correlation of the physical values).
+    pub pairs: Vec<CorrelationPair>,
+    /// The normal-space correlation matrix of the Gaussian copula (study order).
+    pub normal_correlation: Vec<Vec<f64>>,
+}
+
+/// A truncation-error estimate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ErrorEstimate {
+    /// `loo`, `level_difference` or `order_difference`.
+    pub kind: String,
+    /// Per output time (outputs) or one value (quantities).
+    pub values: Vec<f64>,
+}
+
+impl From<&ChaosError> for ErrorEstimate {
+    fn from(e: &ChaosError) -> Self {
+        ErrorEstimate {
+            kind: e.kind.name().to_owned(),
+            values: e.values.clone(),
+        }
+    }
+}
+
+/// The chaos of an output over time, or of a scalar quantity (one "time").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurrogateChaos {
+    /// Output or quantity name.
+    pub name: String,
+    /// Communication points (s); absent for a scalar quantity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub times: Option<Vec<f64>>,
+    /// The multi-indices `k` (one entry per input).
+    pub multi_indices: Vec<Vec<usize>>,
+    /// Coefficients: per time (one for a quantity), one per multi-index.
+    pub coefficients: Vec<Vec<f64>>,
+    /// The estimated relative truncation error, if the method gives one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<ErrorEstimate>,
+}
+
+/// `surrogate.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurrogateFile {
+    /// Always `railuq-surrogate`.
+    pub format: String,
+    /// Format version (1).
+    pub version: u32,
+    /// Study name.
+    pub study: String,
+    /// Method kind.
+    pub method: String,
+    /// The standard space: `normal` (every input through the normal map) or `askey`.
+    pub germ: Germ,
+    /// The inputs, in study order.
+    pub inputs: Vec<SurrogateInput>,
+    /// The correlation, if the inputs are correlated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correlation: Option<SurrogateCorrelation>,
+    /// Outputs over time.
+    pub outputs: Vec<SurrogateChaos>,
+    /// Scalar quantities.
+    pub quantities: Vec<SurrogateChaos>,
+}
+
+/// A named chaos of a study, with its error estimate.
+#[derive(Clone, Debug)]
+pub struct NamedChaos {
+    /// Output or quantity name.
+    pub name: String,
+    /// Times (outputs) or `None` (quantities).
+    pub times: Option<Vec<f64>>,
+    /// The chaos (one column per time, or one).
+    pub pce: Pce,
+    /// Its error estimate.
+    pub error: Option<ChaosError>,
+}
+
+impl SurrogateFile {
+    /// The file of a study's chaoses: `germ` and `inputs` those of the design.
+    pub fn new(
+        study: &str,
+        method: &str,
+        germ: Germ,
+        inputs: &RandomInputs,
+        outputs: &[NamedChaos],
+        quantities: &[NamedChaos],
+    ) -> SurrogateFile {
+        let inputs_out = inputs
+            .iter()
+            .map(|p| {
+                let d = &p.distribution;
+                let (family, map) = match (germ, Family::of(d), d.askey_affine()) {
+                    (Germ::Askey, Some(f), Some((offset, scale))) => {
+                        (f, InputMap::Affine { offset, scale })
+                    }
+                    (_, _, _) => match *d {
+                        Distribution::Normal { mean, std } => (
+                            Family::Hermite,
+                            InputMap::Affine {
+                                offset: mean,
+                                scale: std,
+                            },
+                        ),
+                        _ => (Family::Hermite, InputMap::Normal),
+                    },
+                };
+                SurrogateInput {
+                    name: p.name.clone(),
+                    distribution: d.clone(),
+                    family,
+                    map,
+                }
+            })
+            .collect();
+        let chaos = |c: &NamedChaos| SurrogateChaos {
+            name: c.name.clone(),
+            times: c.times.clone(),
+            multi_indices: c.pce.set().indices().to_vec(),
+            coefficients: (0..c.pce.outputs())
+                .map(|k| c.pce.coeffs.column(k).iter().copied().collect())
+                .collect(),
+            error: c.error.as_ref().map(ErrorEstimate::from),
+        };
+        SurrogateFile {
+            format: FORMAT.into(),
+            version: VERSION,
+            study: study.into(),
+            method: method.into(),
+            germ,
+            inputs: inputs_out,
+            correlation: inputs.correlation.as_ref().map(|c| SurrogateCorrelation {
+                pairs: c.pairs.clone(),
+                normal_correlation: c
+                    .normal_correlation
+                    .row_iter()
+                    .map(|r| r.iter().copied().collect())
+                    .collect(),
+            }),
+            outputs: outputs.iter().map(chaos).collect(),
+            quantities: quantities.iter().map(chaos).collect(),
+        }
+    }
+}
+
+/// A surrogate ready to evaluate: the inputs with their copula, and the chaoses.
+#[derive(Clone, Debug)]
+pub struct Surrogate {
+    /// The file it was read from.
+    pub file: SurrogateFile,
+    /// The inputs (marginals and copula).
+    pub inputs: RandomInputs,
+    /// One chaos per output (columns: times), then one per quantity (one column).
+    chaos: Vec<Pce>,
+}
+
+/// Values of a surrogate at one point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurrogateValues {
+    /// Per output: the values at its times.
+    pub outputs: Vec<Vec<f64>>,
+    /// Per quantity.
+    pub quantities: Vec<f64>,
+}
+
+impl Surrogate {
+    /// Reads `DIR/surrogate.json` (or the file itself when `path` is a file).
+    pub fn load(path: &Path) -> Result<Surrogate, SurrogateError> {
+        let file = if path.is_dir() {
+            path.join("surrogate.json")
+        } else {
+            path.to_path_buf()
+        };
+        let text = std::fs::read_to_string(&file).map_err(|source| SurrogateError::Io {
+            path: file.display().to_string(),
+            source,
+        })?;
+        let f: SurrogateFile = serde_json::from_str(&text).map_err(|e| {
+            SurrogateError::Invalid(format!("{}: not a surrogate file: {e}", file.display()))
+        })?;
+        Surrogate::new(f)
+    }
+
+    /// Checks a parsed file and prepares it for evaluation.
+    pub fn new(f: SurrogateFile) -> Result<Surrogate, SurrogateError> {
+        let invalid = |m: String| SurrogateError::Invalid(m);
+        if f.format != FORMAT || f.version != VERSION {
+            return Err(invalid(format!(
+                "format {} version {} is not {FORMAT} version {VERSION}",
+                f.format, f.version
+            )));
+        }
+        let parameters: Vec<RandomParameter> = f
+            .inputs
+            .iter()
+            .map(|i| {
+                i.distribution
+                    .validate()
+                    .map_err(|e| invalid(format!("input '{}': {e}", i.name)))?;
+                Ok(RandomParameter {
+                    name: i.name.clone(),
+                    distribution: i.distribution.clone(),
+                })
+            })
+            .collect::<Result<_, SurrogateError>>()?;
+        let pairs = f
+            .correlation
+            .as_ref()
+            .map_or(Vec::new(), |c| c.pairs.clone());
+        let correlation =
+            Correlation::new(&parameters, pairs).map_err(|e| invalid(e.to_string()))?;
+        let inputs = RandomInputs {
+            parameters,
+            correlation,
+        };
+        let families: Vec<Family> = f.inputs.iter().map(|i| i.family).collect();
+        let chaos = f
+            .outputs
+            .iter()
+            .chain(&f.quantities)
+            .map(|c| {
+                let set = MultiIndexSet::from_indices(families.len(), c.multi_indices.clone())
+                    .map_err(|e| invalid(format!("'{}': {e}", c.name)))?;
+                let basis = Basis::new(families.clone(), set)
+                    .map_err(|e| invalid(format!("'{}': {e}", c.name)))?;
+                let rows = basis.len();
+                if c.coefficients.iter().any(|col| col.len() != rows) {
+                    return Err(invalid(format!(
+                        "'{}': every coefficient vector needs {rows} entries",
+                        c.name
+                    )));
+                }
+                let coeffs =
+                    DMatrix::from_fn(rows, c.coefficients.len(), |r, k| c.coefficients[k][r]);
+                Pce::new(basis, coeffs).map_err(|e| invalid(e.to_string()))
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Surrogate {
+            file: f,
+            inputs,
+            chaos,
+        })
+    }
+
+    /// The physical values of every input from `NAME=VALUE` assignments; inputs not given
+    /// take their nominal value (the mean).
+    pub fn point(&self, at: &[(String, f64)]) -> Result<Vec<f64>, SurrogateError> {
+        let mut x: Vec<f64> = self
+            .inputs
+            .iter()
+            .map(|p| p.distribution.nominal())
+            .collect();
+        for (name, v) in at {
+            let i = self
+                .inputs
+                .iter()
+                .position(|p| &p.name == name)
+                .ok_or_else(|| {
+                    SurrogateError::Input(format!(
+                        "'{name}' is not an input of the surrogate (inputs: {})",
+                        self.inputs
+                            .iter()
+                            .map(|p| p.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ))
+                })?;
+            let (lo, hi) = self.inputs[i].distribution.support();
+            if !v.is_finite() || *v < lo || *v > hi {
+                return Err(SurrogateError::Input(format!(
+                    "{name} = {v} is outside the support [{lo}, {hi}] of its distribution"
+                )));
+            }
+            x[i] = *v;
+        }
+        Ok(x)
+    }
+
+    /// Every output and quantity at the physical values `x` (one per input).
+    pub fn eval(&self, x: &[f64]) -> SurrogateValues {
+        let t = self.inputs.to_germ(self.file.germ, x);
+        self.eval_germ(&t)
+    }
+
+    fn eval_germ(&self, t: &[f64]) -> SurrogateValues {
+        let n_out = self.file.outputs.len();
+        SurrogateValues {
+            outputs: self.chaos[..n_out].iter().map(|p| p.eval(t)).collect(),
+            quantities: self.chaos[n_out..]
+                .iter()
+                .map(|p| p.eval_column(0, t))
+                .collect(),
+        }
+    }
+
+    /// `eval` as CSV: `name,time,value`, one row per output and time, then one per quantity
+    /// (empty time).
+    pub fn eval_csv(&self, x: &[f64]) -> String {
+        let v = self.eval(x);
+        let mut text = String::from("name,time,value\n");
+        for (o, vals) in self.file.outputs.iter().zip(&v.outputs) {
+            let times = o.times.as_deref().unwrap_or(&[]);
+            for (t, y) in times.iter().zip(vals) {
+                text.push_str(&format!("{},{t},{y}\n", o.name));
+            }
+        }
+        for (q, y) in self.file.quantities.iter().zip(&v.quantities) {
+            text.push_str(&format!("{},,{y}\n", q.name));
+        }
+        text
+    }
+
+    /// `sample` as CSV: the inputs, the quantities, then each output at the communication
+    /// points nearest to `times` (default: its last), as columns `NAME@TIME`.
+    pub fn sample_csv(&self, n: usize, seed: u64, times: &[f64]) -> String {
+        // (output index, time index, column name)
+        let mut picks: Vec<(usize, usize, String)> = Vec::new();
+        for (o, chaos) in self.file.outputs.iter().enumerate() {
+            let ts = chaos.times.as_deref().unwrap_or(&[]);
+            if ts.is_empty() {
+                continue;
+            }
+            let nearest = |t: f64| {
+                (0..ts.len())
+                    .min_by(|&a, &b| (ts[a] - t).abs().total_cmp(&(ts[b] - t).abs()))
+                    .unwrap_or(0)
+            };
+            let wanted: Vec<usize> = if times.is_empty() {
+                vec![ts.len() - 1]
+            } else {
+                times.iter().map(|&t| nearest(t)).collect()
+            };
+            for k in wanted {
+                picks.push((o, k, format!("{}@{}", chaos.name, ts[k])));
+            }
+        }
+        let mut header: Vec<String> = self.inputs.iter().map(|p| p.name.clone()).collect();
+        header.extend(self.file.quantities.iter().map(|q| q.name.clone()));
+        header.extend(picks.iter().map(|p| p.2.clone()));
+        let mut text = header.join(",");
+        text.push('\n');
+        for (x, v) in self.sample(n, seed) {
+            let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
+            row.extend(v.quantities.iter().map(f64::to_string));
+            row.extend(picks.iter().map(|&(o, k, _)| v.outputs[o][k].to_string()));
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        text
+    }
+
+    /// `n` random points of the inputs' joint law with the surrogate's values there: point
+    /// `i` comes from the stream `(seed, i)` only ([`germ_draws`]).
+    pub fn sample(&self, n: usize, seed: u64) -> Vec<(Vec<f64>, SurrogateValues)> {
+        let families: Vec<Family> = self.file.inputs.iter().map(|i| i.family).collect();
+        germ_draws(&families, n, seed)
+            .into_iter()
+            .map(|t| {
+                let x = self.inputs.to_physical(self.file.germ, &t);
+                (x, self.eval_germ(&t))
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::random_inputs::CorrelationPair;
+
+    fn inputs(correlated: bool) -> RandomInputs {
+        let parameters = vec![
+            RandomParameter {
+                name: "a".into(),
+                distribution: Distribution::normal(2.0, 0.5).unwrap(),
+            },
+            RandomParameter {
+                name: "b".into(),
+                distribution: Distribution::uniform(0.0, 4.0).unwrap(),
+            },
+        ];
+        let pairs = if correlated {
+            vec![CorrelationPair {
+                between: ["a".into(), "b".into()],
+                rho: 0.4,
+            }]
+        } else {
+            vec![]
+        };
+        let correlation = Correlation::new(&parameters, pairs).unwrap();
+        RandomInputs {
+            parameters,
+            correlation,
+        }
+    }
+
+    /// f(t) = 1 + 2 p1(t_a) + 0.5 p1(t_b) p1(t_a), Hermite x Legendre (Askey germs).
+    fn chaos() -> NamedChaos {
+        let set = MultiIndexSet::from_indices(2, vec![vec![0, 0], vec![1, 0], vec![1, 1]]).unwrap();
+        let basis = Basis::new(vec![Family::Hermite, Family::Legendre], set).unwrap();
+        NamedChaos {
+            name: "f".into(),
+            times: Some(vec![0.0]),
+            pce: Pce::new(basis, DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 0.5])).unwrap(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_written_surrogate_reads_back_and_evaluates_at_physical_values() {
+        for correlated in [false, true] {
+            let ins = inputs(correlated);
+            let file = SurrogateFile::new("s", "sparse_grid", Germ::Askey, &ins, &[chaos()], &[]);
+            let text = serde_json::to_string(&file).unwrap();
+            assert!(
+                text.contains(r#""map":"affine","offset":2.0,"scale":0.5"#),
+                "{text}"
+            );
+            let s = Surrogate::new(serde_json::from_str(&text).unwrap()).unwrap();
+            // At physical values: germs by the inverse map, then the chaos.
+            let x = [2.5, 3.0];
+            let t = ins.to_germ(Germ::Askey, &x);
+            if !correlated {
+                assert_eq!(t, vec![1.0, 0.5]);
+            }
+            let want = 1.0 + 2.0 * t[0] + 0.5 * t[0] * (3f64.sqrt() * t[1]);
+            assert!((s.eval(&x).outputs[0][0] - want).abs() < 1e-12);
+            // Draws: the inputs' values and the chaos at the same germ points.
+            let draws = s.sample(50, 1);
+            assert_eq!(draws.len(), 50);
+            for (x, v) in &draws {
+                assert!((s.eval(x).outputs[0][0] - v.outputs[0][0]).abs() < 1e-9);
+                assert!((0.0..=4.0).contains(&x[1]));
+            }
+            assert_eq!(s.sample_csv(50, 1, &[]), s.sample_csv(50, 1, &[]));
+        }
+    }
+
+    #[test]
+    fn foreign_files_and_bad_points_are_refused() {
+        let ins = inputs(false);
+        let mut file = SurrogateFile::new("s", "scm", Germ::Askey, &ins, &[chaos()], &[]);
+        let s = Surrogate::new(file.clone()).unwrap();
+        assert!(s.point(&[("zz".into(), 1.0)]).is_err());
+        assert!(s.point(&[("b".into(), 5.0)]).is_err());
+        assert_eq!(s.point(&[("a".into(), 1.0)]).unwrap(), vec![1.0, 2.0]);
+        file.version = 2;
+        assert!(Surrogate::new(file.clone()).is_err());
+        file.version = VERSION;
+        file.outputs[0].coefficients[0].pop();
+        assert!(Surrogate::new(file).is_err());
+    }
+}

@@ -1,0 +1,548 @@
+//! The chaos methods (sparse grids, regression chaos), the new input families, correlated
+//! inputs and the exported surrogate, end to end through the `uq-driver` binary and the
+//! Functions test FMU (`tests/fmus/functions`: 1 Ishigami, 2 borehole, 3 g-function,
+//! 4 `x1 + x2²`). References are closed forms or tensor quadratures written in
+//! `support/benchmarks.rs`, independently of the code under test.
+
+#[path = "support/benchmarks.rs"]
+mod benchmarks;
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+/// A study on the Functions FMU: `function`, the random parameters and the method (TOML),
+/// the output `y` at t = 0 and 0.1, and the quantity `Y` (its final value).
+fn study(dir: &Path, name: &str, function: u32, parameters: &str, method: &str) -> PathBuf {
+    let fmu = test_fmus::test_fmu("Functions").expect("the Functions test FMU");
+    let text = format!(
+        r#"name = "{name}"
+fmu = "{fmu}"
+seed = 11
+[experiment]
+start = 0.0
+stop = 0.1
+step = 0.1
+[fixed]
+function = {function}
+sigma_h = 0.0
+{parameters}
+[outputs]
+variables = ["y"]
+[[qoi]]
+kind = "final"
+name = "Y"
+signal = "y"
+[method]
+{method}
+"#,
+        fmu = fmu.display()
+    );
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn uniform(names: &[&str], low: f64, high: f64) -> String {
+    names
+        .iter()
+        .map(|n| {
+            format!(
+                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = {low}\nhigh = {high}\n"
+            )
+        })
+        .collect()
+}
+
+fn driver(args: &[&str]) -> std::process::Output {
+    Command::new(DRIVER)
+        .args(args)
+        .output()
+        .expect("uq-driver runs")
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let out = driver(args);
+    assert!(
+        out.status.success(),
+        "uq-driver {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs `study` into `dir/out`; returns the output folder.
+fn run_study(study: &Path) -> PathBuf {
+    let out = study.with_extension("out");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    out
+}
+
+/// A CSV file: header and rows of numbers (non-numeric fields as NaN).
+struct Csv {
+    header: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    fn parse(text: &str) -> Csv {
+        let mut lines = text.lines();
+        let header = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(str::to_owned)
+            .collect();
+        let rows = lines
+            .map(|l| {
+                l.split(',')
+                    .map(|x| x.parse::<f64>().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        Csv { header, rows }
+    }
+
+    fn read(path: &Path) -> Csv {
+        Csv::parse(&std::fs::read_to_string(path).unwrap())
+    }
+
+    fn col(&self, name: &str) -> Vec<f64> {
+        let c = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header));
+        self.rows.iter().map(|r| r[c]).collect()
+    }
+
+    /// Column `name` in the last row.
+    fn last(&self, name: &str) -> f64 {
+        *self.col(name).last().unwrap()
+    }
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn ishigami_sobol_indices_within_0_01_by_sparse_regression_with_200_runs() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let pi = std::f64::consts::PI;
+    let s = study(
+        dir.path(),
+        "ishigami",
+        1,
+        &uniform(&["x1", "x2", "x3"], -pi, pi),
+        "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 200\norder = 14\nsparse = true",
+    );
+    let out = run_study(&s);
+    let (first, total) = benchmarks::ishigami_indices();
+    let sobol = Csv::read(&out.join("y_sobol.csv"));
+    for (i, x) in ["x1", "x2", "x3"].iter().enumerate() {
+        let (s1, st) = (
+            sobol.last(&format!("S_{x}")),
+            sobol.last(&format!("ST_{x}")),
+        );
+        println!(
+            "ishigami 200 runs: S_{x} = {s1:.4} ({:.4}), ST_{x} = {st:.4} ({:.4})",
+            first[i], total[i]
+        );
+        assert!((s1 - first[i]).abs() < 0.01, "S_{x} = {s1} vs {}", first[i]);
+        assert!(
+            (st - total[i]).abs() < 0.01,
+            "ST_{x} = {st} vs {}",
+            total[i]
+        );
+    }
+    let (mean, var) = benchmarks::ishigami_moments();
+    let y = Csv::read(&out.join("y.csv"));
+    assert!((y.last("mean") - mean).abs() < 0.01 * var.sqrt());
+    assert!((y.last("std") / var.sqrt() - 1.0).abs() < 0.01);
+    // The leave-one-out error over time and for the quantity; the surrogate is written.
+    let loo = y.last("loo");
+    assert!(loo > 0.0 && loo < 1e-2, "loo {loo}");
+    let q = &summary(&out)["quantities"]["Y"];
+    assert_eq!(q["chaos_error"]["kind"], "loo");
+    assert!(q["chaos_error"]["value"].as_f64().unwrap() < 1e-2);
+    assert_eq!(summary(&out)["model_runs"], 200);
+    assert!(out.join("surrogate.json").is_file());
+}
+
+/// The borehole inputs: rw normal, r log-normal (ln r normal), six uniform.
+fn borehole_parameters() -> String {
+    let (mu, s) = benchmarks::LN_R;
+    let mean_r = (mu + 0.5 * s * s).exp();
+    let std_r = mean_r * (s * s).exp_m1().sqrt();
+    let mut p = format!(
+        "[[parameters]]\nname = \"rw\"\nmean = {}\nstd = {}\n\
+         [[parameters]]\nname = \"r\"\ndistribution = \"lognormal\"\nmean = {mean_r}\nstd = {std_r}\n",
+        benchmarks::RW.0,
+        benchmarks::RW.1
+    );
+    for (k, n) in ["Tu", "Hu", "Tl", "Hl", "L", "Kw"].iter().enumerate() {
+        p.push_str(&format!(
+            "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = {}\nhigh = {}\n",
+            benchmarks::BOREHOLE_LO[k],
+            benchmarks::BOREHOLE_HI[k]
+        ));
+    }
+    p
+}
+
+#[test]
+fn borehole_mean_and_std_by_sparse_regression_and_sparse_grid() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let (m_ref, s_ref) = benchmarks::borehole_reference(12, 5);
+    // The reference is converged: a coarser rule agrees to 1e-6.
+    let (m_c, s_c) = benchmarks::borehole_reference(10, 4);
+    assert!((m_c / m_ref - 1.0).abs() < 1e-6 && (s_c / s_ref - 1.0).abs() < 1e-6);
+    let dir = tempfile::tempdir().unwrap();
+    for (name, method, runs, tol_mean, tol_std) in [
+        (
+            "lars",
+            "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 100\norder = 6\nsparse = true",
+            100,
+            1e-3,
+            1e-2,
+        ),
+        ("sparse", "kind = \"sparse_grid\"\nlevel = 2", 0, 1e-3, 2e-2),
+    ] {
+        let s = study(dir.path(), name, 2, &borehole_parameters(), method);
+        let out = run_study(&s);
+        let y = Csv::read(&out.join("y.csv"));
+        let (em, es) = (
+            (y.last("mean") / m_ref - 1.0).abs(),
+            (y.last("std") / s_ref - 1.0).abs(),
+        );
+        let n = summary(&out)["model_runs"].as_u64().unwrap();
+        println!(
+            "borehole {name}: {n} runs, mean error {:.4} %, std error {:.3} % (reference {m_ref:.4}, {s_ref:.4})",
+            100.0 * em,
+            100.0 * es
+        );
+        if runs > 0 {
+            assert_eq!(n, runs);
+        }
+        assert!(em < tol_mean, "{name}: mean error {em}");
+        assert!(es < tol_std, "{name}: std error {es}");
+    }
+}
+
+#[test]
+fn beta_and_gamma_inputs_through_the_fmu_have_the_closed_form_moments() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    // Function 4 with sigma_h = 0: y = x1 + x2², x1 ~ Gamma(k, theta), x2 ~ Beta(a, b) on
+    // [lo, hi]. E y = k theta + E x2², Var y = k theta² + Var(x2²) (independent).
+    let (k, theta): (f64, f64) = (2.5, 0.4);
+    let (a, b, lo, hi): (f64, f64, f64, f64) = (2.0, 3.0, 1.0, 3.0);
+    // Raw moments of x2 = lo + (hi - lo) B: E B^j = prod_{i<j} (a + i) / (a + b + i).
+    let eb = |j: i32| -> f64 {
+        (0..j)
+            .map(|i| (a + i as f64) / (a + b + i as f64))
+            .product()
+    };
+    let ex2 = |m: i32| -> f64 {
+        // E (lo + w B)^m by the binomial sum.
+        let w = hi - lo;
+        (0..=m)
+            .map(|j| {
+                let c: f64 = (0..j).map(|i| (m - i) as f64 / (i + 1) as f64).product();
+                c * lo.powi(m - j) * w.powi(j) * eb(j)
+            })
+            .sum()
+    };
+    let mean = k * theta + ex2(2);
+    let var = k * theta * theta + ex2(4) - ex2(2) * ex2(2);
+    let params = format!(
+        "[[parameters]]\nname = \"x1\"\ndistribution = \"gamma\"\nshape = {k}\nscale = {theta}\n\
+         [[parameters]]\nname = \"x2\"\ndistribution = \"beta\"\nalpha = {a}\nbeta = {b}\nlow = {lo}\nhigh = {hi}\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    // The Askey chaos (Laguerre x Jacobi) represents y exactly: exact moments.
+    for (i, method) in [
+        "kind = \"sparse_grid\"\nlevel = 2",
+        "kind = \"pce_regression\"\nsamples = 12\norder = 2",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let s = study(dir.path(), &format!("askey{i}"), 4, &params, method);
+        let out = run_study(&s);
+        let y = Csv::read(&out.join("y.csv"));
+        assert!(
+            (y.last("mean") - mean).abs() < 1e-12,
+            "{method}: {}",
+            y.last("mean")
+        );
+        assert!(
+            (y.last("std") - var.sqrt()).abs() < 1e-12,
+            "{method}: {}",
+            y.last("std")
+        );
+    }
+    // Latin hypercube: the sample mean within 4 standard errors.
+    let s = study(
+        dir.path(),
+        "lhs",
+        4,
+        &params,
+        "kind = \"lhs\"\nsamples = 4000",
+    );
+    let out = run_study(&s);
+    let y = Csv::read(&out.join("y.csv"));
+    let se = var.sqrt() / 4000f64.sqrt();
+    assert!(
+        (y.last("mean") - mean).abs() < 4.0 * se,
+        "{} vs {mean}",
+        y.last("mean")
+    );
+    // The design's values follow the marginals (points.csv).
+    let pts = Csv::read(&out.join("points.csv"));
+    let x1 = pts.col("x1");
+    let m1 = x1.iter().sum::<f64>() / x1.len() as f64;
+    assert!((m1 - k * theta).abs() < 1e-3, "{m1}");
+    assert!(pts.col("x2").iter().all(|v| (lo..=hi).contains(v)));
+}
+
+#[test]
+fn correlated_inputs_reproduce_the_target_correlation_in_points_csv() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let params = "[[parameters]]\nname = \"x1\"\ndistribution = \"gamma\"\nshape = 2.0\nscale = 1.5\n\
+         [[parameters]]\nname = \"x2\"\ndistribution = \"beta\"\nalpha = 2.0\nbeta = 5.0\nlow = 0.0\nhigh = 1.0\n\
+         [[parameters]]\nname = \"x3\"\nmean = 1.0\nstd = 0.2\n\
+         [[correlation]]\nbetween = [\"x1\", \"x2\"]\nrho = 0.6\n\
+         [[correlation]]\nbetween = [\"x3\", \"x1\"]\nrho = -0.4\n";
+    let dir = tempfile::tempdir().unwrap();
+    let n = 20_000;
+    for (i, method) in [
+        format!("kind = \"lhs\"\nsamples = {n}"),
+        format!("kind = \"mc\"\nsamples = {n}"),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let s = study(dir.path(), &format!("corr{i}"), 4, params, method);
+        let out = run_study(&s);
+        let pts = Csv::read(&out.join("points.csv"));
+        let cols = [pts.col("x1"), pts.col("x2"), pts.col("x3")];
+        let corr = |a: &[f64], b: &[f64]| {
+            let n = a.len() as f64;
+            let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+            let c: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+            let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+            let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+            c / (va * vb).sqrt()
+        };
+        for (i, j, target) in [(0, 1, 0.6), (2, 0, -0.4), (1, 2, f64::NAN)] {
+            let r = corr(&cols[i], &cols[j]);
+            // Standard error of a sample correlation ~ (1 - rho²) / sqrt(n), doubled for the
+            // non-normal marginals; 4 of them.
+            let se = 2.0 / (n as f64).sqrt();
+            if target.is_nan() {
+                // x2 and x3 are correlated only through x1: rho_23 is not zero but bounded.
+                assert!(r.abs() < 0.6, "{method}: rho(x2, x3) = {r}");
+            } else {
+                assert!(
+                    (r - target).abs() < 4.0 * se,
+                    "{method}: rho({i}, {j}) = {r}"
+                );
+            }
+        }
+        let sm = summary(&out);
+        assert_eq!(sm["correlation"]["pairs"][0]["rho"], 0.6);
+    }
+}
+
+#[test]
+fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    // y = x1 + x2² with x1 normal and x2 uniform: exactly a chaos of degree 2.
+    let params = "[[parameters]]\nname = \"x1\"\nmean = 1.0\nstd = 0.5\n\
+         [[parameters]]\nname = \"x2\"\ndistribution = \"uniform\"\nlow = -1.0\nhigh = 2.0\n";
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "surr",
+        4,
+        params,
+        "kind = \"sparse_grid\"\nlevel = 2",
+    );
+    let out = run_study(&s);
+    let out_s = out.to_str().unwrap();
+    let eval = Csv::parse(&run_ok(&[
+        "surrogate",
+        "eval",
+        out_s,
+        "--at",
+        "x1=0.3",
+        "--at",
+        "x2=1.7",
+    ]));
+    // The model itself at that point, run through the FMU.
+    let fmu = test_fmus::test_fmu("Functions").unwrap();
+    let sim = Csv::parse(&run_ok(&[
+        "simulate",
+        fmu.to_str().unwrap(),
+        "--set",
+        "function=4",
+        "--set",
+        "sigma_h=0",
+        "--set",
+        "x1=0.3",
+        "--set",
+        "x2=1.7",
+        "--output",
+        "y",
+        "--stop",
+        "0.1",
+        "--step",
+        "0.1",
+    ]));
+    let model = sim.last("y");
+    assert!((model - (0.3 + 1.7 * 1.7)).abs() < 1e-12);
+    let value = eval.col("value");
+    assert_eq!(eval.rows.len(), 3, "y at two times and Y");
+    for v in &value {
+        assert!((v - model).abs() < 1e-12, "surrogate {v} vs model {model}");
+    }
+    // An unknown input or one outside its support is refused.
+    assert!(!driver(&["surrogate", "eval", out_s, "--at", "zz=1"])
+        .status
+        .success());
+    let bad = driver(&["surrogate", "eval", out_s, "--at", "x2=5"]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("outside the support"));
+    // Sampling: reproducible for a seed, different for another, right mean.
+    let a = run_ok(&["surrogate", "sample", out_s, "-n", "4000", "--seed", "3"]);
+    let b = run_ok(&["surrogate", "sample", out_s, "-n", "4000", "--seed", "3"]);
+    let c = run_ok(&["surrogate", "sample", out_s, "-n", "4000", "--seed", "4"]);
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+    let draws = Csv::parse(&a);
+    assert_eq!(draws.header, ["x1", "x2", "Y", "y@0.1"]);
+    for r in &draws.rows {
+        assert!((r[2] - (r[0] + r[1] * r[1])).abs() < 1e-12, "{r:?}");
+        assert_eq!(r[2], r[3]);
+    }
+    // E y = 1 + E x2² = 1 + (1 + 8) / 9 = 2 (x2 ~ U(-1, 2): E x2² = (2³ + 1) / 9).
+    let y = draws.col("Y");
+    let m = y.iter().sum::<f64>() / y.len() as f64;
+    assert!((m - 2.0).abs() < 0.05, "{m}");
+    let file = dir.path().join("draws.csv");
+    run_ok(&[
+        "surrogate",
+        "sample",
+        out_s,
+        "-n",
+        "10",
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(Csv::read(&file).rows.len(), 10);
+}
+
+#[test]
+fn chaos_methods_refuse_integer_inputs_and_sampling_runs_them() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let params =
+        "[[parameters]]\nname = \"x1\"\ndistribution = \"integer_uniform\"\nlow = 1\nhigh = 4\n\
+         [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n";
+    let dir = tempfile::tempdir().unwrap();
+    for method in [
+        "kind = \"sparse_grid\"\nlevel = 2",
+        "kind = \"pce_regression\"\nsamples = 20\norder = 2",
+        "kind = \"scm\"\nnodes = 3",
+    ] {
+        let s = study(dir.path(), "int", 4, params, method);
+        let o = driver(&[
+            "run",
+            s.to_str().unwrap(),
+            "--out",
+            dir.path().join("o").to_str().unwrap(),
+        ]);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("integer_uniform") && err.contains("'x1'"),
+            "{err}"
+        );
+    }
+    let s = study(
+        dir.path(),
+        "int-lhs",
+        4,
+        params,
+        "kind = \"lhs\"\nsamples = 400",
+    );
+    let out = run_study(&s);
+    let x1 = Csv::read(&out.join("points.csv")).col("x1");
+    for k in 1..=4 {
+        assert_eq!(x1.iter().filter(|&&v| v == k as f64).count(), 100, "{k}");
+    }
+}
+
+#[test]
+fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let params = "[[parameters]]\nname = \"x1\"\nmean = 1.0\nstd = 0.5\n\
+         [[parameters]]\nname = \"x2\"\ndistribution = \"uniform\"\nlow = -1.0\nhigh = 2.0\n";
+    let dir = tempfile::tempdir().unwrap();
+    // A previous study's points.csv is a points file.
+    let lhs = run_study(&study(
+        dir.path(),
+        "src",
+        4,
+        params,
+        "kind = \"lhs\"\nsamples = 12",
+    ));
+    std::fs::copy(lhs.join("points.csv"), dir.path().join("pts.csv")).unwrap();
+    let s = study(
+        dir.path(),
+        "file",
+        4,
+        params,
+        "kind = \"pce_regression\"\npoints = \"pts.csv\"\norder = 2",
+    );
+    let out = run_study(&s);
+    let y = Csv::read(&out.join("y.csv"));
+    // y = x1 + x2²: E = 1 + 1 = 2; Var = 0.25 + Var(x2²) = 0.25 + (E x2⁴ - 1),
+    // E x2⁴ = (2⁵ + 1) / 15 = 2.2.
+    assert!((y.last("mean") - 2.0).abs() < 1e-12, "{}", y.last("mean"));
+    assert!((y.last("std") - (0.25f64 + 1.2).sqrt()).abs() < 1e-12);
+    assert_eq!(
+        Csv::read(&out.join("points.csv")).col("x1"),
+        Csv::read(&lhs.join("points.csv")).col("x1")
+    );
+    // The same folder with an edited file (one point fewer): a different study, refused.
+    let text = std::fs::read_to_string(dir.path().join("pts.csv")).unwrap();
+    let mut rows: Vec<&str> = text.lines().collect();
+    rows.pop();
+    std::fs::write(dir.path().join("pts.csv"), rows.join("\n")).unwrap();
+    let o = driver(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("different study"));
+}
