@@ -1,9 +1,12 @@
-//! Scalar quantities of interest evaluated on one run's time series, as the study file
-//! declares them (`[[qoi]]`): critical speed, Sperling index, peak |signal|, final value.
+//! Scalar quantities of interest as the study file declares them (`[[qoi]]`): critical speed,
+//! Sperling index, peak |signal|, final value, evaluated on one run's time series; and the
+//! constant-speed critical speed (`hunting_speed`), which needs runs of its own
+//! ([`crate::qoi::hunting_speed`]).
 
 use serde::{Deserialize, Serialize};
 
 use crate::qoi::critical_speed::{critical_speed, CriticalSpeed, CriticalSpeedError};
+use crate::qoi::hunting_speed::HuntingSpeedSpec;
 use crate::qoi::sperling::{
     sperling_index, Direction, SperlingError, SperlingSettings, Statistic, Window,
 };
@@ -90,6 +93,10 @@ pub enum QoiSpec {
         #[serde(default)]
         limits: Vec<f64>,
     },
+    /// Constant-speed critical speed by bisection over runs of its own (see
+    /// [`crate::qoi::hunting_speed`]): two quantities, `name` (lowest speed that keeps hunting)
+    /// and `name_decay` (highest speed at which the disturbance dies out).
+    HuntingSpeed(HuntingSpeedSpec),
 }
 
 fn is_default<T: Default + PartialEq>(x: &T) -> bool {
@@ -147,36 +154,52 @@ pub enum QoiError {
     /// The signal has no sample.
     #[error("{0} is empty")]
     EmptySignal(String),
+    /// A quantity that is not computed from the study's run (`hunting_speed`).
+    #[error("'{0}' is computed from runs of its own, not from the study's run")]
+    NeedsOwnRuns(String),
 }
 
 impl QoiSpec {
-    /// The quantity's name.
+    /// The name of the `[[qoi]]` entry (of its first quantity).
     pub fn name(&self) -> &str {
         match self {
             QoiSpec::CriticalSpeed { name, .. }
             | QoiSpec::Sperling { name, .. }
             | QoiSpec::MaxAbs { name, .. }
             | QoiSpec::Final { name, .. } => name,
+            QoiSpec::HuntingSpeed(h) => &h.name,
         }
     }
 
-    /// The FMU signals it reads.
+    /// The scalar quantities it yields, in the order they are stored: one, except
+    /// `hunting_speed`'s two (`name`, `name_decay`).
+    pub fn quantity_names(&self) -> Vec<String> {
+        match self {
+            QoiSpec::HuntingSpeed(h) => vec![h.name.clone(), h.decay_name()],
+            q => vec![q.name().to_owned()],
+        }
+    }
+
+    /// The FMU signals it reads from the study's run (`hunting_speed` reads its signal from
+    /// its own runs only).
     pub fn signals(&self) -> Vec<&str> {
         match self {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
             QoiSpec::Sperling { signal, .. }
             | QoiSpec::MaxAbs { signal, .. }
             | QoiSpec::Final { signal, .. } => vec![signal],
+            QoiSpec::HuntingSpeed(_) => Vec::new(),
         }
     }
 
-    /// Exceedance limits.
+    /// Exceedance limits (of each of its quantities).
     pub fn limits(&self) -> &[f64] {
         match self {
             QoiSpec::CriticalSpeed { limits, .. }
             | QoiSpec::Sperling { limits, .. }
             | QoiSpec::MaxAbs { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
+            QoiSpec::HuntingSpeed(h) => &h.limits,
         }
     }
 
@@ -186,6 +209,7 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
             QoiSpec::Sperling { .. } => None,
             QoiSpec::MaxAbs { signal, .. } | QoiSpec::Final { signal, .. } => Some(signal),
+            QoiSpec::HuntingSpeed(h) => Some(&h.speed_parameter),
         }
     }
 
@@ -249,6 +273,21 @@ impl QoiSpec {
                 None => format!("largest |{signal}| from {from} s to the end"),
             },
             QoiSpec::Final { signal, .. } => format!("{signal} at the stop time"),
+            QoiSpec::HuntingSpeed(h) => format!(
+                "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs of \
+                 {} s; a run keeps hunting when max |{}| over its last {} s is at least {} \
+                 ({} = lowest speed seen hunting, {}_decay = highest seen dying out)",
+                h.speed_parameter,
+                h.low,
+                h.high,
+                h.tolerance,
+                h.duration,
+                h.signal,
+                h.window,
+                h.threshold,
+                h.name,
+                h.name
+            ),
         };
         QuantityDefinition {
             kind,
@@ -284,19 +323,32 @@ impl QoiSpec {
                 .is_some_and(|t| t <= *from)
                 .then_some("`to` must be after `from`"),
             QoiSpec::Final { .. } => None,
+            QoiSpec::HuntingSpeed(h) => {
+                return match h.problem() {
+                    Some(problem) => Err(InvalidQuantity {
+                        name: h.name.clone(),
+                        problem,
+                    }),
+                    None => self.check_limits(),
+                }
+            }
         };
-        let problem = problem.or_else(|| {
-            self.limits()
-                .iter()
-                .any(|l| !l.is_finite())
-                .then_some("limits must be finite")
-        });
         match problem {
             Some(p) => Err(InvalidQuantity {
                 name: self.name().to_owned(),
                 problem: p.to_owned(),
             }),
-            None => Ok(()),
+            None => self.check_limits(),
+        }
+    }
+
+    fn check_limits(&self) -> Result<(), InvalidQuantity> {
+        match self.limits().iter().any(|l| !l.is_finite()) {
+            true => Err(InvalidQuantity {
+                name: self.name().to_owned(),
+                problem: "limits must be finite".to_owned(),
+            }),
+            false => Ok(()),
         }
     }
 }
@@ -307,9 +359,11 @@ impl QoiSpec {
 pub enum Code {
     /// The value is valid.
     Ok = 0,
-    /// Critical speed: the signal never exceeds the threshold (value NaN).
+    /// Critical speed: the signal never exceeds the threshold (value NaN); `hunting_speed`:
+    /// the disturbance dies out even at the top of the bracket.
     NeverHunts = 1,
-    /// Critical speed: the oscillation never dies out within the run (value NaN).
+    /// Critical speed: the oscillation never dies out within the run (value NaN);
+    /// `hunting_speed`: the disturbance keeps hunting even at the bottom of the bracket.
     NeverStops = 2,
 }
 
@@ -401,6 +455,7 @@ pub fn evaluate<'a>(
             .last()
             .map(|v| (*v, Code::Ok))
             .ok_or_else(|| QoiError::EmptySignal(s.clone())),
+        QoiSpec::HuntingSpeed(h) => Err(QoiError::NeedsOwnRuns(h.name.clone())),
     }
 }
 

@@ -35,12 +35,12 @@ pub fn write(
         .iter()
         .position(|v| v.name == summary.reference)
         .unwrap_or(0);
-    let mut sections = vec![variants_section(summary, &variants[r])];
+    let mut sections = vec![variants_section(summary, variants, r)];
     for (o, rs) in variants[r].outputs.iter().enumerate() {
         sections.push(compare_output(dir, summary, variants, r, o, rs)?);
     }
-    for (qi, rq) in variants[r].quantities.iter().enumerate() {
-        sections.push(compare_scalar(dir, summary, variants, qi, rq)?);
+    for q in quantity_names(variants, r) {
+        sections.push(compare_scalar(dir, summary, variants, &q)?);
     }
     if !summary.paper.is_empty() {
         sections.push(paper_section(summary));
@@ -55,10 +55,41 @@ pub fn write(
     .write(&dir.join("index.html"))
 }
 
+/// The scalar quantities of every variant, by name: the reference's first, then those only
+/// other variants compute (a variant may leave quantities out, `quantities = [...]`).
+fn quantity_names(variants: &[VariantResults], r: usize) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    let order = std::iter::once(&variants[r]).chain(variants);
+    for q in order.flat_map(|v| v.quantities) {
+        if !names.contains(&q.name) {
+            names.push(q.name.clone());
+        }
+    }
+    names
+}
+
+/// The quantity `name` of a variant, if it computes it.
+fn find<'a>(quantities: &'a [ScalarStats], name: &str) -> Option<&'a ScalarStats> {
+    quantities.iter().find(|q| q.name == name)
+}
+
 /// The table of variants: method, runs, wall time, differences against the reference, and
-/// the scalar quantities.
-fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Section {
+/// the scalar quantities (blank where a variant does not compute one).
+fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usize) -> Section {
+    let reference = &variants[r];
     let ref_name = &summary.reference;
+    let names = quantity_names(variants, r);
+    // Exceedance limits of each quantity (the same in every variant that has it).
+    let limits: Vec<Vec<f64>> = names
+        .iter()
+        .map(|n| {
+            variants
+                .iter()
+                .find_map(|v| find(v.quantities, n))
+                .map(|q| q.exceedance.iter().map(|e| e.0).collect())
+                .unwrap_or_default()
+        })
+        .collect();
     let mut header: Vec<String> = ["variant", "method", "model runs", "wall time [s]"]
         .iter()
         .map(|s| s.to_string())
@@ -67,11 +98,11 @@ fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Secti
         header.push(format!("max |Δmean {}| vs {ref_name}", s.name));
         header.push(format!("max |ΔStd {}| vs {ref_name}", s.name));
     }
-    for q in reference.quantities {
-        header.push(format!("mean {}", q.name));
-        header.push(format!("Std {}", q.name));
-        for (l, _, _) in &q.exceedance {
-            header.push(format!("P({} > {l})", q.name));
+    for (n, ls) in names.iter().zip(&limits) {
+        header.push(format!("mean {n}"));
+        header.push(format!("Std {n}"));
+        for l in ls {
+            header.push(format!("P({n} > {l})"));
         }
     }
     let rows = summary
@@ -88,10 +119,15 @@ fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Secti
                 row.push(format!("{:.3e}", o.max_abs_mean_diff_vs_reference));
                 row.push(format!("{:.3e}", o.max_abs_std_diff_vs_reference));
             }
-            for q in &v.quantities {
-                row.push(format!("{:.5}", q.mean));
-                row.push(format!("{:.5}", q.std));
-                row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+            for (n, ls) in names.iter().zip(&limits) {
+                match find(&v.quantities, n) {
+                    Some(q) => {
+                        row.push(format!("{:.5}", q.mean));
+                        row.push(format!("{:.5}", q.std));
+                        row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+                    }
+                    None => row.extend(std::iter::repeat_n(String::new(), 2 + ls.len())),
+                }
             }
             row
         })
@@ -251,27 +287,35 @@ fn output_section(v: &str, ref_name: &str) -> Section {
     }
 }
 
-/// `<q>_pdf_compare.svg`, `<q>_mean_vs_runs.svg`, `<q>_std_vs_runs.svg`, `<q>_compare.csv`.
+/// `<q>_pdf_compare.svg`, `<q>_mean_vs_runs.svg`, `<q>_std_vs_runs.svg`, `<q>_compare.csv`,
+/// over the variants that compute quantity `q`.
 fn compare_scalar(
     dir: &Path,
     summary: &SuiteSummary,
     variants: &[VariantResults],
-    qi: usize,
-    rq: &ScalarStats,
+    q: &str,
 ) -> Result<Section, ReportError> {
-    let q = &rq.name;
-    let runs: Vec<f64> = variants
+    // (index of the variant, its statistics of q)
+    let having: Vec<(usize, &ScalarStats)> = variants
         .iter()
-        .map(|d| d.summary.model_runs as f64)
-        .collect();
-    let stats: Vec<&ScalarStats> = variants.iter().map(|d| &d.quantities[qi]).collect();
-    // A single deterministic run has no distribution: it would be a spike in the plots.
-    let curves = stats
-        .iter()
-        .zip(&summary.variants)
         .enumerate()
-        .filter(|(i, (s, _))| runs[*i] > 1.0 && !s.deterministic)
-        .map(|(i, (s, v))| Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(i)))
+        .filter_map(|(i, d)| find(d.quantities, q).map(|s| (i, s)))
+        .collect();
+    let rq = having[0].1;
+    let runs: Vec<f64> = having
+        .iter()
+        .map(|(i, _)| variants[*i].summary.model_runs as f64)
+        .collect();
+    let stats: Vec<&ScalarStats> = having.iter().map(|(_, s)| *s).collect();
+    // A single deterministic run has no distribution: it would be a spike in the plots.
+    let curves = having
+        .iter()
+        .zip(&runs)
+        .filter(|((_, s), &n)| n > 1.0 && !s.deterministic)
+        .map(|((i, s), _)| {
+            let v = &summary.variants[*i];
+            Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(*i))
+        })
         .collect();
     DensityPlot {
         title: format!("PDF of {q}, every variant"),
@@ -285,9 +329,9 @@ fn compare_scalar(
             .collect(),
     }
     .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
-    let kinds: Vec<&str> = variants
+    let kinds: Vec<&str> = having
         .iter()
-        .map(|d| d.summary.method.kind.as_str())
+        .map(|(i, _)| variants[*i].summary.method.kind.as_str())
         .collect();
     let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
     let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
@@ -311,7 +355,7 @@ fn compare_scalar(
     );
     std_plot.log_x = true;
     convergence(std_plot, &kinds, &runs, &stds).write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
-    let idx: Vec<f64> = (0..variants.len()).map(|i| i as f64).collect();
+    let idx: Vec<f64> = having.iter().map(|(i, _)| *i as f64).collect();
     write_columns(
         &dir.join(format!("{q}_compare.csv")),
         &[
@@ -323,11 +367,14 @@ fn compare_scalar(
         ],
         &[&idx, &runs, &means, &stds, &ses],
     )?;
-    Ok(scalar_section(q, summary))
+    let labels: Vec<&str> = having
+        .iter()
+        .map(|(i, _)| summary.variants[*i].name.as_str())
+        .collect();
+    Ok(scalar_section(q, &labels))
 }
 
-fn scalar_section(q: &str, summary: &SuiteSummary) -> Section {
-    let labels: Vec<&str> = summary.variants.iter().map(|v| v.name.as_str()).collect();
+fn scalar_section(q: &str, labels: &[&str]) -> Section {
     Section {
         heading: format!("Quantity {q} across variants"),
         text: format!(

@@ -44,7 +44,9 @@ pub fn study_units(study: &Study, md: Option<&ModelDescription>) -> BTreeMap<Str
     }
     for q in &study.qoi {
         if let Some(u) = quantity_unit(q, md) {
-            units.insert(q.name().to_owned(), u);
+            for name in q.quantity_names() {
+                units.insert(name, u.clone());
+            }
         }
     }
     units
@@ -78,7 +80,10 @@ pub fn annotate(
 /// index, where on the carbody the acceleration is taken (`Zc_acc_front`: "above the front
 /// bogie centre").
 pub fn describe_signals(quantities: &mut [ScalarStats], qoi: &[QoiSpec], md: &ModelDescription) {
-    for (q, spec) in quantities.iter_mut().zip(qoi) {
+    for q in quantities.iter_mut() {
+        let Some(spec) = qoi.iter().find(|s| s.quantity_names().contains(&q.name)) else {
+            continue;
+        };
         let Some(signal) = spec.signals().first().map(|s| s.to_string()) else {
             continue;
         };

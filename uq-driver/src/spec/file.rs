@@ -282,4 +282,8 @@ pub struct Variant {
     /// Deterministic values of this variant, merged over the study's `[fixed]`.
     #[serde(default)]
     pub fixed: BTreeMap<String, FixedValue>,
+    /// The study's `[[qoi]]` entries this variant computes, by name (default: all), e.g. to
+    /// leave an expensive quantity out of a large design.
+    #[serde(default)]
+    pub quantities: Option<Vec<String>>,
 }

@@ -221,16 +221,18 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
         let e = file.experiment.get_ref();
         e.stop - e.start
     };
-    let mut names: Vec<&str> = file.outputs.variables.iter().map(String::as_str).collect();
+    let mut names: Vec<String> = file.outputs.variables.clone();
     for q in &file.qoi {
         let (span, q): (_, &QoiSpec) = (q.span(), q.get_ref());
-        if names.contains(&q.name()) {
-            return Err(cx.invalid(
-                Some(span),
-                format!("quantity name '{}' is used twice", q.name()),
-            ));
+        for name in q.quantity_names() {
+            if names.contains(&name) {
+                return Err(cx.invalid(
+                    Some(span.clone()),
+                    format!("quantity name '{name}' is used twice"),
+                ));
+            }
+            names.push(name);
         }
-        names.push(q.name());
         q.validate(duration)
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
@@ -322,6 +324,22 @@ fn variant(
     }
     for (k, x) in &v.fixed {
         f.fixed.insert(k.clone(), x.clone());
+    }
+    if let Some(names) = &v.quantities {
+        if let Some(n) = names
+            .iter()
+            .find(|n| !file.qoi.iter().any(|q| q.get_ref().name() == *n))
+        {
+            return Err(cx.invalid(
+                Some(span),
+                format!(
+                    "variant '{}': quantities names '{n}', which is not a [[qoi]] of the study",
+                    v.name
+                ),
+            ));
+        }
+        f.qoi
+            .retain(|q| names.iter().any(|n| n == q.get_ref().name()));
     }
     let origin = format!("{} (variant {})", cx.origin, v.name);
     study(f, &origin, base, cx.text)

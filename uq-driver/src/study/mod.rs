@@ -20,6 +20,7 @@ pub mod runner;
 pub mod shard;
 mod single;
 pub mod size;
+pub mod speed_runs;
 pub mod store;
 pub mod suite;
 

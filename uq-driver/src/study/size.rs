@@ -30,7 +30,9 @@
 //! experiment or [`PROBE_SECONDS`]; the cost of a run is the cost of the one-step run
 //! plus that of the other steps at the measured rate, and the study takes `n` such
 //! runs on `T` threads (the runner's own work, e.g. writing the store, is not included: the
-//! wheel's runs take about twice the estimate). An FMU that fails the probe gives no time
+//! wheel's runs take about twice the estimate). A `hunting_speed` quantity adds its own runs to
+//! every point: the point then costs as much as its simulated time, the experiment plus
+//! 2 + ⌈log2((high − low)/tolerance)⌉ runs of `duration` ([`Shape::cost_factor`]). An FMU that fails the probe gives no time
 //! estimate (the study then reports the failure itself). With `--isolate` or
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
@@ -43,6 +45,7 @@ use super::guard::StudyGuard;
 use super::interface::Interface;
 use super::runner::{self, RunOptions};
 use crate::fmu::Instance;
+use crate::qoi::QoiSpec;
 use crate::spec::Study;
 use crate::uq::method::Evaluation;
 
@@ -259,6 +262,9 @@ pub struct Shape {
     /// Draws of a chaos surrogate per output (`[analysis] surrogate_samples`; 0 for a method
     /// that draws from its runs).
     pub surrogate_samples: usize,
+    /// Simulated time of a point over that of its run: 1, plus the runs of its own of each
+    /// `hunting_speed` quantity.
+    pub cost_factor: f64,
 }
 
 impl Shape {
@@ -277,11 +283,19 @@ impl Shape {
             }
         }
         let e = &study.experiment;
+        let own_runs: f64 = study
+            .qoi
+            .iter()
+            .filter_map(|q| match q {
+                QoiSpec::HuntingSpeed(h) => Some(h.runs_when_found() as f64 * h.duration),
+                _ => None,
+            })
+            .sum();
         Shape {
             runs,
             time_points: ((e.stop - e.start) / e.step).round() + 1.0,
             outputs: study.outputs.len(),
-            quantities: study.qoi.len(),
+            quantities: study.qoi.iter().map(|q| q.quantity_names().len()).sum(),
             signals: signals.len(),
             dim: study.parameters.len(),
             threads: threads.max(1),
@@ -290,6 +304,7 @@ impl Shape {
             } else {
                 0
             },
+            cost_factor: 1.0 + own_runs / (e.stop - e.start),
         }
     }
 
@@ -343,8 +358,10 @@ fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footpri
     judge(&footprint, true)?;
     let timed = opts.isolate.is_none() && opts.timeout_per_run.is_none();
     if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
-        if timed && n * (shape.time_points - 1.0).max(1.0) >= PROBE_MIN_STEPS {
-            footprint.time = probe(study, out_dir).map(|per_run| TimeEstimate {
+        let steps = n * (shape.time_points - 1.0).max(1.0) * shape.cost_factor;
+        if timed && steps >= PROBE_MIN_STEPS {
+            let per_point = probe(study, out_dir).map(|run| run * shape.cost_factor);
+            footprint.time = per_point.map(|per_run| TimeEstimate {
                 per_run,
                 total: per_run * (n / threads as f64).ceil(),
                 threads,
@@ -564,7 +581,20 @@ mod tests {
             dim: 2,
             threads: 2,
             surrogate_samples: 20_000,
+            cost_factor: 1.0,
         }
+    }
+
+    #[test]
+    fn hunting_speed_runs_count_in_the_cost_of_a_point() {
+        let s = Study::load("builtin:bogie-nominal").unwrap();
+        let shape = Shape::of(&s, 1);
+        // v_cr, v_cr_linear, v_hunt, v_hunt_decay.
+        assert_eq!(shape.quantities, 4);
+        // The 650 s ramp plus 14 runs of 300 s (40–100 m/s to 0.02 m/s).
+        assert_eq!(shape.cost_factor, 1.0 + 14.0 * 300.0 / 650.0);
+        let s = Study::load("builtin:bogie-lhs-500").unwrap();
+        assert_eq!(Shape::of(&s, 1).cost_factor, 1.0);
     }
 
     fn footprint(shape: &Shape, available: f64) -> Footprint {

@@ -77,6 +77,27 @@ pub enum AnalysisError {
         #[source]
         source: MethodError,
     },
+    /// A `hunting_speed` quantity whose bracket does not contain the transition at every
+    /// point that needs a value (all points, or any point of a weighted design).
+    #[error(
+        "quantity '{name}': at {decays_at_high} points the disturbance dies out even at the top of \
+         the bracket (high = {high}) and at {hunts_at_low} it keeps hunting even at the bottom \
+         (low = {low}); widen the bracket{more}"
+    )]
+    OutsideBracket {
+        /// The quantity.
+        name: String,
+        /// The bracket.
+        low: f64,
+        /// The bracket.
+        high: f64,
+        /// Points that die out at `high`.
+        decays_at_high: usize,
+        /// Points that keep hunting at `low`.
+        hunts_at_low: usize,
+        /// Further advice.
+        more: &'static str,
+    },
     /// An estimate asks for draws it cannot give.
     #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
     NoDraws(String),
@@ -275,8 +296,10 @@ struct QuantityRuns {
     never_stops: usize,
 }
 
-/// Statistics of a scalar quantity from its estimate and its valid run values.
+/// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
+/// its valid run values.
 fn scalar_stats(
+    name: &str,
     q: &QoiSpec,
     estimate: &Estimate,
     runs: QuantityRuns,
@@ -285,7 +308,7 @@ fn scalar_stats(
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
     let density_samples: Vec<f64> = settings
-        .draws(q.name(), estimate, Some(&data), Use::Scalar)?
+        .draws(name, estimate, Some(&data), Use::Scalar)?
         .column(0)
         .iter()
         .copied()
@@ -318,7 +341,7 @@ fn scalar_stats(
         .collect();
     let valid = runs.valid;
     Ok(ScalarStats {
-        name: q.name().to_owned(),
+        name: name.to_owned(),
         mean: estimate.mean[0],
         std: estimate.std[0],
         std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
@@ -527,29 +550,49 @@ pub fn analyse_runs(
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
     let mut quantity_chaos = Vec::new();
-    for (qi, q) in study.qoi.iter().enumerate() {
+    let scalars = study
+        .qoi
+        .iter()
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
+    for (qi, (name, q)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi);
+        let outside = |more| match q {
+            QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
+                name: name.clone(),
+                low: h.low,
+                high: h.high,
+                decays_at_high: qr.never_hunts,
+                hunts_at_low: qr.never_stops,
+                more,
+            }),
+            _ => None,
+        };
         if qr.valid.is_empty() {
+            if let Some(e) = outside("") {
+                return Err(e);
+            }
             return Err(AnalysisError::NoValue {
-                name: q.name().to_owned(),
+                name,
                 never_hunts: qr.never_hunts,
                 never_stops: qr.never_stops,
             });
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate =
-            method
-                .estimate(design, &qr.rows, &data)
-                .map_err(|source| AnalysisError::Quantity {
-                    name: q.name().to_owned(),
+        let estimate = method.estimate(design, &qr.rows, &data).map_err(|source| {
+            let more = " (or use a method that can leave points out, such as LHS or MC)";
+            outside(more)
+                .filter(|_| qr.never_hunts + qr.never_stops > 0)
+                .unwrap_or(AnalysisError::Quantity {
+                    name: name.clone(),
                     never_hunts: qr.never_hunts,
                     never_stops: qr.never_stops,
                     source,
-                })?;
-        quantities.push(scalar_stats(q, &estimate, qr, &settings)?);
+                })
+        })?;
+        quantities.push(scalar_stats(&name, q, &estimate, qr, &settings)?);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
-                name: q.name().to_owned(),
+                name: name.clone(),
                 times: None,
                 pce,
                 error: estimate.chaos_error,
