@@ -29,13 +29,22 @@ FMI2_HEADERS = $(shell $(VPY) -c 'import fmpy, os; print(os.path.join(os.path.di
 
 all: build fmu
 
+# `build` and `fmu` run the very same cargo command: cargo unifies the features of shared
+# dependencies (nalgebra, ...) over the packages it is asked to build, so `-p railuq` alone
+# after `--workspace` (or the other way round) rebuilt the FMU crate twice on every
+# `make run`. Now the second one is a no-op.
+CARGO_BUILD := $(CARGO) build --release --workspace
+
 build:
-	$(CARGO) build --release --workspace
+	$(CARGO_BUILD)
 
 # The packaged binaries are stripped of symbols and debug info (the ones under target/ keep
-# theirs for profiling).
+# theirs for profiling). The FMUs are packaged again only when the packaging command or one
+# of its inputs changed (stamp: target/fmu/.package-command): stripping the win64 DLL is not
+# byte-reproducible, so a needless repackaging changed the FMU's SHA-256 and made the next
+# `make run` refuse its own result folders ("the FMU differs").
 fmu:
-	$(CARGO) build --release -p railuq --lib --bin railuq-fmu
+	$(CARGO_BUILD)
 	@extra=; \
 	if [ "$(WIN64)" != no ]; then \
 	  if why=$$(bash tests/wine/toolchain.sh check-build 2>&1); then \
@@ -48,8 +57,16 @@ fmu:
 	    echo "make fmu: note: the FMUs carry no win64 binary: $$why ('make win64-toolchain' installs it)" >&2; \
 	  fi; \
 	fi; \
-	echo "target/release/railuq-fmu package $(LIB) $(FMU_DIR) $$extra"; \
-	target/release/railuq-fmu package $(LIB) $(FMU_DIR) $$extra
+	cmd="target/release/railuq-fmu package $(LIB) $(FMU_DIR) $$extra"; \
+	stamp=$(FMU_DIR)/.package-command; \
+	inputs="$(LIB) target/release/railuq-fmu LICENSE-MIT LICENSE-APACHE $${extra:+$(DLL)}"; \
+	if [ -f "$$stamp" ] && [ "$$(cat "$$stamp")" = "$$cmd" ] \
+	   && ls $(FMU_DIR)/Wheel.fmu $(FMU_DIR)/Bogie.fmu $(FMU_DIR)/VehicleTrack.fmu >/dev/null 2>&1 \
+	   && [ -z "$$(find $$inputs -newer "$$stamp" 2>/dev/null)" ]; then \
+	  echo "make fmu: $(FMU_DIR) is up to date"; \
+	else \
+	  echo "$$cmd"; $$cmd && echo "$$cmd" > "$$stamp"; \
+	fi
 
 # rustup's Windows target, Debian's mingw-w64 and wine64, installed if missing (apt-get as
 # root). Where they cannot be had the FMUs go without win64 and the Wine test skips, except
@@ -77,11 +94,12 @@ $(VPY): tests/python/requirements.txt
 venv: $(VPY)
 
 # The default study: the paper's wheel by stochastic collocation (6 x 6 nodes) and by Latin
-# hypercube (10 000 samples), both embedded in the binary.
+# hypercube (10 000 samples), both embedded in the binary, and one page comparing them.
 run: build fmu
 	$(DRIVER) run builtin:wheel-scm --out out/wheel-scm
 	$(DRIVER) run builtin:wheel-lhs-10000 --out out/wheel-lhs-10000
-	@echo "reports: out/wheel-scm/index.html out/wheel-lhs-10000/index.html"
+	$(DRIVER) compare out/wheel-scm out/wheel-lhs-10000 --out out
+	@echo "reports: out/index.html (both compared), out/wheel-scm/index.html, out/wheel-lhs-10000/index.html"
 
 lint:
 	$(CARGO) fmt --all -- --check
@@ -106,7 +124,12 @@ test-rust:
 test-python: venv
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
 
-bench: build fmu venv
+# The bench's peers (OpenTURNS, chaospy) go into the same venv.
+$(VENV)/.bench-requirements: bench/requirements.txt $(VPY)
+	$(VPY) -m pip install -q -r bench/requirements.txt
+	touch $@
+
+bench: build fmu venv $(VENV)/.bench-requirements
 	CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
 # Every study of the paper (long: about an hour on 2 cores, most of it the bogie's 20 000-sample

@@ -855,6 +855,17 @@ def bench_vt_stepping(work, other):
     return sec
 
 
+# ------------------------------------------------------------------ analysis and report (issue 15)
+
+def bench_analysis_report(work, repeats, checks, all_builtins):
+    """Analysis + report against the whole command for the built-ins, and builtin:wheel-scm
+    against OpenTURNS + fmpy and chaospy + fmpy (bench/analysis_report.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import analysis_report
+    return analysis_report.bench(sys.modules[__name__], work, DRIVER, repeats, checks,
+                                 all_builtins)
+
+
 # ------------------------------------------------------------------ BENCHMARKS.md
 
 # ------------------------------------------------------------------ --isolate overhead
@@ -997,6 +1008,9 @@ def main():
                     "target/bench/BENCHMARKS-quick.md with --quick)")
     ap.add_argument("--work", default=str(ROOT / "target" / "bench"),
                     help="scratch folder for study outputs (default target/bench)")
+    ap.add_argument("--all-builtins", action="store_true",
+                    help="also run the built-in studies that take an hour or more (the "
+                         "bogie's 20 000-sample LHS) in the analysis/report section")
     ap.add_argument("--quick", action="store_true",
                     help="smoke test: 1 repeat, short fmi_step budget, simulate_fmu on 100 "
                          "points scaled to 1 000")
@@ -1026,6 +1040,7 @@ def main():
         s_parse = bench_parse_description(work, repeats)
         s7 = bench_vt_stepping(work, s1.other)
         s_iso, same_iso = bench_isolate(work, repeats)
+        s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
         if env_fmu is None:
             del os.environ["RAILUQ_FMU_DIR"]
     except BenchError as e:
@@ -1033,8 +1048,8 @@ def main():
         return 2
     checks_ok = all(ok for _, _, ok in checks) and same_threads and same_iso
     total = time.perf_counter() - t_start
-    write_markdown(md, mach, [s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso], total, argv, checks_ok,
-                   lib_same)
+    write_markdown(md, mach, [s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis, total,
+                   argv, checks_ok, lib_same)
     print(f"\nwrote {rel(md)} ({total:.0f} s in all)", flush=True)
     if not checks_ok:
         print("bench/run.py: a correctness check FAILED (see above)", file=sys.stderr)

@@ -12,7 +12,8 @@
 //! - [`results`]: typed results and the summaries written to `summary.json`;
 //! - [`report`]: CSV/JSON writers, plots, the HTML pages of a study and of a suite;
 //! - [`study`]: running a study: the parallel runner, the resumable results store, the
-//!   statistics, shards for a cluster, suites.
+//!   statistics, shards for a cluster, suites;
+//! - [`suggest`]: "did you mean" for misspelt names.
 
 pub mod fmu;
 pub mod qoi;
@@ -20,4 +21,5 @@ pub mod report;
 pub mod results;
 pub mod spec;
 pub mod study;
+pub mod suggest;
 pub mod uq;

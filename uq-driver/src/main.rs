@@ -9,8 +9,17 @@ use clap::{Args, Parser, Subcommand};
 
 use uq_driver::fmu::{Fmu, VariableKind};
 use uq_driver::report::csv::push_shortest;
-use uq_driver::spec::{builtin, Experiment, FixedValue, InvalidExperiment, Study, BUILTINS};
-use uq_driver::study::{run_study, runner, shard, Outcome, RunOptions, StudyResult, SuiteResult};
+use uq_driver::report::units::with_unit;
+use uq_driver::results::sig;
+use uq_driver::spec::{
+    builtin, fmu_candidates, Experiment, FixedValue, InvalidExperiment, Study, StudyError, BUILTINS,
+};
+use uq_driver::study::interface::{InterfaceError, VariableProblem};
+use uq_driver::study::{
+    run_study, runner, shard, size, Outcome, RunError, RunOptions, StudyResult, StudyRunError,
+    SuiteResult,
+};
+use uq_driver::suggest;
 use uq_driver::uq::surrogate::Surrogate;
 
 #[derive(Parser)]
@@ -38,6 +47,9 @@ enum Command {
         /// Plan folder.
         #[arg(long, short)]
         out: PathBuf,
+        /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+        #[arg(long)]
+        yes: bool,
     },
     /// Run one shard of a plan (resumable); K defaults to $SLURM_ARRAY_TASK_ID.
     RunShard {
@@ -83,6 +95,28 @@ enum Command {
     },
     /// Run an FMU once at given parameter values and write its outputs as CSV.
     Simulate(SimulateArgs),
+    /// Compare finished study folders on one page: DIR/index.html with a table of the
+    /// studies and their outputs and quantities side by side.
+    Compare {
+        /// Study (or suite) folders written by `run`.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Folder of the page.
+        #[arg(long, short)]
+        out: PathBuf,
+    },
+    /// Write every run's time series of a finished study folder: DIR/runs/runs.csv (long
+    /// format run,time,<outputs>) and DIR/runs/runs.npz (NumPy arrays).
+    Export {
+        /// Study folder written by `run`.
+        dir: PathBuf,
+        /// Every run's time series (the only export so far).
+        #[arg(long)]
+        runs: bool,
+        /// Folder of the files (default DIR/runs).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
     /// Serve points to a parent uq-driver (`--isolate`) over stdin/stdout.
     #[command(hide = true)]
     Worker,
@@ -129,7 +163,7 @@ enum SurrogateCommand {
 
 #[derive(Args)]
 struct RunArgs {
-    /// Study file, or builtin:NAME (see `uq-driver list`).
+    /// Study file, or builtin:NAME or just NAME (see `uq-driver list`).
     study: String,
     /// Output folder (re-running into the same folder resumes an interrupted study).
     #[arg(long, short)]
@@ -146,6 +180,12 @@ struct RunArgs {
     /// Stop after this many new points (the study can be resumed later).
     #[arg(long, hide = true)]
     max_points: Option<usize>,
+    /// Start a large study (more than 100 000 runs, or much memory or time) without asking.
+    #[arg(long)]
+    yes: bool,
+    /// Write the CSV files and summary.json only: no plots, no index.html.
+    #[arg(long)]
+    no_report: bool,
     #[command(flatten)]
     safety: SafetyArgs,
 }
@@ -214,6 +254,9 @@ struct SlurmArgs {
     /// Write the scripts but do not submit.
     #[arg(long)]
     dry_run: bool,
+    /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
+    #[arg(long)]
+    yes: bool,
 }
 
 #[derive(Args)]
@@ -280,6 +323,9 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             eprintln!("uq-driver: error: {}", causes(&e));
+            for h in hints(&e) {
+                eprintln!("uq-driver: hint: {h}");
+            }
             ExitCode::FAILURE
         }
     }
@@ -302,11 +348,170 @@ fn causes(e: &anyhow::Error) -> String {
     text
 }
 
+/// "Did you mean" for the errors that name something misspelt: a TOML key or kind, a
+/// variable the FMU does not have.
+fn hints(e: &anyhow::Error) -> Vec<String> {
+    let mut out = Vec::new();
+    for cause in e.chain() {
+        if let Some(StudyError::Parse { message, .. }) = cause.downcast_ref::<StudyError>() {
+            out.extend(suggest::for_serde_message(message));
+        }
+        // `transparent` errors hide their inner error from the chain: look inside.
+        let ie = cause
+            .downcast_ref::<InterfaceError>()
+            .or_else(|| match cause.downcast_ref::<RunError>() {
+                Some(RunError::Interface(ie)) => Some(ie),
+                _ => None,
+            })
+            .or_else(|| match cause.downcast_ref::<StudyRunError>() {
+                Some(StudyRunError::Run(RunError::Interface(ie))) => Some(ie),
+                _ => None,
+            });
+        if let Some(ie) = ie {
+            if let VariableProblem::Unknown { name, .. } = &ie.problem {
+                if let Ok(fmu) = Fmu::open(&ie.fmu) {
+                    let names = fmu.description().variables.iter().map(|v| v.name.as_str());
+                    if let Some(c) = suggest::closest(name, names) {
+                        out.push(format!("'{name}': did you mean '{c}'?"));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A study argument as `Study::load` takes it: a file, `builtin:NAME`, or a bare built-in
+/// NAME when no file of that name exists; a misspelt name gets the closest built-in.
+fn study_spec(arg: &str) -> Result<String> {
+    let names = || BUILTINS.iter().map(|(n, _)| *n);
+    if let Some(name) = arg.strip_prefix("builtin:") {
+        if names().any(|n| n == name) {
+            return Ok(arg.to_owned());
+        }
+        let hint = suggest::closest(name, names())
+            .map(|c| format!(" (did you mean builtin:{c}?)"))
+            .unwrap_or_default();
+        anyhow::bail!("no built-in study '{name}'{hint}; `uq-driver list` shows them all");
+    }
+    let is_builtin = names().any(|n| n == arg);
+    let exists = Path::new(arg).exists();
+    match (exists, is_builtin) {
+        (true, true) => anyhow::bail!(
+            "'{arg}' is both a file here and a built-in study: write ./{arg} for the file or \
+             builtin:{arg} for the built-in"
+        ),
+        (true, false) => Ok(arg.to_owned()),
+        (false, true) => Ok(format!("builtin:{arg}")),
+        (false, false) => {
+            let hint = suggest::closest(arg, names())
+                .map(|c| format!("; did you mean the built-in study {c}?"))
+                .unwrap_or_else(|| "; `uq-driver list` shows the built-in studies".into());
+            anyhow::bail!("no study file '{arg}' and no built-in study of that name{hint}")
+        }
+    }
+}
+
+/// Loads a study argument (file, builtin:NAME or NAME), warns about `cov` values that look
+/// like percentages and checks that its FMU (and every variant's) can be found.
+fn load_study(arg: &str) -> Result<Study> {
+    let s = Study::load(&study_spec(arg)?)?;
+    for w in cov_warnings(&s.source) {
+        eprintln!("uq-driver: warning: {w}");
+    }
+    let mut studies = vec![&s];
+    if let Some(suite) = &s.suite {
+        studies.extend(&suite.variants);
+    }
+    for st in studies {
+        check_fmu_found(st)?;
+    }
+    Ok(s)
+}
+
+/// `cov` is a fraction: a value above 1 is most likely a percentage.
+fn cov_warnings(source: &str) -> Vec<String> {
+    let Ok(table) = source.parse::<toml::Table>() else {
+        return Vec::new();
+    };
+    let mut params: Vec<&toml::Value> = Vec::new();
+    let arrays = |t: &toml::Table| -> Vec<toml::Value> {
+        t.get("parameters")
+            .and_then(|p| p.as_array())
+            .cloned()
+            .unwrap_or_default()
+    };
+    let mut all = arrays(&table);
+    for v in table
+        .get("variants")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        if let Some(t) = v.as_table() {
+            all.extend(arrays(t));
+        }
+    }
+    params.extend(all.iter());
+    let mut out: Vec<String> = params
+        .iter()
+        .filter_map(|p| {
+            let cov = p
+                .get("cov")?
+                .as_float()
+                .or_else(|| p.get("cov").and_then(|c| c.as_integer()).map(|i| i as f64))?;
+            let name = p.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            (cov > 1.0).then(|| {
+                format!(
+                    "parameter '{name}': cov = {cov} is a coefficient of variation of {} %; \
+                     `cov` is a fraction (did you mean cov = {}?)",
+                    cov * 100.0,
+                    cov / 100.0
+                )
+            })
+        })
+        .collect();
+    out.dedup();
+    out
+}
+
+/// An error listing every place searched when a study's FMU is not found.
+fn check_fmu_found(s: &Study) -> Result<()> {
+    let Some(path) = &s.fmu_path else {
+        return Ok(());
+    };
+    if path.exists() {
+        return Ok(());
+    }
+    let given = s
+        .base
+        .as_ref()
+        .and_then(|b| path.strip_prefix(b).ok())
+        .unwrap_or(path);
+    let places: Vec<String> = fmu_candidates(&given.to_string_lossy(), s.base.as_deref())
+        .iter()
+        .map(|p| format!("  {}", p.display()))
+        .collect();
+    anyhow::bail!(
+        "{}: FMU {} not found; looked in:\n{}\n(set RAILUQ_FMU_DIR to the folder of the FMUs, \
+         e.g. target/fmu after `make fmu`)",
+        s.origin,
+        given.display(),
+        places.join("\n")
+    )
+}
+
 fn dispatch(cmd: Command) -> Result<()> {
     match cmd {
         Command::Run(args) => run(args),
-        Command::Plan { study, shards, out } => {
-            let s = Study::load(&study)?;
+        Command::Plan {
+            study,
+            shards,
+            out,
+            yes,
+        } => {
+            let s = load_study(&study)?;
+            check_plan_size(&s, &out, yes)?;
             let p = shard::plan(&s, shards, &out)?;
             println!(
                 "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
@@ -354,13 +559,40 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Show { name } => {
-            let text = builtin(name.strip_prefix("builtin:").unwrap_or(&name))?;
+            let spec = study_spec(&format!(
+                "builtin:{}",
+                name.strip_prefix("builtin:").unwrap_or(&name)
+            ))?;
+            let text = builtin(spec.strip_prefix("builtin:").unwrap_or(&spec))?;
             std::io::stdout().lock().write_all(text.as_bytes())?;
             Ok(())
         }
         Command::Inspect { fmu } => inspect(&fmu),
         Command::Simulate(args) => simulate(args),
         Command::Surrogate(cmd) => surrogate(cmd),
+        Command::Compare { dirs, out } => {
+            uq_driver::report::compare::write(&dirs, &out)?;
+            println!(
+                "compared {} folders: {}",
+                dirs.len(),
+                out.join("index.html").display()
+            );
+            Ok(())
+        }
+        Command::Export { dir, runs, out } => {
+            anyhow::ensure!(runs, "say what to export: --runs (every run's time series)");
+            let out = out.unwrap_or_else(|| dir.join("runs"));
+            let e = uq_driver::study::export::runs(&dir, &out)?;
+            println!(
+                "exported {} runs × {} times of {}: {} and {}",
+                e.runs,
+                e.times,
+                e.outputs.join(", "),
+                e.csv.display(),
+                e.npz.display()
+            );
+            Ok(())
+        }
         Command::Worker => unreachable!("handled in main"),
     }
 }
@@ -396,13 +628,16 @@ fn surrogate(cmd: SurrogateCommand) -> Result<()> {
 
 /// `uq-driver run`.
 fn run(a: RunArgs) -> Result<()> {
-    let s = Study::load(&a.study)?;
+    let s = load_study(&a.study)?;
     let mut opts = RunOptions {
         threads: a.threads,
         progress: std::io::stderr().is_terminal(),
+        progress_lines: !std::io::stderr().is_terminal(),
         allow_failures: a.allow_failures,
         fresh: a.fresh,
         max_new_points: a.max_points,
+        yes: a.yes,
+        no_report: a.no_report,
         ..RunOptions::default()
     };
     a.safety.apply(&mut opts)?;
@@ -411,6 +646,16 @@ fn run(a: RunArgs) -> Result<()> {
         Outcome::Study(r) => print_study(&r, &a.out),
         Outcome::Suite(r) => print_suite(&r, &a.out),
     }
+    Ok(())
+}
+
+/// The size checks of `run` for a plan (whose shards run with the default thread count).
+fn check_plan_size(s: &Study, dir: &Path, yes: bool) -> Result<()> {
+    let opts = RunOptions {
+        yes,
+        ..RunOptions::default()
+    };
+    size::check(s, dir, &opts).with_context(|| format!("study {}", s.origin))?;
     Ok(())
 }
 
@@ -432,6 +677,7 @@ fn run_shard(
     let mut opts = RunOptions {
         threads,
         progress: std::io::stderr().is_terminal(),
+        progress_lines: !std::io::stderr().is_terminal(),
         allow_failures,
         ..RunOptions::default()
     };
@@ -446,7 +692,8 @@ fn run_shard(
 
 /// `uq-driver slurm`: plan, write the batch scripts and (unless --dry-run) submit them.
 fn slurm(a: SlurmArgs) -> Result<()> {
-    let s = Study::load(&a.study)?;
+    let s = load_study(&a.study)?;
+    check_plan_size(&s, &a.out, a.yes)?;
     shard::plan(&s, a.shards, &a.out)?;
     let driver = std::env::current_exe().context("locating the uq-driver executable")?;
     let o = shard::SlurmOptions {
@@ -501,25 +748,40 @@ fn print_study(r: &StudyResult, out: &Path) {
     for w in &s.warnings {
         eprintln!("uq-driver: warning: {w}");
     }
+    let t = &s.timing;
     println!(
-        "{}: {} model runs ({} resumed), wall time {:.2} s; report: {}",
+        "{}: {} model runs ({} resumed); wall time: runs {:.2} s, analysis {:.2} s, report \
+         {:.2} s; report: {}",
         s.study,
         s.model_runs,
         s.runs_resumed,
-        s.wall_time_s,
+        t.runs_s,
+        t.analysis_s,
+        t.report_s,
         out.join("index.html").display()
     );
     for q in &r.quantities {
-        if s.model_runs == 1 {
-            println!("  {} = {:.6}", q.name, q.mean);
+        let u = q.unit.as_deref();
+        let v = |x: f64| with_unit(&format!("{x:.6}"), u);
+        if q.deterministic {
+            println!(
+                "  {} = {} (every run; {})",
+                q.name,
+                v(q.mean),
+                q.definition.text
+            );
         } else {
             println!(
-                "  {}: mean {:.6}, std {:.6} ({} valid runs)",
-                q.name, q.mean, q.std, q.n_valid
+                "  {}: mean {}, Std {} ({} valid runs; {})",
+                q.name,
+                v(q.mean),
+                v(q.std),
+                q.n_valid,
+                q.definition.text
             );
-        }
-        for (l, p, se) in &q.exceedance {
-            println!("  P({} > {l}) = {p:.5} (standard error {se:.1e})", q.name);
+            for e in &q.exceedance_counts {
+                println!("  P({} > {}): {}", q.name, sig(e.limit), e.describe());
+            }
         }
     }
     if s.failed_runs > 0 {
@@ -567,6 +829,12 @@ fn simulate(a: SimulateArgs) -> Result<()> {
         ),
         other => other.into(),
     })?;
+    let series = if a.outputs.is_empty() {
+        fmu.description().output_variables().count()
+    } else {
+        a.outputs.len()
+    };
+    size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
     let params: Vec<(String, FixedValue)> = a
         .set
@@ -639,10 +907,13 @@ fn inspect(path: &Path) -> Result<()> {
         cs.provides_directional_derivative
     )?;
     if let Some(de) = &md.default_experiment {
+        let plain = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |x| x.to_string());
         writeln!(
             o,
-            "  default experiment: start {:?} stop {:?} step {:?}",
-            de.start_time, de.stop_time, de.step_size
+            "  default experiment: start {} s, stop {} s, step {} s",
+            plain(de.start_time),
+            plain(de.stop_time),
+            plain(de.step_size)
         )?;
     }
     writeln!(

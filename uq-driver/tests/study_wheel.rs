@@ -1,112 +1,17 @@
 //! The wheel studies against an independent reference: the closed-form response integrated
-//! over (K, C) on a 40 × 40 Gauss–Hermite grid whose nodes are computed here (Golub–Welsch),
-//! separately from the code under test. Also: thread-count independence, resume after a kill,
+//! over (K, C) on a 40 × 40 Gauss–Hermite grid whose nodes are computed in the tests
+//! (`support/wheel.rs`, Golub–Welsch), separately from the code under test. Also: thread-count independence, resume after a kill,
 //! failed points, and clear errors for bad inputs.
+
+#[path = "support/wheel.rs"]
+mod wheel;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use wheel::{fmu_dir, read_csv, reference, wheel_fmu};
 
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-fn fmu_dir() -> PathBuf {
-    std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-}
-
-fn wheel_fmu() -> PathBuf {
-    let p = fmu_dir().join("Wheel.fmu");
-    assert!(
-        p.is_file(),
-        "{} is missing: run `make fmu` first",
-        p.display()
-    );
-    p
-}
-
-/// Probabilists' Gauss–Hermite rule by Golub–Welsch (weights normalised to 1).
-fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let j = DMatrix::from_fn(n, n, |i, k| {
-        if k == i + 1 || i == k + 1 {
-            (i.max(k) as f64).sqrt()
-        } else {
-            0.0
-        }
-    });
-    let e = SymmetricEigen::new(j);
-    let mut pairs: Vec<(f64, f64)> = (0..n)
-        .map(|i| (e.eigenvalues[i], e.eigenvectors[(0, i)].powi(2)))
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let s: f64 = pairs.iter().map(|p| p.1).sum();
-    (
-        pairs.iter().map(|p| p.0).collect(),
-        pairs.iter().map(|p| p.1 / s).collect(),
-    )
-}
-
-/// q(t) of m q'' + c q' + k q = 0, q(0) = q0, q'(0) = 0, every regime.
-fn closed_form(m: f64, k: f64, c: f64, q0: f64, t: f64) -> f64 {
-    let a = -c / (2.0 * m);
-    let disc = a * a - k / m;
-    if disc < -1e-14 {
-        let wd = (-disc).sqrt();
-        q0 * (a * t).exp() * ((wd * t).cos() - a / wd * (wd * t).sin())
-    } else if disc > 1e-14 {
-        let r = disc.sqrt();
-        let (s1, s2) = (a + r, a - r);
-        (-s2 * q0 * (s1 * t).exp() + s1 * q0 * (s2 * t).exp()) / (s1 - s2)
-    } else {
-        q0 * (a * t).exp() * (1.0 - a * t)
-    }
-}
-
-/// Reference mean and Std of q(t) for K ~ N(100, 10²), C ~ N(20, 2²).
-fn reference(t: f64) -> (f64, f64) {
-    let (x, w) = gauss_hermite(40);
-    let mut vals = Vec::new();
-    for (xi, wi) in x.iter().zip(&w) {
-        for (xj, wj) in x.iter().zip(&w) {
-            vals.push((
-                wi * wj,
-                closed_form(10.0, 100.0 + 10.0 * xi, 20.0 + 2.0 * xj, 0.1, t),
-            ));
-        }
-    }
-    let mean: f64 = vals.iter().map(|(w, v)| w * v).sum();
-    let var: f64 = vals.iter().map(|(w, v)| w * (v - mean).powi(2)).sum();
-    (mean, var.sqrt())
-}
-
-struct Csv {
-    header: Vec<String>,
-    rows: Vec<Vec<f64>>,
-}
-
-fn read_csv(path: &Path) -> Csv {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
-        .collect();
-    Csv { header, rows }
-}
-
-impl Csv {
-    fn at(&self, t: f64, col: &str) -> f64 {
-        let c = self.header.iter().position(|h| h == col).unwrap();
-        let r = self.rows.iter().find(|r| (r[0] - t).abs() < 1e-9).unwrap();
-        r[c]
-    }
-}
 
 fn run(args: &[&str]) -> std::process::Output {
     let out = Command::new(DRIVER)
@@ -127,33 +32,7 @@ fn run_ok(args: &[&str]) {
 }
 
 fn study_file(dir: &Path, name: &str, method: &str, extra: &str) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = 7
-[experiment]
-start = 0.0
-stop = 5.0
-step = 0.01
-[method]
-{method}
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-cov = 0.1
-[outputs]
-variables = ["q"]
-{extra}
-"#,
-        fmu = wheel_fmu().display()
-    );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    wheel::write_study(dir, name, name, 7, wheel::EXPERIMENT, method, extra)
 }
 
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];

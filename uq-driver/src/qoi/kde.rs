@@ -1,6 +1,15 @@
 //! Gaussian kernel density estimation of sampled quantities of interest.
+//!
+//! [`gaussian_kde`] sums every kernel (within 8 bandwidths) at every grid point: exact, and
+//! `O(grid · k)` for `k` samples near a point. [`gaussian_kde_binned`] is the fast path for the
+//! report's many densities (every time step of an output, from tens of thousands of draws):
+//! linear binning onto a lattice at most `h / 8` apart that contains the (uniform) grid,
+//! then one discrete convolution with the kernel (Wand & Jones, *Kernel Smoothing*, 1995,
+//! appendix D; Hall & Wand, 1996): `O(n + grid · 8 · 16)` whatever the sample size, within
+//! 1.5e-3 of the peak density of the exact sum (far below the statistical error of a kernel
+//! density; the tests measure it).
 
-use crate::uq::special::norm_pdf;
+use crate::uq::special::{norm_cdf, norm_pdf};
 
 /// Kernel contributions beyond this many bandwidths are skipped
 /// (relative mass left out: `2 Q(8) = 1.2e-15`).
@@ -40,8 +49,18 @@ pub fn silverman_bandwidth(samples: &[f64]) -> f64 {
     } else {
         0.0
     };
-    let iqr =
-        (crate::uq::moments::quantile(&s, 0.75) - crate::uq::moments::quantile(&s, 0.25)) / 1.34;
+    let iqr = crate::uq::moments::quantile(&s, 0.75) - crate::uq::moments::quantile(&s, 0.25);
+    silverman_from(n, mean, std, iqr)
+}
+
+/// Silverman's rule from the statistics of `n` finite samples: their `mean`, unbiased `std`
+/// and inter-quartile range `iqr` (type-7 quantiles), with the fallbacks of
+/// [`silverman_bandwidth`] (which sorts; this lets a caller that has the statistics skip that).
+pub fn silverman_from(n: usize, mean: f64, std: f64, iqr: f64) -> f64 {
+    if n == 0 {
+        return 1e-3;
+    }
+    let iqr = iqr / 1.34;
     let spread = match (std > 0.0, iqr > 0.0) {
         (true, true) => std.min(iqr),
         (true, false) => std,
@@ -104,6 +123,217 @@ pub fn gaussian_kde(
             s * scale
         })
         .collect()
+}
+
+/// Lattice points per bandwidth of [`gaussian_kde_binned`] and
+/// [`gaussian_kde_cell_average`] (at least).
+const LATTICE_PER_BANDWIDTH: f64 = 8.0;
+/// Largest lattice (points) before [`gaussian_kde_binned`] falls back to the exact sum.
+const MAX_LATTICE: usize = 1 << 20;
+
+/// Equal-weight Gaussian kernel density estimate on the uniform grid of `n` points from `lo`
+/// to `hi` (as [`auto_grid`] makes it), by linear binning: every finite sample splits its
+/// unit mass between the two nearest points of a lattice that contains the grid (every `k`-th
+/// lattice point is a grid point, spacing `δ ≤ h / 8`, reaching 8 bandwidths beyond each
+/// end), and the density at a grid point is the discrete convolution of the lattice masses
+/// with the kernel. Samples more than 8 bandwidths from the grid carry no mass to it (as in
+/// [`gaussian_kde`]). A non-positive or non-finite `bandwidth` is replaced by
+/// [`silverman_bandwidth`]; a lattice that would be too fine falls back to [`gaussian_kde`].
+///
+/// Cost `O(samples + n · 8 · 16)`; the difference to the exact sum is below 1.5e-3 of the
+/// peak density (linear binning errs by `O(δ² / h²)`; the tests measure it).
+pub fn gaussian_kde_binned(
+    samples: &[f64],
+    lo: f64,
+    hi: f64,
+    n: usize,
+    bandwidth: f64,
+) -> Vec<f64> {
+    let grid = auto_grid(lo, hi, n);
+    let total = samples.iter().filter(|x| x.is_finite()).count();
+    if grid.is_empty() || total == 0 {
+        return vec![0.0; grid.len()];
+    }
+    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
+        bandwidth
+    } else {
+        silverman_bandwidth(samples)
+    };
+    let (a, step) = if grid.len() > 1 {
+        (
+            grid[0],
+            (grid[grid.len() - 1] - grid[0]) / (grid.len() - 1) as f64,
+        )
+    } else {
+        (grid[0], h)
+    };
+    // k lattice intervals per grid interval, delta = step / k <= h / 8.
+    let k = ((LATTICE_PER_BANDWIDTH * step / h).ceil().max(1.0)) as usize;
+    let delta = step / k as f64;
+    let taps = (CUTOFF * h / delta).ceil();
+    let lattice = (grid.len() - 1) as f64 * k as f64 + 1.0 + 2.0 * taps;
+    if !(delta > 0.0 && lattice.is_finite() && lattice <= MAX_LATTICE as f64) {
+        return gaussian_kde(samples, None, &grid, h);
+    }
+    let (taps, m) = (taps as usize, lattice as usize);
+    let origin = a - taps as f64 * delta;
+    let mut mass = vec![0.0; m + 1];
+    for &x in samples {
+        let u = (x - origin) / delta;
+        // Also false for NaN and infinities.
+        if u >= 0.0 && u <= (m - 1) as f64 {
+            let j = u.floor() as usize;
+            let f = u - j as f64;
+            mass[j] += 1.0 - f;
+            mass[j + 1] += f;
+        }
+    }
+    let scale = 1.0 / (total as f64 * h);
+    // The whole symmetric kernel, so that each density is one dot product.
+    let kernel: Vec<f64> = (0..=2 * taps)
+        .map(|t| norm_pdf((t as f64 - taps as f64) * delta / h) * scale)
+        .collect();
+    (0..grid.len())
+        .map(|i| dot(&kernel, &mass[i * k..i * k + 2 * taps + 1]))
+        .collect()
+}
+
+/// `Σ a_i b_i` with four partial sums (vectorisable).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for j in 0..4 {
+            acc[j] += x[j] * y[j];
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
+/// The Gaussian kernel density estimate averaged over each cell `[g_i − Δ/2, g_i + Δ/2]` of
+/// the uniform grid of `n` points from `lo` to `hi` (Δ the grid step). This is what a heat
+/// map can show of a distribution narrower than its grid: point values
+/// ([`gaussian_kde_binned`]) would fall between the grid points and miss it. Mass beyond the
+/// outer cells is left out.
+///
+/// The density is taken by linear binning and convolution on a lattice `h / 8` apart that
+/// spans the data (± 8 bandwidths), then integrated over each cell (piecewise linear);
+/// `O(samples + (range / h + 16) · 8 · 129)`. Where that lattice would be too large (data
+/// spread over far more than the bandwidth), every sample adds the kernel's probability of
+/// each cell instead, a difference of normal CDFs.
+pub fn gaussian_kde_cell_average(
+    samples: &[f64],
+    lo: f64,
+    hi: f64,
+    n: usize,
+    bandwidth: f64,
+) -> Vec<f64> {
+    let finite = || samples.iter().copied().filter(|x| x.is_finite());
+    let total = finite().count();
+    if n == 0 || total == 0 || !(lo.is_finite() && hi.is_finite()) {
+        return vec![0.0; n];
+    }
+    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
+        bandwidth
+    } else {
+        silverman_bandwidth(samples)
+    };
+    let grid = auto_grid(lo, hi, n);
+    let step = if n > 1 {
+        (grid[n - 1] - grid[0]) / (n - 1) as f64
+    } else {
+        grid[0].abs().max(1.0) * 1e-3
+    };
+    let first_edge = grid[0] - 0.5 * step;
+    let (xmin, xmax) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    let delta = h / LATTICE_PER_BANDWIDTH;
+    let taps = (CUTOFF * LATTICE_PER_BANDWIDTH) as usize;
+    let points = ((xmax - xmin) / delta).ceil() + 2.0 * taps as f64 + 2.0;
+    if !(points.is_finite() && points <= MAX_LATTICE as f64) {
+        return cell_average_exact(samples, first_edge, step, n, h, total);
+    }
+    let m = points as usize;
+    let origin = xmin - taps as f64 * delta;
+    // Masses padded by `taps` zeros on each side for the convolution.
+    let mut mass = vec![0.0; m + 2 * taps + 1];
+    for x in finite() {
+        let u = (x - origin) / delta;
+        let j = u.floor() as usize;
+        let f = u - j as f64;
+        mass[taps + j] += 1.0 - f;
+        mass[taps + j + 1] += f;
+    }
+    let scale = 1.0 / (total as f64 * h);
+    let kernel: Vec<f64> = (0..=2 * taps)
+        .map(|t| norm_pdf((t as f64 - taps as f64) * delta / h) * scale)
+        .collect();
+    let density: Vec<f64> = (0..m)
+        .map(|j| dot(&kernel, &mass[j..j + 2 * taps + 1]))
+        .collect();
+    // Only the cells the lattice reaches have mass; the cumulative integral is evaluated at
+    // their edges in one sweep.
+    let mut out = vec![0.0; n];
+    let a = (((origin - first_edge) / step).floor().max(0.0) as usize).min(n);
+    let b = ((((origin + (m - 1) as f64 * delta) - first_edge) / step)
+        .ceil()
+        .max(0.0) as usize)
+        .min(n);
+    if a < b {
+        let mut prefix = vec![0.0; m];
+        for j in 1..m {
+            prefix[j] = prefix[j - 1] + 0.5 * (density[j - 1] + density[j]) * delta;
+        }
+        let at = |x: f64| -> f64 {
+            let u = ((x - origin) / delta).clamp(0.0, (m - 1) as f64);
+            let j = (u.floor() as usize).min(m - 2);
+            let f = u - j as f64;
+            prefix[j] + f * delta * (density[j] + 0.5 * f * (density[j + 1] - density[j]))
+        };
+        let mut below = at(first_edge + a as f64 * step);
+        for (i, cell) in out.iter_mut().enumerate().take(b).skip(a) {
+            let above = at(first_edge + (i + 1) as f64 * step);
+            *cell = (above - below) / step;
+            below = above;
+        }
+    }
+    out
+}
+
+/// [`gaussian_kde_cell_average`] by a difference of normal CDFs per sample and cell.
+fn cell_average_exact(
+    samples: &[f64],
+    first_edge: f64,
+    step: f64,
+    n: usize,
+    h: f64,
+    total: usize,
+) -> Vec<f64> {
+    let mut mass = vec![0.0; n];
+    for &x in samples.iter().filter(|x| x.is_finite()) {
+        // Cells whose edges lie within 8 bandwidths of x.
+        let a = ((x - CUTOFF * h - first_edge) / step).floor().max(0.0);
+        let b = ((x + CUTOFF * h - first_edge) / step).ceil().min(n as f64);
+        if a >= b {
+            continue;
+        }
+        let (a, b) = (a as usize, b as usize);
+        let mut below = norm_cdf((first_edge + a as f64 * step - x) / h);
+        for (m, cell) in mass.iter_mut().enumerate().take(b).skip(a) {
+            let above = norm_cdf((first_edge + (m + 1) as f64 * step - x) / h);
+            *cell += above - below;
+            below = above;
+        }
+    }
+    let scale = 1.0 / (total as f64 * step);
+    mass.iter().map(|m| m * scale).collect()
 }
 
 /// `n` equally spaced points from `min` to `max` (both included; swapped if
@@ -233,5 +463,89 @@ mod tests {
         assert!(auto_grid(f64::NAN, 1.0, 10).is_empty());
         let g = auto_grid(-3.0, -3.0, 3);
         assert_eq!(g, vec![-3.015, -3.0, -2.985]);
+    }
+
+    /// Largest |binned − exact| relative to the exact peak.
+    fn binned_error(xs: &[f64], lo: f64, hi: f64, n: usize, h: f64) -> f64 {
+        let grid = auto_grid(lo, hi, n);
+        let exact = gaussian_kde(xs, None, &grid, h);
+        let fast = gaussian_kde_binned(xs, lo, hi, n, h);
+        assert_eq!(fast.len(), grid.len());
+        let peak = exact.iter().copied().fold(0.0, f64::max);
+        exact
+            .iter()
+            .zip(&fast)
+            .map(|(e, f)| (e - f).abs())
+            .fold(0.0, f64::max)
+            / peak
+    }
+
+    #[test]
+    fn binned_kde_matches_the_exact_sum() {
+        let normal = normal_samples(20_000, 5);
+        let h = silverman_bandwidth(&normal);
+        assert!(binned_error(&normal, -5.0, 5.0, 200, h) < 1.5e-3);
+        // A grid much coarser than the bandwidth, and one much finer.
+        assert!(binned_error(&normal, -5.0, 5.0, 11, h) < 1.5e-3);
+        assert!(binned_error(&normal, -1.0, 1.0, 400, h) < 1.5e-3);
+        // Bimodal and skewed, with samples far outside the grid on both sides.
+        let mixed: Vec<f64> = normal
+            .iter()
+            .enumerate()
+            .map(|(i, z)| if i % 3 == 0 { 6.0 + 0.2 * z } else { z.exp() })
+            .collect();
+        let h = silverman_bandwidth(&mixed);
+        assert!(binned_error(&mixed, 0.0, 7.0, 200, h) < 1.5e-3);
+        assert!(binned_error(&mixed, 1.0, 3.0, 50, h) < 1.5e-3);
+        // Few samples: the bandwidth spans many grid points.
+        let few = [0.3, 1.1, 1.2, 2.9, 4.0];
+        assert!(binned_error(&few, -2.0, 6.0, 200, 0.8) < 1.5e-3);
+        assert!(binned_error(&few, -2.0, 6.0, 200, 0.01) < 1.5e-3);
+    }
+
+    #[test]
+    fn binned_kde_integrates_to_one_and_handles_odd_input() {
+        let xs = normal_samples(3000, 9);
+        let grid = auto_grid(-8.0, 8.0, 401);
+        let f = gaussian_kde_binned(&xs, -8.0, 8.0, 401, 0.3);
+        assert!((trapezoid(&grid, &f) - 1.0).abs() < 1e-6);
+        assert_eq!(gaussian_kde_binned(&[], 0.0, 1.0, 5, 1.0), vec![0.0; 5]);
+        assert!(gaussian_kde_binned(&[1.0], 0.0, 1.0, 0, 1.0).is_empty());
+        let f = gaussian_kde_binned(&[f64::NAN, 1.0, f64::INFINITY], 0.0, 2.0, 3, f64::NAN);
+        assert!(f.iter().all(|v| v.is_finite()) && f[1] > 0.0);
+        // A bandwidth far below the grid step: still the exact values (lattice or fallback).
+        let f = gaussian_kde_binned(&[0.5], 0.0, 1.0, 3, 1e-9);
+        assert!(f[1] > 1e8 && f[0] == 0.0);
+    }
+
+    #[test]
+    fn cell_averages_keep_a_narrow_distribution() {
+        // Samples 1e-4 wide on a grid of step 0.1: point values miss them, cell averages
+        // hold all the mass, in the cell around 0.53 (grid 0, 0.1, ..., 1).
+        let xs: Vec<f64> = normal_samples(2000, 4)
+            .iter()
+            .map(|z| 0.53 + 1e-4 * z)
+            .collect();
+        let h = silverman_bandwidth(&xs);
+        let f = gaussian_kde_cell_average(&xs, 0.0, 1.0, 11, h);
+        assert!((f.iter().sum::<f64>() * 0.1 - 1.0).abs() < 1e-12);
+        assert!((f[5] - 10.0).abs() < 1e-9, "{f:?}");
+        let points = gaussian_kde_binned(&xs, 0.0, 1.0, 11, h);
+        assert!(points.iter().all(|v| *v < 1e-6), "{points:?}");
+        // The exact per-sample sum (the fallback) agrees.
+        let exact = cell_average_exact(&xs, -0.05, 0.1, 11, h, xs.len());
+        for (a, b) in f.iter().zip(&exact) {
+            assert!((a - b).abs() < 1e-6 * 10.0, "{a} vs {b}");
+        }
+        // A wide one: cell averages of the exact density (by a fine trapezoid here).
+        let ys = normal_samples(500, 8);
+        let f = gaussian_kde_cell_average(&ys, -3.0, 3.0, 13, 0.4);
+        let fine = auto_grid(-3.25, 3.25, 13 * 400 + 1);
+        let exact = gaussian_kde(&ys, None, &fine, 0.4);
+        for (i, v) in f.iter().enumerate() {
+            let seg = &exact[i * 400..=(i + 1) * 400];
+            let avg = seg.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>() / 400.0;
+            assert!((v - avg).abs() < 1.5e-3 * 0.4, "cell {i}: {v} vs {avg}");
+        }
     }
 }

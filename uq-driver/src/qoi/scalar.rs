@@ -1,10 +1,16 @@
-//! Scalar quantities of interest evaluated on one run's time series, as the study file
-//! declares them (`[[qoi]]`): critical speed, Sperling index, peak |signal|, final value.
+//! Scalar quantities of interest as the study file declares them (`[[qoi]]`): critical speed,
+//! Sperling index, peak |signal|, final value, evaluated on one run's time series; and the
+//! constant-speed critical speed (`hunting_speed`), which needs runs of its own
+//! ([`crate::qoi::hunting_speed`]).
 
 use serde::{Deserialize, Serialize};
 
 use crate::qoi::critical_speed::{critical_speed, CriticalSpeed, CriticalSpeedError};
-use crate::qoi::sperling::{sperling_index, Direction, SperlingError, SperlingSettings};
+use crate::qoi::hunting_speed::HuntingSpeedSpec;
+use crate::qoi::sperling::{
+    sperling_index, Direction, SperlingError, SperlingSettings, Statistic, Window,
+};
+use crate::results::QuantityDefinition;
 
 /// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
 /// `kind`).
@@ -50,6 +56,13 @@ pub enum QoiSpec {
         /// Initial transient left out (s).
         #[serde(default)]
         skip: f64,
+        /// Window of each segment (default none). Left out of the serialized settings when
+        /// default, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "is_default")]
+        window: Window,
+        /// W of the record: the largest segment W (default) or their mean.
+        #[serde(default, skip_serializing_if = "is_default")]
+        statistic: Statistic,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -80,6 +93,14 @@ pub enum QoiSpec {
         #[serde(default)]
         limits: Vec<f64>,
     },
+    /// Constant-speed critical speed by bisection over runs of its own (see
+    /// [`crate::qoi::hunting_speed`]): two quantities, `name` (lowest speed that keeps hunting)
+    /// and `name_decay` (highest speed at which the disturbance dies out).
+    HuntingSpeed(HuntingSpeedSpec),
+}
+
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }
 
 fn default_window() -> f64 {
@@ -133,36 +154,145 @@ pub enum QoiError {
     /// The signal has no sample.
     #[error("{0} is empty")]
     EmptySignal(String),
+    /// A quantity that is not computed from the study's run (`hunting_speed`).
+    #[error("'{0}' is computed from runs of its own, not from the study's run")]
+    NeedsOwnRuns(String),
 }
 
 impl QoiSpec {
-    /// The quantity's name.
+    /// The name of the `[[qoi]]` entry (of its first quantity).
     pub fn name(&self) -> &str {
         match self {
             QoiSpec::CriticalSpeed { name, .. }
             | QoiSpec::Sperling { name, .. }
             | QoiSpec::MaxAbs { name, .. }
             | QoiSpec::Final { name, .. } => name,
+            QoiSpec::HuntingSpeed(h) => &h.name,
         }
     }
 
-    /// The FMU signals it reads.
+    /// The scalar quantities it yields, in the order they are stored: one, except
+    /// `hunting_speed`'s two (`name`, `name_decay`).
+    pub fn quantity_names(&self) -> Vec<String> {
+        match self {
+            QoiSpec::HuntingSpeed(h) => vec![h.name.clone(), h.decay_name()],
+            q => vec![q.name().to_owned()],
+        }
+    }
+
+    /// The FMU signals it reads from the study's run (`hunting_speed` reads its signal from
+    /// its own runs only).
     pub fn signals(&self) -> Vec<&str> {
         match self {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
             QoiSpec::Sperling { signal, .. }
             | QoiSpec::MaxAbs { signal, .. }
             | QoiSpec::Final { signal, .. } => vec![signal],
+            QoiSpec::HuntingSpeed(_) => Vec::new(),
         }
     }
 
-    /// Exceedance limits.
+    /// Exceedance limits (of each of its quantities).
     pub fn limits(&self) -> &[f64] {
         match self {
             QoiSpec::CriticalSpeed { limits, .. }
             | QoiSpec::Sperling { limits, .. }
             | QoiSpec::MaxAbs { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
+            QoiSpec::HuntingSpeed(h) => &h.limits,
+        }
+    }
+
+    /// The signal whose unit the quantity has (`None`: dimensionless, as the Sperling index).
+    pub fn unit_signal(&self) -> Option<&str> {
+        match self {
+            QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
+            QoiSpec::Sperling { .. } => None,
+            QoiSpec::MaxAbs { signal, .. } | QoiSpec::Final { signal, .. } => Some(signal),
+            QoiSpec::HuntingSpeed(h) => Some(&h.speed_parameter),
+        }
+    }
+
+    /// How the quantity is computed, every setting explicit (defaults included), with a
+    /// line of text for the report.
+    pub fn definition(&self) -> QuantityDefinition {
+        let mut settings = match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(m)) => m,
+            _ => serde_json::Map::new(),
+        };
+        let kind = settings
+            .remove("kind")
+            .and_then(|k| k.as_str().map(str::to_owned))
+            .unwrap_or_default();
+        settings.remove("name");
+        let text = match self {
+            QoiSpec::CriticalSpeed {
+                signal,
+                speed,
+                window,
+                threshold,
+                ..
+            } => format!(
+                "critical speed: the {speed} at which the largest |{signal}| over a sliding \
+                 {window} s window last exceeds {threshold}"
+            ),
+            QoiSpec::Sperling {
+                signal,
+                direction,
+                segment,
+                f_min,
+                f_max,
+                skip,
+                window,
+                statistic,
+                ..
+            } => {
+                settings.insert("window".into(), window.as_str().into());
+                settings.insert("statistic".into(), statistic.as_str().into());
+                let direction = match direction {
+                    Direction::Vertical => "vertical",
+                    Direction::Lateral => "lateral",
+                };
+                let window = match window {
+                    Window::None => "no window",
+                    Window::Hann => "Hann window",
+                };
+                let statistic = match statistic {
+                    Statistic::Max => "the largest segment W",
+                    Statistic::Mean => "the mean of the segment W",
+                };
+                format!(
+                    "Sperling index of {signal}, {direction} weighting, {segment} s segments, \
+                     {window}, {statistic}, {f_min}–{f_max} Hz, first {skip} s left out"
+                )
+            }
+            QoiSpec::MaxAbs {
+                signal, from, to, ..
+            } => match to {
+                Some(to) => format!("largest |{signal}| over {from}–{to} s"),
+                None => format!("largest |{signal}| from {from} s to the end"),
+            },
+            QoiSpec::Final { signal, .. } => format!("{signal} at the stop time"),
+            QoiSpec::HuntingSpeed(h) => format!(
+                "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs of \
+                 {} s; a run keeps hunting when max |{}| over its last {} s is at least {} \
+                 ({} = lowest speed seen hunting, {}_decay = highest seen dying out)",
+                h.speed_parameter,
+                h.low,
+                h.high,
+                h.tolerance,
+                h.duration,
+                h.signal,
+                h.window,
+                h.threshold,
+                h.name,
+                h.name
+            ),
+        };
+        QuantityDefinition {
+            kind,
+            settings,
+            text,
         }
     }
 
@@ -193,19 +323,32 @@ impl QoiSpec {
                 .is_some_and(|t| t <= *from)
                 .then_some("`to` must be after `from`"),
             QoiSpec::Final { .. } => None,
+            QoiSpec::HuntingSpeed(h) => {
+                return match h.problem() {
+                    Some(problem) => Err(InvalidQuantity {
+                        name: h.name.clone(),
+                        problem,
+                    }),
+                    None => self.check_limits(),
+                }
+            }
         };
-        let problem = problem.or_else(|| {
-            self.limits()
-                .iter()
-                .any(|l| !l.is_finite())
-                .then_some("limits must be finite")
-        });
         match problem {
             Some(p) => Err(InvalidQuantity {
                 name: self.name().to_owned(),
                 problem: p.to_owned(),
             }),
-            None => Ok(()),
+            None => self.check_limits(),
+        }
+    }
+
+    fn check_limits(&self) -> Result<(), InvalidQuantity> {
+        match self.limits().iter().any(|l| !l.is_finite()) {
+            true => Err(InvalidQuantity {
+                name: self.name().to_owned(),
+                problem: "limits must be finite".to_owned(),
+            }),
+            false => Ok(()),
         }
     }
 }
@@ -216,9 +359,11 @@ impl QoiSpec {
 pub enum Code {
     /// The value is valid.
     Ok = 0,
-    /// Critical speed: the signal never exceeds the threshold (value NaN).
+    /// Critical speed: the signal never exceeds the threshold (value NaN); `hunting_speed`:
+    /// the disturbance dies out even at the top of the bracket.
     NeverHunts = 1,
-    /// Critical speed: the oscillation never dies out within the run (value NaN).
+    /// Critical speed: the oscillation never dies out within the run (value NaN);
+    /// `hunting_speed`: the disturbance keeps hunting even at the bottom of the bracket.
     NeverStops = 2,
 }
 
@@ -261,6 +406,8 @@ pub fn evaluate<'a>(
             f_min,
             f_max,
             skip,
+            window,
+            statistic,
             ..
         } => {
             let dt = times
@@ -270,14 +417,17 @@ pub fn evaluate<'a>(
             let start = times.partition_point(|&t| t < times[0] + skip - 1e-9 * dt);
             let settings = SperlingSettings {
                 direction: *direction,
+                window: *window,
                 segment_length_s: *segment,
                 f_min: *f_min,
                 f_max: *f_max,
             };
-            Ok((
-                sperling_index(&signal(s)[start..], dt, &settings)?.w,
-                Code::Ok,
-            ))
+            let r = sperling_index(&signal(s)[start..], dt, &settings)?;
+            let w = match statistic {
+                Statistic::Max => r.w,
+                Statistic::Mean => r.mean,
+            };
+            Ok((w, Code::Ok))
         }
         QoiSpec::MaxAbs {
             signal: s,
@@ -305,6 +455,7 @@ pub fn evaluate<'a>(
             .last()
             .map(|v| (*v, Code::Ok))
             .ok_or_else(|| QoiError::EmptySignal(s.clone())),
+        QoiSpec::HuntingSpeed(h) => Err(QoiError::NeedsOwnRuns(h.name.clone())),
     }
 }
 
@@ -378,5 +529,49 @@ mod tests {
             evaluate(&q, &empty, |_| &empty[..]).unwrap_err(),
             QoiError::EmptySignal("x".into())
         );
+    }
+
+    #[test]
+    fn sperling_window_and_statistic_are_read_shown_and_hash_neutral() {
+        let base = "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"";
+        let q: QoiSpec = toml::from_str(base).unwrap();
+        // Defaults are not serialized: studies written before keep their hash.
+        let json = serde_json::to_value(&q).unwrap();
+        assert!(json.get("window").is_none() && json.get("statistic").is_none());
+        // ... but the definition states them.
+        let d = q.definition();
+        assert_eq!(d.kind, "sperling");
+        assert_eq!(d.settings["window"], "none");
+        assert_eq!(d.settings["statistic"], "max");
+        assert_eq!(d.settings["segment"], 5.0);
+        assert!(
+            d.text
+                .contains("5 s segments, no window, the largest segment W"),
+            "{}",
+            d.text
+        );
+        let q: QoiSpec = toml::from_str(&format!(
+            "{base}\nwindow = \"hann\"\nstatistic = \"mean\"\nsegment = 1.0"
+        ))
+        .unwrap();
+        assert!(q
+            .definition()
+            .text
+            .contains("1 s segments, Hann window, the mean"));
+        assert!(toml::from_str::<QoiSpec>(&format!("{base}\nwindow = \"hamming\"")).is_err());
+        // The mean of two segments of different amplitude lies below their maximum.
+        let dt = 0.01;
+        let times: Vec<f64> = (0..1000).map(|k| k as f64 * dt).collect();
+        let a: Vec<f64> = times
+            .iter()
+            .map(|t| {
+                let amp = if *t < 5.0 { 0.1 } else { 0.2 };
+                amp * (2.0 * std::f64::consts::PI * t).sin()
+            })
+            .collect();
+        let (mean, _) = evaluate(&q, &times, |_| &a[..]).unwrap();
+        let q_max: QoiSpec = toml::from_str(&format!("{base}\nwindow = \"hann\"")).unwrap();
+        let (max, _) = evaluate(&q_max, &times, |_| &a[..]).unwrap();
+        assert!(mean < max, "{mean} {max}");
     }
 }

@@ -7,9 +7,15 @@
 //!
 //! The record is cut into consecutive segments of fixed length (GB/T 5599-2019: 5 s; a
 //! trailing piece shorter than a segment is not used). For each segment the single-sided
-//! amplitude spectrum `A_i = 2|X_i|/N_s`, `X_i = Σ_n a_n e^{−2πi·i·n/N_s}` (no window), is
+//! amplitude spectrum `A_i = 2|X_i|/Σ_n w_n`, `X_i = Σ_n w_n a_n e^{−2πi·i·n/N_s}`, is
 //! evaluated at every DFT line `f_i = i/(N_s Δt)` in `[f_min, f_max]` (0.5–40 Hz), by a direct
 //! real DFT over a cosine/sine table: O(N_s) per line, only the lines that are used.
+//!
+//! Window `w` ([`Window`]): none (`w_n = 1`, the default, `A_i = 2|X_i|/N_s`) or the periodic
+//! Hann window `w_n = ½ (1 − cos 2πn/N_s)` with the amplitude (coherent-gain) correction
+//! `Σ w_n = N_s/2`: a sinusoid on a DFT line keeps its amplitude on that line and puts half of
+//! it on each neighbouring line; leakage from frequencies between lines falls off as 1/f³
+//! instead of 1/f.
 //!
 //! Frequency weighting F(f):
 //! - vertical: 0.325 f² (f < 5.9 Hz), 400/f² (5.9–20 Hz), 1 (f ≥ 20 Hz);
@@ -33,11 +39,69 @@ pub enum Direction {
     Lateral,
 }
 
+/// Window applied to each segment before its spectrum; `"none"` or `"hann"` in files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Window {
+    /// No window (rectangular), the default.
+    #[default]
+    None,
+    /// Periodic Hann window with amplitude correction.
+    Hann,
+}
+
+impl Window {
+    /// `"none"` or `"hann"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Window::None => "none",
+            Window::Hann => "hann",
+        }
+    }
+
+    /// The weights of an `ns`-sample segment and their sum.
+    fn weights(self, ns: usize) -> (Vec<f64>, f64) {
+        match self {
+            Window::None => (vec![1.0; ns], ns as f64),
+            Window::Hann => {
+                let w: Vec<f64> = (0..ns)
+                    .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / ns as f64).cos())
+                    .collect();
+                // The periodic Hann window sums to exactly N/2.
+                (w, 0.5 * ns as f64)
+            }
+        }
+    }
+}
+
+/// Which W of the segments is the W of the record; `"max"` or `"mean"` in files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Statistic {
+    /// The largest segment W (the conservative reading for a limit), the default.
+    #[default]
+    Max,
+    /// The mean of the segment W.
+    Mean,
+}
+
+impl Statistic {
+    /// `"max"` or `"mean"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Statistic::Max => "max",
+            Statistic::Mean => "mean",
+        }
+    }
+}
+
 /// Evaluation settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SperlingSettings {
     /// Direction.
     pub direction: Direction,
+    /// Window of each segment.
+    pub window: Window,
     /// Segment length (s); default 5 s (GB/T 5599-2019).
     pub segment_length_s: f64,
     /// Lowest frequency used (Hz); default 0.5.
@@ -50,6 +114,7 @@ impl Default for SperlingSettings {
     fn default() -> Self {
         Self {
             direction: Direction::Vertical,
+            window: Window::None,
             segment_length_s: 5.0,
             f_min: 0.5,
             f_max: 40.0,
@@ -186,6 +251,9 @@ struct Lines {
     df: f64,
     /// cos and sin of 2π m / N_s, m = 0..N_s.
     table: Vec<(f64, f64)>,
+    /// Window weights and their sum.
+    window: Vec<f64>,
+    window_sum: f64,
 }
 
 impl Lines {
@@ -198,22 +266,26 @@ impl Lines {
                 (a.cos(), a.sin())
             })
             .collect();
+        let (window, window_sum) = s.window.weights(ns);
         Lines {
             i_lo: ((s.f_min - tol) / df).ceil().max(1.0) as usize,
             i_hi: (((s.f_max + tol) / df).floor() as usize).min(ns / 2),
             df,
             table,
+            window,
+            window_sum,
         }
     }
 
     /// W of one segment of `table.len()` samples.
     fn segment_w(&self, seg: &[f64], direction: Direction) -> f64 {
         let ns = self.table.len();
+        let windowed: Vec<f64> = seg.iter().zip(&self.window).map(|(a, w)| a * w).collect();
         let mut sum = 0.0;
         for i in self.i_lo..=self.i_hi {
             let (mut re, mut im) = (0.0, 0.0);
             let mut idx = 0usize;
-            for &a in seg {
+            for &a in &windowed {
                 let (c, sn) = self.table[idx];
                 re += a * c;
                 im -= a * sn;
@@ -223,7 +295,7 @@ impl Lines {
                 }
             }
             let scale = if 2 * i == ns { 1.0 } else { 2.0 };
-            let amp_cm = 100.0 * scale * (re * re + im * im).sqrt() / ns as f64;
+            let amp_cm = 100.0 * scale * (re * re + im * im).sqrt() / self.window_sum;
             let f = i as f64 * self.df;
             sum += amp_cm.powi(3) * weighting(direction, f) / f;
         }
@@ -407,5 +479,71 @@ mod tests {
                 Err(SperlingError::InvalidSettings(_))
             ));
         }
+    }
+
+    /// W of a record by the definition: every line's amplitude from a direct DFT of the
+    /// windowed segment (angles computed afresh, no table), written out here.
+    fn by_definition(a: &[f64], dt: f64, window: Window) -> f64 {
+        let ns = a.len();
+        let w: Vec<f64> = (0..ns)
+            .map(|n| match window {
+                Window::None => 1.0,
+                Window::Hann => (PI * n as f64 / ns as f64).sin().powi(2),
+            })
+            .collect();
+        let gain: f64 = w.iter().sum();
+        let df = 1.0 / (ns as f64 * dt);
+        let mut sum = 0.0;
+        for i in 1..=ns / 2 {
+            let f = i as f64 * df;
+            if !(0.5 - 1e-9..=40.0 + 1e-9).contains(&f) {
+                continue;
+            }
+            let (mut re, mut im) = (0.0, 0.0);
+            for n in 0..ns {
+                let phi = 2.0 * PI * (i * n) as f64 / ns as f64;
+                re += w[n] * a[n] * phi.cos();
+                im -= w[n] * a[n] * phi.sin();
+            }
+            let amp_cm = 100.0 * 2.0 * (re * re + im * im).sqrt() / gain;
+            sum += amp_cm.powi(3) * weighting(Direction::Vertical, f) / f;
+        }
+        0.896 * sum.powf(0.1)
+    }
+
+    #[test]
+    fn hann_window_on_a_sinusoid() {
+        let dt = 0.01;
+        let hann = SperlingSettings {
+            window: Window::Hann,
+            ..Default::default()
+        };
+        // 3 Hz in 5 s segments is line 15 (df = 0.2 Hz): the Hann window keeps the amplitude
+        // on that line and puts half of it on lines 14 and 16, in closed form.
+        let a = sine(3.0, 0.2, dt, 5.0, 0.4);
+        let r = sperling_index(&a, dt, &hann).unwrap();
+        let term = |amp: f64, f: f64| (100.0 * amp).powi(3) * 0.325 * f * f / f;
+        let expected = 0.896 * (term(0.2, 3.0) + term(0.1, 2.8) + term(0.1, 3.2)).powf(0.1);
+        assert!((r.w - expected).abs() < 1e-9, "{} vs {expected}", r.w);
+        let plain = sperling_index(&a, dt, &Default::default()).unwrap();
+        assert!((plain.w - by_hand(0.2, 3.0, 0.325 * 9.0)).abs() < 1e-9);
+        // Between two lines (3.1 Hz): the rectangular window leaks into every line, the Hann
+        // window much less; both equal the direct definition.
+        let a = sine(3.1, 0.2, dt, 5.0, 0.4);
+        let r_hann = sperling_index(&a, dt, &hann).unwrap().w;
+        let r_none = sperling_index(&a, dt, &Default::default()).unwrap().w;
+        assert!((r_hann - by_definition(&a, dt, Window::Hann)).abs() < 1e-9);
+        assert!((r_none - by_definition(&a, dt, Window::None)).abs() < 1e-9);
+        // The rectangular window scatters the line over many small ones (W counts cubes),
+        // the Hann window keeps most of it on the two nearest lines.
+        assert!(r_hann > r_none, "{r_none} {r_hann}");
+    }
+
+    #[test]
+    fn statistic_and_window_names() {
+        assert_eq!(Window::Hann.as_str(), "hann");
+        assert_eq!(Statistic::Mean.as_str(), "mean");
+        assert_eq!(Window::default(), Window::None);
+        assert_eq!(Statistic::default(), Statistic::Max);
     }
 }

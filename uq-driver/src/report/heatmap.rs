@@ -9,6 +9,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::svg::{c, finite_range, legend, legend_width, Axis, Frame, LegendEntry, Series};
+
+/// Where the colorbar's label sits right of the bar's tick labels (px).
+const BAR_LABEL_GAP: f64 = 14.0;
 use super::{escape_xml, write_bytes, ReportError};
 
 /// A heat map `z[ix][iy]` over `x` (horizontal, e.g. time) and `y` (vertical, e.g. the grid
@@ -117,6 +120,8 @@ impl Heatmap {
         let mut enc = png::Encoder::new(&mut bytes, w, h);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
+        // Runs of equal pixels compress well even on the fast setting (5× faster).
+        enc.set_compression(png::Compression::Fast);
         let mut writer = enc.write_header()?;
         writer.write_image_data(&data)?;
         writer.finish()?;
@@ -144,8 +149,16 @@ impl Heatmap {
             Some(s) => Axis::linear_exact(Some((s.lo, s.hi))),
             None => Axis::linear_exact(None),
         };
-        let right = BAR_GAP + BAR_W + 10.0 + bar_axis.label_chars() as f64 * 6.4 + 26.0;
-        let frame = Frame::new(x_axis, y_axis, right);
+        let mut entries: Vec<LegendEntry> = self
+            .overlay
+            .iter()
+            .map(|s| LegendEntry::line(&s.label, &s.color, s.dashed))
+            .collect();
+        entries.retain(|e| !e.label.is_empty());
+        let bar_right = BAR_GAP + BAR_W + 10.0 + bar_axis.label_chars() as f64 * 6.4;
+        let right = bar_right + BAR_LABEL_GAP + 12.0 + legend_width(&entries);
+        let mut frame = Frame::new(x_axis, y_axis, right);
+        frame.fit_legend(&entries);
 
         let mut out = String::new();
         frame.open(&mut out);
@@ -166,29 +179,24 @@ impl Heatmap {
         out.push_str("</g>\n");
         frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
 
-        self.colorbar(&mut out, &frame, scale.is_some(), &bar_axis);
-
-        let mut entries: Vec<LegendEntry> = self
-            .overlay
-            .iter()
-            .map(|s| LegendEntry::line(&s.label, &s.color, s.dashed))
-            .collect();
-        entries.retain(|e| !e.label.is_empty());
-        let lw = legend_width(&entries);
-        legend(
-            &mut out,
-            &entries,
-            frame.left + frame.width - lw - 4.0,
-            frame.top + 10.0,
-            true,
-        );
+        let label_x = frame.left + frame.width + bar_right + BAR_LABEL_GAP;
+        self.colorbar(&mut out, &frame, scale.is_some(), &bar_axis, label_x);
+        // Outside the plot, right of the colorbar: nothing is drawn over the map.
+        legend(&mut out, &entries, label_x + 16.0, frame.top + 4.0, false);
         out.push_str("</svg>\n");
         out
     }
 
     /// The colorbar right of `frame`: a gradient through the viridis table (grey when there
     /// is no scale), with its own axis and label.
-    fn colorbar(&self, out: &mut String, frame: &Frame, scaled: bool, bar_axis: &Axis) {
+    fn colorbar(
+        &self,
+        out: &mut String,
+        frame: &Frame,
+        scaled: bool,
+        bar_axis: &Axis,
+        label_x: f64,
+    ) {
         let bx = frame.left + frame.width + BAR_GAP;
         let (top, h) = (frame.top, frame.height);
         out.push_str("<g class=\"colorbar\">\n<defs><linearGradient id=\"cmap\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">");
@@ -233,7 +241,7 @@ impl Heatmap {
             }
             out.push_str("</g>\n");
         }
-        let (lx, ly) = (frame.total_w - 12.0, top + h / 2.0);
+        let (lx, ly) = (label_x, top + h / 2.0);
         let _ = writeln!(
             out,
             "<text x=\"{0}\" y=\"{1}\" text-anchor=\"middle\" font-size=\"13\" fill=\"#222\" \
@@ -259,8 +267,12 @@ impl Heatmap {
             path: path.to_path_buf(),
             source,
         })?;
-        let href = format!("data:image/png;base64,{}", base64(&bytes));
-        write_bytes(path, self.to_svg(&href).as_bytes())
+        write_bytes(path, self.to_svg(&Self::data_uri(&bytes)).as_bytes())
+    }
+
+    /// A `data:` URI of PNG bytes, for [`Self::to_svg`] (a self-contained SVG).
+    pub fn data_uri(png: &[u8]) -> String {
+        format!("data:image/png;base64,{}", base64(png))
     }
 
     fn color_scale(&self) -> Option<ColorScale> {
@@ -272,8 +284,17 @@ impl Heatmap {
             let lo = if hi / lo < 1.0 + 1e-9 { hi / 10.0 } else { lo };
             Some(ColorScale { lo, hi, log: true })
         } else {
+            // Colours start at 0 (a density is never negative); no scale without a
+            // positive value.
             let (lo, hi) = finite_range(values, false)?;
-            Some(ColorScale { lo, hi, log: false })
+            if hi <= 0.0 {
+                return None;
+            }
+            Some(ColorScale {
+                lo: lo.min(0.0),
+                hi,
+                log: false,
+            })
         }
     }
 }
@@ -543,6 +564,18 @@ mod tests {
         assert!(svg.contains("linearGradient"));
         assert!(svg.contains("class=\"legend\""));
         assert_eq!(svg.matches("<g").count(), svg.matches("</g>").count());
+    }
+
+    #[test]
+    fn colour_scale_starts_at_zero_and_needs_a_positive_value() {
+        let mut map = gaussian_map();
+        let s = map.color_scale().unwrap();
+        assert_eq!(s.lo, 0.0);
+        assert!(map.to_svg("x.png").contains(">0</text>"));
+        map.z = vec![vec![0.0; 5]; 3];
+        assert!(map.color_scale().is_none(), "no density, no scale");
+        map.z = vec![vec![f64::NAN; 5]; 3];
+        assert!(map.color_scale().is_none());
     }
 
     #[test]

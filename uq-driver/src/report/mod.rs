@@ -8,18 +8,24 @@
 //! - [`html`]: the self-contained `index.html` that ties the files together;
 //! - [`study`]: the files of one study's output folder (one writer per file);
 //! - [`nested`]: what a two-level study adds (conditional statistics, the variance split);
-//! - [`suite`]: the comparison of a suite's variants.
+//! - [`suite`]: the comparison of a suite's variants;
+//! - [`compare`]: one page comparing finished study folders (`uq-driver compare`);
+//! - [`units`]: units from the modelDescription, on axes and in `units.csv`;
+//! - [`inputs`]: the random inputs as written in a study file.
 //!
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
 //! file. Only I/O (and, for CSV, inconsistent column lengths) produce a [`ReportError`].
 
+pub mod compare;
 pub mod csv;
 pub mod heatmap;
 pub mod html;
+pub mod inputs;
 pub mod nested;
 pub mod study;
 pub mod suite;
 pub mod svg;
+pub mod units;
 
 use std::path::{Path, PathBuf};
 
@@ -27,7 +33,9 @@ pub use csv::{write_columns, write_grid};
 pub use heatmap::Heatmap;
 pub use html::{ReportPage, Section, Table};
 pub use study::StudyReport;
-pub use svg::{histogram_density, nice_ticks, palette, Band, DensityPlot, LinePlot, Series};
+pub use svg::{
+    histogram_density, nice_ticks, palette, Band, BarChart, BarGroup, DensityPlot, LinePlot, Series,
+};
 
 /// Errors of the report writers.
 #[derive(Debug, thiserror::Error)]
@@ -65,7 +73,7 @@ pub enum ReportError {
 }
 
 /// Writes `bytes` to `path`, attaching the path to any I/O error.
-pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     std::fs::write(path, bytes).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
@@ -140,7 +148,7 @@ mod tests {
                 Series::new("SGM mean", t.clone(), mean.clone(), palette(0)),
                 Series::new("LHS mean", t.clone(), lhs.clone(), palette(1)).dashed(),
             ],
-            log_y: false,
+            ..LinePlot::default()
         };
         plot.write(&dir.join("q_band.svg")).unwrap();
         let diff: Vec<f64> = mean.iter().zip(&lhs).map(|(a, b)| a - b).collect();

@@ -19,16 +19,21 @@ use super::{
 };
 use crate::results::{ConditionalTable, NestedScalar, OutputSplit, ScalarStats, SuiteSummary};
 
-/// Writes the nested files of a study into `dir`; returns the sections for `index.html`.
+/// Writes the nested files of a study into `dir` (the plots only if `plots`); returns the
+/// sections for `index.html`.
 pub fn write(
     dir: &Path,
     quantities: &[ScalarStats],
     splits: &[OutputSplit],
+    plots: bool,
 ) -> Result<Vec<Section>, ReportError> {
     let mut sections = Vec::new();
     for q in quantities {
         let Some(n) = &q.nested else { continue };
         conditional_csv(&dir.join(&n.conditional_csv), &n.conditional)?;
+        if !plots {
+            continue;
+        }
         let mut images = Vec::new();
         if !n.conditional.limits.is_empty() {
             let file = format!("{}_conditional_exceedance.svg", q.name);
@@ -43,6 +48,9 @@ pub fn write(
     }
     for s in splits {
         split_csv(dir, s)?;
+        if !plots {
+            continue;
+        }
         split_plot(s).write(&dir.join(format!("{}_split.svg", s.name)))?;
         sections.push(Section {
             heading: format!("Two-level split of {} over time", s.name),
@@ -53,7 +61,10 @@ pub fn write(
                  sampling error; drawn as 0 where the correction makes it negative).",
                 s.name, s.outer_samples
             ),
-            images: vec![format!("{}_split.svg", s.name), format!("{}_split.csv", s.name)],
+            images: vec![
+                format!("{}_split.svg", s.name),
+                format!("{}_split.csv", s.name),
+            ],
             table: None,
         });
     }
@@ -79,10 +90,7 @@ fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> S
             format!("outer share of Var ({})", t.outer_names.join(", ")),
             with_ci(v.outer, v.outer_ci),
         ],
-        vec![
-            "E_outer[Var_inner]".into(),
-            format!("{:.4e}", v.var_inner),
-        ],
+        vec!["E_outer[Var_inner]".into(), format!("{:.4e}", v.var_inner)],
         vec![
             "Var_outer[E_inner] (corrected; plug-in; correction)".into(),
             format!(
@@ -196,12 +204,8 @@ fn exceedance_plot(name: &str, t: &ConditionalTable) -> LinePlot {
         }
         x.push(1.0);
         y.push(1.0);
-        plot.series.push(Series::new(
-            format!("limit {limit}"),
-            x,
-            y,
-            palette(l),
-        ));
+        plot.series
+            .push(Series::new(format!("limit {limit}"), x, y, palette(l)));
     }
     plot
 }
@@ -226,16 +230,18 @@ fn conditional_mean_plot(name: &str, t: &ConditionalTable) -> LinePlot {
         upper,
         palette(0),
     ));
-    plot.series.push(Series::new(
-        "conditional mean",
-        x.clone(),
-        mean,
-        palette(0),
-    ));
+    plot.series
+        .push(Series::new("conditional mean", x.clone(), mean, palette(0)));
     for (l, &limit) in t.limits.iter().enumerate() {
         let ends = vec![x[0], x[x.len() - 1]];
         plot.series.push(
-            Series::new(format!("limit {limit}"), ends, vec![limit; 2], palette(l + 3)).dashed(),
+            Series::new(
+                format!("limit {limit}"),
+                ends,
+                vec![limit; 2],
+                palette(l + 3),
+            )
+            .dashed(),
         );
     }
     plot
@@ -267,7 +273,15 @@ fn split_csv(dir: &Path, s: &OutputSplit) -> Result<(), ReportError> {
             "inner_fraction",
             "outer_fraction",
         ],
-        &[&s.times, &s.mean, &s.std, &s.var_inner, &s.var_outer, &fi, &fo],
+        &[
+            &s.times,
+            &s.mean,
+            &s.std,
+            &s.var_inner,
+            &s.var_outer,
+            &fi,
+            &fo,
+        ],
     )
 }
 
@@ -280,7 +294,12 @@ fn split_plot(s: &OutputSplit) -> LinePlot {
         format!("Std {}", s.name),
     );
     plot.series = vec![
-        Series::new("Std (both levels)", s.times.clone(), s.std.clone(), palette(0)),
+        Series::new(
+            "Std (both levels)",
+            s.times.clone(),
+            s.std.clone(),
+            palette(0),
+        ),
         Series::new(
             "sqrt E_outer[Var_inner] (inner)",
             s.times.clone(),

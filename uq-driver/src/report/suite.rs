@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use super::units::label;
 use super::{
     palette, write_bytes, write_columns, DensityPlot, LinePlot, ReportError, ReportPage, Section,
     Series, Table,
@@ -34,12 +35,12 @@ pub fn write(
         .iter()
         .position(|v| v.name == summary.reference)
         .unwrap_or(0);
-    let mut sections = vec![variants_section(summary, &variants[r])];
+    let mut sections = vec![variants_section(summary, variants, r)];
     for (o, rs) in variants[r].outputs.iter().enumerate() {
         sections.push(compare_output(dir, summary, variants, r, o, rs)?);
     }
-    for (qi, rq) in variants[r].quantities.iter().enumerate() {
-        sections.push(compare_scalar(dir, summary, variants, qi, rq)?);
+    for q in quantity_names(variants, r) {
+        sections.push(compare_scalar(dir, summary, variants, &q)?);
     }
     if !summary.paper.is_empty() {
         sections.push(paper_section(summary));
@@ -57,10 +58,41 @@ pub fn write(
     .write(&dir.join("index.html"))
 }
 
+/// The scalar quantities of every variant, by name: the reference's first, then those only
+/// other variants compute (a variant may leave quantities out, `quantities = [...]`).
+fn quantity_names(variants: &[VariantResults], r: usize) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    let order = std::iter::once(&variants[r]).chain(variants);
+    for q in order.flat_map(|v| v.quantities) {
+        if !names.contains(&q.name) {
+            names.push(q.name.clone());
+        }
+    }
+    names
+}
+
+/// The quantity `name` of a variant, if it computes it.
+fn find<'a>(quantities: &'a [ScalarStats], name: &str) -> Option<&'a ScalarStats> {
+    quantities.iter().find(|q| q.name == name)
+}
+
 /// The table of variants: method, runs, wall time, differences against the reference, and
-/// the scalar quantities.
-fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Section {
+/// the scalar quantities (blank where a variant does not compute one).
+fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usize) -> Section {
+    let reference = &variants[r];
     let ref_name = &summary.reference;
+    let names = quantity_names(variants, r);
+    // Exceedance limits of each quantity (the same in every variant that has it).
+    let limits: Vec<Vec<f64>> = names
+        .iter()
+        .map(|n| {
+            variants
+                .iter()
+                .find_map(|v| find(v.quantities, n))
+                .map(|q| q.exceedance.iter().map(|e| e.0).collect())
+                .unwrap_or_default()
+        })
+        .collect();
     let mut header: Vec<String> = ["variant", "method", "model runs", "wall time [s]"]
         .iter()
         .map(|s| s.to_string())
@@ -69,11 +101,11 @@ fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Secti
         header.push(format!("max |Δmean {}| vs {ref_name}", s.name));
         header.push(format!("max |ΔStd {}| vs {ref_name}", s.name));
     }
-    for q in reference.quantities {
-        header.push(format!("mean {}", q.name));
-        header.push(format!("Std {}", q.name));
-        for (l, _, _) in &q.exceedance {
-            header.push(format!("P({} > {l})", q.name));
+    for (n, ls) in names.iter().zip(&limits) {
+        header.push(format!("mean {n}"));
+        header.push(format!("Std {n}"));
+        for l in ls {
+            header.push(format!("P({n} > {l})"));
         }
     }
     let rows = summary
@@ -90,10 +122,15 @@ fn variants_section(summary: &SuiteSummary, reference: &VariantResults) -> Secti
                 row.push(format!("{:.3e}", o.max_abs_mean_diff_vs_reference));
                 row.push(format!("{:.3e}", o.max_abs_std_diff_vs_reference));
             }
-            for q in &v.quantities {
-                row.push(format!("{:.5}", q.mean));
-                row.push(format!("{:.5}", q.std));
-                row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+            for (n, ls) in names.iter().zip(&limits) {
+                match find(&v.quantities, n) {
+                    Some(q) => {
+                        row.push(format!("{:.5}", q.mean));
+                        row.push(format!("{:.5}", q.std));
+                        row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+                    }
+                    None => row.extend(std::iter::repeat_n(String::new(), 2 + ls.len())),
+                }
             }
             row
         })
@@ -124,22 +161,27 @@ fn compare_output(
 ) -> Result<Section, ReportError> {
     let v = &rs.name;
     let ref_name = &summary.reference;
+    // The reference may have no FMU (SGM): any variant that ran the model knows the unit.
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(v))
+        .map(String::as_str);
     let mut header = vec!["time".to_string()];
     let mut cols: Vec<Vec<f64>> = Vec::new();
     let mut mean_plot = LinePlot::new(
         format!("{v}: mean − mean({ref_name})"),
         "time [s]",
-        format!("Δ mean {v}"),
+        label(&format!("Δ mean {v}"), unit),
     );
     let mut std_plot = LinePlot::new(
         format!("{v}: Std − Std({ref_name})"),
         "time [s]",
-        format!("Δ Std {v}"),
+        label(&format!("Δ Std {v}"), unit),
     );
     let mut bands = LinePlot::new(
         format!("{v}: mean ± 3σ of every variant"),
         "time [s]",
-        v.clone(),
+        label(v, unit),
     );
     for (i, (d, vs)) in variants.iter().zip(&summary.variants).enumerate() {
         let s = &d.outputs[o];
@@ -178,10 +220,57 @@ fn compare_output(
     all.extend(cols.iter().map(Vec::as_slice));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(&dir.join(format!("{v}_compare.csv")), &hdr, &all)?;
+    let log_mean = spans_decades(&mean_plot);
+    let log_std = spans_decades(&std_plot);
+    absolute_on_log(
+        &mut mean_plot,
+        log_mean,
+        &format!("|mean − mean({ref_name})| of {v}"),
+    );
+    absolute_on_log(
+        &mut std_plot,
+        log_std,
+        &format!("|Std − Std({ref_name})| of {v}"),
+    );
     mean_plot.write(&dir.join(format!("{v}_mean_diff.svg")))?;
     std_plot.write(&dir.join(format!("{v}_std_diff.svg")))?;
     bands.write(&dir.join(format!("{v}_bands.svg")))?;
     Ok(output_section(v, ref_name))
+}
+
+/// Whether the differences of the variants lie decades apart (more than a factor 100
+/// between the largest |Δ| of two variants): then a log axis shows them (SCM against SGM
+/// at 1e-10, LHS at 1e-5: on a linear axis the first is a flat zero).
+fn spans_decades(plot: &LinePlot) -> bool {
+    let peaks: Vec<f64> = plot
+        .series
+        .iter()
+        .map(|s| {
+            s.y.iter()
+                .filter(|y| y.is_finite())
+                .fold(0.0f64, |m, y| m.max(y.abs()))
+        })
+        .filter(|p| *p > 0.0)
+        .collect();
+    let (lo, hi) = peaks
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &p| (a.min(p), b.max(p)));
+    peaks.len() > 1 && hi / lo > 1e2
+}
+
+/// With `log`: the plot shows |Δ| on a log axis (its zeros drop out), titled `title`.
+fn absolute_on_log(plot: &mut LinePlot, log: bool, title: &str) {
+    if !log {
+        return;
+    }
+    for s in &mut plot.series {
+        for y in &mut s.y {
+            *y = y.abs();
+        }
+    }
+    plot.log_y = true;
+    plot.title = format!("{title} (log axis)");
+    plot.y_label = format!("|{}|", plot.y_label);
 }
 
 fn output_section(v: &str, ref_name: &str) -> Section {
@@ -201,31 +290,39 @@ fn output_section(v: &str, ref_name: &str) -> Section {
     }
 }
 
-/// `<q>_pdf_compare.svg`, `<q>_mean_vs_runs.svg`, `<q>_std_vs_runs.svg`, `<q>_compare.csv`.
+/// `<q>_pdf_compare.svg`, `<q>_mean_vs_runs.svg`, `<q>_std_vs_runs.svg`, `<q>_compare.csv`,
+/// over the variants that compute quantity `q`.
 fn compare_scalar(
     dir: &Path,
     summary: &SuiteSummary,
     variants: &[VariantResults],
-    qi: usize,
-    rq: &ScalarStats,
+    q: &str,
 ) -> Result<Section, ReportError> {
-    let q = &rq.name;
-    let runs: Vec<f64> = variants
+    // (index of the variant, its statistics of q)
+    let having: Vec<(usize, &ScalarStats)> = variants
         .iter()
-        .map(|d| d.summary.model_runs as f64)
-        .collect();
-    let stats: Vec<&ScalarStats> = variants.iter().map(|d| &d.quantities[qi]).collect();
-    // A single deterministic run has no distribution: it would be a spike in the plots.
-    let curves = stats
-        .iter()
-        .zip(&summary.variants)
         .enumerate()
-        .filter(|(i, _)| runs[*i] > 1.0)
-        .map(|(i, (s, v))| Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(i)))
+        .filter_map(|(i, d)| find(d.quantities, q).map(|s| (i, s)))
+        .collect();
+    let rq = having[0].1;
+    let runs: Vec<f64> = having
+        .iter()
+        .map(|(i, _)| variants[*i].summary.model_runs as f64)
+        .collect();
+    let stats: Vec<&ScalarStats> = having.iter().map(|(_, s)| *s).collect();
+    // A single deterministic run has no distribution: it would be a spike in the plots.
+    let curves = having
+        .iter()
+        .zip(&runs)
+        .filter(|((_, s), &n)| n > 1.0 && !s.deterministic)
+        .map(|((i, s), _)| {
+            let v = &summary.variants[*i];
+            Series::new(v.name.clone(), s.pdf_x.clone(), s.pdf.clone(), palette(*i))
+        })
         .collect();
     DensityPlot {
         title: format!("PDF of {q}, every variant"),
-        x_label: q.clone(),
+        x_label: label(q, rq.unit.as_deref()),
         curves,
         histogram: None,
         markers: rq
@@ -235,27 +332,33 @@ fn compare_scalar(
             .collect(),
     }
     .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
-    let kinds: Vec<&str> = variants
+    let kinds: Vec<&str> = having
         .iter()
-        .map(|d| d.summary.method.kind.as_str())
+        .map(|(i, _)| variants[*i].summary.method.kind.as_str())
         .collect();
     let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
     let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
     let ses: Vec<f64> = stats.iter().map(|s| s.std_error_mean).collect();
-    let mean_plot = LinePlot::new(
+    let unit = variants
+        .iter()
+        .find_map(|d| d.summary.units.get(q))
+        .map(String::as_str);
+    let mut mean_plot = LinePlot::new(
         format!("mean of {q} against model runs"),
-        "log10(model runs)",
-        format!("mean {q}"),
+        "model runs",
+        label(&format!("mean {q}"), unit),
     );
+    mean_plot.log_x = true;
     convergence(mean_plot, &kinds, &runs, &means)
         .write(&dir.join(format!("{q}_mean_vs_runs.svg")))?;
-    let std_plot = LinePlot::new(
+    let mut std_plot = LinePlot::new(
         format!("Std of {q} against model runs"),
-        "log10(model runs)",
-        format!("Std {q}"),
+        "model runs",
+        label(&format!("Std {q}"), unit),
     );
+    std_plot.log_x = true;
     convergence(std_plot, &kinds, &runs, &stds).write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
-    let idx: Vec<f64> = (0..variants.len()).map(|i| i as f64).collect();
+    let idx: Vec<f64> = having.iter().map(|(i, _)| *i as f64).collect();
     write_columns(
         &dir.join(format!("{q}_compare.csv")),
         &[
@@ -267,11 +370,14 @@ fn compare_scalar(
         ],
         &[&idx, &runs, &means, &stds, &ses],
     )?;
-    Ok(scalar_section(q, summary))
+    let labels: Vec<&str> = having
+        .iter()
+        .map(|(i, _)| summary.variants[*i].name.as_str())
+        .collect();
+    Ok(scalar_section(q, &labels))
 }
 
-fn scalar_section(q: &str, summary: &SuiteSummary) -> Section {
-    let labels: Vec<&str> = summary.variants.iter().map(|v| v.name.as_str()).collect();
+fn scalar_section(q: &str, labels: &[&str]) -> Section {
     Section {
         heading: format!("Quantity {q} across variants"),
         text: format!(
@@ -288,7 +394,7 @@ fn scalar_section(q: &str, summary: &SuiteSummary) -> Section {
     }
 }
 
-/// `plot` with `y` against log10(model runs), one line per method kind (e.g. SCM 2, 3, 4, 5
+/// `plot` with `y` against the model runs (log axis), one line per method kind (e.g. SCM 2, 3, 4, 5
 /// nodes; LHS 500, 20 000); single runs are left out.
 fn convergence(mut plot: LinePlot, kinds: &[&str], runs: &[f64], y: &[f64]) -> LinePlot {
     let mut distinct: Vec<&str> = kinds.to_vec();
@@ -302,7 +408,7 @@ fn convergence(mut plot: LinePlot, kinds: &[&str], runs: &[f64], y: &[f64]) -> L
         }
         plot.series.push(Series::new(
             kind.to_string(),
-            idx.iter().map(|&i| runs[i].log10()).collect(),
+            idx.iter().map(|&i| runs[i]).collect(),
             idx.iter().map(|&i| y[i]).collect(),
             palette(ki),
         ));

@@ -18,6 +18,11 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/wheel-lhs-50000.toml"),
     ),
     ("wheel-mc", include_str!("../../studies/wheel-mc.toml")),
+    ("wheel-qmc", include_str!("../../studies/wheel-qmc.toml")),
+    (
+        "wheel-sobol-sampling",
+        include_str!("../../studies/wheel-sobol-sampling.toml"),
+    ),
     ("wheel-sgm", include_str!("../../studies/wheel-sgm.toml")),
     (
         "wheel-sparse",

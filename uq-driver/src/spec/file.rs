@@ -11,6 +11,10 @@ use crate::qoi::QoiSpec;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::MethodSpec;
 
+/// Most communication points of one run (the limit of [`Experiment::check`]): 10^8 points
+/// hold 800 MB per recorded variable.
+pub const MAX_TIME_POINTS: f64 = 1e8;
+
 /// Start, stop and communication step (s).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -69,7 +73,8 @@ impl Experiment {
         t
     }
 
-    /// Checks that start < stop and step > 0, all finite.
+    /// Checks that start < stop and step > 0, all finite, and that the grid has at most
+    /// [`MAX_TIME_POINTS`] points (before anything allocates it).
     pub fn check(&self) -> Result<(), InvalidExperiment> {
         if self.step == 0.0 {
             return Err(InvalidExperiment::ZeroStep);
@@ -79,6 +84,14 @@ impl Experiment {
             return Err(InvalidExperiment::Range {
                 start: self.start,
                 stop: self.stop,
+                step: self.step,
+            });
+        }
+        // t_0 … t_n with n = ceil((stop − start) / step) at most (a shorter last step).
+        let points = ((self.stop - self.start) / self.step).ceil() + 1.0;
+        if points.is_nan() || points > MAX_TIME_POINTS {
+            return Err(InvalidExperiment::TooManyPoints {
+                points,
                 step: self.step,
             });
         }
@@ -101,6 +114,19 @@ pub enum InvalidExperiment {
         start: f64,
         /// Stop (s).
         stop: f64,
+        /// Step (s).
+        step: f64,
+    },
+    /// More communication points than [`MAX_TIME_POINTS`].
+    #[error(
+        "experiment: {points:.3e} communication points (step {step:e} s), more than the limit of \
+         1e8 per run (each recorded variable would take {:.1e} bytes of memory); use a \
+         coarser step or a shorter experiment",
+        8.0 * points
+    )]
+    TooManyPoints {
+        /// Communication points (t_0 … t_n).
+        points: f64,
         /// Step (s).
         step: f64,
     },
@@ -132,8 +158,12 @@ pub struct Analysis {
     pub pdf_grid: usize,
     /// Largest number of time columns in the PDF evolution (evenly thinned).
     pub pdf_times: usize,
-    /// Samples of a chaos surrogate used for densities and quantiles.
+    /// Samples of a chaos surrogate used for the densities, quantiles and exceedance
+    /// probabilities of the scalar quantities.
     pub surrogate_samples: usize,
+    /// Samples of a chaos surrogate used for the quantiles and densities over time of the
+    /// outputs (at most `surrogate_samples`; the first of the same draws).
+    pub series_samples: usize,
     /// Quantile levels written to the CSV.
     pub quantiles: Vec<f64>,
     /// Unweighted designs (MC/LHS): continue when some points fail and report how many.
@@ -144,8 +174,9 @@ impl Default for Analysis {
     fn default() -> Self {
         Analysis {
             pdf_grid: 200,
-            pdf_times: 250,
+            pdf_times: 150,
             surrogate_samples: 20_000,
+            series_samples: 4_000,
             quantiles: vec![0.01, 0.5, 0.99],
             allow_failures: false,
         }
@@ -251,4 +282,8 @@ pub struct Variant {
     /// Deterministic values of this variant, merged over the study's `[fixed]`.
     #[serde(default)]
     pub fixed: BTreeMap<String, FixedValue>,
+    /// The study's `[[qoi]]` entries this variant computes, by name (default: all), e.g. to
+    /// leave an expensive quantity out of a large design.
+    #[serde(default)]
+    pub quantities: Option<Vec<String>>,
 }

@@ -41,21 +41,41 @@ impl Study {
     }
 }
 
-/// Folders searched for an FMU named by a relative path that is not next to the study file:
-/// `$RAILUQ_FMU_DIR`, `<folder of the executable>/../fmu` (i.e. `target/fmu` for a cargo
-/// build), `./target/fmu`.
+/// Folders searched for an FMU named by a relative path that is not next to the study file,
+/// in order: `$RAILUQ_FMU_DIR`; beside the executable, `<exe dir>/fmu` (an installed binary
+/// with its FMUs) and `<exe dir>/../share/railuq/fmu` (a `PREFIX/bin` + `PREFIX/share`
+/// install); `<exe dir>/../fmu` (`target/fmu` for a cargo build); `./target/fmu`.
 pub fn fmu_search_path() -> Vec<PathBuf> {
     let mut dirs = Vec::new();
     if let Some(d) = std::env::var_os("RAILUQ_FMU_DIR") {
         dirs.push(PathBuf::from(d));
     }
-    if let Ok(exe) = std::env::current_exe() {
-        if let Some(parent) = exe.parent().and_then(Path::parent) {
-            dirs.push(parent.join("fmu"));
+    if let Some(exe_dir) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().map(Path::to_path_buf))
+    {
+        dirs.push(exe_dir.join("fmu"));
+        if let Some(prefix) = exe_dir.parent() {
+            dirs.push(prefix.join("share").join("railuq").join("fmu"));
+            dirs.push(prefix.join("fmu"));
         }
     }
     dirs.push(PathBuf::from("target/fmu"));
     dirs
+}
+
+/// Every place a study's `fmu = "..."` is looked for, in order: as given when absolute;
+/// else beside the study file, relative to the working folder, then in each folder of
+/// [`fmu_search_path`].
+pub fn fmu_candidates(fmu: &str, base: Option<&Path>) -> Vec<PathBuf> {
+    let p = Path::new(fmu);
+    if p.is_absolute() {
+        return vec![p.to_path_buf()];
+    }
+    let mut c: Vec<PathBuf> = base.map(|b| b.join(p)).into_iter().collect();
+    c.push(p.to_path_buf());
+    c.extend(fmu_search_path().into_iter().map(|d| d.join(p)));
+    c
 }
 
 /// Where errors point: the origin and the text the spans refer to.
@@ -206,16 +226,18 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
         let e = file.experiment.get_ref();
         e.stop - e.start
     };
-    let mut names: Vec<&str> = file.outputs.variables.iter().map(String::as_str).collect();
+    let mut names: Vec<String> = file.outputs.variables.clone();
     for q in &file.qoi {
         let (span, q): (_, &QoiSpec) = (q.span(), q.get_ref());
-        if names.contains(&q.name()) {
-            return Err(cx.invalid(
-                Some(span),
-                format!("quantity name '{}' is used twice", q.name()),
-            ));
+        for name in q.quantity_names() {
+            if names.contains(&name) {
+                return Err(cx.invalid(
+                    Some(span.clone()),
+                    format!("quantity name '{name}' is used twice"),
+                ));
+            }
+            names.push(name);
         }
-        names.push(q.name());
         q.validate(duration)
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
@@ -223,10 +245,16 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
 }
 
 fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
-    if a.pdf_grid < 2 || a.pdf_times < 1 || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q)) {
+    if a.pdf_grid < 2
+        || a.pdf_times < 1
+        || a.series_samples < 2
+        || a.surrogate_samples < 2
+        || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q))
+    {
         return Err(cx.invalid(
             None,
-            "analysis: pdf_grid >= 2, pdf_times >= 1, quantiles in [0, 1]",
+            "analysis: pdf_grid >= 2, pdf_times >= 1, series_samples >= 2, \
+             surrogate_samples >= 2, quantiles in [0, 1]",
         ));
     }
     Ok(())
@@ -313,6 +341,22 @@ fn variant(
     for (k, x) in &v.fixed {
         f.fixed.insert(k.clone(), x.clone());
     }
+    if let Some(names) = &v.quantities {
+        if let Some(n) = names
+            .iter()
+            .find(|n| !file.qoi.iter().any(|q| q.get_ref().name() == *n))
+        {
+            return Err(cx.invalid(
+                Some(span),
+                format!(
+                    "variant '{}': quantities names '{n}', which is not a [[qoi]] of the study",
+                    v.name
+                ),
+            ));
+        }
+        f.qoi
+            .retain(|q| names.iter().any(|n| n == q.get_ref().name()));
+    }
     let origin = format!("{} (variant {})", cx.origin, v.name);
     study(f, &origin, base, cx.text)
 }
@@ -327,25 +371,13 @@ fn resolve_relative(file: &str, base: Option<&Path>) -> PathBuf {
     }
 }
 
+/// The first of [`fmu_candidates`] that exists, else the first candidate (opening it then
+/// fails; the command line lists every place searched).
 fn resolve_fmu(fmu: &str, base: Option<&Path>) -> PathBuf {
-    let p = Path::new(fmu);
-    if p.is_absolute() {
-        return p.to_path_buf();
-    }
-    if let Some(b) = base {
-        let c = b.join(p);
-        if c.exists() {
-            return c;
-        }
-    }
-    if p.exists() {
-        return p.to_path_buf();
-    }
-    for d in fmu_search_path() {
-        let c = d.join(p);
-        if c.exists() {
-            return c;
-        }
-    }
-    base.map(|b| b.join(p)).unwrap_or_else(|| p.to_path_buf())
+    let candidates = fmu_candidates(fmu, base);
+    candidates
+        .iter()
+        .find(|c| c.exists())
+        .unwrap_or(&candidates[0])
+        .clone()
 }

@@ -46,7 +46,7 @@ pub use file::{
     Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue,
     StudyFile, Variant,
 };
-pub use load::fmu_search_path;
+pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};
 pub use study::{Study, Suite};
 pub use value::FixedValue;

@@ -93,7 +93,7 @@ impl Study {
             parameters: &self.parameters,
             correlation: self.correlation.as_ref(),
             outputs: &self.outputs,
-            quantities: self.qoi.len(),
+            quantities: self.qoi.iter().map(|q| q.quantity_names().len()).sum(),
             times,
             system: self.system.as_ref(),
         }

@@ -205,3 +205,50 @@ fn a_zero_step_has_its_own_message() {
     assert_eq!(err, InvalidExperiment::ZeroStep);
     assert!(err.to_string().contains("step is 0"), "{err}");
 }
+
+#[test]
+fn hunting_speed_yields_two_quantities_and_variants_can_leave_quantities_out() {
+    let s = Study::load("builtin:paper-bogie").unwrap();
+    let names =
+        |s: &Study| -> Vec<String> { s.qoi.iter().flat_map(|q| q.quantity_names()).collect() };
+    assert_eq!(names(&s), ["v_cr", "v_cr_linear", "v_hunt", "v_hunt_decay"]);
+    let times = s.times();
+    assert_eq!(s.problem(&times).quantities, 4);
+    let suite = s.suite.as_ref().unwrap();
+    for v in &suite.variants {
+        let expected: &[&str] = if v.name == "lhs-20000" {
+            &["v_cr", "v_cr_linear"]
+        } else {
+            &["v_cr", "v_cr_linear", "v_hunt", "v_hunt_decay"]
+        };
+        assert_eq!(names(v), expected, "variant {}", v.name);
+    }
+    let base = include_str!("../../studies/paper-bogie.toml");
+    let cases = [
+        // The second quantity's name is taken like any other.
+        (
+            base.replace("name = \"v_cr_linear\"", "name = \"v_hunt_decay\""),
+            "quantity name 'v_hunt_decay' is used twice",
+        ),
+        (
+            base.replace(
+                "quantities = [\"v_cr\", \"v_cr_linear\"]",
+                "quantities = [\"v_crr\"]",
+            ),
+            "'v_crr', which is not a [[qoi]]",
+        ),
+        (
+            base.replace("tolerance = 0.02", "tolerance = 0.0"),
+            "quantity 'v_hunt': tolerance must be > 0",
+        ),
+        (base.replace("low = 40.0", "low = 140.0"), "low < high"),
+        (
+            base.replace("duration = 300.0", "duration = 300.0\nspeed = \"V\""),
+            "unknown field `speed`",
+        ),
+    ];
+    for (text, needle) in cases {
+        let err = Study::parse(&text, "t.toml", None).unwrap_err().to_string();
+        assert!(err.contains(needle), "{err} should mention {needle}");
+    }
+}

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::inputs::{InputError, InputTable};
+use super::speed_runs::SpeedRuns;
 use crate::fmu::{Fmu, FmuError, Instance, ScalarVariable, VariableKind};
 use crate::qoi::QoiSpec;
 use crate::spec::{FixedValue, Study};
@@ -114,6 +115,14 @@ pub enum VariableProblem {
     /// The input signals do not fit.
     #[error("{0}")]
     Inputs(String),
+    /// A quantity's settings do not fit the FMU or the study.
+    #[error("quantity '{name}': {problem}")]
+    Quantity {
+        /// The quantity.
+        name: String,
+        /// What does not fit.
+        problem: String,
+    },
 }
 
 /// Values set before initialization, by FMI type: (value reference, value).
@@ -234,12 +243,16 @@ pub struct Interface {
     pub inputs: Option<InputTable>,
     /// Outputs left out of a run that records "every output", with the reason.
     pub skipped: Vec<(String, String)>,
+    /// The runs of its own of each `hunting_speed` quantity.
+    pub speed_runs: Vec<SpeedRuns>,
 }
 
 impl Interface {
-    /// Values recorded per successful point: stored series, then (value, code) per quantity.
+    /// Values recorded per successful point: stored series, then (value, code) per scalar
+    /// quantity (a `hunting_speed` entry yields two).
     pub fn n_values(&self, n_times: usize) -> usize {
-        self.n_stored * n_times + 2 * self.qois.len()
+        let scalars: usize = self.qois.iter().map(|q| q.quantity_names().len()).sum();
+        self.n_stored * n_times + 2 * scalars
     }
 
     /// Checks the study's variables against the FMU and resolves their value references
@@ -258,7 +271,7 @@ impl Interface {
                 signal_names.push(s.to_owned());
             }
         }
-        Ok(Interface {
+        let mut iface = Interface {
             random,
             fixed,
             signals: vars.signals(&signal_names)?,
@@ -267,7 +280,10 @@ impl Interface {
             qois: study.qoi.clone(),
             inputs: vars.inputs(study.inputs.as_deref())?,
             skipped: Vec::new(),
-        })
+            speed_runs: Vec::new(),
+        };
+        iface.speed_runs = SpeedRuns::resolve_all(study, &iface, &vars)?;
+        Ok(iface)
     }
 
     /// The interface of one deterministic run: `params` set before initialization, `outputs`
@@ -306,6 +322,7 @@ impl Interface {
             qois: Vec::new(),
             inputs: vars.inputs(inputs)?,
             skipped,
+            speed_runs: Vec::new(),
         })
     }
 
@@ -379,19 +396,19 @@ fn to_i32(v: f64) -> Option<i32> {
 }
 
 /// Lookups of study variables in one FMU, with errors that name it.
-struct Variables<'a> {
-    fmu: &'a Fmu,
+pub(super) struct Variables<'a> {
+    pub(super) fmu: &'a Fmu,
 }
 
 impl<'a> Variables<'a> {
-    fn error(&self, problem: VariableProblem) -> InterfaceError {
+    pub(super) fn error(&self, problem: VariableProblem) -> InterfaceError {
         InterfaceError {
             fmu: self.fmu.path().to_path_buf(),
             problem,
         }
     }
 
-    fn any(&self, name: &str) -> Result<&'a ScalarVariable, InterfaceError> {
+    pub(super) fn any(&self, name: &str) -> Result<&'a ScalarVariable, InterfaceError> {
         let md = self.fmu.description();
         md.variable(name).ok_or_else(|| {
             self.error(VariableProblem::Unknown {
@@ -423,7 +440,7 @@ impl<'a> Variables<'a> {
     }
 
     /// The signals `names`, grouped by type.
-    fn signals(&self, names: &[String]) -> Result<Signals, InterfaceError> {
+    pub(super) fn signals(&self, names: &[String]) -> Result<Signals, InterfaceError> {
         let mut s = Signals {
             len: names.len(),
             ..Signals::default()
@@ -453,7 +470,7 @@ impl<'a> Variables<'a> {
             .map_err(|e: InputError| self.error(VariableProblem::Inputs(e.to_string())))
     }
 
-    fn check_settable(&self, var: &ScalarVariable) -> Result<(), InterfaceError> {
+    pub(super) fn check_settable(&self, var: &ScalarVariable) -> Result<(), InterfaceError> {
         if self.fmu.description().settable_before_init(var) {
             return Ok(());
         }
@@ -465,7 +482,7 @@ impl<'a> Variables<'a> {
     }
 
     /// Deterministic values by FMI type, each checked against its variable.
-    fn settings<'n>(
+    pub(super) fn settings<'n>(
         &self,
         values: impl Iterator<Item = (&'n str, &'n FixedValue)>,
     ) -> Result<Settings, InterfaceError> {

@@ -7,6 +7,7 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+pub mod export;
 pub mod guard;
 pub mod inputs;
 pub mod interface;
@@ -15,9 +16,12 @@ pub mod lock;
 pub mod nested;
 mod outcome;
 mod point;
+pub mod progress;
 pub mod runner;
 pub mod shard;
 mod single;
+pub mod size;
+pub mod speed_runs;
 pub mod store;
 pub mod suite;
 
@@ -30,11 +34,15 @@ use crate::spec::Study;
 
 /// Runs a study into `out_dir` (resuming what a previous run there finished). A suite runs
 /// every variant into `out_dir/<variant>/` and writes the comparison into `out_dir`.
+///
+/// Nothing is allocated, run or written (`out_dir` is not even created) before the study
+/// passes [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`.
 pub fn run_study(
     study: &Study,
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<Outcome, StudyRunError> {
+    size::check(study, out_dir, opts)?;
     runner::prepare_out_dir(out_dir)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),

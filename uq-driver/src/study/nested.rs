@@ -17,7 +17,8 @@ use rand::RngCore;
 use rayon::prelude::*;
 
 use super::analysis::{
-    output_stats, scalar_stats, Analysed, AnalysisError, QuantityRuns, Runs, Settings,
+    output_stats, scalar_stats, Analysed, AnalysisError, QuantityRuns, Runs, Settings, Surrogates,
+    SURROGATE_SEED,
 };
 use super::store::Record;
 use crate::qoi::QoiSpec;
@@ -56,7 +57,8 @@ pub fn analyse(
     design: &Design,
     records: &[Option<Record>],
 ) -> Result<NestedAnalysed, AnalysisError> {
-    let settings = Settings::of(study);
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();
     let runs = Runs::of(records);
@@ -65,10 +67,12 @@ pub fn analyse(
             ok: runs.rows.len(),
         });
     }
-    let blocks = method.blocks(design).map_err(|source| AnalysisError::Output {
-        name: "(the nested design)".into(),
-        source,
-    })?;
+    let blocks = method
+        .blocks(design)
+        .map_err(|source| AnalysisError::Output {
+            name: "(the nested design)".into(),
+            source,
+        })?;
     let mut out = NestedAnalysed {
         analysed: Analysed {
             outputs: Vec::new(),
@@ -91,7 +95,8 @@ pub fn analyse(
         let estimate = marginal(&cond, nt).map_err(fail)?;
         let splits: Vec<Split> = (0..nt).map(|j| Split::all(&cond.column(j))).collect();
         let pooled = pooled_series(&cond, &data, &settings, nt);
-        let mut stats: OutputStats = output_stats(name, &times, &estimate, Some(&pooled), &settings)?;
+        let mut stats: OutputStats =
+            output_stats(name, &times, &estimate, Some(&pooled), &settings)?;
         stats.draws = draws_of(&cond);
         out.splits.push(OutputSplit {
             name: name.clone(),
@@ -105,16 +110,21 @@ pub fn analyse(
         out.analysed.outputs.push(stats);
     }
     let base = study.outputs.len() * nt;
-    for (qi, q) in study.qoi.iter().enumerate() {
+    let scalars = study
+        .qoi
+        .iter()
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
+    for (qi, (name, q)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi);
         if qr.valid.is_empty() {
             return Err(AnalysisError::NoValue {
-                name: q.name().to_owned(),
+                name,
                 never_hunts: qr.never_hunts,
                 never_stops: qr.never_stops,
             });
         }
-        let (stats, warning) = quantity(study, method, &blocks, q, qr, qi, &settings)?;
+        let scalar = Scalar { name: &name, q, qi };
+        let (stats, warning) = quantity(study, method, &blocks, scalar, qr, &settings)?;
         out.warnings.extend(warning);
         out.analysed.quantities.push(stats);
     }
@@ -170,19 +180,28 @@ fn pooled_series(
     pooled
 }
 
-/// The statistics of quantity `q` (number `qi`) and, when its corrected outer variance is
-/// negative, a note.
+/// One scalar quantity: its name, the `[[qoi]]` that defines it, its number among the
+/// study's scalars.
+#[derive(Clone, Copy)]
+struct Scalar<'a> {
+    name: &'a str,
+    q: &'a QoiSpec,
+    qi: usize,
+}
+
+/// The statistics of a scalar quantity and, when its corrected outer variance is negative, a
+/// note.
 fn quantity(
     study: &Study,
     method: &Nested,
     blocks: &Blocks,
-    q: &QoiSpec,
+    scalar: Scalar,
     qr: QuantityRuns,
-    qi: usize,
     settings: &Settings,
 ) -> Result<(ScalarStats, Option<String>), AnalysisError> {
+    let Scalar { name, q, qi } = scalar;
     let fail = |source: MethodError| AnalysisError::Quantity {
-        name: q.name().to_owned(),
+        name: name.to_owned(),
         never_hunts: qr.never_hunts,
         never_stops: qr.never_stops,
         source,
@@ -226,11 +245,14 @@ fn quantity(
         per_outer.iter().flatten().copied().collect()
     } else {
         let per = n_draws.div_ceil(present.len()).clamp(1, equal.max(1));
-        per_outer.iter().flat_map(|d| d[..per].iter().copied()).collect()
+        per_outer
+            .iter()
+            .flat_map(|d| d[..per].iter().copied())
+            .collect()
     };
     let table = conditional_table(study, blocks, &cond, &limits, &exceedance);
     let n = present.len() as f64;
-    let mut stats = scalar_stats(q, &estimate, qr, settings, Some(pooled))?;
+    let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled))?;
     stats.draws = draws_of(&cond);
     stats.exceedance = exceedance
         .iter()
@@ -279,7 +301,7 @@ fn quantity(
             split::RESAMPLES
         ),
         outer_samples: present.len(),
-        conditional_csv: format!("{}_conditional.csv", q.name()),
+        conditional_csv: format!("{name}_conditional.csv"),
         conditional: table,
     });
     let warning = (s.var_outer < 0.0).then(|| {
@@ -287,9 +309,7 @@ fn quantity(
             "{}: the estimated variance between outer samples, {:.3e}, is below the inner \
              sampling error it is corrected for ({:.3e}); the outer share is counted as 0 \
              (more inner runs or outer samples would resolve it)",
-            q.name(),
-            s.var_outer_plugin,
-            s.correction
+            name, s.var_outer_plugin, s.correction
         )
     });
     Ok((stats, warning))

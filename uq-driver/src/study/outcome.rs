@@ -2,6 +2,7 @@
 
 use super::analysis::AnalysisError;
 use super::runner::RunError;
+use super::size::SizeError;
 use crate::report::ReportError;
 use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
 use crate::uq::method::MethodError;
@@ -12,6 +13,9 @@ pub enum StudyRunError {
     /// Running the points failed.
     #[error(transparent)]
     Run(#[from] RunError),
+    /// The study is too large to start (or to start without `--yes`).
+    #[error(transparent)]
+    Size(#[from] SizeError),
     /// An intrusive method failed.
     #[error(transparent)]
     Method(#[from] MethodError),

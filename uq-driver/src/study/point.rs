@@ -9,6 +9,7 @@ use super::interface::{Interface, RandomValueError};
 use super::runner::RunError;
 use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
 use crate::qoi::scalar::{self, QoiError};
+use crate::qoi::QoiSpec;
 use crate::spec::FixedValue;
 
 /// Why one model run failed. Its text is stored with the point, so it is complete on its own.
@@ -51,6 +52,18 @@ pub enum PointError {
         /// Why.
         error: QoiError,
     },
+    /// A constant-speed run of a `hunting_speed` quantity failed.
+    #[error("quantity '{name}': the constant-speed run at {parameter} = {speed}: {source}")]
+    SpeedRun {
+        /// The quantity.
+        name: String,
+        /// The speed parameter.
+        parameter: String,
+        /// Its value in the failed run.
+        speed: f64,
+        /// Why the run failed.
+        source: Box<PointError>,
+    },
 }
 
 /// What one run recorded.
@@ -68,14 +81,16 @@ pub struct Trace {
     pub ended: Option<(f64, Option<Vec<f64>>)>,
 }
 
-/// Starts (or resets) `slot`'s instance, sets the parameters and the inputs, initializes and
-/// records the signals at `times`, ending early where the FMU ends the simulation.
-fn simulate_point(
+/// Starts (or resets) `slot`'s instance, sets the parameters (the fixed ones, the random
+/// `values`, then the Real `extra` values) and the inputs, initializes and records the signals
+/// at `times`, ending early where the FMU ends the simulation.
+pub(super) fn simulate_point(
     fmu: &Fmu,
     slot: &mut Option<Instance>,
     iface: &Interface,
     values: &[f64],
     times: &[f64],
+    extra: &[(u32, f64)],
 ) -> Result<Trace, PointError> {
     let nt = times.len();
     let inst = match slot {
@@ -90,6 +105,10 @@ fn simulate_point(
         RandomValueError::Fmu(e) => PointError::Fmu(e),
         RandomValueError::Value(p) => PointError::Value(p.to_string()),
     })?;
+    if !extra.is_empty() {
+        let (vr, v): (Vec<u32>, Vec<f64>) = extra.iter().copied().unzip();
+        inst.set_real(&vr, &v)?;
+    }
     let stop = *times.last().expect("at least one time");
     inst.setup_experiment(None, times[0], Some(stop))?;
     inst.enter_initialization_mode()?;
@@ -167,8 +186,9 @@ fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f
 
 /// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
 /// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
-/// (value, code) of each quantity of interest. A run the FMU ends before the stop time is a
-/// failed point ([`PointError::EndedEarly`]).
+/// (value, code) of each scalar quantity (a `hunting_speed` entry gives two, from its own
+/// constant-speed runs on the same instance after the point's run). A run the FMU ends
+/// before the stop time is a failed point ([`PointError::EndedEarly`]).
 pub fn run_point(
     fmu: &Fmu,
     slot: &mut Option<Instance>,
@@ -177,7 +197,7 @@ pub fn run_point(
     times: &[f64],
 ) -> Result<Vec<f64>, PointError> {
     let nt = times.len();
-    let trace = simulate_point(fmu, slot, iface, values, times).inspect_err(|_| {
+    let trace = simulate_point(fmu, slot, iface, values, times, &[]).inspect_err(|_| {
         // A failed instance may be in Error state: start the next point on a fresh one.
         *slot = None;
     })?;
@@ -205,7 +225,16 @@ pub fn run_point(
             .expect("resolved");
         &traces[i * nt..(i + 1) * nt]
     };
-    for q in &iface.qois {
+    for (qi, q) in iface.qois.iter().enumerate() {
+        if let QoiSpec::HuntingSpeed(h) = q {
+            let runs = iface
+                .speed_runs
+                .iter()
+                .find(|r| r.qoi == qi)
+                .expect("resolved with the interface");
+            out.extend(runs.evaluate(h, fmu, slot, values)?);
+            continue;
+        }
         let (v, code) =
             scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
                 name: q.name().to_owned(),
@@ -244,7 +273,7 @@ pub fn simulate(
     times: &[f64],
 ) -> Result<Simulation, RunError> {
     let iface = Interface::for_run(fmu, params, outputs, inputs)?;
-    let trace = simulate_point(fmu, &mut None, &iface, &[], times)?;
+    let trace = simulate_point(fmu, &mut None, &iface, &[], times, &[])?;
     let nt = times.len();
     let mut out_times = times[..trace.recorded].to_vec();
     let mut series: Vec<Vec<f64>> = trace

@@ -13,6 +13,7 @@ use super::interface::{Interface, InterfaceError};
 use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
 use super::lock::{FolderLock, LockError};
 pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
+use super::progress::{Progress, ProgressMode};
 use super::store::{Manifest, Record, Store, StoreError};
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
@@ -25,6 +26,9 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
+    /// Print progress lines (when the output is a log file, not a terminal); ignored when
+    /// `progress` is set.
+    pub progress_lines: bool,
     /// Unweighted designs: continue past failed points (overrides the study file when true).
     pub allow_failures: bool,
     /// Discard earlier results in the output folder.
@@ -33,6 +37,8 @@ pub struct RunOptions {
     pub max_new_points: Option<usize>,
     /// Run only these points of the design (a shard); None: all.
     pub points: Option<Vec<usize>>,
+    /// Write the CSV files and `summary.json` only: no plots, no `index.html`.
+    pub no_report: bool,
     /// Run the points that failed in an earlier run again (`--retry-failed`).
     pub retry_failed: bool,
     /// `--isolate`: run each point in a worker process started from this uq-driver executable
@@ -41,6 +47,8 @@ pub struct RunOptions {
     /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point; in-process
     /// the study stops with a message naming the point (an FMU call cannot be interrupted).
     pub timeout_per_run: Option<Duration>,
+    /// Start a large study without asking (`--yes`; see [`super::size`]).
+    pub yes: bool,
 }
 
 impl RunOptions {
@@ -218,20 +226,6 @@ pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, R
     })
 }
 
-fn progress_bar(show: bool, n: usize) -> Option<indicatif::ProgressBar> {
-    if !show || n == 0 {
-        return None;
-    }
-    let b = indicatif::ProgressBar::new(n as u64);
-    b.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} points  {elapsed} elapsed, ~{eta} left",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    Some(b)
-}
-
 /// Runs every point of `design` not yet in the store of `out_dir` (with
 /// [`RunOptions::retry_failed`], also the points that failed before), holding the folder's
 /// lock ([`FolderLock`]) meanwhile.
@@ -315,20 +309,23 @@ pub fn run_points(
         workers,
         guard: &guard,
     };
-    let bar = progress_bar(opts.progress, missing.len());
+    let mode = match (opts.progress, opts.progress_lines) {
+        (true, _) => ProgressMode::Bar,
+        (false, true) => ProgressMode::Lines,
+        _ => ProgressMode::Off,
+    };
+    let progress = Progress::new(mode, missing.len());
     let done = AtomicBool::new(false);
     let new = std::thread::scope(|scope| {
         if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
             let (guard, done) = (&guard, &done);
             scope.spawn(move || watchdog(guard, limit, done));
         }
-        let new = pool.install(|| batch.run(&missing, bar.as_ref()));
+        let new = pool.install(|| batch.run(&missing, &progress));
         done.store(true, Ordering::Release);
         new
     })?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    progress.finish();
     let n_new = new.len();
     for (i, r) in new {
         records[i] = Some(r);
@@ -402,11 +399,7 @@ struct Batch<'a> {
 }
 
 impl Batch<'_> {
-    fn run(
-        &self,
-        points: &[usize],
-        bar: Option<&indicatif::ProgressBar>,
-    ) -> Result<Vec<(usize, Record)>, RunError> {
+    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Record)>, RunError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
         points
@@ -435,9 +428,7 @@ impl Batch<'_> {
                         stop.store(true, Ordering::Relaxed);
                     }
                     self.store.append(i, &rec)?;
-                    if let Some(b) = bar {
-                        b.inc(1);
-                    }
+                    progress.inc();
                     Ok(Some((i, rec)))
                 },
             )

@@ -8,11 +8,14 @@ use std::time::Instant;
 use super::analysis;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
+use super::size;
 use super::store::Record;
 use crate::fmu::Fmu;
+use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
 use crate::results::{
-    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, ScalarStats, Summary, Versions,
+    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout, ScalarStats,
+    Summary, Timing, Versions,
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
@@ -31,10 +34,14 @@ pub(crate) fn run_single(
         source,
     })?;
     match study.method().evaluation() {
-        Evaluation::Intrusive(method) => solve(study, method, out_dir),
+        Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
+            if method.planned_runs(study.parameters.len()).is_none() {
+                // Only the design knew its size: check it before it runs.
+                size::check_runs(study, design.len(), opts)?;
+            }
             eprintln!(
                 "{}: {} with {} model runs",
                 study.name,
@@ -62,6 +69,7 @@ struct RunFacts {
     failed: usize,
     wall_time: f64,
     threads: usize,
+    analysis_time: f64,
 }
 
 fn summary(
@@ -99,6 +107,16 @@ fn summary(
             .iter()
             .map(|q| (q.name.clone(), q.clone()))
             .collect::<BTreeMap<_, _>>(),
+        timing: Timing {
+            runs_s: facts.wall_time,
+            analysis_s: facts.analysis_time,
+            report_s: 0.0,
+        },
+        units: BTreeMap::new(),
+        record_layout: RecordLayout {
+            outputs: study.outputs.clone(),
+            quantities: study.qoi.iter().map(|q| q.name().to_owned()).collect(),
+        },
     }
 }
 
@@ -121,6 +139,7 @@ pub(crate) fn finish(
             total: design.len(),
         });
     }
+    let started = Instant::now();
     let (analysed, splits, mut warnings) = match &study.method {
         MethodSpec::Nested(nested) => {
             let n = super::nested::analyse(study, nested, design, &outcome.records)?;
@@ -132,8 +151,12 @@ pub(crate) fn finish(
             Vec::new(),
         ),
     };
-    let (outputs, quantities) = (analysed.outputs, analysed.quantities);
+    let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
+    let units = units::study_units(study, Some(md));
+    units::annotate(&units, &mut outputs, &mut quantities);
+    units::describe_signals(&mut quantities, &study.qoi, md);
+    let analysis_time = started.elapsed().as_secs_f64();
     let facts = RunFacts {
         fmu: Some(FmuInfo {
             path: fmu.path().display().to_string(),
@@ -148,10 +171,11 @@ pub(crate) fn finish(
         failed,
         wall_time: outcome.wall_time,
         threads: outcome.threads,
+        analysis_time,
     };
     let method_summary = study.method().summary(study.parameters.len());
     warnings.splice(0..0, design.warnings.iter().cloned());
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -167,9 +191,10 @@ pub(crate) fn finish(
         &analysed.quantity_chaos,
         out_dir,
     )?;
+    summary.units = units;
     let points = point_table(study, design, &outcome.records);
-    let extra = report::nested::write(out_dir, &quantities, &splits)?;
-    report::study::write(
+    let extra = report::nested::write(out_dir, &quantities, &splits, !opts.no_report)?;
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -178,6 +203,7 @@ pub(crate) fn finish(
             qoi: &study.qoi,
             points: Some(&points),
             extra: &extra,
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {
@@ -192,11 +218,13 @@ fn solve(
     study: &Study,
     method: &dyn Intrusive,
     out_dir: &Path,
+    opts: &RunOptions,
 ) -> Result<StudyResult, StudyRunError> {
     let started = Instant::now();
     let times = study.times();
     let solution = method.solve(&study.problem(&times))?;
     let wall_time = started.elapsed().as_secs_f64();
+    let started = Instant::now();
     let outputs = analysis::analyse_solution(study, &solution)?;
     let chaos: Vec<NamedChaos> = study
         .outputs
@@ -219,6 +247,7 @@ fn solve(
         &[],
         out_dir,
     )?;
+    let analysis_time = started.elapsed().as_secs_f64();
     let mut method_summary = study.method().summary(study.parameters.len());
     method_summary.details.extend(solution.details);
     let facts = RunFacts {
@@ -229,8 +258,9 @@ fn solve(
         failed: 0,
         wall_time,
         threads: 1,
+        analysis_time,
     };
-    let summary = summary(
+    let mut summary = summary(
         study,
         facts,
         method_summary,
@@ -238,7 +268,8 @@ fn solve(
         &outputs,
         &[],
     );
-    report::study::write(
+    summary.units = units::study_units(study, None);
+    summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
             summary: &summary,
@@ -247,6 +278,7 @@ fn solve(
             qoi: &study.qoi,
             points: None,
             extra: &[],
+            plots: !opts.no_report,
         },
     )?;
     Ok(StudyResult {

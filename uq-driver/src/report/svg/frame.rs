@@ -13,10 +13,18 @@ const PLOT_H: f64 = 380.0;
 /// Approximate advance of one character of 12 px sans-serif text (legend).
 const TEXT_CHAR_W: f64 = 6.9;
 
-/// A legend entry: a line or a filled swatch with a label.
+/// Characters per line of a legend label (longer labels wrap, never cut).
+const LEGEND_CHARS: usize = 34;
+/// Height of one text line of a legend (px).
+const LEGEND_LINE: f64 = 15.0;
+/// Gap between legend entries (px).
+const LEGEND_GAP: f64 = 6.0;
+
+/// A legend entry: a line or a filled swatch with a label (wrapped into lines).
 #[derive(Debug, Clone)]
 pub(crate) struct LegendEntry {
     pub label: String,
+    pub lines: Vec<String>,
     pub color: String,
     pub dashed: bool,
     pub filled: bool,
@@ -25,7 +33,8 @@ pub(crate) struct LegendEntry {
 impl LegendEntry {
     pub fn line(label: &str, color: &str, dashed: bool) -> Self {
         Self {
-            label: truncate(label, 36),
+            label: label.to_string(),
+            lines: wrap(label, LEGEND_CHARS),
             color: color.to_string(),
             dashed,
             filled: false,
@@ -34,19 +43,42 @@ impl LegendEntry {
 
     pub fn fill(label: &str, color: &str) -> Self {
         Self {
-            label: truncate(label, 36),
-            color: color.to_string(),
-            dashed: false,
             filled: true,
+            ..Self::line(label, color, false)
         }
     }
+
+    fn height(&self) -> f64 {
+        self.lines.len().max(1) as f64 * LEGEND_LINE + LEGEND_GAP
+    }
+}
+
+/// `text` broken at spaces into lines of at most `max` characters (a longer word stands
+/// on a line of its own).
+pub(crate) fn wrap(text: &str, max: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut cur = String::new();
+    for word in text.split(' ') {
+        let len = cur.chars().count();
+        if len > 0 && len + 1 + word.chars().count() > max {
+            lines.push(std::mem::take(&mut cur));
+        }
+        if !cur.is_empty() {
+            cur.push(' ');
+        }
+        cur.push_str(word);
+    }
+    if !cur.is_empty() || lines.is_empty() {
+        lines.push(cur);
+    }
+    lines
 }
 
 /// Width of a legend block (0 without entries).
 pub(crate) fn legend_width(entries: &[LegendEntry]) -> f64 {
     let chars = entries
         .iter()
-        .map(|e| e.label.chars().count())
+        .flat_map(|e| e.lines.iter().map(|l| l.chars().count()))
         .max()
         .unwrap_or(0);
     if chars == 0 {
@@ -56,14 +88,9 @@ pub(crate) fn legend_width(entries: &[LegendEntry]) -> f64 {
     }
 }
 
-pub(crate) fn truncate(text: &str, max: usize) -> String {
-    if text.chars().count() <= max {
-        text.to_string()
-    } else {
-        let mut t: String = text.chars().take(max - 1).collect();
-        t.push('…');
-        t
-    }
+/// Height of a legend block (0 without entries).
+pub(crate) fn legend_height(entries: &[LegendEntry]) -> f64 {
+    entries.iter().map(LegendEntry::height).sum()
 }
 
 /// Formats a pixel coordinate rounded to 0.01 (and clamped to ±1e6 px).
@@ -90,6 +117,8 @@ pub(crate) struct Frame {
     pub total_h: f64,
     pub x: Axis,
     pub y: Axis,
+    /// Room below the x tick labels before the axis label (rotated category labels).
+    pub below: f64,
 }
 
 impl Frame {
@@ -106,7 +135,21 @@ impl Frame {
             total_h: TOP + PLOT_H + BOTTOM,
             x,
             y,
+            below: 0.0,
         }
+    }
+
+    /// Makes the image tall enough for a legend right of the plot area.
+    pub fn fit_legend(&mut self, entries: &[LegendEntry]) {
+        self.total_h = self
+            .total_h
+            .max(self.top + 4.0 + legend_height(entries) + 12.0);
+    }
+
+    /// Adds `px` of room below the x tick labels.
+    pub fn add_below(&mut self, px: f64) {
+        self.below += px;
+        self.total_h += px;
     }
 
     pub fn px(&self, x: f64) -> f64 {
@@ -218,7 +261,7 @@ impl Frame {
             out,
             "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" font-size=\"13\">{}</text>",
             c(l + w / 2.0),
-            c(bottom + 44.0),
+            c(bottom + 44.0 + self.below),
             escape_xml(x_label)
         );
         let (yx, yy) = (16.0, t + h / 2.0);
@@ -230,12 +273,21 @@ impl Frame {
             c(yy),
             escape_xml(y_label)
         );
+        // A long title is set smaller so that it fits the image, never cut.
+        let chars = title.chars().count().max(1) as f64;
+        let size = (15.0f64)
+            .min((self.total_w - 16.0) / (0.62 * chars))
+            .max(8.0);
+        let centre = (l + w / 2.0)
+            .max(8.0 + 0.31 * size * chars)
+            .min(self.total_w - 8.0 - 0.31 * size * chars);
         let _ = writeln!(
             out,
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" font-size=\"15\" \
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" font-size=\"{}\" \
              font-weight=\"bold\">{}</text>",
-            c(l + w / 2.0),
+            c(centre),
             c(t - 16.0),
+            c(size),
             escape_xml(title)
         );
         out.push_str("</g>\n");
@@ -296,8 +348,9 @@ impl Frame {
         flush(&mut d, &mut run);
         let _ = writeln!(
             out,
-            "<path d=\"{d}\" fill=\"{}\" fill-opacity=\"0.25\" stroke=\"none\"/>",
-            escape_xml(&b.color)
+            "<path d=\"{d}\" fill=\"{}\" fill-opacity=\"{}\" stroke=\"none\"/>",
+            escape_xml(&b.color),
+            b.opacity
         );
     }
 
@@ -327,11 +380,12 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
             c(x - 6.0),
             c(y - 4.0),
             c(legend_width(entries)),
-            c(entries.len() as f64 * 20.0 + 6.0)
+            c(legend_height(entries) + 6.0)
         );
     }
-    for (i, e) in entries.iter().enumerate() {
-        let cy = y + 10.0 + 20.0 * i as f64;
+    let mut top = y;
+    for e in entries {
+        let cy = top + 10.0;
         let color = escape_xml(&e.color);
         if e.filled {
             let _ = writeln!(
@@ -347,6 +401,15 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
             } else {
                 ""
             };
+            if is_light(&e.color) {
+                // A white line (drawn over a heat map) needs a dark ground to be seen.
+                let _ = writeln!(
+                    out,
+                    "<rect x=\"{}\" y=\"{}\" width=\"28\" height=\"10\" fill=\"#440154\"/>",
+                    c(x - 2.0),
+                    c(cy - 5.0)
+                );
+            }
             let _ = writeln!(
                 out,
                 "<path d=\"M{} {}h24\" stroke=\"{color}\" stroke-width=\"2\"{dash}/>",
@@ -354,15 +417,28 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
                 c(cy)
             );
         }
-        let _ = writeln!(
-            out,
-            "<text x=\"{}\" y=\"{}\">{}</text>",
-            c(x + 30.0),
-            c(cy + 4.0),
-            escape_xml(&e.label)
-        );
+        for (i, line) in e.lines.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "<text x=\"{}\" y=\"{}\">{}</text>",
+                c(x + 30.0),
+                c(cy + 4.0 + LEGEND_LINE * i as f64),
+                escape_xml(line)
+            );
+        }
+        top += e.height();
     }
     out.push_str("</g>\n");
+}
+
+/// Whether a `#rrggbb` colour is too light to be seen on white.
+fn is_light(color: &str) -> bool {
+    let hex = color.trim_start_matches('#');
+    if hex.len() != 6 {
+        return color.eq_ignore_ascii_case("white");
+    }
+    let v = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).unwrap_or(0) as u32;
+    v(0) + v(2) + v(4) > 3 * 0xe8
 }
 
 /// Appends one sub-path through the pixel points, dropping sub-pixel steps (the last point

@@ -17,7 +17,7 @@ mod tests;
 
 pub use axis::nice_ticks;
 pub(crate) use axis::{finite_range, Axis};
-pub(crate) use frame::{c, legend, legend_width, truncate, Frame, LegendEntry};
+pub(crate) use frame::{c, legend, legend_width, Frame, LegendEntry};
 
 use super::{escape_xml, write_bytes, ReportError};
 
@@ -71,8 +71,10 @@ pub struct Band {
     pub lower: Vec<f64>,
     /// Upper edge.
     pub upper: Vec<f64>,
-    /// Fill color, drawn with opacity 0.25.
+    /// Fill color.
     pub color: String,
+    /// Fill opacity (0.25 unless set with [`Band::opacity`]).
+    pub opacity: f64,
 }
 
 impl Band {
@@ -90,7 +92,14 @@ impl Band {
             lower,
             upper,
             color: color.into(),
+            opacity: 0.25,
         }
+    }
+
+    /// The same band with another fill opacity (e.g. stacked areas).
+    pub fn opacity(mut self, opacity: f64) -> Self {
+        self.opacity = opacity;
+        self
     }
 }
 
@@ -109,6 +118,10 @@ pub struct LinePlot {
     pub bands: Vec<Band>,
     /// Logarithmic vertical axis (non-positive values are skipped).
     pub log_y: bool,
+    /// Logarithmic horizontal axis (non-positive values are skipped).
+    pub log_x: bool,
+    /// Fixed vertical range instead of the data's (e.g. `(0, 1)` for indices).
+    pub y_range: Option<(f64, f64)>,
 }
 
 impl LinePlot {
@@ -143,11 +156,16 @@ impl LinePlot {
                     .iter()
                     .flat_map(|b| b.lower.iter().chain(&b.upper).copied()),
             );
-        let x_axis = Axis::linear_exact(finite_range(xs, false));
-        let y_axis = if log {
-            Axis::log(finite_range(ys, true), true)
+        let x_axis = if self.log_x {
+            Axis::log(finite_range(xs, true), false)
         } else {
-            Axis::linear_padded(finite_range(ys, false))
+            Axis::linear_exact(finite_range(xs, false))
+        };
+        let y_axis = match self.y_range {
+            Some((lo, hi)) if log => Axis::log(Some((lo, hi)), false),
+            Some((lo, hi)) => Axis::linear(lo, hi),
+            None if log => Axis::log(finite_range(ys, true), true),
+            None => Axis::linear_padded(finite_range(ys, false)),
         };
 
         let mut legend: Vec<LegendEntry> = Vec::new();
@@ -159,7 +177,8 @@ impl LinePlot {
         }
         legend.retain(|e| !e.label.is_empty());
 
-        let frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        let mut frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        frame.fit_legend(&legend);
         let mut out = String::new();
         frame.open(&mut out);
         frame.grid(&mut out);
@@ -203,7 +222,9 @@ pub struct DensityPlot {
 }
 
 impl DensityPlot {
-    /// Renders the plot as an SVG document.
+    /// Renders the plot as an SVG document. The horizontal range is that of the curves and
+    /// the histogram; a marker outside it is drawn as an arrow at the edge, and its legend
+    /// entry says so.
     pub fn to_svg(&self) -> String {
         let (edges, dens): (&[f64], &[f64]) = match &self.histogram {
             Some((e, d)) => (e, d),
@@ -215,34 +236,49 @@ impl DensityPlot {
             (l.is_finite() && r.is_finite() && h.is_finite()).then_some((l, r, h))
         });
 
-        let xs = self
+        let data_xs = self
             .curves
             .iter()
             .flat_map(|s| paired(&s.x, &s.y).map(|(x, _)| x))
-            .chain(bars.clone().flat_map(|(l, r, _)| [l, r]))
-            .chain(self.markers.iter().map(|m| m.0));
+            .chain(bars.clone().flat_map(|(l, r, _)| [l, r]));
+        let data = finite_range(data_xs, false);
+        let markers_finite = self.markers.iter().map(|m| m.0).filter(|x| x.is_finite());
+        // Without data, the markers set the range.
+        let x_range = data.or_else(|| finite_range(markers_finite, false));
         let ys = self
             .curves
             .iter()
             .flat_map(|s| paired(&s.x, &s.y).map(|(_, y)| y))
             .chain(bars.clone().map(|b| b.2))
             .chain([0.0]);
-        let x_axis = Axis::linear_exact(finite_range(xs, false));
+        let x_axis = Axis::linear_exact(x_range);
         let y_axis = Axis::linear_padded(finite_range(ys, false));
 
         let mut legend: Vec<LegendEntry> = Vec::new();
         if self.histogram.is_some() {
-            legend.push(LegendEntry::fill("histogram", HISTOGRAM_COLOR));
+            legend.push(LegendEntry::fill("histogram of the runs", HISTOGRAM_COLOR));
         }
         for s in &self.curves {
             legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
         }
-        for (i, (_, label)) in self.markers.iter().enumerate() {
-            legend.push(LegendEntry::line(label, marker_color(i), true));
+        for (i, (x, label)) in self.markers.iter().enumerate() {
+            let side = if *x < x_axis.lo {
+                " (left of the plotted range ←)"
+            } else if *x > x_axis.hi {
+                " (right of the plotted range →)"
+            } else {
+                ""
+            };
+            legend.push(LegendEntry::line(
+                &format!("{label}{side}"),
+                marker_color(i),
+                true,
+            ));
         }
         legend.retain(|e| !e.label.is_empty());
 
-        let frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        let mut frame = Frame::new(x_axis, y_axis, legend_width(&legend));
+        frame.fit_legend(&legend);
         let mut out = String::new();
         frame.open(&mut out);
         frame.grid(&mut out);
@@ -285,15 +321,42 @@ fn histogram(frame: &Frame, out: &mut String, bars: impl Iterator<Item = (f64, f
     out.push_str("</g>\n");
 }
 
-/// Draws dashed vertical marker lines with their labels.
+/// Draws dashed vertical marker lines (their labels are in the legend, so nothing is drawn
+/// over the data); a marker beyond the horizontal range becomes an arrow at that edge.
 fn markers(frame: &Frame, out: &mut String, markers: &[(f64, String)]) {
     out.push_str("<g class=\"markers\">\n");
-    for (i, (x, label)) in markers.iter().enumerate() {
+    for (i, (x, _)) in markers.iter().enumerate() {
         if !x.is_finite() {
             continue;
         }
-        let px = frame.px(*x);
         let color = marker_color(i);
+        let y = frame.top + 14.0 + 12.0 * (i % 4) as f64;
+        if *x < frame.x.lo || *x > frame.x.hi {
+            let (edge, dir) = if *x < frame.x.lo {
+                (frame.left, -1.0)
+            } else {
+                (frame.left + frame.width, 1.0)
+            };
+            // Inside the plot area, pointing at the edge beyond which the limit lies.
+            let tip = edge - dir * 3.0;
+            let _ = writeln!(
+                out,
+                "<path d=\"M{} {}L{} {}M{} {}L{} {}L{} {}Z\" stroke=\"{color}\" fill=\"{color}\" \
+                 stroke-width=\"1.5\"/>",
+                c(tip - dir * 26.0),
+                c(y),
+                c(tip - dir * 6.0),
+                c(y),
+                c(tip),
+                c(y),
+                c(tip - dir * 7.0),
+                c(y - 4.0),
+                c(tip - dir * 7.0),
+                c(y + 4.0),
+            );
+            continue;
+        }
+        let px = frame.px(*x);
         let _ = writeln!(
             out,
             "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"{color}\" \
@@ -302,15 +365,160 @@ fn markers(frame: &Frame, out: &mut String, markers: &[(f64, String)]) {
             c(frame.top),
             c(frame.top + frame.height),
         );
-        let _ = writeln!(
-            out,
-            "<text x=\"{}\" y=\"{}\" fill=\"{color}\" font-size=\"11\">{}</text>",
-            c(px + 4.0),
-            c(frame.top + 14.0 + 14.0 * (i % 3) as f64),
-            escape_xml(&truncate(label, 40)),
-        );
     }
     out.push_str("</g>\n");
+}
+
+/// Bars of several groups per category (e.g. first-order and total Sobol' indices per
+/// parameter), each bar with an optional interval drawn as an error bar.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BarChart {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the vertical axis.
+    pub y_label: String,
+    /// Label under the categories.
+    pub x_label: String,
+    /// Category names (e.g. parameters), along the horizontal axis.
+    pub categories: Vec<String>,
+    /// Groups: (legend label, color, one value per category, optional interval per
+    /// category).
+    pub groups: Vec<BarGroup>,
+    /// Fixed vertical range (e.g. `(0, 1)`); the data's range when `None`.
+    pub y_range: Option<(f64, f64)>,
+}
+
+/// One group of bars of a [`BarChart`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BarGroup {
+    /// Legend label.
+    pub label: String,
+    /// Fill color.
+    pub color: String,
+    /// One value per category (non-finite: no bar).
+    pub values: Vec<f64>,
+    /// An interval `(low, high)` per category, where there is one.
+    pub intervals: Vec<Option<(f64, f64)>>,
+}
+
+impl BarChart {
+    /// Renders the chart as an SVG document.
+    pub fn to_svg(&self) -> String {
+        let n = self.categories.len().max(1);
+        let values = self.groups.iter().flat_map(|g| {
+            g.values
+                .iter()
+                .copied()
+                .chain(g.intervals.iter().flatten().flat_map(|&(lo, hi)| [lo, hi]))
+        });
+        let y_axis = match self.y_range {
+            Some((lo, hi)) => {
+                let (dlo, dhi) = finite_range(values, false).unwrap_or((lo, hi));
+                Axis::linear(lo.min(dlo), hi.max(dhi))
+            }
+            None => Axis::linear_padded(finite_range(values.chain([0.0]), false)),
+        };
+        let mut x_axis = Axis::linear(0.0, n as f64);
+        x_axis.ticks = (0..n).map(|i| i as f64 + 0.5).collect();
+        x_axis.labels = self.categories.clone();
+        x_axis.labels.resize(n, String::new());
+        let longest = x_axis
+            .labels
+            .iter()
+            .map(|l| l.chars().count())
+            .max()
+            .unwrap_or(0);
+        let slot = 600.0 / n as f64;
+        let rotate = longest as f64 * 6.4 > slot - 4.0;
+        let mut legend: Vec<LegendEntry> = self
+            .groups
+            .iter()
+            .map(|g| LegendEntry::fill(&g.label, &g.color))
+            .collect();
+        if self
+            .groups
+            .iter()
+            .any(|g| g.intervals.iter().any(Option::is_some))
+        {
+            legend.push(LegendEntry::line("95 % interval", "#222", false));
+        }
+        legend.retain(|e| !e.label.is_empty());
+        let mut frame = Frame::new(x_axis.clone(), y_axis, legend_width(&legend));
+        frame.fit_legend(&legend);
+        if rotate {
+            frame.add_below(longest as f64 * 6.4 * 0.6);
+        }
+        let mut out = String::new();
+        frame.open(&mut out);
+        frame.grid(&mut out);
+        out.push_str("<g class=\"bars\" clip-path=\"url(#plot-area)\">\n");
+        let k = self.groups.len().max(1) as f64;
+        let bar_w = slot * 0.8 / k;
+        let y0 = frame.py(0.0f64.clamp(frame.y.lo, frame.y.hi));
+        for (gi, g) in self.groups.iter().enumerate() {
+            for (ci, &v) in g.values.iter().enumerate().take(n) {
+                let x = frame.left + slot * (ci as f64 + 0.1) + bar_w * gi as f64;
+                if v.is_finite() {
+                    let yv = frame.py(v);
+                    let _ = writeln!(
+                        out,
+                        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" \
+                         fill-opacity=\"0.8\"/>",
+                        c(x),
+                        c(yv.min(y0)),
+                        c(bar_w * 0.92),
+                        c((yv - y0).abs()),
+                        escape_xml(&g.color)
+                    );
+                }
+                if let Some(Some((lo, hi))) = g.intervals.get(ci) {
+                    let xm = x + bar_w * 0.46;
+                    let (a, b) = (frame.py(*lo), frame.py(*hi));
+                    let _ = writeln!(
+                        out,
+                        "<path d=\"M{xm} {a}V{b}M{l} {a}H{r}M{l} {b}H{r}\" stroke=\"#222\" \
+                         stroke-width=\"1.3\" fill=\"none\"/>",
+                        xm = c(xm),
+                        a = c(a),
+                        b = c(b),
+                        l = c(xm - 4.0),
+                        r = c(xm + 4.0),
+                    );
+                }
+            }
+        }
+        out.push_str("</g>\n");
+        if rotate {
+            // Category names slanted below the axis instead of the axis's own labels.
+            frame.x.labels = vec![String::new(); n];
+            frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
+            out.push_str("<g font-size=\"11\" text-anchor=\"end\" fill=\"#222\">\n");
+            for (i, name) in self.categories.iter().enumerate() {
+                let (x, y) = (
+                    frame.left + slot * (i as f64 + 0.5),
+                    frame.top + frame.height + 14.0,
+                );
+                let _ = writeln!(
+                    out,
+                    "<text x=\"{0}\" y=\"{1}\" transform=\"rotate(-35 {0} {1})\">{2}</text>",
+                    c(x),
+                    c(y),
+                    escape_xml(name)
+                );
+            }
+            out.push_str("</g>\n");
+        } else {
+            frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
+        }
+        frame.legend_outside(&mut out, &legend);
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// Writes [`Self::to_svg`] to `path`.
+    pub fn write(&self, path: &Path) -> Result<(), ReportError> {
+        write_bytes(path, self.to_svg().as_bytes())
+    }
 }
 
 /// A histogram of the finite `samples` as (bin edges, density per bin), normalized so that

@@ -230,3 +230,129 @@ fn write_reports_the_path_on_error() {
     band_plot().write(&ok).unwrap();
     assert!(std::fs::read_to_string(ok).unwrap().starts_with("<svg"));
 }
+
+#[test]
+fn bar_chart_labels_categories_and_draws_intervals() {
+    let chart = BarChart {
+        title: "Sobol' indices of W".into(),
+        y_label: "share of the variance [-]".into(),
+        x_label: "parameter".into(),
+        categories: vec!["Kpz".into(), "Cpz".into(), "Ksz".into()],
+        groups: vec![
+            BarGroup {
+                label: "first order S".into(),
+                color: palette(0).into(),
+                values: vec![0.2, 0.7, f64::NAN],
+                intervals: vec![Some((0.15, 0.25)), None, None],
+            },
+            BarGroup {
+                label: "total ST".into(),
+                color: palette(1).into(),
+                values: vec![0.25, 0.75, 0.0],
+                intervals: vec![None; 3],
+            },
+        ],
+        y_range: Some((0.0, 1.0)),
+    };
+    let svg = chart.to_svg();
+    assert!(balanced(&svg, "g") && balanced(&svg, "text"));
+    for name in [
+        "Kpz",
+        "Cpz",
+        "Ksz",
+        "first order S",
+        "total ST",
+        "95 % interval",
+    ] {
+        assert!(svg.contains(&format!(">{name}</text>")), "{name}");
+    }
+    // Five bars (the NaN has none) and one error bar.
+    assert_eq!(
+        svg.split("class=\"bars\"")
+            .nth(1)
+            .unwrap()
+            .split("</g>")
+            .next()
+            .unwrap()
+            .matches("<rect ")
+            .count(),
+        5
+    );
+    assert!(!svg.contains("NaN"));
+    // Many long names are slanted instead of overlapping.
+    let many = BarChart {
+        categories: (0..12).map(|i| format!("parameter_{i}")).collect(),
+        ..chart.clone()
+    };
+    assert!(many.to_svg().contains("rotate(-35"));
+}
+
+#[test]
+fn legends_wrap_long_labels_and_grow_the_image() {
+    let long = "kernel density of 20000 draws of the chaos surrogate, which is a long label";
+    let mut plot = LinePlot::new("t", "x", "y");
+    plot.series.push(Series::new(
+        long,
+        vec![0.0, 1.0],
+        vec![0.0, 1.0],
+        palette(0),
+    ));
+    let svg = plot.to_svg();
+    // Every word is there (nothing cut), on more than one line.
+    assert!(
+        svg.contains(">kernel density of 20000 draws of</text>"),
+        "{svg}"
+    );
+    assert!(svg.contains("long label</text>"));
+    assert!(!svg.contains('…'));
+    let many = LinePlot {
+        series: (0..40)
+            .map(|i| {
+                Series::new(
+                    format!("series {i}"),
+                    vec![0.0, 1.0],
+                    vec![0.0, i as f64],
+                    palette(i),
+                )
+            })
+            .collect(),
+        ..LinePlot::new("t", "x", "y")
+    };
+    let svg = many.to_svg();
+    let h: f64 = svg
+        .split("height=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(h > 40.0 * 21.0, "{h}: the legend must fit");
+}
+
+#[test]
+fn density_markers_beyond_the_data_are_arrows_not_a_squashed_plot() {
+    let x: Vec<f64> = (0..=100).map(|i| 2.0 + i as f64 * 0.005).collect();
+    let pdf: Vec<f64> = x
+        .iter()
+        .map(|x| (-(x - 2.25f64).powi(2) / 0.01).exp())
+        .collect();
+    let plot = DensityPlot {
+        title: "W".into(),
+        x_label: "W [-]".into(),
+        curves: vec![Series::new("KDE", x, pdf, palette(0))],
+        histogram: None,
+        markers: vec![(2.4, "limit 2.4".into()), (3.0, "limit 3".into())],
+    };
+    let svg = plot.to_svg();
+    // (The legend wraps the label.)
+    assert!(
+        svg.contains(">limit 3 (right of the plotted</text>"),
+        "{svg}"
+    );
+    assert!(svg.contains(">range →)</text>"), "{svg}");
+    assert!(svg.contains(">limit 2.4</text>"));
+    // The axis ends at the data (2.5), not at the far limit.
+    assert!(svg.contains(">2.5</text>") && !svg.contains(">3.0</text>"));
+}

@@ -3,6 +3,7 @@
 
 use crate::uq::galerkin::system::InvalidSystem;
 use crate::uq::galerkin::GalerkinError;
+use crate::uq::hd::sensitivity::SensitivityError;
 use crate::uq::pce::PceError;
 use crate::uq::quadrature::QuadratureError;
 
@@ -29,6 +30,9 @@ pub enum MethodError {
     /// The `[system]` does not describe a valid system.
     #[error(transparent)]
     System(#[from] InvalidSystem),
+    /// Sobol' indices could not be estimated from a pick-freeze design.
+    #[error(transparent)]
+    Sensitivity(#[from] SensitivityError),
     /// A weighted design lacks results at some of its points.
     #[error(
         "{missing} of {total} weighted points have no value; a weighted design cannot drop a point"

@@ -3,6 +3,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::uq::hd::sensitivity::replicate_summary;
 use crate::uq::moments;
 use crate::uq::pce::Pce;
 
@@ -59,23 +60,46 @@ pub struct ChaosError {
     pub values: Vec<f64>,
 }
 
-/// First-order and total Sobol' indices, each `[column][parameter]`.
+/// First-order and total Sobol' indices, each `[column][parameter]`, with confidence
+/// intervals where the method estimates them (sampling).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sobol {
     /// First-order indices.
     pub first: Vec<Vec<f64>>,
     /// Total indices.
     pub total: Vec<Vec<f64>>,
+    /// Confidence intervals of the indices, where the method has them.
+    pub intervals: Option<SobolIntervals>,
+}
+
+/// Confidence intervals `(low, high)` of Sobol' indices, each `[column][parameter]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SobolIntervals {
+    /// Confidence level (e.g. 0.95).
+    pub level: f64,
+    /// Intervals of the first-order indices.
+    pub first: Vec<Vec<(f64, f64)>>,
+    /// Intervals of the total indices.
+    pub total: Vec<Vec<(f64, f64)>>,
 }
 
 impl Sobol {
+    /// Point estimates without intervals.
+    pub fn new(first: Vec<Vec<f64>>, total: Vec<Vec<f64>>) -> Sobol {
+        Sobol {
+            first,
+            total,
+            intervals: None,
+        }
+    }
+
     /// The indices of every column of a chaos (variance shares of its terms).
     pub fn from_chaos(pce: &Pce) -> Sobol {
         let cols = 0..pce.outputs();
-        Sobol {
-            first: cols.clone().map(|k| pce.sobol_first(k)).collect(),
-            total: cols.map(|k| pce.sobol_total(k)).collect(),
-        }
+        Sobol::new(
+            cols.clone().map(|k| pce.sobol_first(k)).collect(),
+            cols.map(|k| pce.sobol_total(k)).collect(),
+        )
     }
 }
 
@@ -108,6 +132,41 @@ impl Estimate {
         let (mean, std) = moments::sample_mean_std(data);
         let root_n = (data.nrows() as f64).sqrt();
         let sem = std.iter().map(|s| s / root_n).collect();
+        Estimate {
+            mean,
+            std,
+            std_error_mean: Some(sem),
+            ..Estimate::empty(Draws::Runs)
+        }
+    }
+
+    /// Estimates from `R` independent replicates of an equally weighted design of `n` points
+    /// each (point `i` of the design belongs to replicate `i / n`): per column, the mean of
+    /// the replicate means and its standard error `sd(replicate means) / sqrt(R)`; the Std
+    /// is the unbiased Std of all runs. `rows` are the design indices of the rows of `data`
+    /// (failed points left out: a replicate's mean is over its successful runs; a replicate
+    /// without any is left out; fewer than two replicates give a NaN standard error).
+    pub fn from_replicates(data: &DMatrix<f64>, rows: &[usize], n: usize) -> Estimate {
+        let (_, std) = moments::sample_mean_std(data);
+        let replicate_of: Vec<usize> = rows.iter().map(|&i| i / n.max(1)).collect();
+        let count = replicate_of.iter().max().map_or(0, |&r| r + 1);
+        let (mean, sem) = data
+            .column_iter()
+            .map(|col| {
+                let mut sums = vec![(0.0, 0usize); count];
+                for (v, &r) in col.iter().zip(&replicate_of) {
+                    sums[r].0 += v;
+                    sums[r].1 += 1;
+                }
+                let means: Vec<f64> = sums
+                    .iter()
+                    .filter(|(_, k)| *k > 0)
+                    .map(|(s, k)| s / *k as f64)
+                    .collect();
+                let r = replicate_summary(&means);
+                (r.mean, r.std_error)
+            })
+            .unzip();
         Estimate {
             mean,
             std,
@@ -180,5 +239,31 @@ mod tests {
         assert!((s.first[0][0] - 4.0 / 13.0).abs() < 1e-15);
         assert!((s.total[0][1] - 9.0 / 13.0).abs() < 1e-15);
         assert_eq!(e.draws, Draws::Chaos);
+    }
+}
+
+#[cfg(test)]
+mod replicate_tests {
+    use super::*;
+
+    #[test]
+    fn replicate_estimate_is_the_spread_of_the_replicate_means() {
+        // Three replicates of two points: means 1.5, 3.5, 5.5 -> mean 3.5, SE sd/sqrt(3) = 2/sqrt(3).
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let data = DMatrix::from_column_slice(6, 1, &v);
+        let rows: Vec<usize> = (0..6).collect();
+        let e = Estimate::from_replicates(&data, &rows, 2);
+        assert_eq!(e.mean, vec![3.5]);
+        assert!((e.std_error_mean.as_ref().unwrap()[0] - 2.0 / 3f64.sqrt()).abs() < 1e-15);
+        // The Std is that of all runs.
+        assert!((e.std[0] - 3.5f64.sqrt()).abs() < 1e-15);
+        // A failed point leaves its replicate's mean over the others.
+        let data = DMatrix::from_column_slice(5, 1, &[1.0, 2.0, 3.0, 5.0, 6.0]);
+        let e = Estimate::from_replicates(&data, &[0, 1, 2, 4, 5], 2);
+        assert_eq!(e.mean, vec![(1.5 + 3.0 + 5.5) / 3.0]);
+        // One replicate left: no standard error.
+        let data = DMatrix::from_column_slice(2, 1, &[1.0, 2.0]);
+        let e = Estimate::from_replicates(&data, &[4, 5], 2);
+        assert!(e.std_error_mean.unwrap()[0].is_nan());
     }
 }

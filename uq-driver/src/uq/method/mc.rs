@@ -3,7 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::sample::UnitCubeSample;
+use super::error::MethodError;
+use super::sample::{UnitCubeSample, SE_MONTE_CARLO};
 use crate::uq::sampling;
 
 /// `kind = "mc"`.
@@ -22,7 +23,17 @@ impl UnitCubeSample for Mc {
     }
 
     /// Point `i` takes its uniforms from the stream `(seed, i)` only.
-    fn points(n: usize, d: usize, seed: u64) -> Vec<Vec<f64>> {
-        sampling::monte_carlo(n, d, seed)
+    fn block(
+        &self,
+        n: usize,
+        d: usize,
+        seed: u64,
+        _replicate: Option<usize>,
+    ) -> Result<Vec<Vec<f64>>, MethodError> {
+        Ok(sampling::monte_carlo(n, d, seed))
+    }
+
+    fn standard_error(&self) -> &'static str {
+        SE_MONTE_CARLO
     }
 }

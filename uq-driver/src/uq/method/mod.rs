@@ -43,7 +43,7 @@ use serde::{Deserialize, Serialize};
 pub use chaos::ChaosBasis;
 pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
-pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol};
+pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
     details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
 };
@@ -78,6 +78,8 @@ macro_rules! methods {
 methods! {
     mc::Mc,
     lhs::Lhs,
+    qmc::Qmc,
+    sobol_sampling::SobolSampling,
     scm::Scm,
     sgm::Sgm,
     nominal::Nominal,
@@ -133,6 +135,9 @@ mod tests {
         for (text, kind) in [
             ("kind = \"mc\"\nsamples = 10", "mc"),
             ("kind = \"lhs\"\nsamples = 10", "lhs"),
+            ("kind = \"lhs\"\nsamples = 10\nreplicates = 4", "lhs"),
+            ("kind = \"qmc\"\nsamples = 16", "qmc"),
+            ("kind = \"sobol_sampling\"\nsamples = 16", "sobol_sampling"),
             ("kind = \"scm\"\nnodes = 3", "scm"),
             ("kind = \"sgm\"\norder = 2", "sgm"),
             ("kind = \"nominal\"", "nominal"),
@@ -157,6 +162,8 @@ mod tests {
             "kind = \"scm\"\nsamples = 10\nnodes = 3",
             "kind = \"nominal\"\norder = 1",
             "kind = \"mc\"",
+            "kind = \"mc\"\nsamples = 10\nreplicates = 4",
+            "kind = \"qmc\"\nnodes = 3",
         ] {
             let r: Result<MethodSpec, _> = toml::from_str(text);
             assert!(r.is_err(), "{text}");
@@ -190,6 +197,9 @@ mod tests {
         for text in [
             "kind = \"mc\"\nsamples = 20000",
             "kind = \"lhs\"\nsamples = 20000",
+            "kind = \"lhs\"\nsamples = 2000\nreplicates = 10",
+            "kind = \"qmc\"\nsamples = 4096\nreplicates = 8",
+            "kind = \"sobol_sampling\"\nsamples = 8192",
             "kind = \"scm\"\nnodes = 3",
             "kind = \"nominal\"",
             "kind = \"sparse_grid\"\nlevel = 2",
@@ -221,6 +231,16 @@ mod tests {
                     assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 1e-12);
                     assert_eq!(e.draws, Draws::Chaos);
                 }
+                "sobol_sampling" => {
+                    // Pick-freeze indices of the same fixture, within sampling error.
+                    let sobol = e.sobol.unwrap();
+                    assert!((sobol.first[0][0] - parts[0] / var).abs() < 0.03);
+                    assert!((sobol.first[0][1] - parts[1] / var).abs() < 0.03);
+                    assert!((sobol.total[0][0] - (parts[0] + parts[2]) / var).abs() < 0.03);
+                    assert!(sobol.intervals.is_some());
+                    assert!((e.mean[0] - mean).abs() < 4.0 * e.std_error_mean.unwrap()[0]);
+                    assert!((e.std[0] / var.sqrt() - 1.0).abs() < 0.03);
+                }
                 kind @ ("sparse_grid" | "pce_regression") => {
                     // A polynomial of degree 2 in the chaos space: exact, with a vanishing
                     // error estimate.
@@ -244,7 +264,9 @@ mod tests {
                 }
                 kind => {
                     let se = e.std_error_mean.as_ref().unwrap()[0];
-                    assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    if !text.contains("replicates") {
+                        assert!((se - e.std[0] / 20000f64.sqrt()).abs() < 1e-15);
+                    }
                     assert!((e.mean[0] - mean).abs() < 4.0 * se, "{kind}: {}", e.mean[0]);
                     assert!(
                         (e.std[0] / var.sqrt() - 1.0).abs() < 0.03,

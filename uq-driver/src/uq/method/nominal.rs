@@ -72,4 +72,12 @@ impl Sampling for Nominal {
     fn min_runs(&self) -> usize {
         1
     }
+
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn draws_from_chaos(&self) -> bool {
+        false
+    }
 }

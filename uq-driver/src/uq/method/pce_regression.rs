@@ -288,6 +288,14 @@ impl Sampling for PceRegression {
         Ok(Design::mapped(germ, points, None, inputs))
     }
 
+    /// `samples` (a points file: known only once read).
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        match self.points {
+            Some(_) => None,
+            None => self.samples.map(|n| n as f64),
+        }
+    }
+
     /// The chaos of every column at the runs that gave a value (`rows`).
     fn estimate(
         &self,

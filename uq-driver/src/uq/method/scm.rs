@@ -66,7 +66,10 @@ impl Method for Scm {
         let dim = problem.parameters.len();
         if (nodes as f64).powi(dim as i32) > MAX_POINTS {
             return Err(InvalidSettings(format!(
-                "tensor grid of {nodes}^{dim} points is too large"
+                "tensor grid of {nodes}^{dim} = {:.3e} points is too large (at most {MAX_POINTS:.0e}); \
+                 in {dim} dimensions use `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`, \
+                 which need far fewer runs",
+                (nodes as f64).powi(dim as i32)
             )));
         }
         Ok(())
@@ -96,6 +99,10 @@ impl Sampling for Scm {
             Some(grid.weights),
             inputs,
         ))
+    }
+
+    fn planned_runs(&self, dim: usize) -> Option<f64> {
+        Some((self.nodes as f64).powi(dim as i32))
     }
 
     /// Needs every node: a missing weighted node would bias every moment.

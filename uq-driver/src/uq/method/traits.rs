@@ -114,6 +114,21 @@ pub trait Sampling {
     fn min_runs(&self) -> usize {
         2
     }
+
+    /// The number of model runs of the design for `dim` random parameters, computed without
+    /// building it (as a float: it may be far beyond any integer type), or `None` when only
+    /// the design knows. The study checks it before anything is allocated (`study::size`):
+    /// every method should give it.
+    fn planned_runs(&self, _dim: usize) -> Option<f64> {
+        None
+    }
+
+    /// Whether the estimates may draw their quantiles and densities from a chaos surrogate
+    /// (`[analysis] surrogate_samples` draws of every output time): counted in the memory
+    /// estimate of `study::size`. `true` unless the method never builds a chaos.
+    fn draws_from_chaos(&self) -> bool {
+        true
+    }
 }
 
 /// A method that solves a projected (intrusive) system instead of running the model.

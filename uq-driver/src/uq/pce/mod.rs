@@ -31,6 +31,7 @@ pub use basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
 pub use hermite::{hermite_all, hermite_he, hermite_norm_sq, hermite_triple};
 
 use crate::uq::rng;
+use crate::uq::Distribution;
 
 /// Errors of the polynomial-chaos construction.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -327,16 +328,20 @@ impl Pce {
 pub fn germ_draws(families: &[Family], n: usize, seed: u64) -> Vec<Vec<f64>> {
     let laws: Vec<_> = families.iter().map(Family::law).collect();
     (0..n)
-        .map(|i| {
-            let mut r = rng::stream(seed, i as u64);
-            families
-                .iter()
-                .zip(&laws)
-                .map(|(f, law)| match f {
-                    Family::Hermite => rng::standard_normal(&mut r),
-                    _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
-                })
-                .collect()
+        .map(|i| germ_draw(families, &laws, seed, i))
+        .collect()
+}
+
+/// Point `i` of [`germ_draws`] (`laws[j]` is `families[j].law()`): a function of
+/// `(seed, i)` only.
+pub fn germ_draw(families: &[Family], laws: &[Distribution], seed: u64, i: usize) -> Vec<f64> {
+    let mut r = rng::stream(seed, i as u64);
+    families
+        .iter()
+        .zip(laws)
+        .map(|(f, law)| match f {
+            Family::Hermite => rng::standard_normal(&mut r),
+            _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
         })
         .collect()
 }

@@ -36,6 +36,8 @@ pub struct OutputStats {
     pub quantiles: Vec<(f64, Vec<f64>)>,
     /// Std of the chaos surrogate where it differs from `std` (collocation).
     pub std_pce: Option<Vec<f64>>,
+    /// Standard error of the mean over time, where the method estimates it (sampling).
+    pub std_error_mean: Option<Vec<f64>>,
     /// First-order and total Sobol' indices over time.
     pub sobol: Option<Sobol>,
     /// PDF evolution: times of the columns.
@@ -49,6 +51,14 @@ pub struct OutputStats {
     /// The chaos's estimated truncation error over time (a column of `<V>.csv` named after
     /// its kind: `loo`, `level_difference` or `order_difference`).
     pub chaos_error: Option<ChaosError>,
+    /// Every run (or draw) has the same value at every time: no density is drawn.
+    pub deterministic: bool,
+    /// Unit of the variable, from the FMU's modelDescription (`None`: not declared).
+    pub unit: Option<String>,
+    /// Mean and Std at `convergence_time` against the work spent (runs, or chaos order).
+    pub convergence: Option<Convergence>,
+    /// The time of the convergence plot: where the Std is largest (s).
+    pub convergence_time: Option<f64>,
 }
 
 impl OutputStats {
@@ -86,6 +96,21 @@ pub struct ScalarStats {
     pub max: f64,
     /// P(q > limit): (limit, p, standard error of p).
     pub exceedance: Vec<(f64, f64, f64)>,
+    /// P(q > limit) as counts: how many of how many draws exceeded, with the exact
+    /// (Clopper–Pearson) 95 % interval; the honest statement when none exceeded.
+    pub exceedance_counts: Vec<ExceedanceCount>,
+    /// Every run gives the same value (or there is one run): no density is estimated
+    /// (`pdf_x` and `pdf` are empty).
+    pub deterministic: bool,
+    /// Unit of the quantity (from the FMU's modelDescription; `"1"` for a dimensionless
+    /// index, `None` when not declared).
+    pub unit: Option<String>,
+    /// How the quantity is computed from each run: kind, signal and every setting
+    /// (defaults included), and one line of text.
+    pub definition: QuantityDefinition,
+    /// Mean and Std against the work spent (runs, or chaos order), for the report.
+    #[serde(skip)]
+    pub convergence: Option<Convergence>,
     /// PDF grid.
     pub pdf_x: Vec<f64>,
     /// PDF values (KDE of the runs, or of the chaos surrogate).
@@ -100,6 +125,10 @@ pub struct ScalarStats {
     pub sobol_first: Option<Vec<f64>>,
     /// Total Sobol' indices per parameter.
     pub sobol_total: Option<Vec<f64>>,
+    /// The Sobol' indices labelled by parameter name, with their confidence intervals where
+    /// the method gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sobol: Option<SobolSummary>,
     /// Where the quantiles and the PDF come from.
     #[serde(skip)]
     pub draws: Draws,
@@ -120,6 +149,153 @@ pub struct ScalarChaosError {
     pub kind: &'static str,
     /// The relative error.
     pub value: f64,
+}
+
+/// Sobol' indices of a scalar quantity by parameter name (`quantities.NAME.sobol` in
+/// `summary.json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SobolSummary {
+    /// First-order index of each parameter.
+    pub first: BTreeMap<String, f64>,
+    /// Total index of each parameter.
+    pub total: BTreeMap<String, f64>,
+    /// `[low, high]` interval of each first-order index, where estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_ci: Option<BTreeMap<String, [f64; 2]>>,
+    /// `[low, high]` interval of each total index, where estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub total_ci: Option<BTreeMap<String, [f64; 2]>>,
+    /// Confidence level of the intervals.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ci_level: Option<f64>,
+}
+
+impl SobolSummary {
+    /// Column `col` of `sobol`, labelled by `names` (the parameters, in study order).
+    pub fn of(sobol: &Sobol, col: usize, names: &[&str]) -> SobolSummary {
+        let label = |v: &[f64]| -> BTreeMap<String, f64> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().copied())
+                .collect()
+        };
+        let label_ci = |v: &[(f64, f64)]| -> BTreeMap<String, [f64; 2]> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().map(|&(lo, hi)| [lo, hi]))
+                .collect()
+        };
+        let ci = sobol.intervals.as_ref();
+        SobolSummary {
+            first: label(&sobol.first[col]),
+            total: label(&sobol.total[col]),
+            first_ci: ci.map(|c| label_ci(&c.first[col])),
+            total_ci: ci.map(|c| label_ci(&c.total[col])),
+            ci_level: ci.map(|c| c.level),
+        }
+    }
+}
+
+/// P(q > limit) counted over the runs (or the draws of a surrogate).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ExceedanceCount {
+    /// The limit.
+    pub limit: f64,
+    /// Draws above it.
+    pub exceeded: usize,
+    /// Draws in all.
+    pub of: usize,
+    /// `exceeded / of`.
+    pub p: f64,
+    /// Clopper–Pearson (exact binomial) 95 % interval of the probability.
+    pub ci_95: [f64; 2],
+    /// One-sided 95 % upper bound (`1 − 0.05^(1/of)`, about `3/of`, when none exceeded).
+    pub upper_95: f64,
+    /// What was counted: `runs` or `draws of the chaos surrogate`.
+    pub of_what: String,
+}
+
+impl ExceedanceCount {
+    /// E.g. `0 of 10 000 runs exceeded 2.5 (95 % upper bound 3.0e-4)` or
+    /// `12 of 1 000 runs exceeded 2.5: P = 0.012 (95 % interval 0.0062–0.021)`.
+    pub fn describe(&self) -> String {
+        let head = format!(
+            "{} of {} {} exceeded {}",
+            group_digits(self.exceeded),
+            group_digits(self.of),
+            self.of_what,
+            self.limit
+        );
+        if self.exceeded == 0 {
+            format!("{head} (95 % upper bound of P: {})", sig(self.upper_95))
+        } else {
+            format!(
+                "{head}: P = {} (95 % interval {}–{})",
+                sig(self.p),
+                sig(self.ci_95[0]),
+                sig(self.ci_95[1])
+            )
+        }
+    }
+}
+
+/// `1234567` as `1 234 567`.
+pub fn group_digits(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, ch) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push('\u{202f}');
+        }
+        out.push(ch);
+    }
+    out
+}
+
+/// Three significant digits, plain for 1e-3 ≤ |x| < 1e5, else with an exponent.
+pub fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct QuantityDefinition {
+    /// `kind` of the `[[qoi]]` entry.
+    pub kind: String,
+    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
+    /// `window`, `statistic`).
+    pub settings: serde_json::Map<String, serde_json::Value>,
+    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
+    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
+    /// 1 s left out`.
+    pub text: String,
+}
+
+/// Mean and Std of an estimate against the work spent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Convergence {
+    /// What `x` counts: `runs` (running estimates over the first n runs) or `chaos order`.
+    pub axis: String,
+    /// Runs, or orders.
+    pub x: Vec<f64>,
+    /// Mean at each x.
+    pub mean: Vec<f64>,
+    /// Std at each x.
+    pub std: Vec<f64>,
+    /// Chaos: the Std of the terms of each total order alone (its decay shows the
+    /// convergence of the expansion); empty for runs.
+    pub std_of_order: Vec<f64>,
 }
 
 /// Outcome of one point of a design.
@@ -194,6 +370,11 @@ pub struct OutputSummary {
     pub max_std: f64,
     /// When it is reached (s).
     pub time_of_max_std: f64,
+    /// Unit of the variable (modelDescription); the unit of every column of `<V>.csv`
+    /// except `time` (s).
+    pub unit: Option<String>,
+    /// Every run has the same value at every time (no density is drawn).
+    pub deterministic: bool,
 }
 
 impl OutputSummary {
@@ -210,6 +391,8 @@ impl OutputSummary {
             std_at_stop: s.std[last],
             max_std: s.std[imax],
             time_of_max_std: s.times[imax],
+            unit: s.unit.clone(),
+            deterministic: s.deterministic,
         }
     }
 }
@@ -259,6 +442,37 @@ pub struct Summary {
     pub outputs: BTreeMap<String, OutputSummary>,
     /// Per scalar quantity.
     pub quantities: BTreeMap<String, ScalarStats>,
+    /// Wall time of each stage of this invocation (s).
+    pub timing: Timing,
+    /// Unit of every variable the study names (parameters, outputs, signals of the
+    /// quantities) and of every quantity, from the FMU's modelDescription; `time` is in s.
+    /// Undeclared units are left out.
+    pub units: BTreeMap<String, String>,
+    /// The order of the values in each record of `store/records.bin` (what
+    /// `uq-driver export` reads).
+    pub record_layout: RecordLayout,
+}
+
+/// Wall time of the stages of one invocation (s).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Timing {
+    /// The model runs (the same as `wall_time_s`): opening the store, running the points
+    /// not yet finished, appending them.
+    pub runs_s: f64,
+    /// The statistics: estimators, quantiles, densities, surrogate draws.
+    pub analysis_s: f64,
+    /// Writing the CSV files, plots and `index.html` (everything but `summary.json`
+    /// itself, which carries this number).
+    pub report_s: f64,
+}
+
+/// What a record of the store holds, in order.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RecordLayout {
+    /// The outputs stored as time series (all times of the first, then the second, …).
+    pub outputs: Vec<String>,
+    /// The scalar quantities, each as (value, outcome code), after the series.
+    pub quantities: Vec<String>,
 }
 
 /// An output of a suite variant against the reference variant.

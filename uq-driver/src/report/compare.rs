@@ -1,0 +1,477 @@
+//! One page comparing finished study folders (`uq-driver compare DIR... --out DIR`; `make
+//! run` writes `out/index.html` this way): a table of the studies (method, runs, wall time
+//! of each stage, the outputs at the stop time, the scalar quantities), and for every output
+//! and quantity that several studies share, their bands, Std and PDFs in one plot each.
+//! Everything is read back from the folders' `summary.json` and CSV files.
+
+use std::path::{Component, Path, PathBuf};
+
+use serde_json::Value;
+
+use super::units::label;
+use super::{
+    palette, write_columns, Band, DensityPlot, LinePlot, ReportError, ReportPage, Section, Series,
+    Table,
+};
+use crate::results::sig;
+
+/// Why a folder cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A file could not be read.
+    #[error("cannot read {}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file is not what `uq-driver run` writes.
+    #[error("{}: {message}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing the page failed.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+}
+
+/// A study folder as read back.
+struct Folder {
+    dir: PathBuf,
+    summary: Value,
+}
+
+impl Folder {
+    fn name(&self) -> String {
+        self.summary["study"].as_str().unwrap_or("?").to_owned()
+    }
+
+    fn unit(&self, var: &str) -> Option<String> {
+        self.summary["units"][var].as_str().map(str::to_owned)
+    }
+}
+
+fn read(path: &Path) -> Result<String, CompareError> {
+    std::fs::read_to_string(path).map_err(|source| CompareError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// The study folders in `dirs`; a suite's folder stands for its variants' folders.
+fn folders(dirs: &[PathBuf]) -> Result<Vec<Folder>, CompareError> {
+    let mut out = Vec::new();
+    for dir in dirs {
+        let path = dir.join("summary.json");
+        let summary: Value =
+            serde_json::from_str(&read(&path)?).map_err(|e| CompareError::Invalid {
+                path: path.clone(),
+                message: format!("not JSON: {e}"),
+            })?;
+        if let Some(variants) = summary["variants"]
+            .as_array()
+            .filter(|_| summary["suite"].is_string())
+        {
+            let subs: Vec<PathBuf> = variants
+                .iter()
+                .filter_map(|v| v["folder"].as_str())
+                .map(|f| dir.join(f))
+                .collect();
+            out.extend(folders(&subs)?);
+        } else if summary["study"].is_string() {
+            out.push(Folder {
+                dir: dir.clone(),
+                summary,
+            });
+        } else {
+            return Err(CompareError::Invalid {
+                path,
+                message: "not the summary of a study or suite written by uq-driver".into(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Columns of a CSV file written by uq-driver (a header, then numbers).
+struct Csv {
+    header: Vec<String>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    fn read(path: &Path) -> Result<Csv, CompareError> {
+        let text = read(path)?;
+        let mut lines = text.lines();
+        let header: Vec<String> = lines
+            .next()
+            .unwrap_or("")
+            .split(',')
+            .map(str::to_owned)
+            .collect();
+        let mut columns = vec![Vec::new(); header.len()];
+        for (i, line) in lines.enumerate() {
+            for (j, cell) in line.split(',').enumerate().take(header.len()) {
+                let v: f64 = cell.trim().parse().map_err(|_| CompareError::Invalid {
+                    path: path.to_path_buf(),
+                    message: format!("line {}: '{cell}' is not a number", i + 2),
+                })?;
+                columns[j].push(v);
+            }
+        }
+        Ok(Csv { header, columns })
+    }
+
+    fn column(&self, name: &str) -> Option<&[f64]> {
+        let j = self.header.iter().position(|h| h == name)?;
+        Some(&self.columns[j])
+    }
+}
+
+/// `target` relative to the folder `from` (both made absolute), for links.
+fn relative(target: &Path, from: &Path) -> PathBuf {
+    let abs = |p: &Path| {
+        std::fs::canonicalize(p).unwrap_or_else(|_| {
+            std::env::current_dir()
+                .map(|c| c.join(p))
+                .unwrap_or_else(|_| p.to_path_buf())
+        })
+    };
+    let (t, f) = (abs(target), abs(from));
+    let tc: Vec<Component> = t.components().collect();
+    let fc: Vec<Component> = f.components().collect();
+    let common = tc.iter().zip(&fc).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..fc.len() {
+        out.push("..");
+    }
+    for c in &tc[common..] {
+        out.push(c.as_os_str());
+    }
+    out
+}
+
+/// Names of the outputs (or quantities, `key`) of a summary.
+fn names(f: &Folder, key: &str) -> Vec<String> {
+    f.summary[key]
+        .as_object()
+        .map(|m| m.keys().cloned().collect())
+        .unwrap_or_default()
+}
+
+/// Writes `out/index.html` (and its plots and `compare.csv`) comparing the study folders
+/// `dirs`.
+pub fn write(dirs: &[PathBuf], out: &Path) -> Result<(), CompareError> {
+    let studies = folders(dirs)?;
+    std::fs::create_dir_all(out).map_err(|source| ReportError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut sections = vec![table_section(&studies, out)];
+    let mut outputs: Vec<String> = Vec::new();
+    let mut quantities: Vec<String> = Vec::new();
+    for f in &studies {
+        for n in names(f, "outputs") {
+            if !outputs.contains(&n) {
+                outputs.push(n);
+            }
+        }
+        for n in names(f, "quantities") {
+            if !quantities.contains(&n) {
+                quantities.push(n);
+            }
+        }
+    }
+    for v in &outputs {
+        sections.push(output_section(&studies, v, out)?);
+    }
+    for q in &quantities {
+        sections.push(quantity_section(&studies, q, out)?);
+    }
+    ReportPage {
+        title: "railuq: studies compared".into(),
+        summary_json: String::new(),
+        sections,
+    }
+    .write(&out.join("index.html"))?;
+    Ok(())
+}
+
+fn num(v: &Value) -> String {
+    match (v.as_u64(), v.as_f64()) {
+        (Some(i), _) => i.to_string(),
+        (None, Some(x)) => sig(x),
+        _ => "–".into(),
+    }
+}
+
+/// The table of the studies, with links to their reports.
+fn table_section(studies: &[Folder], out: &Path) -> Section {
+    let header: Vec<String> = [
+        "study",
+        "method",
+        "model runs",
+        "runs [s]",
+        "analysis [s]",
+        "report [s]",
+        "outputs at the stop time: mean / Std",
+        "quantities: mean / Std",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let rows = studies
+        .iter()
+        .map(|f| {
+            let s = &f.summary;
+            let outputs: Vec<String> = names(f, "outputs")
+                .iter()
+                .map(|n| {
+                    let o = &s["outputs"][n];
+                    format!(
+                        "{n}: {} / {}",
+                        num(&o["mean_at_stop"]),
+                        num(&o["std_at_stop"])
+                    )
+                })
+                .collect();
+            let quantities: Vec<String> = names(f, "quantities")
+                .iter()
+                .map(|n| {
+                    let q = &s["quantities"][n];
+                    format!("{n}: {} / {}", num(&q["mean"]), num(&q["std"]))
+                })
+                .collect();
+            vec![
+                f.name(),
+                s["method"]["kind"].as_str().unwrap_or("?").to_owned(),
+                num(&s["model_runs"]),
+                num(&s["timing"]["runs_s"]),
+                num(&s["timing"]["analysis_s"]),
+                num(&s["timing"]["report_s"]),
+                outputs.join("; "),
+                quantities.join("; "),
+            ]
+        })
+        .collect();
+    Section {
+        heading: "Studies".into(),
+        text: "Each study's own report is linked below; the plots further down put the studies \
+               side by side (outputs and quantities that several studies share)."
+            .into(),
+        images: studies
+            .iter()
+            .map(|f| {
+                relative(&f.dir.join("index.html"), out)
+                    .display()
+                    .to_string()
+            })
+            .collect(),
+        table: Some(Table { header, rows }),
+    }
+}
+
+/// Bands and Std of output `v` in every study that has it, and `<v>_compare.csv` when the
+/// studies share a time grid.
+fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, CompareError> {
+    let have: Vec<(&Folder, Csv)> = studies
+        .iter()
+        .filter(|f| !f.summary["outputs"][v].is_null())
+        .map(|f| Csv::read(&f.dir.join(format!("{v}.csv"))).map(|c| (f, c)))
+        .collect::<Result<_, _>>()?;
+    let unit = have.first().and_then(|(f, _)| f.unit(v));
+    let unit = unit.as_deref();
+    let mut bands = LinePlot::new(
+        format!("{v}: mean ± 3σ of every study"),
+        "time [s]",
+        label(v, unit),
+    );
+    let mut std = LinePlot::new(
+        format!("Std of {v} in every study"),
+        "time [s]",
+        label(&format!("Std {v}"), unit),
+    );
+    for (i, (f, c)) in have.iter().enumerate() {
+        let (Some(t), Some(m), Some(s)) = (c.column("time"), c.column("mean"), c.column("std"))
+        else {
+            continue;
+        };
+        let name = f.name();
+        let (lo, hi) = crate::results::OutputStats::band(m, s, 3.0);
+        bands.bands.push(Band::new(
+            format!("{name} ±3σ"),
+            t.to_vec(),
+            lo,
+            hi,
+            palette(i),
+        ));
+        bands.series.push(Series::new(
+            format!("{name} mean"),
+            t.to_vec(),
+            m.to_vec(),
+            palette(i),
+        ));
+        let line = Series::new(name, t.to_vec(), s.to_vec(), palette(i));
+        std.series.push(if i > 0 { line.dashed() } else { line });
+    }
+    bands.write(&out.join(format!("{v}_bands.svg")))?;
+    std.write(&out.join(format!("{v}_std.svg")))?;
+    let mut images = vec![format!("{v}_bands.svg"), format!("{v}_std.svg")];
+    let mut text = format!(
+        "{v} in {} studies: their μ ± 3σ bands and Std over time.",
+        have.len()
+    );
+    // Differences against the first study, where the time grids agree.
+    if let Some((f0, c0)) = have.first() {
+        let t0 = c0.column("time").unwrap_or(&[]);
+        let mut diff = LinePlot::new(
+            format!("|Std − Std({})| of {v} (log axis)", f0.name()),
+            "time [s]",
+            label(&format!("|Δ Std {v}|"), unit),
+        );
+        diff.log_y = true;
+        let mut header = vec!["time".to_string()];
+        let mut cols: Vec<Vec<f64>> = vec![t0.to_vec()];
+        for (i, (f, c)) in have.iter().enumerate() {
+            if c.column("time") != Some(t0) {
+                continue;
+            }
+            header.push(format!("mean_{}", f.name()));
+            cols.push(c.column("mean").unwrap_or(&[]).to_vec());
+            header.push(format!("std_{}", f.name()));
+            cols.push(c.column("std").unwrap_or(&[]).to_vec());
+            if i > 0 {
+                let d: Vec<f64> = c
+                    .column("std")
+                    .unwrap_or(&[])
+                    .iter()
+                    .zip(c0.column("std").unwrap_or(&[]))
+                    .map(|(a, b)| (a - b).abs())
+                    .collect();
+                diff.series
+                    .push(Series::new(f.name(), t0.to_vec(), d, palette(i)));
+            }
+        }
+        if cols.len() > 3 {
+            let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
+            let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+            write_columns(&out.join(format!("{v}_compare.csv")), &hdr, &refs)?;
+            diff.write(&out.join(format!("{v}_std_diff.svg")))?;
+            images.push(format!("{v}_std_diff.svg"));
+            images.push(format!("{v}_compare.csv"));
+            text.push_str(&format!(
+                " The difference of each Std from that of {} is on a log axis (it spans decades \
+                 between methods).",
+                f0.name()
+            ));
+        }
+    }
+    Ok(Section {
+        heading: format!("Output {v}"),
+        text,
+        images,
+        table: None,
+    })
+}
+
+/// PDFs of quantity `q` in every study that has one, and a table of its statistics.
+fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, CompareError> {
+    let have: Vec<&Folder> = studies
+        .iter()
+        .filter(|f| !f.summary["quantities"][q].is_null())
+        .collect();
+    let unit = have.first().and_then(|f| f.unit(q));
+    let mut plot = DensityPlot {
+        title: format!("PDF of {q} in every study"),
+        x_label: label(q, unit.as_deref()),
+        ..DensityPlot::default()
+    };
+    let mut rows = Vec::new();
+    for (i, f) in have.iter().enumerate() {
+        let s = &f.summary["quantities"][q];
+        let deterministic = s["deterministic"].as_bool().unwrap_or(false);
+        if !deterministic {
+            let c = Csv::read(&f.dir.join(format!("{q}_pdf.csv")))?;
+            if let (Some(x), Some(d)) = (c.column("x"), c.column("density")) {
+                plot.curves
+                    .push(Series::new(f.name(), x.to_vec(), d.to_vec(), palette(i)));
+            }
+        }
+        let exceed: Vec<String> = s["exceedance_counts"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|e| {
+                format!(
+                    "P(> {}): {} of {}",
+                    num(&e["limit"]),
+                    num(&e["exceeded"]),
+                    num(&e["of"])
+                )
+            })
+            .collect();
+        rows.push(vec![
+            f.name(),
+            num(&s["mean"]),
+            num(&s["std"]),
+            if deterministic {
+                "deterministic (no density)".into()
+            } else {
+                num(&s["n_valid"])
+            },
+            exceed.join("; "),
+        ]);
+    }
+    let mut images = Vec::new();
+    if !plot.curves.is_empty() {
+        plot.write(&out.join(format!("{q}_pdf_compare.svg")))?;
+        images.push(format!("{q}_pdf_compare.svg"));
+    }
+    Ok(Section {
+        heading: format!("Quantity {q}"),
+        text: format!("{q} in {} studies.", have.len()),
+        images,
+        table: Some(Table {
+            header: ["study", "mean", "Std", "valid runs", "exceedance"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+            rows,
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_links() {
+        let d = tempfile::tempdir().unwrap();
+        let a = d.path().join("out/wheel-scm");
+        let b = d.path().join("out");
+        std::fs::create_dir_all(&a).unwrap();
+        assert_eq!(
+            relative(&a.join("index.html"), &b),
+            PathBuf::from("wheel-scm/index.html")
+        );
+        let c = d.path().join("other/x");
+        std::fs::create_dir_all(&c).unwrap();
+        assert_eq!(
+            relative(&a.join("index.html"), &c),
+            PathBuf::from("../../out/wheel-scm/index.html")
+        );
+    }
+
+    #[test]
+    fn a_folder_without_a_summary_is_named() {
+        let d = tempfile::tempdir().unwrap();
+        let e = write(&[d.path().to_path_buf()], &d.path().join("o")).unwrap_err();
+        assert!(e.to_string().contains("summary.json"), "{e}");
+    }
+}

@@ -1,0 +1,100 @@
+//! P(q > limit) as counts with an exact (Clopper–Pearson) interval, so that "0 of N
+//! exceeded" carries its 95 % upper bound instead of a meaningless "0 ± 0".
+
+use crate::results::ExceedanceCount;
+use crate::uq::method::Draws;
+
+/// `k` of `n` draws above `limit`, with the Clopper–Pearson 95 % interval of the probability
+/// (`[0, 1 − 0.025^(1/n)]` two-sided when none exceeds; the one-sided 95 % upper bound
+/// `1 − 0.05^(1/n)`, about `3/n`, the rule of three, is given beside it).
+pub fn exceedance_count(draws: &[f64], limit: f64, source: Draws) -> ExceedanceCount {
+    let n = draws.len();
+    let k = draws.iter().filter(|&&x| x > limit).count();
+    let (lo, hi) = clopper_pearson(k, n, 0.05);
+    ExceedanceCount {
+        limit,
+        exceeded: k,
+        of: n,
+        p: if n == 0 {
+            f64::NAN
+        } else {
+            k as f64 / n as f64
+        },
+        ci_95: [lo, hi],
+        upper_95: if n == 0 {
+            f64::NAN
+        } else if k == 0 {
+            1.0 - 0.05f64.powf(1.0 / n as f64)
+        } else {
+            clopper_pearson(k, n, 0.1).1
+        },
+        of_what: match source {
+            Draws::Runs => "runs".into(),
+            Draws::Chaos => "draws of the chaos surrogate".into(),
+        },
+    }
+}
+
+/// The Clopper–Pearson (exact binomial) interval of level `1 − alpha` for `k` successes in
+/// `n` trials; `(NaN, NaN)` for `n = 0`.
+pub fn clopper_pearson(k: usize, n: usize, alpha: f64) -> (f64, f64) {
+    use statrs::function::beta::inv_beta_reg;
+    if n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let (kf, nf) = (k as f64, n as f64);
+    let lo = if k == 0 {
+        0.0
+    } else {
+        inv_beta_reg(kf, nf - kf + 1.0, alpha / 2.0)
+    };
+    let hi = if k == n {
+        1.0
+    } else {
+        inv_beta_reg(kf + 1.0, nf - kf, 1.0 - alpha / 2.0)
+    };
+    (lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clopper_pearson_matches_published_values() {
+        // R: binom.test(5, 20)$conf.int = 0.08657147 0.49104587.
+        let (lo, hi) = clopper_pearson(5, 20, 0.05);
+        assert!((lo - 0.08657147).abs() < 1e-7 && (hi - 0.49104587).abs() < 1e-7);
+        // k = 0: [0, 1 - 0.025^(1/n)]; k = n: [0.025^(1/n), 1].
+        let (lo, hi) = clopper_pearson(0, 50, 0.05);
+        assert_eq!(lo, 0.0);
+        assert!((hi - (1.0 - 0.025f64.powf(1.0 / 50.0))).abs() < 1e-12);
+        let (lo, hi) = clopper_pearson(50, 50, 0.05);
+        assert!((lo - 0.025f64.powf(1.0 / 50.0)).abs() < 1e-12 && hi == 1.0);
+        assert!(clopper_pearson(0, 0, 0.05).0.is_nan());
+    }
+
+    #[test]
+    fn none_exceeded_reads_as_an_upper_bound() {
+        let e = exceedance_count(&[1.0; 1000], 2.5, Draws::Runs);
+        assert_eq!((e.exceeded, e.of, e.p), (0, 1000, 0.0));
+        assert!((e.upper_95 - (1.0 - 0.05f64.powf(0.001))).abs() < 1e-15);
+        assert!((e.upper_95 - 3.0 / 1000.0).abs() < 1e-4, "rule of three");
+        let text = e.describe();
+        assert!(
+            text.starts_with("0 of 1\u{202f}000 runs exceeded 2.5"),
+            "{text}"
+        );
+        assert!(text.contains("95 % upper bound of P: 0.00299"), "{text}");
+        assert!(!text.contains('±'));
+        let e = exceedance_count(&[1.0, 3.0, 4.0, 0.0], 2.5, Draws::Chaos);
+        assert_eq!(e.exceeded, 2);
+        let text = e.describe();
+        assert!(
+            text.contains(
+                "2 of 4 draws of the chaos surrogate exceeded 2.5: P = 0.500 (95 % interval"
+            ),
+            "{text}"
+        );
+    }
+}

@@ -1,0 +1,678 @@
+//! From a method's estimates to the statistics of the report: quantiles and the PDF evolution
+//! of every output, the distribution of every scalar quantity. Quantiles and densities come
+//! from the draws the estimate names: the runs, or a large sample of its chaos surrogate.
+//! Nothing here depends on which method produced the estimate.
+
+use std::borrow::Cow;
+
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+mod columns;
+mod exceedance;
+mod surrogate;
+
+pub use exceedance::{clopper_pearson, exceedance_count};
+
+use columns::{column, Column};
+pub(crate) use surrogate::Surrogates;
+
+use super::store::Record;
+use crate::qoi::scalar::Code;
+use crate::qoi::{kde, QoiSpec};
+use crate::results::{
+    Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
+};
+use crate::spec::{Analysis, Study};
+use crate::uq::distributions::RandomParameter;
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
+use crate::uq::surrogate::NamedChaos;
+
+/// Offset of the surrogate's random streams from the design's (independent draws).
+pub(crate) const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
+
+/// Failures of the analysis.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// Too few runs succeeded.
+    #[error("only {ok} successful runs: nothing to analyse")]
+    TooFewRuns {
+        /// Successful runs.
+        ok: usize,
+    },
+    /// The estimator refused an output.
+    #[error("output '{name}'")]
+    Output {
+        /// The output.
+        name: String,
+        /// Why.
+        #[source]
+        source: MethodError,
+    },
+    /// No run gave a value of a quantity.
+    #[error(
+        "quantity '{name}': no run gave a value ({never_hunts} never hunt, {never_stops} never stop)"
+    )]
+    NoValue {
+        /// The quantity.
+        name: String,
+        /// Runs that never hunt.
+        never_hunts: usize,
+        /// Runs whose oscillation never stops.
+        never_stops: usize,
+    },
+    /// The estimator refused a quantity (e.g. a weighted point without a value).
+    #[error(
+        "quantity '{name}' ({never_hunts} runs never hunt, {never_stops} never stop; use a method \
+         that can leave points out, such as LHS or MC, or change the detection settings or the run length)"
+    )]
+    Quantity {
+        /// The quantity.
+        name: String,
+        /// Runs that never hunt.
+        never_hunts: usize,
+        /// Runs whose oscillation never stops.
+        never_stops: usize,
+        /// Why.
+        #[source]
+        source: MethodError,
+    },
+    /// A `hunting_speed` quantity whose bracket does not contain the transition at every
+    /// point that needs a value (all points, or any point of a weighted design).
+    #[error(
+        "quantity '{name}': at {decays_at_high} points the disturbance dies out even at the top of \
+         the bracket (high = {high}) and at {hunts_at_low} it keeps hunting even at the bottom \
+         (low = {low}); widen the bracket{more}"
+    )]
+    OutsideBracket {
+        /// The quantity.
+        name: String,
+        /// The bracket.
+        low: f64,
+        /// The bracket.
+        high: f64,
+        /// Points that die out at `high`.
+        decays_at_high: usize,
+        /// Points that keep hunting at `low`.
+        hunts_at_low: usize,
+        /// Further advice.
+        more: &'static str,
+    },
+    /// An estimate asks for draws it cannot give.
+    #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
+    NoDraws(String),
+}
+
+/// The analysis settings of a study, and the surrogate draws it shares.
+#[derive(Clone, Copy)]
+pub struct Settings<'a> {
+    /// `[analysis]`.
+    pub analysis: &'a Analysis,
+    /// The study's seed.
+    pub seed: u64,
+    /// The names of the random parameters, in study order (labels of Sobol' indices).
+    pub parameters: &'a [RandomParameter],
+    surrogates: &'a Surrogates,
+}
+
+/// What quantiles and densities are taken from.
+enum Use {
+    /// The time series of an output.
+    Series,
+    /// A scalar quantity.
+    Scalar,
+}
+
+impl<'a> Settings<'a> {
+    /// The settings of `study`, drawing from `surrogates`.
+    pub(crate) fn of(study: &'a Study, surrogates: &'a Surrogates) -> Settings<'a> {
+        Settings {
+            analysis: &study.analysis,
+            seed: study.seed,
+            parameters: &study.parameters,
+            surrogates,
+        }
+    }
+
+    /// The matrix quantiles and densities are taken from: `runs`, or draws of the chaos
+    /// (`series_samples` of them for a time series, `surrogate_samples` for a scalar).
+    fn draws<'m>(
+        &self,
+        name: &str,
+        estimate: &Estimate,
+        runs: Option<&'m DMatrix<f64>>,
+        what: Use,
+    ) -> Result<Cow<'m, DMatrix<f64>>, AnalysisError> {
+        match (estimate.draws, &estimate.chaos, runs) {
+            (Draws::Chaos, Some(pce), _) => {
+                let n = match what {
+                    Use::Series => self
+                        .analysis
+                        .series_samples
+                        .min(self.analysis.surrogate_samples),
+                    Use::Scalar => self.analysis.surrogate_samples,
+                };
+                Ok(Cow::Owned(self.surrogates.draws(pce, n.max(2))))
+            }
+            (Draws::Runs, _, Some(r)) => Ok(Cow::Borrowed(r)),
+            _ => Err(AnalysisError::NoDraws(name.to_owned())),
+        }
+    }
+}
+
+/// Column indices of at most `max` evenly spaced columns out of `n`, always with the last.
+fn thinned(n: usize, max: usize) -> Vec<usize> {
+    if n <= max {
+        return (0..n).collect();
+    }
+    let step = n.div_ceil(max);
+    let mut v: Vec<usize> = (0..n).step_by(step).collect();
+    if *v.last().expect("n > 0") != n - 1 {
+        v.push(n - 1);
+    }
+    v
+}
+
+/// A spread at or below this fraction of the largest magnitude of an output counts as none
+/// (a chaos surrogate of a deterministic value scatters at the rounding level of its
+/// coefficients).
+const ZERO_SPREAD: f64 = 1e-9;
+
+/// Statistics of an output over `times` from its estimate; `runs` are the successful runs
+/// (rows) over time (columns), if the model was run.
+///
+/// Every column is summarised in parallel (quantiles by selection, Silverman's bandwidth),
+/// then the densities of at most `pdf_times` columns are taken on one common grid by the
+/// binned kernel estimate. A column whose values all agree (to [`ZERO_SPREAD`] of the
+/// output's magnitude) has no density: its entries are NaN. The results do not depend on
+/// the thread count.
+pub(crate) fn output_stats(
+    name: &str,
+    times: &[f64],
+    estimate: &Estimate,
+    runs: Option<&DMatrix<f64>>,
+    settings: &Settings,
+) -> Result<OutputStats, AnalysisError> {
+    let a = settings.analysis;
+    let samples = settings.draws(name, estimate, runs, Use::Series)?;
+    let rows = samples.nrows();
+    let all = samples.as_slice();
+    let cols: Vec<Column> = (0..samples.ncols())
+        .into_par_iter()
+        .map(|k| column(&all[k * rows..(k + 1) * rows], &a.quantiles))
+        .collect();
+    let quantiles = a
+        .quantiles
+        .iter()
+        .enumerate()
+        .map(|(qi, &p)| (p, cols.iter().map(|c| c.quantiles[qi]).collect()))
+        .collect();
+    let magnitude = cols
+        .iter()
+        .map(|c| c.min.abs().max(c.max.abs()))
+        .filter(|m| m.is_finite())
+        .fold(0.0, f64::max);
+    let spread = |c: &Column| c.max - c.min > ZERO_SPREAD * magnitude;
+    let deterministic = !cols.iter().any(spread);
+    let picked = if deterministic {
+        Vec::new()
+    } else {
+        thinned(times.len(), a.pdf_times)
+    };
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &k in &picked {
+        lo = lo.min(cols[k].min);
+        hi = hi.max(cols[k].max);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
+    let grid = if picked.is_empty() {
+        Vec::new()
+    } else {
+        kde::auto_grid(lo - pad, hi + pad, a.pdf_grid)
+    };
+    let (g0, g1) = (
+        grid.first().copied().unwrap_or(0.0),
+        grid.last().copied().unwrap_or(0.0),
+    );
+    let step = (g1 - g0) / grid.len().saturating_sub(1).max(1) as f64;
+    let pdf = picked
+        .par_iter()
+        .map(|&k| {
+            if spread(&cols[k]) {
+                let col = &all[k * rows..(k + 1) * rows];
+                let h = cols[k].bandwidth;
+                if h < 2.0 * step {
+                    // Narrower than the grid: averages over the grid cells keep its mass.
+                    kde::gaussian_kde_cell_average(col, g0, g1, grid.len(), h)
+                } else {
+                    kde::gaussian_kde_binned(col, g0, g1, grid.len(), h)
+                }
+            } else {
+                vec![f64::NAN; grid.len()]
+            }
+        })
+        .collect();
+    let (lower_3sigma, upper_3sigma) = OutputStats::band(&estimate.mean, &estimate.std, 3.0);
+    let k_max = (0..estimate.std.len())
+        .max_by(|&i, &j| estimate.std[i].total_cmp(&estimate.std[j]))
+        .filter(|_| !deterministic);
+    let convergence = k_max.and_then(|k| {
+        let runs = match estimate.draws {
+            Draws::Runs => &all[k * rows..(k + 1) * rows],
+            Draws::Chaos => &[],
+        };
+        convergence(estimate, k, runs)
+    });
+    Ok(OutputStats {
+        name: name.to_owned(),
+        times: times.to_vec(),
+        mean: estimate.mean.clone(),
+        std: estimate.std.clone(),
+        lower_3sigma,
+        upper_3sigma,
+        quantiles,
+        std_pce: estimate.std_chaos.clone(),
+        std_error_mean: estimate.std_error_mean.clone(),
+        sobol: estimate.sobol.clone(),
+        pdf_times: picked.iter().map(|&k| times[k]).collect(),
+        pdf_grid: grid,
+        pdf,
+        draws: estimate.draws,
+        chaos_error: estimate.chaos_error.clone(),
+        deterministic,
+        unit: None,
+        convergence,
+        convergence_time: k_max.map(|k| times[k]),
+    })
+}
+
+/// The values of one quantity over the successful runs, with their outcome codes.
+pub(crate) struct QuantityRuns {
+    /// Design indices of the runs with a valid value.
+    pub rows: Vec<usize>,
+    /// Their values.
+    pub valid: Vec<f64>,
+    pub never_hunts: usize,
+    pub never_stops: usize,
+}
+
+/// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
+/// its valid run values; quantiles and the density from `density` where given (e.g. the
+/// pooled draws of a nested study), else from the draws the estimate names.
+pub(crate) fn scalar_stats(
+    name: &str,
+    q: &QoiSpec,
+    estimate: &Estimate,
+    runs: QuantityRuns,
+    settings: &Settings,
+    density: Option<Vec<f64>>,
+) -> Result<ScalarStats, AnalysisError> {
+    let a = settings.analysis;
+    let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
+    let density_samples: Vec<f64> = match density {
+        Some(d) => d,
+        None => settings
+            .draws(name, estimate, Some(&data), Use::Scalar)?
+            .column(0)
+            .iter()
+            .copied()
+            .collect(),
+    };
+    let c = column(&density_samples, &a.quantiles);
+    let quantiles = a.quantiles.iter().copied().zip(c.quantiles).collect();
+    let magnitude = c.min.abs().max(c.max.abs());
+    let deterministic = runs.valid.len() < 2 || c.max - c.min <= ZERO_SPREAD * magnitude;
+    let (pdf_x, pdf) = if deterministic {
+        (Vec::new(), Vec::new())
+    } else {
+        let bw = c.bandwidth;
+        let (lo, hi) = (c.min - 3.0 * bw, c.max + 3.0 * bw);
+        (
+            kde::auto_grid(lo, hi, a.pdf_grid),
+            kde::gaussian_kde_binned(&density_samples, lo, hi, a.pdf_grid, bw),
+        )
+    };
+    let exceedance_counts: Vec<ExceedanceCount> = q
+        .limits()
+        .iter()
+        .map(|&l| exceedance_count(&density_samples, l, estimate.draws))
+        .collect();
+    let exceedance = exceedance_counts
+        .iter()
+        .map(|e| {
+            let se = (e.p * (1.0 - e.p) / e.of as f64).sqrt();
+            (e.limit, e.p, se)
+        })
+        .collect();
+    let valid = runs.valid;
+    Ok(ScalarStats {
+        name: name.to_owned(),
+        mean: estimate.mean[0],
+        std: estimate.std[0],
+        std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
+        n_valid: valid.len(),
+        n_never_hunts: runs.never_hunts,
+        n_never_stops: runs.never_stops,
+        quantiles,
+        min: valid.iter().copied().fold(f64::INFINITY, f64::min),
+        max: valid.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        exceedance,
+        exceedance_counts,
+        pdf_x,
+        pdf,
+        deterministic,
+        convergence: convergence(estimate, 0, &valid).filter(|_| !deterministic),
+        definition: q.definition(),
+        unit: None,
+        samples: valid,
+        density_samples,
+        sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
+        sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
+        sobol: estimate.sobol.as_ref().map(|s| {
+            let names: Vec<&str> = settings
+                .parameters
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect();
+            SobolSummary::of(s, 0, &names)
+        }),
+        draws: estimate.draws,
+        chaos_error: estimate.chaos_error.as_ref().map(|e| ScalarChaosError {
+            kind: e.kind.name(),
+            value: e.values[0],
+        }),
+        nested: None,
+    })
+}
+
+/// Mean and Std against the work spent: for a chaos, those of the expansion truncated at
+/// total order 0, 1, … (terms of a full-tensor projection do not depend on each other, so
+/// the truncation is the lower-order projection); for runs, the running estimates over the
+/// first n runs in design order (at about 30 values of n on a log scale).
+fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Convergence> {
+    if let Some(pce) = &estimate.chaos {
+        // An orthonormal basis: each term's variance is its coefficient squared.
+        let set = pce.set();
+        let c0 = set.position(&vec![0; set.dim()]);
+        let mean = c0.map_or(0.0, |t| pce.coeffs[(t, col)]);
+        let order = set.order();
+        let mut of_order = vec![0.0_f64; order + 1];
+        for (t, k) in set.indices().iter().enumerate() {
+            if Some(t) != c0 {
+                let degree: usize = k.iter().sum();
+                of_order[degree] += pce.coeffs[(t, col)].powi(2);
+            }
+        }
+        let cumulative: Vec<f64> = of_order
+            .iter()
+            .scan(0.0_f64, |acc, v| {
+                *acc += v;
+                Some(acc.sqrt())
+            })
+            .collect();
+        return Some(Convergence {
+            axis: "chaos order".into(),
+            x: (0..=order).map(|o| o as f64).collect(),
+            mean: vec![mean; order + 1],
+            std: cumulative,
+            std_of_order: of_order.iter().map(|v: &f64| v.sqrt()).collect(),
+        });
+    }
+    if valid.len() < 4 {
+        return None;
+    }
+    let n = valid.len();
+    let mut points: Vec<usize> = (0..=30)
+        .map(|i| (2.0 * (n as f64 / 2.0).powf(i as f64 / 30.0)).round() as usize)
+        .collect();
+    points.dedup();
+    let (mut mean, mut std) = (Vec::new(), Vec::new());
+    let (mut m, mut m2) = (0.0, 0.0);
+    let mut next = 0;
+    for (i, &x) in valid.iter().enumerate() {
+        // Welford's running mean and sum of squared deviations.
+        let d = x - m;
+        m += d / (i + 1) as f64;
+        m2 += d * (x - m);
+        if next < points.len() && i + 1 == points[next] {
+            mean.push(m);
+            std.push((m2 / i.max(1) as f64).sqrt());
+            next += 1;
+        }
+    }
+    Some(Convergence {
+        axis: "runs".into(),
+        x: points.iter().map(|&p| p as f64).collect(),
+        mean,
+        std,
+        std_of_order: Vec::new(),
+    })
+}
+
+/// The values of the successful runs, in design order.
+pub(crate) struct Runs<'a> {
+    /// Design indices.
+    pub rows: Vec<usize>,
+    values: Vec<&'a [f64]>,
+}
+
+impl<'a> Runs<'a> {
+    pub(crate) fn of(records: &'a [Option<Record>]) -> Runs<'a> {
+        let (rows, values) = records
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| match r {
+                Some(Record::Ok(v)) => Some((i, v.as_slice())),
+                _ => None,
+            })
+            .unzip();
+        Runs { rows, values }
+    }
+
+    /// Output `o` (of `nt` times each) as runs × times.
+    pub(crate) fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(self.rows.len(), nt, |r, k| self.values[r][o * nt + k])
+    }
+
+    /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
+    pub(crate) fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
+        let mut out = QuantityRuns {
+            rows: Vec::new(),
+            valid: Vec::new(),
+            never_hunts: 0,
+            never_stops: 0,
+        };
+        for (&row, v) in self.rows.iter().zip(&self.values) {
+            match Code::from_f64(v[base + 2 * qi + 1]) {
+                Code::Ok => {
+                    out.rows.push(row);
+                    out.valid.push(v[base + 2 * qi]);
+                }
+                Code::NeverHunts => out.never_hunts += 1,
+                Code::NeverStops => out.never_stops += 1,
+            }
+        }
+        out
+    }
+}
+
+/// What [`analyse_runs`] finds.
+#[derive(Clone, Debug)]
+pub struct Analysed {
+    /// Per output.
+    pub outputs: Vec<OutputStats>,
+    /// Per scalar quantity.
+    pub quantities: Vec<ScalarStats>,
+    /// The chaos of each output that has one (chaos methods).
+    pub output_chaos: Vec<NamedChaos>,
+    /// The chaos of each quantity that has one.
+    pub quantity_chaos: Vec<NamedChaos>,
+}
+
+/// Statistics of every output and quantity of a study whose points have all been run
+/// (`records` holds one record per point of `design`), and the chaoses of a chaos method.
+pub fn analyse_runs(
+    study: &Study,
+    method: &dyn Sampling,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<Analysed, AnalysisError> {
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
+    let times = study.times();
+    let nt = times.len();
+    let runs = Runs::of(records);
+    if runs.rows.len() < method.min_runs() {
+        return Err(AnalysisError::TooFewRuns {
+            ok: runs.rows.len(),
+        });
+    }
+    let mut outputs = Vec::new();
+    let mut output_chaos = Vec::new();
+    for (o, name) in study.outputs.iter().enumerate() {
+        let data = runs.output(o, nt);
+        let estimate = method
+            .estimate(design, &runs.rows, &data)
+            .map_err(|source| AnalysisError::Output {
+                name: name.clone(),
+                source,
+            })?;
+        outputs.push(output_stats(
+            name,
+            &times,
+            &estimate,
+            Some(&data),
+            &settings,
+        )?);
+        if let Some(pce) = estimate.chaos {
+            output_chaos.push(NamedChaos {
+                name: name.clone(),
+                times: Some(times.clone()),
+                pce,
+                error: estimate.chaos_error,
+            });
+        }
+    }
+    let base = study.outputs.len() * nt;
+    let mut quantities = Vec::new();
+    let mut quantity_chaos = Vec::new();
+    let scalars = study
+        .qoi
+        .iter()
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
+    for (qi, (name, q)) in scalars.enumerate() {
+        let qr = runs.quantity(base, qi);
+        let outside = |more| match q {
+            QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
+                name: name.clone(),
+                low: h.low,
+                high: h.high,
+                decays_at_high: qr.never_hunts,
+                hunts_at_low: qr.never_stops,
+                more,
+            }),
+            _ => None,
+        };
+        if qr.valid.is_empty() {
+            if let Some(e) = outside("") {
+                return Err(e);
+            }
+            return Err(AnalysisError::NoValue {
+                name,
+                never_hunts: qr.never_hunts,
+                never_stops: qr.never_stops,
+            });
+        }
+        let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
+        let estimate = method.estimate(design, &qr.rows, &data).map_err(|source| {
+            let more = " (or use a method that can leave points out, such as LHS or MC)";
+            outside(more)
+                .filter(|_| qr.never_hunts + qr.never_stops > 0)
+                .unwrap_or(AnalysisError::Quantity {
+                    name: name.clone(),
+                    never_hunts: qr.never_hunts,
+                    never_stops: qr.never_stops,
+                    source,
+                })
+        })?;
+        quantities.push(scalar_stats(&name, q, &estimate, qr, &settings, None)?);
+        if let Some(pce) = estimate.chaos {
+            quantity_chaos.push(NamedChaos {
+                name: name.clone(),
+                times: None,
+                pce,
+                error: estimate.chaos_error,
+            });
+        }
+    }
+    Ok(Analysed {
+        outputs,
+        quantities,
+        output_chaos,
+        quantity_chaos,
+    })
+}
+
+/// Statistics of every output of an intrusive method's solution.
+pub fn analyse_solution(
+    study: &Study,
+    solution: &Solution,
+) -> Result<Vec<OutputStats>, AnalysisError> {
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
+    let times = study.times();
+    study
+        .outputs
+        .iter()
+        .zip(&solution.outputs)
+        .map(|(name, estimate)| output_stats(name, &times, estimate, None, &settings))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where the analysis of a chaos study spends its time:
+    /// `cargo test --release -p uq-driver --lib -- --ignored analysis_timing --nocapture`.
+    #[test]
+    #[ignore = "prints timings"]
+    fn analysis_timing() {
+        use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce};
+        let set = MultiIndexSet::total_degree(2, 5).unwrap();
+        let basis = Basis::new(vec![Family::Hermite; 2], set).unwrap();
+        let coeffs = DMatrix::from_fn(basis.len(), 501, |t, k| {
+            ((t + 1) as f64).recip() * (0.01 * k as f64).sin()
+        });
+        let pce = Pce { basis, coeffs };
+        let t = std::time::Instant::now();
+        let draws = Surrogates::new(1).draws(&pce, 4_000);
+        eprintln!("sample: {:?}", t.elapsed());
+        let t = std::time::Instant::now();
+        let rows = draws.nrows();
+        let cols: Vec<Column> = (0..draws.ncols())
+            .map(|k| {
+                column(
+                    &draws.as_slice()[k * rows..(k + 1) * rows],
+                    &[0.01, 0.5, 0.99],
+                )
+            })
+            .collect();
+        eprintln!("columns: {:?}", t.elapsed());
+        let t = std::time::Instant::now();
+        for (k, c) in cols.iter().enumerate().step_by(2) {
+            let col = &draws.as_slice()[k * rows..(k + 1) * rows];
+            kde::gaussian_kde_binned(col, -1.0, 1.0, 200, c.bandwidth);
+        }
+        eprintln!("kde: {:?}", t.elapsed());
+    }
+
+    #[test]
+    fn thinning_keeps_ends() {
+        assert_eq!(thinned(5, 10), vec![0, 1, 2, 3, 4]);
+        let t = thinned(501, 100);
+        assert_eq!(t[0], 0);
+        assert_eq!(*t.last().unwrap(), 500);
+        assert!(t.len() <= 101);
+    }
+}

@@ -1,0 +1,124 @@
+//! Draws of a chaos surrogate for quantiles and densities, computed once per study and in
+//! parallel: the basis at the random germ points (the same points as
+//! [`germ_draws`], row `i` from the stream `(seed, i)`) is shared by every output
+//! and quantity whose chaos has that basis, and each chaos is one matrix product with it,
+//! split over blocks of columns. The draws are those of [`Pce::sample`], whatever the
+//! thread count.
+
+use std::sync::{Arc, Mutex};
+
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+use crate::uq::pce::{germ_draw, Basis, Pce};
+
+/// Rows of germ points evaluated per parallel task.
+const ROWS_PER_TASK: usize = 512;
+/// Columns of the product per parallel task.
+const COLUMNS_PER_TASK: usize = 32;
+
+/// The basis at the germ points, per basis, grown on demand.
+pub(crate) struct Surrogates {
+    seed: u64,
+    cache: Mutex<Vec<(Basis, Arc<DMatrix<f64>>)>>,
+}
+
+impl Surrogates {
+    /// Draws under `seed`.
+    pub fn new(seed: u64) -> Surrogates {
+        Surrogates {
+            seed,
+            cache: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The first `n` draws of `pce` (one row per draw, one column per output of the chaos):
+    /// equal to `pce.sample(n, seed)`.
+    pub fn draws(&self, pce: &Pce, n: usize) -> DMatrix<f64> {
+        let psi = self.basis_at_germs(&pce.basis, n);
+        let cols = pce.coeffs.ncols();
+        let mut out = DMatrix::<f64>::zeros(n, cols);
+        out.as_mut_slice()
+            .par_chunks_mut(n * COLUMNS_PER_TASK)
+            .enumerate()
+            .for_each(|(b, block)| {
+                let j0 = b * COLUMNS_PER_TASK;
+                let w = block.len() / n.max(1);
+                let part = psi.rows(0, n) * pce.coeffs.columns(j0, w);
+                block.copy_from_slice(part.as_slice());
+            });
+        out
+    }
+
+    /// The basis at the first `n` germ points (rows), computed at most once per size.
+    fn basis_at_germs(&self, basis: &Basis, n: usize) -> Arc<DMatrix<f64>> {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, psi)) = cache.iter().find(|(b, psi)| b == basis && psi.nrows() >= n) {
+            return Arc::clone(psi);
+        }
+        let psi = Arc::new(basis_at_germs(basis, n, self.seed));
+        cache.retain(|(b, _)| b != basis);
+        cache.push((basis.clone(), Arc::clone(&psi)));
+        psi
+    }
+}
+
+/// `basis.design_matrix(&germ_draws(basis.families(), n, seed))`, rows computed in parallel.
+fn basis_at_germs(basis: &Basis, n: usize, seed: u64) -> DMatrix<f64> {
+    let terms = basis.len();
+    let laws: Vec<_> = basis.families().iter().map(|f| f.law()).collect();
+    // Row-major per task, then transposed into the column-major matrix.
+    let rows: Vec<Vec<f64>> = (0..n.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|task| {
+            let (i0, i1) = (task * ROWS_PER_TASK, ((task + 1) * ROWS_PER_TASK).min(n));
+            let mut block = vec![0.0; (i1 - i0) * terms];
+            for (i, row) in (i0..i1).zip(block.chunks_exact_mut(terms.max(1))) {
+                let z = germ_draw(basis.families(), &laws, seed, i);
+                basis.eval(&z, row);
+            }
+            block
+        })
+        .collect();
+    let mut psi = DMatrix::<f64>::zeros(n, terms);
+    for (task, block) in rows.iter().enumerate() {
+        let i0 = task * ROWS_PER_TASK;
+        for (r, row) in block.chunks_exact(terms.max(1)).enumerate() {
+            for (t, v) in row.iter().enumerate() {
+                psi[(i0 + r, t)] = *v;
+            }
+        }
+    }
+    psi
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shared_parallel_draws_are_those_of_pce_sample() {
+        use crate::uq::pce::{Family, MultiIndexSet};
+        let set = MultiIndexSet::total_degree(3, 3).unwrap();
+        let families = vec![Family::Hermite, Family::Legendre, Family::Hermite];
+        let basis = Basis::new(families.clone(), set).unwrap();
+        let coeffs = DMatrix::from_fn(basis.len(), 70, |t, k| {
+            (t as f64 + 1.0).recip() * (1.0 + 0.1 * k as f64).cos()
+        });
+        let pce = Pce { basis, coeffs };
+        let s = Surrogates::new(11);
+        for n in [1, 700, 1500, 300] {
+            let fast = s.draws(&pce, n);
+            let slow = pce.sample(n, 11);
+            assert_eq!(fast.shape(), slow.shape());
+            let err = (&fast - &slow).abs().max();
+            assert!(err <= 1e-14 * slow.abs().max(), "n = {n}: {err}");
+        }
+        // Another basis is drawn on its own, at the same germ points.
+        let small = Pce {
+            basis: Basis::new(families, MultiIndexSet::total_degree(3, 1).unwrap()).unwrap(),
+            coeffs: DMatrix::from_element(4, 1, 1.0),
+        };
+        assert_eq!(s.draws(&small, 5), small.sample(5, 11));
+    }
+}

@@ -1,0 +1,326 @@
+//! `uq-driver export DIR --runs`: every run's time series of a finished study, read back
+//! from its results store, as
+//! - `runs.csv`: long format `run,time,<output>...` (one row per run and time; `run` is the
+//!   design index of `points.csv`), and
+//! - `runs.npz`: NumPy arrays, `time` (times), `run` (design indices of the successful
+//!   runs), one `runs × times` array per output, and `<parameter>` (the parameters of each
+//!   run) — `np.load("runs.npz")["q"]`.
+//!
+//! The `.npz` is a zip of `.npy` files (format 1.0: magic, a header dict, little-endian
+//! `<f8` / `<i8` data in C order), written here with the zip crate: a dependency on
+//! ndarray for this alone is not worth it.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use super::store::{self, Manifest, Record};
+use crate::report::{write_bytes, ReportError};
+use crate::spec::Experiment;
+
+/// Why the runs cannot be exported.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// A file could not be read.
+    #[error("cannot read {}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The folder is not a finished study written by this version of `uq-driver run`.
+    #[error("{}: {message}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing failed.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    /// Writing the zip failed.
+    #[error("cannot write {}", path.display())]
+    Zip {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: zip::result::ZipError,
+    },
+}
+
+/// What was exported.
+#[derive(Clone, Debug)]
+pub struct Exported {
+    /// Successful runs.
+    pub runs: usize,
+    /// Times per run.
+    pub times: usize,
+    /// The outputs.
+    pub outputs: Vec<String>,
+    /// `runs.csv`.
+    pub csv: PathBuf,
+    /// `runs.npz`.
+    pub npz: PathBuf,
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, ExportError> {
+    std::fs::read(path).map_err(|source| ExportError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn invalid(path: &Path, message: impl Into<String>) -> ExportError {
+    ExportError::Invalid {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+/// Writes `runs.csv` and `runs.npz` of the study in `dir` into `out`.
+pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
+    let sp = dir.join("summary.json");
+    let summary: Value =
+        serde_json::from_slice(&read(&sp)?).map_err(|e| invalid(&sp, format!("not JSON: {e}")))?;
+    let outputs: Vec<String> = serde_json::from_value(summary["record_layout"]["outputs"].clone())
+        .map_err(|_| {
+            invalid(
+                &sp,
+                "no record_layout: written by an older uq-driver (run the study again)",
+            )
+        })?;
+    let experiment: Experiment = serde_json::from_value(summary["experiment"].clone())
+        .map_err(|e| invalid(&sp, format!("experiment: {e}")))?;
+    let times = experiment.times();
+    let nt = times.len();
+    let mp = dir.join("store").join("manifest.json");
+    let manifest: Manifest = serde_json::from_slice(&read(&mp)?)
+        .map_err(|e| invalid(&mp, format!("not a store manifest: {e}")))?;
+    if manifest.n_values < outputs.len() * nt {
+        return Err(invalid(
+            &mp,
+            format!(
+                "records hold {} values, fewer than {} outputs × {nt} times",
+                manifest.n_values,
+                outputs.len()
+            ),
+        ));
+    }
+    let rp = dir.join("store").join("records.bin");
+    let (_, decoded) = store::decode(&read(&rp)?, manifest.n_values);
+    let mut ok: Vec<(usize, Vec<f64>)> = decoded
+        .records
+        .into_iter()
+        .filter_map(|(i, r, _)| match r {
+            Record::Ok(v) => Some((i, v)),
+            Record::Failed(_) => None,
+        })
+        .collect();
+    ok.sort_by_key(|(i, _)| *i);
+    ok.dedup_by_key(|(i, _)| *i);
+    let parameters = read_points(&dir.join("points.csv"))?;
+    std::fs::create_dir_all(out).map_err(|source| ReportError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let csv = out.join("runs.csv");
+    write_csv(&csv, &outputs, &times, &ok)?;
+    let npz = out.join("runs.npz");
+    write_npz(&npz, &outputs, &times, &ok, &parameters)?;
+    Ok(Exported {
+        runs: ok.len(),
+        times: nt,
+        outputs,
+        csv,
+        npz,
+    })
+}
+
+/// The parameter columns of `points.csv` by design index: (name, values).
+fn read_points(path: &Path) -> Result<Vec<(String, Vec<f64>)>, ExportError> {
+    let text = String::from_utf8_lossy(&read(path)?).into_owned();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let cols: Vec<usize> = (0..header.len())
+        .filter(|&j| !matches!(header[j], "index" | "weight" | "status"))
+        .collect();
+    let mut out: Vec<(String, Vec<f64>)> = cols
+        .iter()
+        .map(|&j| (header[j].to_owned(), Vec::new()))
+        .collect();
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        for (k, &j) in cols.iter().enumerate() {
+            let v = cells
+                .get(j)
+                .and_then(|c| c.parse().ok())
+                .unwrap_or(f64::NAN);
+            out[k].1.push(v);
+        }
+    }
+    Ok(out)
+}
+
+fn write_csv(
+    path: &Path,
+    outputs: &[String],
+    times: &[f64],
+    runs: &[(usize, Vec<f64>)],
+) -> Result<(), ExportError> {
+    let nt = times.len();
+    let mut text = String::with_capacity(24 * runs.len() * nt * (2 + outputs.len()));
+    text.push_str("run,time");
+    for o in outputs {
+        text.push(',');
+        text.push_str(o);
+    }
+    text.push('\n');
+    for (i, v) in runs {
+        for (k, t) in times.iter().enumerate() {
+            let _ = write!(text, "{i},{t}");
+            for o in 0..outputs.len() {
+                let _ = write!(text, ",{}", v[o * nt + k]);
+            }
+            text.push('\n');
+        }
+    }
+    Ok(write_bytes(path, text.as_bytes())?)
+}
+
+/// One `.npy` file (format 1.0) of a C-ordered array with `shape`, of `<f8` or `<i8`.
+pub fn npy(shape: &[usize], data: Npy) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape = if dims.len() == 1 {
+        format!("({},)", dims[0])
+    } else {
+        format!("({})", dims.join(", "))
+    };
+    let descr = match data {
+        Npy::F64(_) => "<f8",
+        Npy::I64(_) => "<i8",
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    // Magic (6) + version (2) + length (2) + header, padded with spaces to a multiple of 64
+    // and ended by a newline.
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.next_multiple_of(64) - total));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + 8 * data.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    match data {
+        Npy::F64(v) => v
+            .iter()
+            .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+        Npy::I64(v) => v
+            .iter()
+            .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+    }
+    out
+}
+
+/// The data of a `.npy` array.
+#[derive(Clone, Copy, Debug)]
+pub enum Npy<'a> {
+    /// 64-bit floats.
+    F64(&'a [f64]),
+    /// 64-bit integers.
+    I64(&'a [i64]),
+}
+
+impl Npy<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Npy::F64(v) => v.len(),
+            Npy::I64(v) => v.len(),
+        }
+    }
+}
+
+fn write_npz(
+    path: &Path,
+    outputs: &[String],
+    times: &[f64],
+    runs: &[(usize, Vec<f64>)],
+    parameters: &[(String, Vec<f64>)],
+) -> Result<(), ExportError> {
+    let nt = times.len();
+    let zip_err = |source| ExportError::Zip {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut z = zip::ZipWriter::new(file);
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Stored)
+        .large_file(true);
+    let mut add = |name: &str, bytes: Vec<u8>| -> Result<(), ExportError> {
+        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.write_all(&bytes).map_err(|source| ReportError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(())
+    };
+    add("time", npy(&[nt], Npy::F64(times)))?;
+    let index: Vec<i64> = runs.iter().map(|(i, _)| *i as i64).collect();
+    add("run", npy(&[runs.len()], Npy::I64(&index)))?;
+    for (o, name) in outputs.iter().enumerate() {
+        let data: Vec<f64> = runs
+            .iter()
+            .flat_map(|(_, v)| v[o * nt..(o + 1) * nt].iter().copied())
+            .collect();
+        add(name, npy(&[runs.len(), nt], Npy::F64(&data)))?;
+    }
+    for (name, values) in parameters {
+        if outputs.contains(name) || name == "time" || name == "run" {
+            continue;
+        }
+        let per_run: Vec<f64> = runs
+            .iter()
+            .map(|(i, _)| values.get(*i).copied().unwrap_or(f64::NAN))
+            .collect();
+        add(name, npy(&[runs.len()], Npy::F64(&per_run)))?;
+    }
+    z.finish().map_err(zip_err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_header_is_aligned_and_parsable() {
+        let b = npy(&[2, 3], Npy::F64(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+        assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
+        let hlen = u16::from_le_bytes([b[8], b[9]]) as usize;
+        assert_eq!((10 + hlen) % 64, 0);
+        let header = std::str::from_utf8(&b[10..10 + hlen]).unwrap();
+        assert!(header.starts_with("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }"));
+        assert!(header.ends_with('\n'));
+        assert_eq!(b.len(), 10 + hlen + 48);
+        assert_eq!(
+            f64::from_le_bytes(b[10 + hlen + 40..].try_into().unwrap()),
+            6.0
+        );
+        let one = npy(&[3], Npy::I64(&[7, 8, 9]));
+        let hlen = u16::from_le_bytes([one[8], one[9]]) as usize;
+        assert!(std::str::from_utf8(&one[10..10 + hlen])
+            .unwrap()
+            .contains("'<i8'"));
+        assert!(std::str::from_utf8(&one[10..10 + hlen])
+            .unwrap()
+            .contains("(3,)"));
+    }
+}

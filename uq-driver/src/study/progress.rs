@@ -1,0 +1,171 @@
+//! Progress of a run: a bar on a terminal, and plain lines when the output goes to a file or
+//! a pipe (a cluster job's log): one line every `interval` (default 10 s), or whenever
+//! another tenth of the points is done once the run has taken a second, and one at the end
+//! (a run shorter than a second prints none).
+
+use std::io::Write;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// How progress is shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProgressMode {
+    /// Not at all.
+    #[default]
+    Off,
+    /// A bar that redraws itself (a terminal).
+    Bar,
+    /// A line now and then (a log file).
+    Lines,
+}
+
+impl ProgressMode {
+    /// A bar when standard error is a terminal, else lines.
+    pub fn auto() -> ProgressMode {
+        use std::io::IsTerminal;
+        if std::io::stderr().is_terminal() {
+            ProgressMode::Bar
+        } else {
+            ProgressMode::Lines
+        }
+    }
+}
+
+/// Progress over `total` points.
+pub struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    lines: Option<Lines>,
+}
+
+struct Lines {
+    total: usize,
+    done: AtomicUsize,
+    started: Instant,
+    interval: Duration,
+    /// When the last line was printed, the tenth it reported, and whether any was.
+    last: Mutex<(Instant, usize, bool)>,
+}
+
+/// Lines about tenths start once the run has taken this long.
+const QUIET: Duration = Duration::from_secs(1);
+
+impl Progress {
+    /// Progress shown as `mode` (nothing for no points).
+    pub fn new(mode: ProgressMode, total: usize) -> Progress {
+        Progress::with_interval(mode, total, Duration::from_secs(10))
+    }
+
+    /// As [`Progress::new`], with lines at most `interval` apart.
+    pub fn with_interval(mode: ProgressMode, total: usize, interval: Duration) -> Progress {
+        let (mut bar, mut lines) = (None, None);
+        if total > 0 {
+            match mode {
+                ProgressMode::Off => {}
+                ProgressMode::Bar => {
+                    let b = indicatif::ProgressBar::new(total as u64);
+                    b.set_style(
+                        indicatif::ProgressStyle::with_template(
+                            "{bar:40} {pos}/{len} points  {elapsed} elapsed, ~{eta} left",
+                        )
+                        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+                    );
+                    bar = Some(b);
+                }
+                ProgressMode::Lines => {
+                    let now = Instant::now();
+                    lines = Some(Lines {
+                        total,
+                        done: AtomicUsize::new(0),
+                        started: now,
+                        interval,
+                        last: Mutex::new((now, 0, false)),
+                    });
+                }
+            }
+        }
+        Progress { bar, lines }
+    }
+
+    /// One more point done.
+    pub fn inc(&self) {
+        if let Some(b) = &self.bar {
+            b.inc(1);
+        }
+        if let Some(l) = &self.lines {
+            let done = l.done.fetch_add(1, Ordering::Relaxed) + 1;
+            let tenth = done * 10 / l.total;
+            let mut last = l.last.lock().unwrap_or_else(|e| e.into_inner());
+            let due =
+                (tenth > last.1 && l.started.elapsed() >= QUIET) || last.0.elapsed() >= l.interval;
+            if done < l.total && due {
+                *last = (Instant::now(), tenth, true);
+                l.print(done);
+            }
+        }
+    }
+
+    /// The run is over (a last line with the count).
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+        if let Some(l) = &self.lines {
+            let printed = l.last.lock().unwrap_or_else(|e| e.into_inner()).2;
+            if printed || l.started.elapsed() >= QUIET {
+                l.print(l.done.load(Ordering::Relaxed));
+            }
+        }
+    }
+}
+
+impl Lines {
+    fn print(&self, done: usize) {
+        let elapsed = self.started.elapsed().as_secs_f64();
+        let left = if done > 0 && done < self.total {
+            format!(
+                ", ~{:.0} s left",
+                elapsed * (self.total - done) as f64 / done as f64
+            )
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            std::io::stderr().lock(),
+            "uq-driver: {done}/{} points ({:.0} %), {elapsed:.1} s elapsed{left}",
+            self.total,
+            100.0 * done as f64 / self.total as f64
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_come_at_tenths_after_a_second_and_count_every_point() {
+        let p = Progress::with_interval(ProgressMode::Lines, 95, Duration::from_secs(3600));
+        for _ in 0..50 {
+            p.inc();
+        }
+        let l = p.lines.as_ref().unwrap();
+        assert!(
+            !l.last.lock().unwrap().2,
+            "nothing printed in the first second"
+        );
+        std::thread::sleep(QUIET);
+        for _ in 50..95 {
+            p.inc();
+        }
+        assert_eq!(l.done.load(Ordering::Relaxed), 95);
+        assert_eq!(
+            l.last.lock().unwrap().1,
+            9,
+            "the last tenth printed before the end"
+        );
+        p.finish();
+        assert!(Progress::new(ProgressMode::Lines, 0).lines.is_none());
+        assert!(Progress::new(ProgressMode::Off, 10).lines.is_none());
+    }
+}

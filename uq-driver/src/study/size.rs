@@ -1,0 +1,692 @@
+//! Guards against designs too large to run, checked before anything is allocated or run.
+//!
+//! A study is estimated first ([`Footprint`]): its model runs (from the method, without
+//! building the design), the memory the driver will hold, and the wall time. Then:
+//! - it is **refused** (whatever `--yes` says) when the memory estimate exceeds the memory
+//!   available to the process ([`available_memory`]): it could not be allocated;
+//! - it **needs `--yes`** when it has more than [`MAX_RUNS`] model runs, when the memory
+//!   estimate exceeds [`MEMORY_FRACTION`] of the available memory, or when the time estimate
+//!   exceeds [`MAX_SECONDS`].
+//!
+//! Memory (bytes), with `n` runs, `nt` communication points, `s` stored outputs, `q` scalar
+//! quantities, `g` signals read per step, `d` random parameters, `T` threads:
+//! - the records of every run, held until the analysis: `n (8 (s nt + 2 q) + 64)`;
+//! - the results store read back whole when a study resumes: `n (8 (s nt + 2 q) + 48)`;
+//! - the analysis of one output: its matrix and the estimators' copies, `1.5 × 8 n nt`, and,
+//!   for a method that may build a chaos, its surrogate draws `8 × surrogate_samples × nt`;
+//! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
+//! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
+//! - the time grid (a few copies): `4 × 8 nt`.
+//!
+//! The peak is the design, grid and records plus the larger of the store read and the
+//! analysis (with the worker buffers).
+//!
+//! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
+//! (runs × steps; a smaller study reaches an hour only if one step costs more than 0.36 ms on
+//! one thread, and is not timed). The FMU is run at the parameters' means on short grids: a
+//! warm-up of one communication step, then 1 step (best of 3), then [`PROBE_STEPS`], 4×, 16×,
+//! … steps (best of 2) until a run takes 4 times the one-step run and [`PROBE_MIN_SECONDS`]
+//! more (the steps show above the initialisation and the timer's noise), the whole
+//! experiment or [`PROBE_SECONDS`]; the cost of a run is the cost of the one-step run
+//! plus that of the other steps at the measured rate, and the study takes `n` such
+//! runs on `T` threads (the runner's own work, e.g. writing the store, is not included: the
+//! wheel's runs take about twice the estimate). A `hunting_speed` quantity adds its own runs to
+//! every point: the point then costs as much as its simulated time, the experiment plus
+//! 2 + ⌈log2((high − low)/tolerance)⌉ runs of `duration` ([`Shape::cost_factor`]). An FMU that fails the probe gives no time
+//! estimate (the study then reports the failure itself). With `--isolate` or
+//! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
+//! without a limit).
+
+use std::fmt;
+use std::path::Path;
+use std::time::Instant;
+
+use super::guard::StudyGuard;
+use super::interface::Interface;
+use super::runner::{self, RunOptions};
+use crate::fmu::Instance;
+use crate::qoi::QoiSpec;
+use crate::spec::Study;
+use crate::uq::method::Evaluation;
+
+/// More model runs than this need `--yes`.
+pub const MAX_RUNS: f64 = 100_000.0;
+/// A memory estimate above this fraction of the available memory needs `--yes`.
+pub const MEMORY_FRACTION: f64 = 0.5;
+/// A time estimate above this (s; one hour) needs `--yes`.
+pub const MAX_SECONDS: f64 = 3600.0;
+/// Communication steps of the first timed run of the probe (then 4×, 16×, … as needed).
+pub const PROBE_STEPS: usize = 50;
+/// The probe's runs stop growing once one takes this long (s).
+pub const PROBE_SECONDS: f64 = 1.0;
+/// ... or once the steps of one take this long beyond the one-step run (s).
+pub const PROBE_MIN_SECONDS: f64 = 0.02;
+/// Studies of fewer communication steps in all (runs × steps) are not timed.
+pub const PROBE_MIN_STEPS: f64 = 1e7;
+/// Memory assumed available where the system does not say (bytes; 4 GiB).
+pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Why a study does not start.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SizeError {
+    /// The study needs more memory than there is.
+    #[error(
+        "the study cannot run: {footprint}; it needs more memory than the {limit} available \
+         to this process, so it is refused even with --yes. Use fewer samples, a coarser \
+         communication step, a shorter experiment or fewer outputs{suggest}"
+    )]
+    Refused {
+        /// The estimate.
+        footprint: Box<Footprint>,
+        /// The memory available (formatted).
+        limit: String,
+        /// A hint for many random parameters.
+        suggest: Suggestion,
+    },
+    /// The study is large: it starts only with `--yes`.
+    #[error(
+        "the study is large ({reasons}): {footprint}. Run again with --yes to start it \
+         anyway{suggest}"
+    )]
+    NeedsConfirmation {
+        /// The estimate.
+        footprint: Box<Footprint>,
+        /// What is large.
+        reasons: String,
+        /// A hint for many random parameters.
+        suggest: Suggestion,
+    },
+}
+
+/// The hint that cheaper methods exist.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Suggestion;
+
+impl fmt::Display for Suggestion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            ", or use a method that needs far fewer runs for a smooth response in many random \
+             parameters: `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`"
+        )
+    }
+}
+
+/// The estimated size of a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Footprint {
+    /// Model runs (`None`: only the design knows, see [`check_runs`]).
+    pub runs: Option<f64>,
+    /// Communication points per run.
+    pub time_points: f64,
+    /// Peak memory (bytes), by part.
+    pub memory: Memory,
+    /// Memory available to the process (bytes), and whether the system said so.
+    pub available: (f64, bool),
+    /// Time estimate, if measured.
+    pub time: Option<TimeEstimate>,
+}
+
+/// The memory estimate by part (bytes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Memory {
+    /// The records of every run.
+    pub records: f64,
+    /// The store read back on resume.
+    pub store: f64,
+    /// The analysis of one output, with the workers' buffers.
+    pub analysis: f64,
+    /// The design and its copies.
+    pub design: f64,
+    /// The time grid.
+    pub grid: f64,
+}
+
+impl Memory {
+    /// The peak (bytes).
+    pub fn total(&self) -> f64 {
+        self.design + self.grid + self.records + self.store.max(self.analysis)
+    }
+}
+
+/// The wall-time estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeEstimate {
+    /// One run (s).
+    pub per_run: f64,
+    /// The study (s).
+    pub total: f64,
+    /// Threads it assumes.
+    pub threads: usize,
+}
+
+impl fmt::Display for Footprint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.runs {
+            Some(n) => write!(f, "{} model runs", count(n))?,
+            None => write!(f, "model runs not known before the design")?,
+        }
+        write!(
+            f,
+            " of {} communication points, about {} of memory (records {}, analysis {}, \
+             design {}; {} {})",
+            count(self.time_points),
+            bytes(self.memory.total()),
+            bytes(self.memory.records),
+            bytes(self.memory.analysis),
+            bytes(self.memory.design),
+            bytes(self.available.0),
+            if self.available.1 {
+                "available"
+            } else {
+                "assumed available: the system does not say"
+            }
+        )?;
+        match self.time {
+            Some(t) => write!(
+                f,
+                ", about {} on {} thread{} ({} per run, measured on a short run at the \
+                 parameters' means)",
+                duration(t.total),
+                t.threads,
+                if t.threads == 1 { "" } else { "s" },
+                duration(t.per_run)
+            ),
+            None => write!(f, ", time not estimated"),
+        }
+    }
+}
+
+/// A count, exact below 10^15.
+fn count(n: f64) -> String {
+    if n < 1e15 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.3e}")
+    }
+}
+
+/// Bytes in binary units.
+pub fn bytes(b: f64) -> String {
+    const UNITS: [&str; 7] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    let mut v = b;
+    let mut unit = 0;
+    while v >= 1024.0 && unit + 1 < UNITS.len() {
+        v /= 1024.0;
+        unit += 1;
+    }
+    if unit + 1 == UNITS.len() && v >= 1024.0 {
+        return format!("{b:.3e} B");
+    }
+    format!("{v:.1} {}", UNITS[unit])
+}
+
+/// Seconds in the largest sensible unit.
+pub fn duration(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.0} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.1} ms", s * 1e3)
+    } else if s < 120.0 {
+        format!("{s:.1} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 3.0 * 86400.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else if s < 3.0 * 365.25 * 86400.0 {
+        format!("{:.0} days", s / 86400.0)
+    } else {
+        format!("{:.2e} years", s / (365.25 * 86400.0))
+    }
+}
+
+/// What the estimate needs to know of a study.
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    /// Model runs, if known.
+    pub runs: Option<f64>,
+    /// Communication points per run.
+    pub time_points: f64,
+    /// Stored outputs.
+    pub outputs: usize,
+    /// Scalar quantities.
+    pub quantities: usize,
+    /// Signals read at every step (outputs and the quantities' signals).
+    pub signals: usize,
+    /// Random parameters.
+    pub dim: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// Draws of a chaos surrogate per output (`[analysis] surrogate_samples`; 0 for a method
+    /// that draws from its runs).
+    pub surrogate_samples: usize,
+    /// Simulated time of a point over that of its run: 1, plus the runs of its own of each
+    /// `hunting_speed` quantity.
+    pub cost_factor: f64,
+}
+
+impl Shape {
+    /// The shape of `study` run on `threads` threads.
+    pub fn of(study: &Study, threads: usize) -> Shape {
+        let (runs, chaos) = match study.method().evaluation() {
+            Evaluation::Sampling(m) => {
+                (m.planned_runs(study.parameters.len()), m.draws_from_chaos())
+            }
+            Evaluation::Intrusive(_) => (Some(0.0), true),
+        };
+        let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
+        for s in study.qoi.iter().flat_map(|q| q.signals()) {
+            if !signals.contains(&s) {
+                signals.push(s);
+            }
+        }
+        let e = &study.experiment;
+        let own_runs: f64 = study
+            .qoi
+            .iter()
+            .filter_map(|q| match q {
+                QoiSpec::HuntingSpeed(h) => Some(h.runs_when_found() as f64 * h.duration),
+                _ => None,
+            })
+            .sum();
+        Shape {
+            runs,
+            time_points: ((e.stop - e.start) / e.step).round() + 1.0,
+            outputs: study.outputs.len(),
+            quantities: study.qoi.iter().map(|q| q.quantity_names().len()).sum(),
+            signals: signals.len(),
+            dim: study.parameters.len(),
+            threads: threads.max(1),
+            surrogate_samples: if chaos {
+                study.analysis.surrogate_samples
+            } else {
+                0
+            },
+            cost_factor: 1.0 + own_runs / (e.stop - e.start),
+        }
+    }
+
+    /// The memory estimate for `runs` runs (see the module documentation).
+    pub fn memory(&self, runs: f64) -> Memory {
+        let (n, nt) = (runs, self.time_points);
+        let values = self.outputs as f64 * nt + 2.0 * self.quantities as f64;
+        let draws = if self.outputs > 0 {
+            8.0 * self.surrogate_samples as f64 * nt
+        } else {
+            0.0
+        };
+        Memory {
+            records: n * (8.0 * values + 64.0),
+            store: n * (8.0 * values + 48.0),
+            analysis: 1.5 * 8.0 * n * if self.outputs > 0 { nt } else { 1.0 }
+                + draws
+                + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
+            design: 4.0 * n * (8.0 * self.dim as f64 + 24.0),
+            grid: 4.0 * 8.0 * nt,
+        }
+    }
+}
+
+/// Checks `study` (to be written to `out_dir`) before anything is allocated or run (a suite:
+/// each variant). Opens the FMU to time a short run, unless the points are to run isolated
+/// or under a time limit (`--isolate`, `--timeout-per-run`: the timing run would run the FMU
+/// in-process, without a limit). `Ok` with the estimate when it may start.
+pub fn check(
+    study: &Study,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<Vec<Footprint>, SizeError> {
+    let studies: Vec<&Study> = match &study.suite {
+        Some(s) => s.variants.iter().collect(),
+        None => vec![study],
+    };
+    studies
+        .into_iter()
+        .map(|s| check_one(s, out_dir, opts))
+        .collect()
+}
+
+fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footprint, SizeError> {
+    let threads = opts
+        .threads
+        .unwrap_or_else(rayon::current_num_threads)
+        .max(1);
+    let shape = Shape::of(study, threads);
+    let mut footprint = estimate(&shape, shape.runs);
+    judge(&footprint, true)?;
+    let timed = opts.isolate.is_none() && opts.timeout_per_run.is_none();
+    if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
+        let steps = n * (shape.time_points - 1.0).max(1.0) * shape.cost_factor;
+        if timed && steps >= PROBE_MIN_STEPS {
+            let per_point = probe(study, out_dir).map(|run| run * shape.cost_factor);
+            footprint.time = per_point.map(|per_run| TimeEstimate {
+                per_run,
+                total: per_run * (n / threads as f64).ceil(),
+                threads,
+            });
+        }
+    }
+    judge(&footprint, opts.yes)?;
+    Ok(footprint)
+}
+
+/// Checks a design whose size only the design knew (a method without
+/// [`planned_runs`](crate::uq::method::Sampling::planned_runs)), before it runs.
+pub fn check_runs(study: &Study, runs: usize, opts: &RunOptions) -> Result<Footprint, SizeError> {
+    let threads = opts
+        .threads
+        .unwrap_or_else(rayon::current_num_threads)
+        .max(1);
+    let shape = Shape::of(study, threads);
+    let footprint = estimate(&shape, Some(runs as f64));
+    judge(&footprint, opts.yes)?;
+    Ok(footprint)
+}
+
+/// Checks one deterministic run (`uq-driver simulate`) of `time_points` communication points
+/// recording `series` variables, written as CSV text: refused when it cannot be held in
+/// memory (the series, twice, and about 25 bytes of text per value).
+pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, SizeError> {
+    let values = time_points * (series as f64 + 1.0);
+    let footprint = Footprint {
+        runs: Some(1.0),
+        time_points,
+        memory: Memory {
+            records: 2.0 * 8.0 * values,
+            analysis: 25.0 * values,
+            grid: 4.0 * 8.0 * time_points,
+            ..Memory::default()
+        },
+        available: match available_memory() {
+            Some(b) => (b, true),
+            None => (ASSUMED_MEMORY, false),
+        },
+        time: None,
+    };
+    judge(&footprint, true)?;
+    Ok(footprint)
+}
+
+/// The footprint of `shape` with `runs` runs (none known: the grid and one run's buffers).
+pub fn estimate(shape: &Shape, runs: Option<f64>) -> Footprint {
+    Footprint {
+        runs,
+        time_points: shape.time_points,
+        memory: shape.memory(runs.unwrap_or(1.0)),
+        available: match available_memory() {
+            Some(b) => (b, true),
+            None => (ASSUMED_MEMORY, false),
+        },
+        time: None,
+    }
+}
+
+/// Refuses what cannot be allocated; asks for `--yes` (unless `yes`) for what is large.
+pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
+    let total = f.memory.total();
+    let available = f.available.0;
+    if total.is_nan() || total > available {
+        return Err(SizeError::Refused {
+            footprint: Box::new(f.clone()),
+            limit: bytes(available),
+            suggest: Suggestion,
+        });
+    }
+    if yes {
+        return Ok(());
+    }
+    let mut reasons = Vec::new();
+    if let Some(n) = f.runs.filter(|&n| n > MAX_RUNS) {
+        reasons.push(format!(
+            "{} model runs, more than {}",
+            count(n),
+            count(MAX_RUNS)
+        ));
+    }
+    if total > MEMORY_FRACTION * available {
+        reasons.push(format!(
+            "about {} of memory, more than half of the {} available",
+            bytes(total),
+            bytes(available)
+        ));
+    }
+    if let Some(t) = f.time.filter(|t| t.total > MAX_SECONDS) {
+        reasons.push(format!(
+            "about {}, more than {}",
+            duration(t.total),
+            duration(MAX_SECONDS)
+        ));
+    }
+    if reasons.is_empty() {
+        return Ok(());
+    }
+    Err(SizeError::NeedsConfirmation {
+        footprint: Box::new(f.clone()),
+        reasons: reasons.join("; "),
+        suggest: Suggestion,
+    })
+}
+
+/// The cost of one run of `study` (s), measured on a short run at the parameters' means, or
+/// `None` when the FMU cannot be opened or fails the short run.
+fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
+    // An FMU that calls exit() here is reported as during a study.
+    let study_guard = StudyGuard::begin(&study.name, out_dir, true);
+    let _running = study_guard.running(
+        0,
+        "a short timing run at the parameters' means, before the study".to_owned(),
+    );
+    let fmu = super::single::open_fmu(study).ok()?;
+    let iface = Interface {
+        qois: Vec::new(),
+        ..Interface::resolve(study, &fmu).ok()?
+    };
+    let values: Vec<f64> = study
+        .parameters
+        .iter()
+        .map(|p| p.distribution.mean())
+        .collect();
+    let e = &study.experiment;
+    let steps = ((e.stop - e.start) / e.step).round();
+    let grid = |m: usize| -> Vec<f64> { (0..=m).map(|i| e.start + i as f64 * e.step).collect() };
+    let mut slot: Option<Instance> = None;
+    // The best of a few repeats: other work on the machine only ever adds time.
+    let mut time = |m: usize, repeats: usize| -> Option<f64> {
+        let times = grid(m);
+        let mut best = f64::INFINITY;
+        for _ in 0..repeats {
+            let started = Instant::now();
+            runner::run_point(&fmu, &mut slot, &iface, &values, &times).ok()?;
+            best = best.min(started.elapsed().as_secs_f64());
+        }
+        Some(best)
+    };
+    time(1, 1)?; // warm-up: the instance is created here
+    let one = time(1, 3)?;
+    if steps <= 1.0 {
+        return Some(one);
+    }
+    // Longer runs until the steps show well above the start-up (initialisation may cost as
+    // much as thousands of steps) and above timer noise, at most the whole run or a second.
+    let mut k = (steps as usize).clamp(2, PROBE_STEPS);
+    loop {
+        let many = time(k, 2)?;
+        let clear = many >= 4.0 * one && many - one >= PROBE_MIN_SECONDS;
+        if clear || k as f64 >= steps || many > PROBE_SECONDS {
+            let per_step = ((many - one) / (k - 1) as f64).max(0.0);
+            return Some(one + per_step * (steps - 1.0));
+        }
+        k = (k * 4).min(steps as usize);
+    }
+}
+
+/// Memory available to this process (bytes): the least of the system's available memory
+/// (`MemAvailable` of `/proc/meminfo`), the room left under a cgroup limit
+/// (`memory.max` − `memory.current`, v2; `memory.limit_in_bytes` − `memory.usage_in_bytes`,
+/// v1) and the room left in the address-space limit (`ulimit -v`: `Max address space` of
+/// `/proc/self/limits` − `VmSize` of `/proc/self/status`). `None` where none is known.
+pub fn available_memory() -> Option<f64> {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let number = |s: Option<String>| -> Option<f64> { s?.trim().parse::<f64>().ok() };
+    let kib_field = |text: &str, key: &str| -> Option<f64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        let kib: f64 = line[key.len()..].split_whitespace().next()?.parse().ok()?;
+        Some(kib * 1024.0)
+    };
+    let mut limits = Vec::new();
+    if let Some(m) = read("/proc/meminfo").and_then(|t| kib_field(&t, "MemAvailable:")) {
+        limits.push(m);
+    }
+    for (max, used) in [
+        ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+        (
+            "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+            "/sys/fs/cgroup/memory/memory.usage_in_bytes",
+        ),
+    ] {
+        if let (Some(m), Some(u)) = (number(read(max)), number(read(used))) {
+            // "max" (no limit) does not parse; v1 reports no limit as a huge number.
+            if m < 1e18 {
+                limits.push((m - u).max(0.0));
+            }
+        }
+    }
+    if let Some(text) = read("/proc/self/limits") {
+        let soft = text
+            .lines()
+            .find(|l| l.starts_with("Max address space"))
+            .and_then(|l| l.split_whitespace().nth(3))
+            .and_then(|v| v.parse::<f64>().ok());
+        let size = read("/proc/self/status").and_then(|t| kib_field(&t, "VmSize:"));
+        if let (Some(limit), Some(size)) = (soft, size) {
+            limits.push((limit - size).max(0.0));
+        }
+    }
+    limits.into_iter().reduce(f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wheel_shape(runs: f64) -> Shape {
+        Shape {
+            runs: Some(runs),
+            time_points: 501.0,
+            outputs: 1,
+            quantities: 0,
+            signals: 1,
+            dim: 2,
+            threads: 2,
+            surrogate_samples: 20_000,
+            cost_factor: 1.0,
+        }
+    }
+
+    #[test]
+    fn hunting_speed_runs_count_in_the_cost_of_a_point() {
+        let s = Study::load("builtin:bogie-nominal").unwrap();
+        let shape = Shape::of(&s, 1);
+        // v_cr, v_cr_linear, v_hunt, v_hunt_decay.
+        assert_eq!(shape.quantities, 4);
+        // The 650 s ramp plus 14 runs of 300 s (40–100 m/s to 0.02 m/s).
+        assert_eq!(shape.cost_factor, 1.0 + 14.0 * 300.0 / 650.0);
+        let s = Study::load("builtin:bogie-lhs-500").unwrap();
+        assert_eq!(Shape::of(&s, 1).cost_factor, 1.0);
+    }
+
+    fn footprint(shape: &Shape, available: f64) -> Footprint {
+        Footprint {
+            available: (available, true),
+            ..estimate(shape, shape.runs)
+        }
+    }
+
+    #[test]
+    fn memory_estimate_counts_records_analysis_and_design() {
+        let m = wheel_shape(1000.0).memory(1000.0);
+        // 1000 records of 501 values.
+        assert_eq!(m.records, 1000.0 * (8.0 * 501.0 + 64.0));
+        assert!(m.analysis >= 1.5 * 8.0 * 1000.0 * 501.0 + 8.0 * 20_000.0 * 501.0);
+        assert_eq!(m.design, 4.0 * 1000.0 * (16.0 + 24.0));
+        assert_eq!(m.total(), m.design + m.grid + m.records + m.analysis);
+        // Quantities only (no output): no surrogate draws over time.
+        let q = Shape {
+            outputs: 0,
+            quantities: 2,
+            ..wheel_shape(10.0)
+        };
+        assert!(q.memory(10.0).analysis < 1e7);
+    }
+
+    #[test]
+    fn a_huge_design_is_refused_even_with_yes() {
+        let shape = wheel_shape(1e12);
+        let f = footprint(&shape, 16.0 * GIB);
+        let e = judge(&f, true).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, SizeError::Refused { .. }));
+        assert!(text.contains("1000000000000 model runs"), "{text}");
+        assert!(text.contains("16.0 GiB available"), "{text}");
+        assert!(text.contains("refused even with --yes"), "{text}");
+        assert!(text.contains("sparse_grid") && text.contains("pce_regression"));
+    }
+
+    #[test]
+    fn many_runs_need_yes() {
+        let f = footprint(&wheel_shape(100_001.0), 1e15);
+        let e = judge(&f, false).unwrap_err();
+        assert!(matches!(e, SizeError::NeedsConfirmation { .. }));
+        assert!(e
+            .to_string()
+            .contains("100001 model runs, more than 100000"));
+        assert!(e.to_string().contains("--yes"));
+        assert!(judge(&f, true).is_ok());
+        assert!(judge(&footprint(&wheel_shape(100_000.0), 1e15), false).is_ok());
+    }
+
+    #[test]
+    fn much_memory_or_time_needs_yes() {
+        let shape = wheel_shape(10_000.0);
+        let need = shape.memory(10_000.0).total();
+        let f = footprint(&shape, 1.5 * need);
+        let e = judge(&f, false).unwrap_err().to_string();
+        assert!(e.contains("of memory, more than half"), "{e}");
+        assert!(judge(&f, true).is_ok());
+        let mut f = footprint(&shape, 1e15);
+        f.time = Some(TimeEstimate {
+            per_run: 1.0,
+            total: 5000.0,
+            threads: 2,
+        });
+        let e = judge(&f, false).unwrap_err().to_string();
+        assert!(e.contains("about 83 min, more than 60 min"), "{e}");
+        assert!(e.contains("1.0 s per run"), "{e}");
+    }
+
+    #[test]
+    fn a_nan_estimate_is_refused() {
+        let mut f = footprint(&wheel_shape(1.0), 1e12);
+        f.memory.records = f64::NAN;
+        assert!(matches!(judge(&f, true), Err(SizeError::Refused { .. })));
+    }
+
+    #[test]
+    fn units() {
+        assert_eq!(bytes(512.0), "512.0 B");
+        assert_eq!(bytes(1.5 * GIB), "1.5 GiB");
+        assert!(bytes(1e30).ends_with(" B"));
+        assert_eq!(duration(5400.0), "90 min");
+        assert_eq!(duration(3.0 * 3600.0), "3.0 h");
+        assert!(duration(1e12).ends_with("years"));
+    }
+
+    #[test]
+    fn available_memory_is_positive_where_known() {
+        if let Some(m) = available_memory() {
+            assert!(m > 0.0 && m.is_finite());
+        }
+    }
+}

@@ -1,0 +1,333 @@
+//! Oversized designs (issue 12 item 3, issue 11 item 7): `samples = 1000000000000`,
+//! `step = 1e-12` and `stop = 1e15` with `step = 1` used to end in an out-of-memory abort
+//! (exit 134) and an empty output folder. They must end in a clear refusal with the estimate
+//! and the limit, whatever `--yes` says, before anything is allocated, with the output folder
+//! as it was. A study of more than 100 000 runs starts only with `--yes`.
+
+#[path = "support/wheel.rs"]
+mod wheel;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use wheel::{fmu_dir, wheel_fmu};
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+fn study(dir: &Path, name: &str, experiment: &str, method: &str) -> PathBuf {
+    wheel::write_study(dir, name, name, 42, experiment, method, "")
+}
+
+const WHEEL_GRID: &str = "stop = 5.0\nstep = 0.01";
+
+fn run(args: &[&str]) -> Output {
+    Command::new(DRIVER)
+        .args(args)
+        .env("RAILUQ_FMU_DIR", fmu_dir())
+        .output()
+        .expect("uq-driver runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Every file under `dir` with its bytes, sorted by path.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.clone(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A refusal: exit status 1 (an error, not an abort), a message, no panic.
+fn assert_refused(o: &Output, needles: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "missing '{n}' in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    // A finished study in the folder first: the refusal must leave it as it is.
+    let small = study(
+        dir.path(),
+        "small",
+        WHEEL_GRID,
+        "kind = \"lhs\"\nsamples = 20",
+    );
+    assert!(run(&[
+        "run",
+        small.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let before = snapshot(&out);
+    for method in [
+        "kind = \"lhs\"\nsamples = 1000000000000",
+        "kind = \"mc\"\nsamples = 1000000000000",
+        "kind = \"lhs\"\nsamples = 1000000000\nreplicates = 1000",
+        "kind = \"sobol_sampling\"\nsamples = 1000000000\nbase = \"lhs\"",
+    ] {
+        let huge = study(dir.path(), "huge", WHEEL_GRID, method);
+        for extra in [&[][..], &["--yes"][..], &["--yes", "--fresh"][..]] {
+            let mut args = vec![
+                "run",
+                huge.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            args.extend(extra);
+            let o = run(&args);
+            assert_refused(
+                &o,
+                &[
+                    "model runs",
+                    "of memory",
+                    "available",
+                    "refused even with --yes",
+                    "sparse_grid",
+                    "pce_regression",
+                ],
+            );
+            assert_eq!(snapshot(&out), before, "{method} {extra:?}: folder changed");
+        }
+    }
+    let o = run(&[
+        "run",
+        study(
+            dir.path(),
+            "h",
+            WHEEL_GRID,
+            "kind = \"lhs\"\nsamples = 1000000000000",
+        )
+        .to_str()
+        .unwrap(),
+        "--out",
+        dir.path().join("new").to_str().unwrap(),
+    ]);
+    assert!(stderr(&o).contains("1000000000000 model runs"));
+    assert!(!dir.path().join("new").exists(), "nothing is created");
+    // A quasi-Monte Carlo design beyond 2^32 points per sequence is refused at load time.
+    let qmc = study(
+        dir.path(),
+        "q",
+        WHEEL_GRID,
+        "kind = \"qmc\"\nsamples = 1000000000000",
+    );
+    let o = run(&[
+        "run",
+        qmc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--yes",
+    ]);
+    assert_refused(&o, &["2^32"]);
+    // Planning refuses too.
+    let huge = study(
+        dir.path(),
+        "p",
+        WHEEL_GRID,
+        "kind = \"lhs\"\nsamples = 1000000000000",
+    );
+    let plan = dir.path().join("plan");
+    let o = run(&[
+        "plan",
+        huge.to_str().unwrap(),
+        "--shards",
+        "4",
+        "--out",
+        plan.to_str().unwrap(),
+        "--yes",
+    ]);
+    assert_refused(&o, &["refused even with --yes"]);
+    assert!(!plan.exists());
+}
+
+/// Runs a study of the wheel with the `[experiment]` keys `experiment` and `--yes`: refused,
+/// with `needles` in the message and no output folder. Returns the temporary folder.
+fn refused_grid(experiment: &str, needles: &[&str]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let p = study(
+        dir.path(),
+        "grid",
+        experiment,
+        "kind = \"lhs\"\nsamples = 10",
+    );
+    let out = dir.path().join("out");
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--yes",
+    ]);
+    assert_refused(&o, needles);
+    assert!(!out.exists());
+    dir
+}
+
+#[test]
+fn a_tiny_step_is_refused_before_the_grid_is_allocated() {
+    refused_grid(
+        "stop = 5.0\nstep = 1e-12",
+        &[
+            "5.000e12 communication points",
+            "limit of 1e8",
+            "coarser step",
+        ],
+    );
+}
+
+#[test]
+fn a_huge_stop_is_refused_before_the_grid_is_allocated() {
+    let dir = refused_grid(
+        "stop = 1e15\nstep = 1.0",
+        &["1.000e15 communication points", "limit of 1e8"],
+    );
+    let out = dir.path().join("out");
+    // One run with such a grid (`simulate`) too.
+    let csv = dir.path().join("y.csv");
+    let o = run(&[
+        "simulate",
+        wheel_fmu().to_str().unwrap(),
+        "--stop",
+        "1e15",
+        "--step",
+        "1",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["communication points", "limit of 1e8"]);
+    assert!(!csv.exists());
+    // Under the grid limit but beyond what the whole study could hold: refused by the memory
+    // estimate (2e7 points per run, 2 000 runs: 320 GB of records).
+    let p = study(
+        dir.path(),
+        "long2",
+        "stop = 2e7\nstep = 1.0",
+        "kind = \"lhs\"\nsamples = 2000",
+    );
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--yes",
+    ]);
+    assert_refused(&o, &["2000 model runs", "refused even with --yes"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn more_than_100000_runs_need_yes() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = study(
+        dir.path(),
+        "big",
+        WHEEL_GRID,
+        "kind = \"lhs\"\nsamples = 100001",
+    );
+    let out = dir.path().join("out");
+    let o = run(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_refused(
+        &o,
+        &[
+            "100001 model runs, more than 100000",
+            "--yes",
+            "sparse_grid",
+            "per run, measured",
+        ],
+    );
+    assert!(!out.exists());
+    // With --yes it starts (stopped after a few points here; it would resume).
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--yes",
+        "--max-points",
+        "4",
+    ]);
+    assert!(
+        stderr(&o).contains("stopped after 4 of 100001 points"),
+        "{}",
+        stderr(&o)
+    );
+    // 100 000 runs start without asking (stopped at once here).
+    let p = study(
+        dir.path(),
+        "edge",
+        WHEEL_GRID,
+        "kind = \"qmc\"\nsamples = 12500\nreplicates = 8",
+    );
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        dir.path().join("edge").to_str().unwrap(),
+        "--max-points",
+        "1",
+    ]);
+    assert!(
+        stderr(&o).contains("stopped after 1 of 100000 points"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// A study of fewer than 100 000 runs that takes hours (VehicleTrack over 60 s, about 1.5 s a
+/// run here, 99 000 runs on one thread): timed on a short run, it needs --yes.
+#[test]
+fn a_long_study_needs_yes() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vehicle-track-nominal.toml"),
+    )
+    .unwrap()
+    .replace("kind = \"nominal\"", "kind = \"lhs\"\nsamples = 99000")
+    .replace("stop = 6.0", "stop = 60.0")
+    .replace("variables = [\"Zc_acc\", \"P1\"]", "variables = []");
+    let p = dir.path().join("long.toml");
+    std::fs::write(&p, text).unwrap();
+    let out = dir.path().join("out");
+    let o = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    assert_refused(
+        &o,
+        &[
+            "more than 60 min",
+            "on 1 thread",
+            "per run, measured",
+            "--yes",
+        ],
+    );
+    let err = stderr(&o);
+    assert!(!err.contains("model runs, more than"), "{err}");
+    assert!(!err.contains("of memory, more than"), "{err}");
+    assert!(!out.exists());
+}

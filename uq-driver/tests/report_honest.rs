@@ -1,0 +1,399 @@
+//! Honest reports (issue 15): degenerate studies (one run, zero spread, no exceedance) get no
+//! density and the right words; units from the modelDescription appear on the axes, in
+//! summary.json and in units.csv; every plot file is well-formed SVG (parsed with quick-xml)
+//! or PNG (decoded); `--no-report` writes the data files only; `export --runs` and `compare`
+//! write what they promise.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+fn fmu_dir() -> PathBuf {
+    std::env::var_os("RAILUQ_FMU_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
+}
+
+fn wheel_fmu() -> PathBuf {
+    let p = fmu_dir().join("Wheel.fmu");
+    assert!(
+        p.is_file(),
+        "{} is missing: run `make fmu` first",
+        p.display()
+    );
+    p
+}
+
+fn run(args: &[&str]) -> std::process::Output {
+    Command::new(DRIVER)
+        .args(args)
+        .env("RAILUQ_FMU_DIR", fmu_dir())
+        .output()
+        .expect("uq-driver runs")
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "uq-driver {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
+/// with a limit no run reaches and `q_peak` (largest |q| after 0.5 s).
+fn study(dir: &Path, name: &str, method: &str, parameters: &str) -> PathBuf {
+    let text = format!(
+        r#"name = "{name}"
+fmu = "{fmu}"
+seed = 3
+[experiment]
+start = 0.0
+stop = 2.0
+step = 0.01
+[method]
+{method}
+{parameters}
+[outputs]
+variables = ["q"]
+[[qoi]]
+kind = "final"
+name = "q_end"
+signal = "q"
+limits = [1.0]
+[[qoi]]
+kind = "max_abs"
+name = "q_peak"
+signal = "q"
+from = 0.5
+limits = [10.0]
+"#,
+        fmu = wheel_fmu().display()
+    );
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Every `.svg` of `dir` parses as XML (quick-xml, to the end) with an `<svg>` root, every
+/// `.png` decodes.
+fn plots_are_well_formed(dir: &Path) -> usize {
+    let mut n = 0;
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        match p.extension().and_then(|x| x.to_str()) {
+            Some("svg") => {
+                let text = std::fs::read_to_string(&p).unwrap();
+                let mut reader = quick_xml::Reader::from_str(&text);
+                let mut depth = 0i64;
+                let mut root = None;
+                loop {
+                    match reader.read_event() {
+                        Ok(quick_xml::events::Event::Start(s)) => {
+                            depth += 1;
+                            root.get_or_insert_with(|| s.name().as_ref().to_vec());
+                        }
+                        Ok(quick_xml::events::Event::End(_)) => depth -= 1,
+                        Ok(quick_xml::events::Event::Eof) => break,
+                        Ok(_) => {}
+                        Err(e) => panic!("{}: not well-formed: {e}", p.display()),
+                    }
+                }
+                assert_eq!(depth, 0, "{}: unbalanced elements", p.display());
+                assert_eq!(root.as_deref(), Some(&b"svg"[..]), "{}", p.display());
+                assert!(!text.contains("NaN"), "{}: NaN coordinates", p.display());
+                n += 1;
+            }
+            Some("png") => {
+                let bytes = std::fs::read(&p).unwrap();
+                let mut reader = png::Decoder::new(&bytes[..]).read_info().unwrap();
+                let mut buf = vec![0; reader.output_buffer_size()];
+                let info = reader.next_frame(&mut buf).unwrap();
+                assert!(info.width > 0 && info.height > 0, "{}", p.display());
+                n += 1;
+            }
+            _ => {}
+        }
+    }
+    n
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn a_single_run_has_no_density_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "one-run",
+        "kind = \"nominal\"",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
+    );
+    let out = dir.path().join("out");
+    let stdout = run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(stdout.contains("q_end = "), "{stdout}");
+    assert!(stdout.contains("(every run;"), "{stdout}");
+    for f in [
+        "q_pdf.svg",
+        "q_pdf.png",
+        "q_end_pdf.svg",
+        "q_peak_pdf.svg",
+        "q_sobol.svg",
+    ] {
+        assert!(!out.join(f).exists(), "{f} drawn for a single run");
+    }
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains("there is 1 run: it is deterministic in this study"),
+        "{html}"
+    );
+    assert!(html.contains("no density"));
+    assert!(!html.contains("Some("), "Rust debug text in the page");
+    assert!(!html.contains("Normal {"), "Rust debug text in the page");
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["quantities"]["q_end"]["deterministic"], true);
+    assert_eq!(s["quantities"]["q_end"]["pdf"], serde_json::json!([]));
+    assert_eq!(s["outputs"]["q"]["deterministic"], true);
+    assert!(plots_are_well_formed(&out) >= 1);
+}
+
+#[test]
+fn zero_spread_and_no_exceedance_read_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    // The largest RK4 step h around 1.5 ms always gives 7 substeps per 0.01 s step: every run
+    // computes the same q, bit for bit.
+    let s = study(
+        dir.path(),
+        "zero-spread",
+        "kind = \"lhs\"\nsamples = 20",
+        "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
+    );
+    let out = dir.path().join("out");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(
+        !out.join("q_pdf.svg").exists(),
+        "heat map of a deterministic output"
+    );
+    assert!(!out.join("q_end_pdf.svg").exists());
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains("every one of the 20 runs gives the same value"),
+        "{html}"
+    );
+    assert!(html.contains("q has the same value in every run at every time"));
+    // No run exceeds the limit: a count with its upper bound, not "0 ± 0".
+    assert!(
+        html.contains("0 of 20 runs exceeded 1 (95 % upper bound of P: 0.139)"),
+        "{html}"
+    );
+    assert!(!html.contains("± 0"), "{html}");
+    let s = json(&out.join("summary.json"));
+    let e = &s["quantities"]["q_end"]["exceedance_counts"][0];
+    assert_eq!(
+        (e["exceeded"].as_u64(), e["of"].as_u64()),
+        (Some(0), Some(20))
+    );
+    // 1 - 0.05^(1/20), the exact one-sided binomial bound.
+    assert!((e["upper_95"].as_f64().unwrap() - 0.1391).abs() < 1e-4);
+    plots_are_well_formed(&out);
+}
+
+#[test]
+fn units_reach_axes_summary_and_sidecar() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "units",
+        "kind = \"scm\"\nnodes = 3",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
+    );
+    let out = dir.path().join("out");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["outputs"]["q"]["unit"], "m");
+    assert_eq!(s["quantities"]["q_peak"]["unit"], "m");
+    assert_eq!(s["units"]["K"], "N/m");
+    assert_eq!(s["units"]["C"], "N.s/m");
+    assert_eq!(s["units"]["time"], "s");
+    for k in ["runs_s", "analysis_s", "report_s"] {
+        assert!(s["timing"][k].as_f64().unwrap() >= 0.0, "{k}");
+    }
+    assert_eq!(s["record_layout"]["outputs"], serde_json::json!(["q"]));
+    let units = std::fs::read_to_string(out.join("units.csv")).unwrap();
+    for line in [
+        "q.csv,time,s",
+        "q.csv,mean,m",
+        "q.csv,q99,m",
+        "q_pdf.csv,density,1/m",
+        "q_sobol.csv,S_K,1",
+        "q_peak_samples.csv,q_peak,m",
+        "points.csv,K,N/m",
+    ] {
+        assert!(units.lines().any(|l| l == line), "{line} not in:\n{units}");
+    }
+    let band = std::fs::read_to_string(out.join("q_band.svg")).unwrap();
+    assert!(band.contains("q [m]") && band.contains("time [s]"));
+    let pdf = std::fs::read_to_string(out.join("q_peak_pdf.svg")).unwrap();
+    assert!(pdf.contains("q_peak [m]"));
+    let heat = std::fs::read_to_string(out.join("q_pdf.svg")).unwrap();
+    assert!(heat.contains("PDF of q [1/m]"));
+    // The colour bar starts at 0.
+    assert!(heat.contains(">0</text>"), "colour bar without 0");
+    // Sobol' bars of the scalar quantities, labelled by parameter.
+    let bars = std::fs::read_to_string(out.join("q_peak_sobol.svg")).unwrap();
+    assert!(bars.contains(">K</text>") && bars.contains(">C</text>"));
+    assert!(bars.contains("first order S") && bars.contains("total ST"));
+    // Inputs as written.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains("normal, mean 20.0, std 2.00 (cov 0.100)"),
+        "{html}"
+    );
+    assert!(plots_are_well_formed(&out) >= 6);
+}
+
+#[test]
+fn no_report_export_and_compare() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "lhs",
+        "kind = \"lhs\"\nsamples = 30",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
+    );
+    let a = dir.path().join("a");
+    run_ok(&[
+        "run",
+        s.to_str().unwrap(),
+        "--out",
+        a.to_str().unwrap(),
+        "--no-report",
+    ]);
+    assert!(a.join("q.csv").exists() && a.join("summary.json").exists());
+    assert!(!a.join("index.html").exists() && !a.join("q_band.svg").exists());
+    run_ok(&["export", a.to_str().unwrap(), "--runs"]);
+    let csv = std::fs::read_to_string(a.join("runs/runs.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("run,time,q"));
+    assert_eq!(lines.count(), 30 * 201);
+    let npz = std::fs::File::open(a.join("runs/runs.npz")).unwrap();
+    let mut z = zip::ZipArchive::new(npz).unwrap();
+    let names: Vec<String> = (0..z.len())
+        .map(|i| z.by_index(i).unwrap().name().to_owned())
+        .collect();
+    for n in ["time.npy", "run.npy", "q.npy", "K.npy"] {
+        assert!(names.iter().any(|x| x == n), "{n} not in {names:?}");
+    }
+    let mut q = Vec::new();
+    std::io::Read::read_to_end(&mut z.by_name("q.npy").unwrap(), &mut q).unwrap();
+    let hlen = u16::from_le_bytes([q[8], q[9]]) as usize;
+    assert!(std::str::from_utf8(&q[10..10 + hlen])
+        .unwrap()
+        .contains("'shape': (30, 201)"));
+    assert_eq!(q.len(), 10 + hlen + 8 * 30 * 201);
+    // The first value of the first run is q(0) = q0 = 0.1 m, as in runs.csv.
+    let first = f64::from_le_bytes(q[10 + hlen..10 + hlen + 8].try_into().unwrap());
+    assert_eq!(first, 0.1);
+
+    let b = dir.path().join("b");
+    run_ok(&["run", s.to_str().unwrap(), "--out", b.to_str().unwrap()]);
+    let page = dir.path().join("page");
+    run_ok(&[
+        "compare",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        page.to_str().unwrap(),
+    ]);
+    let html = std::fs::read_to_string(page.join("index.html")).unwrap();
+    assert!(html.contains("href=\"../b/index.html\""), "{html}");
+    assert!(html.contains("Quantity q_end"));
+    plots_are_well_formed(&page);
+}
+
+#[test]
+fn names_are_forgiven_or_suggested() {
+    // A built-in without the prefix; a misspelt one gets the closest.
+    let out = run(&["show", "wheel-scm"]);
+    assert!(out.status.success());
+    let out = run(&["run", "wheel-sgn", "--out", "/nonexistent/x"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("did you mean the built-in study wheel-sgm?"),
+        "{err}"
+    );
+    // A misspelt key and a misspelt variable.
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "typo",
+        "kind = \"scm\"\nnodse = 3",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
+    );
+    let out = run(&["run", s.to_str().unwrap(), "--out", "/nonexistent/x"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("hint: did you mean `nodes`?"), "{err}");
+    let s = study(
+        dir.path(),
+        "var",
+        "kind = \"scm\"\nnodes = 2",
+        "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0",
+    );
+    let out = run(&[
+        "run",
+        s.to_str().unwrap(),
+        "--out",
+        dir.path().join("v").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("'Kk': did you mean 'K'?"), "{err}");
+    // cov = 15 is most likely 15 %.
+    let s = study(
+        dir.path(),
+        "cov",
+        "kind = \"scm\"\nnodes = 2",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15",
+    );
+    let out = run(&[
+        "run",
+        s.to_str().unwrap(),
+        "--out",
+        dir.path().join("c").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("did you mean cov = 0.15?"), "{err}");
+}
+
+#[test]
+fn a_missing_fmu_lists_every_place_searched() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("s.toml");
+    std::fs::write(
+        &p,
+        "name = \"s\"\nfmu = \"Nowhere.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+         [method]\nkind = \"scm\"\nnodes = 2\n[[parameters]]\nname = \"K\"\nmean = 1.0\nstd = 0.1\n\
+         [outputs]\nvariables = [\"q\"]\n",
+    )
+    .unwrap();
+    let out = run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--out",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("FMU Nowhere.fmu not found; looked in:"),
+        "{err}"
+    );
+    assert!(err.contains(&dir.path().join("Nowhere.fmu").display().to_string()));
+    assert!(err.contains("share/railuq/fmu/Nowhere.fmu"), "{err}");
+    assert!(err.contains(&fmu_dir().join("Nowhere.fmu").display().to_string()));
+}

@@ -1,0 +1,434 @@
+//! Quasi-Monte Carlo, replicated Latin hypercubes and Sobol' indices, run through uq-driver on
+//! FMUs (issue 11 items 3, 4 and 8), against references computed here: the wheel's closed form
+//! on a Gauss–Hermite grid (`support/wheel.rs`), the closed-form indices of the Ishigami and
+//! g-functions on the C test FMU `Functions` (`support/test_fmus.rs`).
+
+#[path = "support/benchmarks.rs"]
+mod benchmarks;
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+#[path = "support/wheel.rs"]
+mod wheel;
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use wheel::{read_csv, reference, reference_sobol};
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
+
+fn run_ok(args: &[&str]) {
+    let out = Command::new(DRIVER)
+        .args(args)
+        .env("RAILUQ_FMU_DIR", wheel::fmu_dir())
+        .output()
+        .expect("uq-driver runs");
+    assert!(
+        out.status.success(),
+        "uq-driver {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// A wheel study (stop 5 s, step 0.01 s, output q) with `method`, seed `seed` and `extra`.
+fn wheel_study(dir: &Path, name: &str, seed: u64, method: &str, extra: &str) -> PathBuf {
+    let file = format!("{name}-{seed}");
+    wheel::write_study(dir, &file, name, seed, wheel::EXPERIMENT, method, extra)
+}
+
+/// (mean − reference) / standard error of the mean at each of TIMES, for `method` and `seed`.
+fn z_scores(dir: &Path, tag: &str, method: &str, seed: u64) -> Vec<f64> {
+    let study = wheel_study(dir, tag, seed, method, "");
+    let out = dir.join(format!("{tag}-{seed}"));
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let csv = read_csv(&out.join("q.csv"));
+    TIMES
+        .iter()
+        .map(|&t| (csv.at(t, "mean") - reference(t).0) / csv.at(t, "std_error_mean"))
+        .collect()
+}
+
+fn mean_square(z: &[f64]) -> f64 {
+    z.iter().map(|x| x * x).sum::<f64>() / z.len() as f64
+}
+
+/// Over 5 seeds and 5 times, a standard error that is honest gives errors of about one
+/// standard error (a mean square of the ratios near 1: the replicate means have 7 degrees of
+/// freedom, so near 7/5), never many; one that overstates the error k times gives a mean
+/// square near 1/k².
+#[test]
+fn qmc_meets_the_wheel_reference_within_its_standard_error_and_the_error_is_honest() {
+    let dir = tempfile::tempdir().unwrap();
+    let qmc: Vec<f64> = (1..=5)
+        .flat_map(|s| {
+            z_scores(
+                dir.path(),
+                "qmc",
+                "kind = \"qmc\"\nsamples = 256\nreplicates = 8",
+                s,
+            )
+        })
+        .collect();
+    let lhs_rep: Vec<f64> = (1..=5)
+        .flat_map(|s| {
+            z_scores(
+                dir.path(),
+                "lhs-rep",
+                "kind = \"lhs\"\nsamples = 256\nreplicates = 8",
+                s,
+            )
+        })
+        .collect();
+    let lhs_plain: Vec<f64> = (1..=5)
+        .flat_map(|s| z_scores(dir.path(), "lhs", "kind = \"lhs\"\nsamples = 2048", s))
+        .collect();
+    eprintln!(
+        "mean square of error / SE: qmc {:.3}, replicated lhs {:.3}, plain lhs {:.5}",
+        mean_square(&qmc),
+        mean_square(&lhs_rep),
+        mean_square(&lhs_plain)
+    );
+    for (name, z) in [("qmc", &qmc), ("replicated lhs", &lhs_rep)] {
+        let worst = z.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(
+            worst < 5.0,
+            "{name}: an error of {worst:.2} standard errors"
+        );
+        let ms = mean_square(z);
+        assert!(
+            (0.2..5.0).contains(&ms),
+            "{name}: mean square ratio {ms:.3}"
+        );
+    }
+    // The Monte Carlo formula on a Latin hypercube of the same 2048 runs is an upper bound,
+    // far too pessimistic here (measured: a mean square of 0.013, the errors about 1/9 of
+    // that "standard error" in the root mean square).
+    let ms = mean_square(&lhs_plain);
+    assert!(ms < 0.1, "plain LHS: mean square ratio {ms:.4}");
+}
+
+#[test]
+fn builtin_wheel_qmc_meets_the_reference_within_4_standard_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("qmc");
+    run_ok(&["run", "builtin:wheel-qmc", "--out", out.to_str().unwrap()]);
+    let csv = read_csv(&out.join("q.csv"));
+    for t in TIMES {
+        let (m, s) = reference(t);
+        let se = csv.at(t, "std_error_mean");
+        let dm = csv.at(t, "mean") - m;
+        assert!(
+            dm.abs() < 4.0 * se,
+            "t = {t}: mean off by {dm:e}, SE {se:e}"
+        );
+        // 8192 runs: far below the Monte Carlo error.
+        assert!(se < 0.1 * s / 8192f64.sqrt(), "t = {t}: SE {se:e}");
+        assert!((csv.at(t, "std") / s - 1.0).abs() < 0.01, "t = {t}: std");
+    }
+    let s = summary(&out);
+    assert_eq!(s["model_runs"], 8192);
+    assert_eq!(s["method"]["kind"], "qmc");
+    assert_eq!(s["method"]["replicates"], 8);
+    assert!(s["method"]["standard_error"]
+        .as_str()
+        .unwrap()
+        .starts_with("replicates"));
+}
+
+#[test]
+fn qmc_and_sobol_sampling_do_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, method, files) in [
+        (
+            "qmc",
+            "kind = \"qmc\"\nsamples = 64\nreplicates = 4",
+            &["q.csv", "q_pdf.csv", "points.csv"][..],
+        ),
+        (
+            "sobol",
+            "kind = \"sobol_sampling\"\nsamples = 128",
+            &["q.csv", "q_sobol.csv", "points.csv"][..],
+        ),
+    ] {
+        let study = wheel_study(dir.path(), name, 3, method, "");
+        let (a, b) = (
+            dir.path().join(format!("{name}-1")),
+            dir.path().join(format!("{name}-2")),
+        );
+        for (out, threads) in [(&a, "1"), (&b, "2")] {
+            run_ok(&[
+                "run",
+                study.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                threads,
+            ]);
+        }
+        for f in files {
+            assert_eq!(
+                std::fs::read(a.join(f)).unwrap(),
+                std::fs::read(b.join(f)).unwrap(),
+                "{name}: {f}"
+            );
+        }
+    }
+}
+
+/// A quasi-Monte Carlo study split into shards gives the files of the unsplit study.
+#[test]
+fn a_sharded_qmc_study_gives_the_files_of_the_whole_study() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = wheel_study(
+        dir.path(),
+        "shq",
+        9,
+        "kind = \"qmc\"\nsamples = 32\nreplicates = 4",
+        "",
+    );
+    let whole = dir.path().join("whole");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    let plan = dir.path().join("plan");
+    let result = dir.path().join("result");
+    run_ok(&[
+        "plan",
+        study.to_str().unwrap(),
+        "--shards",
+        "3",
+        "--out",
+        plan.to_str().unwrap(),
+    ]);
+    for k in ["0", "1", "2"] {
+        run_ok(&["run-shard", plan.to_str().unwrap(), "--shard", k]);
+    }
+    run_ok(&[
+        "merge",
+        plan.to_str().unwrap(),
+        "--out",
+        result.to_str().unwrap(),
+    ]);
+    for f in ["q.csv", "q_pdf.csv", "points.csv"] {
+        assert_eq!(
+            std::fs::read(whole.join(f)).unwrap(),
+            std::fs::read(result.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+}
+
+/// The Sobol' indices of the wheel by pick-freeze sampling (the built-in study) against the
+/// indices of the closed form on the Gauss–Hermite grid.
+#[test]
+fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s");
+    run_ok(&[
+        "run",
+        "builtin:wheel-sobol-sampling",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let csv = read_csv(&out.join("q_sobol.csv"));
+    let mut covered = 0;
+    for t in TIMES {
+        let (s, st) = reference_sobol(t);
+        for (j, p) in ["K", "C"].iter().enumerate() {
+            for (col, exact) in [(format!("S_{p}"), s[j]), (format!("ST_{p}"), st[j])] {
+                let (v, lo, hi) = (
+                    csv.at(t, &col),
+                    csv.at(t, &format!("{col}_lo")),
+                    csv.at(t, &format!("{col}_hi")),
+                );
+                assert!((v - exact).abs() < 0.03, "t = {t} {col}: {v} vs {exact}");
+                assert!(lo <= v && v <= hi, "t = {t} {col}: [{lo}, {hi}]");
+                covered += usize::from(lo <= exact && exact <= hi);
+            }
+        }
+    }
+    assert!(
+        covered >= 18,
+        "{covered} of 20 intervals cover the reference"
+    );
+    // At t = 0 every run starts at q0: no variance, indices 0.
+    assert_eq!(csv.at(0.0, "S_K"), 0.0);
+    let s = summary(&out);
+    assert_eq!(s["model_runs"], 2048 * 4);
+    let q = &s["quantities"]["q_max_late"]["sobol"];
+    for key in ["first", "total", "first_ci", "total_ci"] {
+        assert!(
+            q[key]["K"].is_number() || q[key]["K"].is_array(),
+            "{key}: {q}"
+        );
+        assert!(!q[key]["C"].is_null(), "{key}: {q}");
+    }
+    assert_eq!(q["ci_level"], 0.95);
+}
+
+/// SCM's indices of a scalar quantity in summary.json, labelled by parameter name, against
+/// the closed form on the Gauss–Hermite grid.
+#[test]
+fn scm_sobol_indices_of_a_quantity_are_labelled_by_parameter_name() {
+    let dir = tempfile::tempdir().unwrap();
+    // The wheel over 0..1 s, with q(1) as a scalar quantity.
+    let study = wheel_study(
+        dir.path(),
+        "scm",
+        42,
+        "kind = \"scm\"\nnodes = 6\norder = 5",
+        "[[qoi]]\nkind = \"final\"\nname = \"q_at_1\"\nsignal = \"q\"\n",
+    );
+    let text = std::fs::read_to_string(&study).unwrap();
+    std::fs::write(&study, text.replace("stop = 5.0", "stop = 1.0")).unwrap();
+    let out = dir.path().join("scm");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let s = summary(&out);
+    let q = &s["quantities"]["q_at_1"];
+    let (first, total) = reference_sobol(1.0);
+    for (j, p) in ["K", "C"].iter().enumerate() {
+        let f = q["sobol"]["first"][p].as_f64().unwrap();
+        let t = q["sobol"]["total"][p].as_f64().unwrap();
+        // Measured: 1e-11 apart (the order-5 chaos of the 6 x 6 grid is that accurate at 1 s).
+        assert!((f - first[j]).abs() < 1e-8, "S_{p} = {f} vs {}", first[j]);
+        assert!((t - total[j]).abs() < 1e-8, "ST_{p} = {t} vs {}", total[j]);
+        // The arrays of before, in parameter order, hold the same numbers.
+        assert_eq!(q["sobol_first"][j].as_f64().unwrap(), f);
+    }
+    assert!(
+        q["sobol"].get("first_ci").is_none(),
+        "no intervals for a chaos"
+    );
+    // Over time too (q_sobol.csv, as before).
+    let csv = read_csv(&out.join("q_sobol.csv"));
+    assert!((csv.at(1.0, "S_K") - first[0]).abs() < 1e-8);
+}
+
+/// The Functions test FMU with `function` and uniform inputs `x1..xd` on `[low, high]`, Sobol'
+/// sampling of `samples` base points; output `y` over time and the quantity `y_end`.
+fn functions_study(
+    dir: &Path,
+    fmu: &Path,
+    function: u32,
+    d: usize,
+    low: f64,
+    high: f64,
+    samples: usize,
+) -> PathBuf {
+    let mut text = format!(
+        r#"name = "f{function}"
+fmu = "{fmu}"
+seed = 5
+[experiment]
+stop = 0.2
+step = 0.1
+[method]
+kind = "sobol_sampling"
+samples = {samples}
+[fixed]
+function = {function}
+[outputs]
+variables = ["y"]
+[[qoi]]
+kind = "final"
+name = "y_end"
+signal = "y"
+"#,
+        fmu = fmu.display()
+    );
+    for i in 1..=d {
+        text.push_str(&format!(
+            "[[parameters]]\nname = \"x{i}\"\ndistribution = \"uniform\"\nlow = {low}\nhigh = {high}\n"
+        ));
+    }
+    let p = dir.join(format!("f{function}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, 8192);
+    let out = dir.path().join("ishigami");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (s, st) = benchmarks::ishigami_indices();
+    assert!((s[0] - 0.3139).abs() < 1e-4 && (st[2] - 0.2437).abs() < 1e-4);
+    let q = &summary(&out)["quantities"]["y_end"]["sobol"];
+    let mut covered = 0;
+    for i in 0..3 {
+        let p = format!("x{}", i + 1);
+        for (kind, exact) in [("first", s[i]), ("total", st[i])] {
+            let v = q[kind][&p].as_f64().unwrap();
+            let ci = &q[format!("{kind}_ci")][&p];
+            let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+            // Measured: within 0.002 of the closed form.
+            assert!((v - exact).abs() < 0.01, "{kind} {p}: {v} vs {exact}");
+            assert!(hi - lo < 0.1, "{kind} {p}: [{lo}, {hi}]");
+            covered += usize::from(lo <= exact && exact <= hi);
+        }
+    }
+    assert!(
+        covered >= 5,
+        "{covered} of 6 intervals cover the exact indices"
+    );
+    // Over time, y is constant after initialization: the same indices at every time.
+    let csv = read_csv(&out.join("y_sobol.csv"));
+    assert_eq!(csv.at(0.1, "S_x1"), q["first"]["x1"].as_f64().unwrap());
+    assert!(csv.header.contains(&"ST_x3_hi".to_string()));
+}
+
+#[test]
+fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let study = functions_study(dir.path(), &fmu, 3, 8, 0.0, 1.0, 4096);
+    let out = dir.path().join("g");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // g = prod (|4 x_i − 2| + a_i) / (1 + a_i): closed-form indices.
+    let (first, total) = benchmarks::g_function_indices();
+    let q = &summary(&out)["quantities"]["y_end"]["sobol"];
+    for i in 0..8 {
+        let p = format!("x{}", i + 1);
+        let f = q["first"][&p].as_f64().unwrap();
+        let t = q["total"][&p].as_f64().unwrap();
+        // Measured: within 0.0013 of the closed form.
+        assert!((f - first[i]).abs() < 0.005, "S_{p}: {f} vs {}", first[i]);
+        assert!((t - total[i]).abs() < 0.005, "ST_{p}: {t} vs {}", total[i]);
+    }
+    assert_eq!(summary(&out)["model_runs"], 4096 * 10);
+}
