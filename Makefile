@@ -138,6 +138,7 @@ bench: build fmu venv $(VENV)/.bench-requirements
 paper: build fmu
 	$(DRIVER) run builtin:paper-wheel --out out/paper-wheel
 	$(DRIVER) run builtin:paper-vehicle-track --out out/paper-vehicle-track
+	$(DRIVER) run builtin:paper-vehicle-track-tracks --out out/paper-vehicle-track-tracks
 	$(DRIVER) run builtin:vehicle-track-defect --out out/vehicle-track-defect
 	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
 	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
