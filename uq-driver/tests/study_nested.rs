@@ -70,7 +70,10 @@ fn inner_exceedance(c: f64) -> f64 {
 }
 
 fn run(args: &[&str]) -> Output {
-    let o = Command::new(DRIVER).args(args).output().expect("uq-driver runs");
+    let o = Command::new(DRIVER)
+        .args(args)
+        .output()
+        .expect("uq-driver runs");
     assert!(
         o.status.success(),
         "uq-driver {args:?} failed:\n{}",
@@ -186,12 +189,21 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     assert!((inner + outer - 1.0).abs() < 1e-12);
     assert!((inner - f_inner).abs() < 0.02, "inner {inner} vs {f_inner}");
     assert!((outer - f_outer).abs() < 0.02, "outer {outer} vs {f_outer}");
-    assert!(inner_ci[0] <= f_inner && f_inner <= inner_ci[1], "{inner_ci:?}");
-    assert!(outer_ci[0] <= f_outer && f_outer <= outer_ci[1], "{outer_ci:?}");
+    assert!(
+        inner_ci[0] <= f_inner && f_inner <= inner_ci[1],
+        "{inner_ci:?}"
+    );
+    assert!(
+        outer_ci[0] <= f_outer && f_outer <= outer_ci[1],
+        "{outer_ci:?}"
+    );
     // The marginal moments with their intervals.
     let std_exact = (var_inner + var_outer).sqrt();
     let std_ci = pair(&q["std_ci"]);
-    assert!(std_ci[0] <= std_exact && std_exact <= std_ci[1], "{std_ci:?}");
+    assert!(
+        std_ci[0] <= std_exact && std_exact <= std_ci[1],
+        "{std_ci:?}"
+    );
     let mean_ci = pair(&q["mean_ci"]);
     assert!(mean_ci[0] <= 1.0 + h_mean && 1.0 + h_mean <= mean_ci[1]);
     // The marginal P(y > 3): the mean of the conditional probabilities.
@@ -307,7 +319,12 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
 
     for other in [&resumed, &merged] {
         for f in files {
-            assert_eq!(read(&whole, f), read(other, f), "{f} in {}", other.display());
+            assert_eq!(
+                read(&whole, f),
+                read(other, f),
+                "{f} in {}",
+                other.display()
+            );
         }
         assert_eq!(split(&whole), split(other));
     }

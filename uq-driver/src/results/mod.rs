@@ -10,7 +10,10 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-pub use nested::{ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit, VarianceSplit};
+pub use nested::{
+    ConditionalChaos, ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit,
+    VarianceSplit,
+};
 
 use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;

@@ -96,8 +96,12 @@ pub struct ConditionalTable {
     /// First-order Sobol' indices of the inner parameters per row, if the inner method has them.
     pub sobol_first: Option<Vec<Vec<f64>>>,
     /// The conditional chaos: its multi-indices and the coefficients of each row.
-    pub chaos: Option<(Vec<Vec<usize>>, Vec<Vec<f64>>)>,
+    pub chaos: Option<ConditionalChaos>,
 }
+
+/// The conditional chaos of a quantity: its multi-indices (one per term, shared by every
+/// outer sample) and the coefficients of each outer sample.
+pub type ConditionalChaos = (Vec<Vec<usize>>, Vec<Vec<f64>>);
 
 /// The split of an output over time.
 #[derive(Clone, Debug, PartialEq)]

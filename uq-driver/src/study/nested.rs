@@ -85,28 +85,8 @@ pub fn analyse(
     };
     for (o, name) in study.outputs.iter().enumerate() {
         let data = runs.output(o, nt);
-        let fail = |source| AnalysisError::Output {
-            name: name.clone(),
-            source,
-        };
-        let cond = method
-            .conditional(&blocks, &runs.rows, &data)
-            .map_err(fail)?;
-        let estimate = marginal(&cond, nt).map_err(fail)?;
-        let splits: Vec<Split> = (0..nt).map(|j| Split::all(&cond.column(j))).collect();
-        let pooled = pooled_series(&cond, &data, &settings, nt);
-        let mut stats: OutputStats =
-            output_stats(name, &times, &estimate, Some(&pooled), &settings)?;
-        stats.draws = draws_of(&cond);
-        out.splits.push(OutputSplit {
-            name: name.clone(),
-            times: times.clone(),
-            mean: stats.mean.clone(),
-            std: stats.std.clone(),
-            var_inner: splits.iter().map(|s| s.var_inner).collect(),
-            var_outer: splits.iter().map(|s| s.var_outer).collect(),
-            outer_samples: cond.present().len(),
-        });
+        let (stats, split) = output(method, &blocks, name, &times, &runs.rows, &data, &settings)?;
+        out.splits.push(split);
         out.analysed.outputs.push(stats);
     }
     let base = study.outputs.len() * nt;
@@ -129,6 +109,40 @@ pub fn analyse(
         out.analysed.quantities.push(stats);
     }
     Ok(out)
+}
+
+/// The marginal statistics of output `name` (its runs `data`, design rows `rows`) and its
+/// split over time.
+fn output(
+    method: &Nested,
+    blocks: &Blocks,
+    name: &str,
+    times: &[f64],
+    rows: &[usize],
+    data: &DMatrix<f64>,
+    settings: &Settings,
+) -> Result<(OutputStats, OutputSplit), AnalysisError> {
+    let nt = data.ncols();
+    let fail = |source| AnalysisError::Output {
+        name: name.to_owned(),
+        source,
+    };
+    let cond = method.conditional(blocks, rows, data).map_err(fail)?;
+    let estimate = marginal(&cond, nt).map_err(fail)?;
+    let splits: Vec<Split> = (0..nt).map(|j| Split::all(&cond.column(j))).collect();
+    let pooled = pooled_series(&cond, data, settings, nt);
+    let mut stats: OutputStats = output_stats(name, times, &estimate, Some(&pooled), settings)?;
+    stats.draws = draws_of(&cond);
+    let split = OutputSplit {
+        name: name.to_owned(),
+        times: times.to_vec(),
+        mean: stats.mean.clone(),
+        std: stats.std.clone(),
+        var_inner: splits.iter().map(|s| s.var_inner).collect(),
+        var_outer: splits.iter().map(|s| s.var_outer).collect(),
+        outer_samples: cond.present().len(),
+    };
+    Ok((stats, split))
 }
 
 /// Where the densities of the conditional estimates come from.
@@ -263,8 +277,45 @@ fn quantity(
             (l, m, (var / n).sqrt())
         })
         .collect();
+    let parts = Parts {
+        split: &s,
+        ci: &ci,
+        limits: &limits,
+        exceedance: &exceedance,
+    };
+    stats.nested = Some(nested_scalar(name, parts, table));
+    let warning = (s.var_outer < 0.0).then(|| {
+        format!(
+            "{}: the estimated variance between outer samples, {:.3e}, is below the inner \
+             sampling error it is corrected for ({:.3e}); the outer share is counted as 0 \
+             (more inner runs or outer samples would resolve it)",
+            name, s.var_outer_plugin, s.correction
+        )
+    });
+    Ok((stats, warning))
+}
+
+/// The split of a quantity with its intervals and the conditional exceedance probabilities
+/// (`exceedance[l][k]`: limit `l`, outer sample `k`).
+struct Parts<'a> {
+    split: &'a Split,
+    ci: &'a split::Intervals,
+    limits: &'a [f64],
+    exceedance: &'a [Vec<f64>],
+}
+
+/// What a nested study adds to the statistics of quantity `name`.
+fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedScalar {
+    let outer = table.mean.len();
+    let Parts {
+        split: s,
+        ci,
+        limits,
+        exceedance,
+    } = parts;
+    let n = exceedance.first().map_or(0, Vec::len);
     let (fi, fo) = s.fractions();
-    stats.nested = Some(NestedScalar {
+    NestedScalar {
         variance_split: VarianceSplit {
             inner: fi,
             outer: fo,
@@ -279,14 +330,14 @@ fn quantity(
         std_ci: ci.std,
         exceedance_ci: exceedance
             .iter()
-            .zip(&limits)
+            .zip(limits)
             .zip(&ci.exceedance)
             .map(|((p, &limit), &ci)| {
                 let mut sorted = p.clone();
                 sorted.sort_by(f64::total_cmp);
                 ExceedanceInterval {
                     limit,
-                    p: p.iter().sum::<f64>() / n,
+                    p: p.iter().sum::<f64>() / n as f64,
                     ci,
                     conditional_min: sorted[0],
                     conditional_median: moments::quantile(&sorted, 0.5),
@@ -297,22 +348,13 @@ fn quantity(
         intervals: format!(
             "{} % percentile bootstrap over the {} outer samples ({} resamples)",
             split::LEVEL * 100.0,
-            present.len(),
+            outer,
             split::RESAMPLES
         ),
-        outer_samples: present.len(),
+        outer_samples: outer,
         conditional_csv: format!("{name}_conditional.csv"),
         conditional: table,
-    });
-    let warning = (s.var_outer < 0.0).then(|| {
-        format!(
-            "{}: the estimated variance between outer samples, {:.3e}, is below the inner \
-             sampling error it is corrected for ({:.3e}); the outer share is counted as 0 \
-             (more inner runs or outer samples would resolve it)",
-            name, s.var_outer_plugin, s.correction
-        )
-    });
-    Ok((stats, warning))
+    }
 }
 
 /// One row per outer sample with an estimate.

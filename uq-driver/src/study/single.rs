@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use super::analysis;
+use super::analysis::{self, Analysed, AnalysisError};
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
@@ -14,8 +14,8 @@ use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
 use crate::results::{
-    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout, ScalarStats,
-    Summary, Timing, Versions,
+    FmuInfo, OutputSplit, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout,
+    ScalarStats, Summary, Timing, Versions,
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
@@ -140,17 +140,7 @@ pub(crate) fn finish(
         });
     }
     let started = Instant::now();
-    let (analysed, splits, mut warnings) = match &study.method {
-        MethodSpec::Nested(nested) => {
-            let n = super::nested::analyse(study, nested, design, &outcome.records)?;
-            (n.analysed, n.splits, n.warnings)
-        }
-        _ => (
-            analysis::analyse_runs(study, method, design, &outcome.records)?,
-            Vec::new(),
-            Vec::new(),
-        ),
-    };
+    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.records)?;
     let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
@@ -210,6 +200,27 @@ pub(crate) fn finish(
         summary,
         outputs,
         quantities,
+    })
+}
+
+/// The statistics of every output and quantity; a nested study adds the split of each output
+/// over time and its notes.
+fn analyse(
+    study: &Study,
+    method: &dyn Sampling,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
+    Ok(match &study.method {
+        MethodSpec::Nested(nested) => {
+            let n = super::nested::analyse(study, nested, design, records)?;
+            (n.analysed, n.splits, n.warnings)
+        }
+        _ => (
+            analysis::analyse_runs(study, method, design, records)?,
+            Vec::new(),
+            Vec::new(),
+        ),
     })
 }
 

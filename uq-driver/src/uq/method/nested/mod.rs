@@ -232,7 +232,7 @@ impl Nested {
     pub fn blocks(&self, design: &Design) -> Result<Blocks, MethodError> {
         let levels = self.levels(&design.inputs)?;
         let n_outer = self.outer_len(&levels)?;
-        if n_outer == 0 || design.len() % n_outer != 0 {
+        if n_outer == 0 || !design.len().is_multiple_of(n_outer) {
             return Err(InvalidSettings(format!(
                 "a nested design of {} points cannot hold {n_outer} outer samples",
                 design.len()

@@ -48,8 +48,8 @@ fn the_design_is_the_product_of_the_outer_design_and_one_inner_design_per_outer_
     let design = n.design(&inputs(), 7).unwrap();
     assert_eq!(design.len(), 20);
     assert!(design.weights.is_none());
-    let outer = Mc_design(5, 7);
-    for k in 0..5 {
+    let outer = mc_design(5, 7);
+    for (k, &u) in outer.iter().enumerate() {
         let inner = crate::uq::method::mc::Mc { samples: 4 }
             .design(
                 &RandomInputs::independent(vec![inputs()[0].clone(), inputs()[2].clone()]),
@@ -58,7 +58,7 @@ fn the_design_is_the_product_of_the_outer_design_and_one_inner_design_per_outer_
             .unwrap();
         for i in 0..4 {
             let v = &design.values[k * 4 + i];
-            assert_eq!(v[1], outer[k], "outer value of point {k},{i}");
+            assert_eq!(v[1], u, "outer value of point {k},{i}");
             assert_eq!([v[0], v[2]], [inner.values[i][0], inner.values[i][1]]);
         }
     }
@@ -73,8 +73,7 @@ fn the_design_is_the_product_of_the_outer_design_and_one_inner_design_per_outer_
 }
 
 /// The outer values an `mc` design of `u` alone gives with `seed`.
-#[allow(non_snake_case)]
-fn Mc_design(samples: usize, seed: u64) -> Vec<f64> {
+fn mc_design(samples: usize, seed: u64) -> Vec<f64> {
     let u = RandomInputs::independent(vec![inputs()[1].clone()]);
     crate::uq::method::mc::Mc { samples }
         .design(&u, seed)
