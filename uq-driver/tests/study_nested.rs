@@ -223,7 +223,7 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
         assert!((r[col("mean")] - (1.0 + hk)).abs() < 1e-9, "{r:?}");
         assert!((r[col("std")] - 3f64.sqrt()).abs() < 1e-9, "{r:?}");
         let pk = inner_exceedance(3.0 - hk);
-        // From 4000 draws of the (exact) conditional chaos.
+        // From 20 000 draws of the (exact) conditional chaos.
         assert!((r[col("p_exceed_3")] - pk).abs() < 0.03, "{r:?} vs {pk}");
     }
     assert!(out.join("y_end_conditional_exceedance.svg").exists());

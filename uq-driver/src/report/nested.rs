@@ -400,20 +400,31 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
         for q in &v.quantities {
             let Some(n) = &q.nested else { continue };
             let s = &n.variance_split;
-            let mut row = vec![
+            let head = vec![
                 v.name.clone(),
                 q.name.clone(),
                 with_ci(q.mean, n.mean_ci),
                 with_ci(q.std, n.std_ci),
                 paper(&v.name, &q.name, "std"),
+                format!("{:.4}", s.var_inner.max(0.0).sqrt()),
+                format!("{:.4}", s.var_outer.max(0.0).sqrt()),
                 with_ci(s.inner, s.inner_ci),
                 with_ci(s.outer, s.outer_ci),
             ];
-            for e in &n.exceedance_ci {
-                row.push(format!("P > {}: {}", e.limit, with_ci(e.p, e.ci)));
-                row.push(paper(&v.name, &q.name, &format!("p>{}", e.limit)));
+            if n.exceedance_ci.is_empty() {
+                rows.push(head.clone());
             }
-            rows.push(row);
+            for e in &n.exceedance_ci {
+                let mut row = head.clone();
+                row.push(format!("{}", e.limit));
+                row.push(with_ci(e.p, e.ci));
+                row.push(format!(
+                    "{:.4} [{:.4}, {:.4}]",
+                    e.conditional_median, e.conditional_min, e.conditional_max
+                ));
+                row.push(paper(&v.name, &q.name, &format!("p>{}", e.limit)));
+                rows.push(row);
+            }
         }
     }
     if rows.is_empty() {
@@ -422,9 +433,13 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
     Some(Section {
         heading: "Two-level split".into(),
         text: "Each nested variant over both levels (95 % bootstrap intervals over the outer \
-               samples): the marginal mean and Std, the shares of the variance from the inner \
-               and the outer parameters, and P(q > limit) (the mean of the conditional \
-               probabilities), beside the published values where the suite gives them."
+               samples): the marginal mean and Std; the Std's two parts, the root of the mean \
+               conditional variance (the inner parameters alone, e.g. the vehicle) and of the \
+               variance of the conditional means (the outer parameters, e.g. the track); their \
+               shares of the variance; P(q > limit) over both levels (the mean of the \
+               conditional probabilities) and how P(q > limit | outer) spreads over the outer \
+               samples (median [min, max]); beside the published values where the suite gives \
+               them (see the suite's description for what those were computed on)."
             .into(),
         images: vec!["variance_split.csv".into()],
         table: Some(Table {
@@ -434,9 +449,13 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
                 "mean",
                 "Std",
                 "Std (paper)",
+                "√E[Var inner]",
+                "√Var[E inner] (outer)",
                 "inner share",
                 "outer share",
+                "limit",
                 "P(q > limit)",
+                "P(q > limit | outer): median [min, max]",
                 "P (paper)",
             ]
             .map(String::from)
