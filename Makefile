@@ -141,6 +141,7 @@ paper: build fmu
 	$(DRIVER) run builtin:paper-vehicle-track --out out/paper-vehicle-track
 	$(DRIVER) run builtin:paper-vehicle-track-tracks --out out/paper-vehicle-track-tracks
 	$(DRIVER) run builtin:vehicle-track-defect --out out/vehicle-track-defect
+	$(DRIVER) run builtin:vehicle-track-sleeper-passing --out out/vehicle-track-sleeper-passing
 	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
 	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
