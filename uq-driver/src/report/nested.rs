@@ -119,7 +119,11 @@ fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> S
              Var = E_outer[Var_inner] + Var_outer[E_inner]; the second term is the sample \
              variance of the conditional means less the mean squared standard error of those \
              means (the inner sampling error; none for collocation or chaos). P(q > limit) is \
-             the mean of the conditional probabilities. Intervals: {}.",
+             the mean of the conditional probabilities. Intervals: {}. The plots: how \
+             P(q > limit | outer) spreads over the outer samples (its empirical distribution \
+             function, one step per outer sample: steps near 0 and 1 mean the outer parameters \
+             decide the exceedance, steps in between that the inner ones do), and the \
+             conditional mean ± Std of every outer sample, sorted by the mean.",
             q.name,
             n.outer_samples,
             t.outer_names.join(", "),
