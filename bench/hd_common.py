@@ -163,7 +163,7 @@ def fmt_err(case, err):
         return "—"
     if case == "borehole":
         return f"{100 * err[0]:.3f} % / {100 * err[1]:.2f} %"
-    return f"{err:.4f}"
+    return f"{err:.4f}" if err >= 1e-3 else f"{err:.1e}"
 
 
 def worst(case, errs):

@@ -43,11 +43,19 @@ CASES = {
                  "goal": "all S and S_T within 0.01", "error": "max |S − exact|"},
     "borehole": {"title": "borehole (8 mixed inputs)", "limit": 100,
                  "ladder": (25, 50, 75, 100, 150, 200), "order": 6, "q": 1.0,
-                 "levels": (1, 2, 3),
+                 # Level 3 (1 185 runs) is left out: its Genz–Keister nodes reach 6.4 σ,
+                 # where the normal rw is negative and the function undefined.
+                 "levels": (1, 2),
                  "goal": "mean within 0.1 %, Std within 1 %",
                  "error": "mean / Std relative error"},
     "gfunction": {"title": "Sobol' g-function (8 uniform inputs)", "limit": 500,
-                  "ladder": (150, 300, 500, 800), "order": 14, "q": 0.5,
+                  "ladder": (100, 200, 300, 500, 800), "order": 10, "q": 0.5,
+                  "why": "The largest degree is 10 for every tool (uq-driver's test "
+                         "hd_goals.rs uses 14): in a trial at N = 500, 14 made no tool more "
+                         "accurate (uq-driver's worst error over 3 designs 0.0133 at 14 vs "
+                         "0.0117 at 10; OpenTURNS on one design 0.0092 vs 0.0017: the kinks "
+                         "of |4x − 2| stop the convergence) and cost OpenTURNS 4× and "
+                         "uq-driver 5× the time.",
                   "levels": (1, 2, 3),
                   "goal": "all S within 0.02", "error": "max |S − exact|"},
 }
@@ -194,10 +202,16 @@ def bench_case(h, driver, work, fmu, case):
         err = hc.errors(case, est, ref)
         sg.append((runs, level, err))
         sec.row(runs, f"sparse_grid level {level}: {hc.fmt_err(case, err)}"
-                f"{' ✓' if hc.meets(case, err) else ''}", "", "")
+                f"{' ✓' if hc.meets(case, err) else ''}", "—", "—")
     sec.cmd(f"target/release/uq-driver run {h.rel(work)}/{case}-pce-N-R.toml --out "
             f"{h.rel(work)}/{case}-pce-N-R --fresh   # N = {', '.join(map(str, cfg['ladder']))}; "
             f"R = {', '.join(map(str, REPLICATES))} (the study seed)")
+    if "why" in cfg:
+        sec.note(cfg["why"])
+    if case == "borehole":
+        sec.note("sparse_grid level 3 (1 185 runs) is not tried: its Genz–Keister nodes reach "
+                 "6.4 σ, where the normal rw is negative and the borehole function undefined "
+                 "(the FMU refuses the point, and uq-driver stops the study, naming it).")
     sec.cmd(f"target/release/uq-driver run {h.rel(work)}/{case}-sg-L.toml --out "
             f"{h.rel(work)}/{case}-sg-L --fresh   # L = {', '.join(map(str, cfg['levels']))}")
     sec.note(
@@ -410,7 +424,19 @@ def bench_vt(h, driver, work, fmu_dir):
 
 # ------------------------------------------------------------------ summary
 
-def summary_section(h, summaries):
+def versus(s):
+    """'Ishigami: as many runs as OpenTURNS, fewer than chaospy' (by the smallest N)."""
+    top = max(s["ladder"]) + 1  # not met on the ladder: more than its largest N
+    mine = s["need"]["uq-driver"] or top
+    words = []
+    for tool in ("OpenTURNS", "chaospy"):
+        theirs = s["need"][tool] or top
+        words.append(("fewer runs than " if mine < theirs else "as many runs as "
+                      if mine == theirs else "more runs than ") + tool)
+    return f"{s['case'].split(' (')[0]}: {' and '.join(words)}"
+
+
+def summary_section(h, summaries, sections):
     sec = h.Section("High-dimensional goals (issue 11): runs needed, uq-driver vs OpenTURNS vs "
                     "chaospy",
                     ["benchmark", "goal", "uq-driver", "OpenTURNS", "chaospy",
@@ -434,7 +460,10 @@ def summary_section(h, summaries):
              "too. uq-driver runs the Functions test FMU; the peers evaluate the same "
              "closed-form functions in numpy (runs counted alike).")
     met = sum(s["met"] for s in summaries)
-    sec.done(f"uq-driver meets {met} of {len(summaries)} goals.")
+    # It ran while the sections below did: their average load.
+    sec.other = sum(s.other for s in sections) / len(sections)
+    sec.done(f"uq-driver meets {met} of {len(summaries)} goals. Against the peers (smallest "
+             f"N of the ladders): {'; '.join(versus(s) for s in summaries if 'need' in s)}.")
     return sec
 
 
@@ -454,4 +483,4 @@ def bench(h, work, driver, fmu_dir, test_fmu_dir):
     sec, s = bench_vt(h, driver, work, fmu_dir)
     sections.append(sec)
     summaries.append(s)
-    return [summary_section(h, summaries)] + sections
+    return [summary_section(h, summaries, sections)] + sections
