@@ -139,6 +139,7 @@ paper: build fmu
 	$(DRIVER) run builtin:paper-wheel --out out/paper-wheel
 	$(DRIVER) run builtin:paper-vehicle-track --out out/paper-vehicle-track
 	$(DRIVER) run builtin:vehicle-track-defect --out out/vehicle-track-defect
+	$(DRIVER) run builtin:vehicle-track-sleeper-passing --out out/vehicle-track-sleeper-passing
 	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
 	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie

@@ -15,7 +15,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 seconds="${FUZZ_SECONDS:-60}"
-targets="${FUZZ_TARGETS:-model_description store_reader}"
+targets="${FUZZ_TARGETS:-model_description store_reader study_file}"
 triple="$(rustc -vV | sed -n 's/^host: //p')"
 out="$root/target/fuzz"
 

@@ -50,3 +50,8 @@ fn model_description_corpus_and_regressions_pass_the_fuzz_checks() {
 fn store_reader_corpus_and_regressions_pass_the_fuzz_checks() {
     run("store_reader", checks::store_reader);
 }
+
+#[test]
+fn study_file_corpus_and_regressions_pass_the_fuzz_checks() {
+    run("study_file", checks::study_file);
+}

@@ -133,3 +133,33 @@ fn open_store(data: &[u8]) {
         assert!(agree(&done), "the repair changed the records");
     });
 }
+
+/// `Study::parse` on arbitrary bytes (as UTF-8 text, the way a study file is read): no panic,
+/// no huge allocation (the parser validates, it does not build designs or time grids), an
+/// error message that formats, and the same answer when parsed again.
+pub fn study_file(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let first = uq_driver::spec::Study::parse(text, "fuzz.toml", None);
+    match &first {
+        Ok(s) => {
+            assert!(!s.name.is_empty(), "a study without a name was accepted");
+            for p in &s.parameters {
+                assert!(
+                    !p.name.is_empty(),
+                    "a parameter without a name was accepted"
+                );
+            }
+        }
+        Err(e) => {
+            let _ = e.to_string();
+        }
+    }
+    let again = uq_driver::spec::Study::parse(text, "fuzz.toml", None);
+    assert_eq!(
+        format!("{first:?}"),
+        format!("{again:?}"),
+        "parsing the same text twice gave different answers"
+    );
+}

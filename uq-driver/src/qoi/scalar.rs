@@ -83,6 +83,23 @@ pub enum QoiSpec {
         #[serde(default)]
         limits: Vec<f64>,
     },
+    /// Peak-to-peak value, max − min of the signal over [from, to] (s): e.g. the ripple of a
+    /// wheel–rail force as the wheel passes the sleepers.
+    Range {
+        /// Name in reports.
+        name: String,
+        /// Signal.
+        signal: String,
+        /// Start of the interval (s).
+        #[serde(default)]
+        from: f64,
+        /// End of the interval (s; default the stop time).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<f64>,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
     /// Value of a signal at the stop time.
     Final {
         /// Name in reports.
@@ -166,6 +183,7 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { name, .. }
             | QoiSpec::Sperling { name, .. }
             | QoiSpec::MaxAbs { name, .. }
+            | QoiSpec::Range { name, .. }
             | QoiSpec::Final { name, .. } => name,
             QoiSpec::HuntingSpeed(h) => &h.name,
         }
@@ -187,6 +205,7 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
             QoiSpec::Sperling { signal, .. }
             | QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Range { signal, .. }
             | QoiSpec::Final { signal, .. } => vec![signal],
             QoiSpec::HuntingSpeed(_) => Vec::new(),
         }
@@ -198,6 +217,7 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { limits, .. }
             | QoiSpec::Sperling { limits, .. }
             | QoiSpec::MaxAbs { limits, .. }
+            | QoiSpec::Range { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
             QoiSpec::HuntingSpeed(h) => &h.limits,
         }
@@ -208,7 +228,9 @@ impl QoiSpec {
         match self {
             QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
             QoiSpec::Sperling { .. } => None,
-            QoiSpec::MaxAbs { signal, .. } | QoiSpec::Final { signal, .. } => Some(signal),
+            QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Range { signal, .. }
+            | QoiSpec::Final { signal, .. } => Some(signal),
             QoiSpec::HuntingSpeed(h) => Some(&h.speed_parameter),
         }
     }
@@ -272,6 +294,12 @@ impl QoiSpec {
                 Some(to) => format!("largest |{signal}| over {from}–{to} s"),
                 None => format!("largest |{signal}| from {from} s to the end"),
             },
+            QoiSpec::Range {
+                signal, from, to, ..
+            } => match to {
+                Some(to) => format!("peak-to-peak (max − min) of {signal} over {from}–{to} s"),
+                None => format!("peak-to-peak (max − min) of {signal} from {from} s to the end"),
+            },
             QoiSpec::Final { signal, .. } => format!("{signal} at the stop time"),
             QoiSpec::HuntingSpeed(h) => format!(
                 "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs of \
@@ -319,7 +347,7 @@ impl QoiSpec {
                     None
                 }
             }
-            QoiSpec::MaxAbs { from, to, .. } => to
+            QoiSpec::MaxAbs { from, to, .. } | QoiSpec::Range { from, to, .. } => to
                 .is_some_and(|t| t <= *from)
                 .then_some("`to` must be after `from`"),
             QoiSpec::Final { .. } => None,
@@ -451,6 +479,29 @@ pub fn evaluate<'a>(
             }
             Ok((m, Code::Ok))
         }
+        QoiSpec::Range {
+            signal: s,
+            from,
+            to,
+            ..
+        } => {
+            let to = to.unwrap_or(f64::INFINITY);
+            let (lo, hi) = times
+                .iter()
+                .zip(signal(s))
+                .filter(|(t, v)| **t >= *from && **t <= to && v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, v)| {
+                    (lo.min(*v), hi.max(*v))
+                });
+            if lo > hi {
+                return Err(QoiError::EmptyInterval {
+                    signal: s.clone(),
+                    from: *from,
+                    to,
+                });
+            }
+            Ok((hi - lo, Code::Ok))
+        }
         QoiSpec::Final { signal: s, .. } => signal(s)
             .last()
             .map(|v| (*v, Code::Ok))
@@ -518,6 +569,25 @@ mod tests {
             limits: vec![],
         };
         assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (2.0, Code::Ok));
+        let q = QoiSpec::Range {
+            name: "r".into(),
+            signal: "x".into(),
+            from: 0.5,
+            to: Some(2.5),
+            limits: vec![],
+        };
+        // Values at t = 1 and 2 only: the range is their difference, by hand.
+        let (r, code) = evaluate(&q, &t, |_| &x[..]).unwrap();
+        assert_eq!(code, Code::Ok);
+        assert_eq!(r, (x[2] - x[1]).abs());
+        let q = QoiSpec::Range {
+            name: "r".into(),
+            signal: "x".into(),
+            from: 10.0,
+            to: None,
+            limits: vec![],
+        };
+        assert!(evaluate(&q, &t, |_| &x[..]).is_err());
         let q = QoiSpec::Final {
             name: "f".into(),
             signal: "x".into(),

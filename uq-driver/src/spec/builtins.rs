@@ -74,6 +74,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/vehicle-track-defect.toml"),
     ),
     (
+        "vehicle-track-sleeper-passing",
+        include_str!("../../studies/vehicle-track-sleeper-passing.toml"),
+    ),
+    (
         "vehicle-track-8d-pce",
         include_str!("../../studies/vehicle-track-8d-pce.toml"),
     ),

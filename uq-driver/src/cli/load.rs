@@ -1,0 +1,128 @@
+//! Reading a study argument: files, built-in names, warnings, the FMU search.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use uq_driver::spec::{fmu_candidates, Study, BUILTINS};
+use uq_driver::suggest;
+
+/// A study argument as `Study::load` takes it: a file, `builtin:NAME`, or a bare built-in
+/// NAME when no file of that name exists; a misspelt name gets the closest built-in.
+pub(crate) fn study_spec(arg: &str) -> Result<String> {
+    let names = || BUILTINS.iter().map(|(n, _)| *n);
+    if let Some(name) = arg.strip_prefix("builtin:") {
+        if names().any(|n| n == name) {
+            return Ok(arg.to_owned());
+        }
+        let hint = suggest::closest(name, names())
+            .map(|c| format!(" (did you mean builtin:{c}?)"))
+            .unwrap_or_default();
+        anyhow::bail!("no built-in study '{name}'{hint}; `uq-driver list` shows them all");
+    }
+    let is_builtin = names().any(|n| n == arg);
+    let exists = Path::new(arg).exists();
+    match (exists, is_builtin) {
+        (true, true) => anyhow::bail!(
+            "'{arg}' is both a file here and a built-in study: write ./{arg} for the file or \
+             builtin:{arg} for the built-in"
+        ),
+        (true, false) => Ok(arg.to_owned()),
+        (false, true) => Ok(format!("builtin:{arg}")),
+        (false, false) => {
+            let hint = suggest::closest(arg, names())
+                .map(|c| format!("; did you mean the built-in study {c}?"))
+                .unwrap_or_else(|| "; `uq-driver list` shows the built-in studies".into());
+            anyhow::bail!("no study file '{arg}' and no built-in study of that name{hint}")
+        }
+    }
+}
+
+/// Loads a study argument (file, builtin:NAME or NAME), warns about `cov` values that look
+/// like percentages and checks that its FMU (and every variant's) can be found.
+pub(crate) fn load_study(arg: &str) -> Result<Study> {
+    let s = Study::load(&study_spec(arg)?)?;
+    for w in cov_warnings(&s.source) {
+        eprintln!("uq-driver: warning: {w}");
+    }
+    let mut studies = vec![&s];
+    if let Some(suite) = &s.suite {
+        studies.extend(&suite.variants);
+    }
+    for st in studies {
+        check_fmu_found(st)?;
+    }
+    Ok(s)
+}
+
+/// `cov` is a fraction: a value above 1 is most likely a percentage.
+pub(crate) fn cov_warnings(source: &str) -> Vec<String> {
+    let Ok(table) = source.parse::<toml::Table>() else {
+        return Vec::new();
+    };
+    let mut params: Vec<&toml::Value> = Vec::new();
+    let arrays = |t: &toml::Table| -> Vec<toml::Value> {
+        t.get("parameters")
+            .and_then(|p| p.as_array())
+            .cloned()
+            .unwrap_or_default()
+    };
+    let mut all = arrays(&table);
+    for v in table
+        .get("variants")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        if let Some(t) = v.as_table() {
+            all.extend(arrays(t));
+        }
+    }
+    params.extend(all.iter());
+    let mut out: Vec<String> = params
+        .iter()
+        .filter_map(|p| {
+            let cov = p
+                .get("cov")?
+                .as_float()
+                .or_else(|| p.get("cov").and_then(|c| c.as_integer()).map(|i| i as f64))?;
+            let name = p.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            (cov > 1.0).then(|| {
+                format!(
+                    "parameter '{name}': cov = {cov} is a coefficient of variation of {} %; \
+                     `cov` is a fraction (did you mean cov = {}?)",
+                    cov * 100.0,
+                    cov / 100.0
+                )
+            })
+        })
+        .collect();
+    out.dedup();
+    out
+}
+
+/// An error listing every place searched when a study's FMU is not found.
+pub(crate) fn check_fmu_found(s: &Study) -> Result<()> {
+    let Some(path) = &s.fmu_path else {
+        return Ok(());
+    };
+    if path.exists() {
+        return Ok(());
+    }
+    let given = s
+        .base
+        .as_ref()
+        .and_then(|b| path.strip_prefix(b).ok())
+        .unwrap_or(path);
+    let places: Vec<String> = fmu_candidates(&given.to_string_lossy(), s.base.as_deref())
+        .iter()
+        .map(|p| format!("  {}", p.display()))
+        .collect();
+    anyhow::bail!(
+        "{}: FMU {} not found; looked in:\n{}\n(set RAILUQ_FMU_DIR to the folder of the FMUs, \
+         e.g. target/fmu after `make fmu`)",
+        s.origin,
+        given.display(),
+        places.join("\n")
+    )
+}

@@ -1,0 +1,74 @@
+//! What `run` prints about a finished study or suite.
+
+use std::path::Path;
+
+use uq_driver::report::units::with_unit;
+use uq_driver::results::sig;
+use uq_driver::study::{StudyResult, SuiteResult};
+
+/// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings.
+pub(crate) fn print_study(r: &StudyResult, out: &Path) {
+    let s = &r.summary;
+    for w in &s.warnings {
+        eprintln!("uq-driver: warning: {w}");
+    }
+    let t = &s.timing;
+    println!(
+        "{}: {} model runs ({} resumed); wall time: runs {:.2} s, analysis {:.2} s, report \
+         {:.2} s; report: {}",
+        s.study,
+        s.model_runs,
+        s.runs_resumed,
+        t.runs_s,
+        t.analysis_s,
+        t.report_s,
+        out.join("index.html").display()
+    );
+    for q in &r.quantities {
+        let u = q.unit.as_deref();
+        let v = |x: f64| with_unit(&format!("{x:.6}"), u);
+        if q.deterministic {
+            println!(
+                "  {} = {} (every run; {})",
+                q.name,
+                v(q.mean),
+                q.definition.text
+            );
+        } else {
+            println!(
+                "  {}: mean {}, Std {} ({} valid runs; {})",
+                q.name,
+                v(q.mean),
+                v(q.std),
+                q.n_valid,
+                q.definition.text
+            );
+            for e in &q.exceedance_counts {
+                println!("  P({} > {}): {}", q.name, sig(e.limit), e.describe());
+            }
+        }
+    }
+    if s.failed_runs > 0 {
+        println!("{} points failed (see points.csv)", s.failed_runs);
+    }
+}
+
+/// The result of `run` for a suite: one line per variant.
+pub(crate) fn print_suite(r: &SuiteResult, out: &Path) {
+    for v in &r.variants {
+        for w in &v.summary.warnings {
+            eprintln!("uq-driver: warning: {}: {w}", v.summary.study);
+        }
+    }
+    println!(
+        "{}: report {}",
+        r.summary.suite,
+        out.join("index.html").display()
+    );
+    for v in &r.summary.variants {
+        println!(
+            "  {:<12} {:<16} {:>7} model runs, wall time {:.2} s",
+            v.name, v.method, v.model_runs, v.wall_time_s
+        );
+    }
+}
