@@ -878,8 +878,7 @@ def bench_analysis_report(work, repeats, checks, all_builtins):
 
 def bench_hd_goals(work):
     """Issue 11's goals (Ishigami, borehole, g-function through the Functions test FMU; the
-    VehicleTrack 8-D chaos), runs counted, beside OpenTURNS and chaospy (bench/hd_goals.py).
-    Reuses builtin:vehicle-track-8d-pce/-lhs from the analysis section when they ran."""
+    VehicleTrack 8-D chaos), runs counted, beside OpenTURNS and chaospy (bench/hd_goals.py)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import hd_goals
     return hd_goals.bench(sys.modules[__name__], work, DRIVER, FMU_DIR,
@@ -1091,7 +1090,7 @@ def all_sections(args, work, repeats, checks):
     s7 = bench_vt_stepping(work, s1.other)
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
-    s_hd = bench_hd_goals(work)  # after the analysis section: reuses its VehicleTrack runs
+    s_hd = bench_hd_goals(work)
     return ([s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
             same_iso, lib_same)
 
