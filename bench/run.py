@@ -6,6 +6,10 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
+                                  [--only hd]
+
+`--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
+target/bench/BENCHMARKS-hd.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals of the issue are reported as met or not met. The only hard failures are missing
@@ -870,6 +874,17 @@ def bench_analysis_report(work, repeats, checks, all_builtins):
                                  all_builtins)
 
 
+# ------------------------------------------------------------------ high-dimensional goals
+
+def bench_hd_goals(work):
+    """Issue 11's goals (Ishigami, borehole, g-function through the Functions test FMU; the
+    VehicleTrack 8-D chaos), runs counted, beside OpenTURNS and chaospy (bench/hd_goals.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import hd_goals
+    return hd_goals.bench(sys.modules[__name__], work, DRIVER, FMU_DIR,
+                          ROOT / "target" / "test-fmu")
+
+
 # ------------------------------------------------------------------ BENCHMARKS.md
 
 # ------------------------------------------------------------------ --isolate overhead
@@ -1004,6 +1019,9 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
+SECTIONS = ("hd",)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=3,
@@ -1015,6 +1033,9 @@ def main():
     ap.add_argument("--all-builtins", action="store_true",
                     help="also run the built-in studies that take an hour or more (the "
                          "bogie's 20 000-sample LHS) in the analysis/report section")
+    ap.add_argument("--only", choices=SECTIONS, default=None,
+                    help="run one section alone (default output "
+                         "target/bench/BENCHMARKS-<section>.md)")
     ap.add_argument("--quick", action="store_true",
                     help="smoke test: 1 repeat, short fmi_step budget, simulate_fmu on 100 "
                          "points scaled to 1 000")
@@ -1023,7 +1044,8 @@ def main():
         ap.error("--repeats must be >= 1")
     repeats = 1 if args.quick else args.repeats
     md = Path(args.md) if args.md else (
-        ROOT / "target" / "bench" / "BENCHMARKS-quick.md" if args.quick
+        ROOT / "target" / "bench" / f"BENCHMARKS-{args.only}.md" if args.only
+        else ROOT / "target" / "bench" / "BENCHMARKS-quick.md" if args.quick
         else ROOT / "BENCHMARKS.md")
     argv = sys.argv[1:]
     work = Path(args.work)
@@ -1036,15 +1058,12 @@ def main():
         mach = machine()
         print("railuq benchmarks: " + ", ".join(f"{k}: {v}" for k, v in mach.items()), flush=True)
         checks = []
-        s1, step_cost, lib_same = bench_fmi_step(work, 0.3 if args.quick else 1.5)
-        s2 = bench_wheel_1000(work, repeats, args.quick, checks)
-        s3, same_threads = bench_threads(work, 1 if args.quick else max(repeats, 7))
-        s4, s5 = bench_paper_wheel(work)
-        s6 = bench_realtime(work, repeats if args.quick else max(repeats, 5), step_cost)
-        s_parse = bench_parse_description(work, repeats)
-        s7 = bench_vt_stepping(work, s1.other)
-        s_iso, same_iso = bench_isolate(work, repeats)
-        s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
+        if args.only == "hd":
+            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
+            sections, same_threads, same_iso = bench_hd_goals(work), True, True
+        else:
+            sections, same_threads, same_iso, lib_same = all_sections(args, work, repeats,
+                                                                      checks)
         if env_fmu is None:
             del os.environ["RAILUQ_FMU_DIR"]
     except BenchError as e:
@@ -1052,13 +1071,28 @@ def main():
         return 2
     checks_ok = all(ok for _, _, ok in checks) and same_threads and same_iso
     total = time.perf_counter() - t_start
-    write_markdown(md, mach, [s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis, total,
-                   argv, checks_ok, lib_same)
+    write_markdown(md, mach, sections, total, argv, checks_ok, lib_same)
     print(f"\nwrote {rel(md)} ({total:.0f} s in all)", flush=True)
     if not checks_ok:
         print("bench/run.py: a correctness check FAILED (see above)", file=sys.stderr)
         return 1
     return 0
+
+
+def all_sections(args, work, repeats, checks):
+    """Every section in order; returns (sections, same_threads, same_iso, lib_same)."""
+    s1, step_cost, lib_same = bench_fmi_step(work, 0.3 if args.quick else 1.5)
+    s2 = bench_wheel_1000(work, repeats, args.quick, checks)
+    s3, same_threads = bench_threads(work, 1 if args.quick else max(repeats, 7))
+    s4, s5 = bench_paper_wheel(work)
+    s6 = bench_realtime(work, repeats if args.quick else max(repeats, 5), step_cost)
+    s_parse = bench_parse_description(work, repeats)
+    s7 = bench_vt_stepping(work, s1.other)
+    s_iso, same_iso = bench_isolate(work, repeats)
+    s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
+    s_hd = bench_hd_goals(work)
+    return ([s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
+            same_iso, lib_same)
 
 
 if __name__ == "__main__":

@@ -148,9 +148,18 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
             plain(de.step_size)
         )?;
     }
+    // The name column as wide as the longest name (capped, so that one absurd name does not
+    // push every row off the screen).
+    let w = md
+        .variables
+        .iter()
+        .map(|v| v.name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .clamp(16, 48);
     writeln!(
         o,
-        "  {:<16} {:>5} {:<8} {:<20} {:<11} {:>12} {:<8} description",
+        "  {:<w$} {:>5} {:<8} {:<20} {:<11} {:>12} {:<8} description",
         "name", "vr", "type", "causality", "variability", "start", "unit"
     )?;
     for v in &md.variables {
@@ -164,7 +173,7 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
         };
         writeln!(
             o,
-            "  {:<16} {:>5} {:<8} {:<20} {:<11} {:>12} {:<8} {}",
+            "  {:<w$} {:>5} {:<8} {:<20} {:<11} {:>12} {:<8} {}",
             v.name,
             v.value_reference,
             v.kind.type_name(),

@@ -463,19 +463,11 @@ pub fn evaluate<'a>(
             to,
             ..
         } => {
-            let to = to.unwrap_or(f64::INFINITY);
-            let m = times
-                .iter()
-                .zip(signal(s))
-                .filter(|(t, _)| **t >= *from && **t <= to)
-                .map(|(_, v)| v.abs())
+            let m = in_window(times, signal(s), *from, *to)
+                .map(f64::abs)
                 .fold(f64::NAN, f64::max);
             if m.is_nan() {
-                return Err(QoiError::EmptyInterval {
-                    signal: s.clone(),
-                    from: *from,
-                    to,
-                });
+                return Err(empty_window(s, *from, *to));
             }
             Ok((m, Code::Ok))
         }
@@ -485,20 +477,13 @@ pub fn evaluate<'a>(
             to,
             ..
         } => {
-            let to = to.unwrap_or(f64::INFINITY);
-            let (lo, hi) = times
-                .iter()
-                .zip(signal(s))
-                .filter(|(t, v)| **t >= *from && **t <= to && v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, v)| {
-                    (lo.min(*v), hi.max(*v))
+            let (lo, hi) = in_window(times, signal(s), *from, *to)
+                .filter(|v| v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
                 });
             if lo > hi {
-                return Err(QoiError::EmptyInterval {
-                    signal: s.clone(),
-                    from: *from,
-                    to,
-                });
+                return Err(empty_window(s, *from, *to));
             }
             Ok((hi - lo, Code::Ok))
         }
@@ -507,6 +492,30 @@ pub fn evaluate<'a>(
             .map(|v| (*v, Code::Ok))
             .ok_or_else(|| QoiError::EmptySignal(s.clone())),
         QoiSpec::HuntingSpeed(h) => Err(QoiError::NeedsOwnRuns(h.name.clone())),
+    }
+}
+
+/// The values of `values` (sampled at `times`, s) with from <= t <= to (to: the end if None).
+fn in_window<'a>(
+    times: &'a [f64],
+    values: &'a [f64],
+    from: f64,
+    to: Option<f64>,
+) -> impl Iterator<Item = f64> + 'a {
+    let to = to.unwrap_or(f64::INFINITY);
+    times
+        .iter()
+        .zip(values)
+        .filter(move |(t, _)| **t >= from && **t <= to)
+        .map(|(_, v)| *v)
+}
+
+/// No sample of `signal` in [from, to].
+fn empty_window(signal: &str, from: f64, to: Option<f64>) -> QoiError {
+    QoiError::EmptyInterval {
+        signal: signal.to_owned(),
+        from,
+        to: to.unwrap_or(f64::INFINITY),
     }
 }
 

@@ -27,9 +27,10 @@ fn mean_std(xs: &[f64]) -> (f64, f64) {
         s1 += d;
         s2 += d * d;
     }
-    // The s1 term corrects the rounding error of the mean.
+    // The s1 term corrects the rounding error of the mean (of the mean itself, too: equal
+    // values give exactly that value).
     let var = (s2 - s1 * s1 / m as f64) / (m - 1) as f64;
-    (mean, var.max(0.0).sqrt())
+    (mean + s1 / m as f64, var.max(0.0).sqrt())
 }
 
 /// Per-column sample mean and unbiased (`M - 1`) standard deviation of an
@@ -166,6 +167,18 @@ pub fn exceedance_probability(samples: &[f64], limit: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mean_of_equal_values_is_that_value_exactly() {
+        // 0.1 + 0.2 + ... in floating point rounds; the corrected mean does not.
+        for x in [0.1, 1.0 / 3.0, 2.000_000_000_000_001_3, -7.7e-3] {
+            for m in [3, 10, 50, 1001] {
+                let (mean, std) = mean_std(&vec![x; m]);
+                assert_eq!(mean, x, "{m} copies of {x}");
+                assert_eq!(std, 0.0);
+            }
+        }
+    }
     use crate::uq::quadrature::gauss_hermite;
 
     #[test]
