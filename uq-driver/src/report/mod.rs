@@ -7,6 +7,7 @@
 //! - [`heatmap`]: PDF-evolution heat maps as a viridis PNG plus an SVG frame with axes and colorbar;
 //! - [`html`]: the self-contained `index.html` that ties the files together;
 //! - [`study`]: the files of one study's output folder (one writer per file);
+//! - [`nested`]: what a two-level study adds (conditional statistics, the variance split);
 //! - [`suite`]: the comparison of a suite's variants;
 //! - [`compare`]: one page comparing finished study folders (`uq-driver compare`);
 //! - [`units`]: units from the modelDescription, on axes and in `units.csv`;
@@ -20,6 +21,7 @@ pub mod csv;
 pub mod heatmap;
 pub mod html;
 pub mod inputs;
+pub mod nested;
 pub mod study;
 pub mod suite;
 pub mod svg;

@@ -45,6 +45,9 @@ pub fn write(
     if !summary.paper.is_empty() {
         sections.push(paper_section(summary));
     }
+    if super::nested::write_suite(dir, summary)?.is_some() {
+        sections.extend(super::nested::suite_section(summary));
+    }
     let json = results::to_json(summary);
     write_bytes(&dir.join("summary.json"), json.as_bytes())?;
     ReportPage {

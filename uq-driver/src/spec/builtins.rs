@@ -89,6 +89,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "paper-vehicle-track",
         include_str!("../../studies/paper-vehicle-track.toml"),
     ),
+    (
+        "paper-vehicle-track-tracks",
+        include_str!("../../studies/paper-vehicle-track-tracks.toml"),
+    ),
 ];
 
 /// The text of a built-in study.

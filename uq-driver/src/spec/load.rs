@@ -9,7 +9,7 @@ use toml::Spanned;
 use super::builtins::builtin;
 use super::error::{location, Location, StudyError};
 use super::file::{Analysis, StudyFile, Variant};
-use super::parameter::ParameterSpec;
+use super::parameter::{Level, ParameterSpec};
 use super::study::{Study, Suite};
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
@@ -140,7 +140,12 @@ fn study(
         system: file.system.clone(),
         suite: None,
     };
-    check_method(&cx, &mut study, file.method.span())?;
+    let outer: Vec<String> = params
+        .iter()
+        .filter(|(_, p)| p.level == Level::Outer)
+        .map(|(_, p)| p.name.clone())
+        .collect();
+    check_method(&cx, &mut study, &outer, file.method.span())?;
     if let Evaluation::Sampling(_) = study.method().evaluation() {
         let fmu = file
             .fmu
@@ -255,12 +260,23 @@ fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
     Ok(())
 }
 
-fn check_method(cx: &Context, study: &mut Study, span: Range<usize>) -> Result<(), StudyError> {
+/// Resolves the method's files and the levels of its parameters (`outer`: the names marked
+/// `level = "outer"`), then checks its settings against the study.
+fn check_method(
+    cx: &Context,
+    study: &mut Study,
+    outer: &[String],
+    span: Range<usize>,
+) -> Result<(), StudyError> {
     let kind = study.method().kind();
     let base = study.base.clone();
     study
         .method
         .resolve_files(base.as_deref())
+        .map_err(|e| cx.invalid(Some(span.clone()), format!("method {kind}: {e}")))?;
+    study
+        .method
+        .set_levels(outer)
         .map_err(|e| cx.invalid(Some(span.clone()), format!("method {kind}: {e}")))?;
     let times = study.times();
     study

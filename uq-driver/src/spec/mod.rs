@@ -14,6 +14,7 @@
 //! order = 5                    # SCM: total order of the Hermite chaos (default nodes − 1)
 //! [[parameters]]
 //! name = "K"
+//! level = "inner"              # nested studies: "outer" (the outer design) or "inner"
 //! distribution = "normal"      # "normal" | "lognormal" | "uniform" | "truncated_normal" |
 //!                              # "beta" | "gamma" | "weibull" | "integer_uniform"
 //! mean = 100.0
@@ -46,7 +47,7 @@ pub use file::{
     StudyFile, Variant,
 };
 pub use load::{fmu_candidates, fmu_search_path};
-pub use parameter::{DistributionSpec, InvalidParameter, ParameterSpec};
+pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};
 pub use study::{Study, Suite};
 pub use value::FixedValue;
 

@@ -13,6 +13,20 @@ pub struct ParameterSpec {
     pub name: String,
     /// Its distribution, as written.
     pub distribution: DistributionSpec,
+    /// `level = "outer" | "inner"` (default inner): in a nested study, whether the
+    /// parameter is drawn by the outer design or by the inner method.
+    pub level: Level,
+}
+
+/// The level of a random parameter in a two-level (nested) study.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Level {
+    /// Drawn by the inner method, anew for every outer sample (the default).
+    #[default]
+    Inner,
+    /// Drawn by the outer design (e.g. the track: an irregularity seed).
+    Outer,
 }
 
 /// A distribution as written: `distribution = "<kind>"` and the kind's keys only.
@@ -138,12 +152,24 @@ impl<'de> Deserialize<'de> for ParameterSpec {
             }
             None => return Err(D::Error::missing_field("name")),
         };
+        let level = match table.remove("level") {
+            None => Level::Inner,
+            Some(v) => Level::deserialize(v).map_err(|_| {
+                D::Error::custom(format!(
+                    "parameter '{name}': `level` must be \"outer\" or \"inner\""
+                ))
+            })?,
+        };
         table
             .entry("distribution")
             .or_insert_with(|| "normal".into());
         let distribution = DistributionSpec::deserialize(toml::Value::Table(table))
             .map_err(|e| D::Error::custom(format!("parameter '{name}': {}", e.message())))?;
-        Ok(ParameterSpec { name, distribution })
+        Ok(ParameterSpec {
+            name,
+            distribution,
+            level,
+        })
     }
 }
 

@@ -13,6 +13,7 @@ pub mod inputs;
 pub mod interface;
 pub mod isolate;
 pub mod lock;
+pub mod nested;
 mod outcome;
 mod point;
 pub mod progress;

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use super::analysis;
+use super::analysis::{self, Analysed, AnalysisError};
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
@@ -14,12 +14,12 @@ use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
 use crate::results::{
-    FmuInfo, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout, ScalarStats,
-    Summary, Timing, Versions,
+    FmuInfo, OutputSplit, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout,
+    ScalarStats, Summary, Timing, Versions,
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
-use crate::uq::method::{Design, Evaluation, Intrusive, MethodSummary, Sampling};
+use crate::uq::method::{Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
@@ -140,7 +140,7 @@ pub(crate) fn finish(
         });
     }
     let started = Instant::now();
-    let analysed = analysis::analyse_runs(study, method, design, &outcome.records)?;
+    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.records)?;
     let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
@@ -164,11 +164,12 @@ pub(crate) fn finish(
         analysis_time,
     };
     let method_summary = study.method().summary(study.parameters.len());
+    warnings.splice(0..0, design.warnings.iter().cloned());
     let mut summary = summary(
         study,
         facts,
         method_summary,
-        design.warnings.clone(),
+        warnings,
         &outputs,
         &quantities,
     );
@@ -182,6 +183,7 @@ pub(crate) fn finish(
     )?;
     summary.units = units;
     let points = point_table(study, design, &outcome.records);
+    let extra = report::nested::write(out_dir, &quantities, &splits, !opts.no_report)?;
     summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
@@ -190,6 +192,7 @@ pub(crate) fn finish(
             quantities: &quantities,
             qoi: &study.qoi,
             points: Some(&points),
+            extra: &extra,
             plots: !opts.no_report,
         },
     )?;
@@ -197,6 +200,27 @@ pub(crate) fn finish(
         summary,
         outputs,
         quantities,
+    })
+}
+
+/// The statistics of every output and quantity; a nested study adds the split of each output
+/// over time and its notes.
+fn analyse(
+    study: &Study,
+    method: &dyn Sampling,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
+    Ok(match &study.method {
+        MethodSpec::Nested(nested) => {
+            let n = super::nested::analyse(study, nested, design, records)?;
+            (n.analysed, n.splits, n.warnings)
+        }
+        _ => (
+            analysis::analyse_runs(study, method, design, records)?,
+            Vec::new(),
+            Vec::new(),
+        ),
     })
 }
 
@@ -264,6 +288,7 @@ fn solve(
             quantities: &[],
             qoi: &study.qoi,
             points: None,
+            extra: &[],
             plots: !opts.no_report,
         },
     )?;

@@ -31,6 +31,8 @@ pub struct StudyReport<'a> {
     pub points: Option<&'a PointTable>,
     /// Write the plots and `index.html` (false: the CSV files and `summary.json` only).
     pub plots: bool,
+    /// Further sections of `index.html` (e.g. a nested study's split), after the others.
+    pub extra: &'a [Section],
 }
 
 /// Column name of a quantile level: 0.01 → `q1`, 0.5 → `q50`, 0.025 → `q2.5`.
@@ -97,6 +99,7 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
     if r.plots {
         let mut page = head_sections(r, &summary);
         page.extend(sections);
+        page.extend(r.extra.iter().cloned());
         ReportPage {
             title: format!("railuq study {}", r.summary.study),
             summary_json: json.clone(),

@@ -15,7 +15,7 @@ mod surrogate;
 pub use exceedance::{clopper_pearson, exceedance_count};
 
 use columns::{column, Column};
-use surrogate::Surrogates;
+pub(crate) use surrogate::Surrogates;
 
 use super::store::Record;
 use crate::qoi::scalar::Code;
@@ -29,7 +29,7 @@ use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
-const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
+pub(crate) const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
 
 /// Failures of the analysis.
 #[derive(Debug, thiserror::Error)]
@@ -125,7 +125,7 @@ enum Use {
 
 impl<'a> Settings<'a> {
     /// The settings of `study`, drawing from `surrogates`.
-    fn of(study: &'a Study, surrogates: &'a Surrogates) -> Settings<'a> {
+    pub(crate) fn of(study: &'a Study, surrogates: &'a Surrogates) -> Settings<'a> {
         Settings {
             analysis: &study.analysis,
             seed: study.seed,
@@ -186,7 +186,7 @@ const ZERO_SPREAD: f64 = 1e-9;
 /// binned kernel estimate. A column whose values all agree (to [`ZERO_SPREAD`] of the
 /// output's magnitude) has no density: its entries are NaN. The results do not depend on
 /// the thread count.
-fn output_stats(
+pub(crate) fn output_stats(
     name: &str,
     times: &[f64],
     estimate: &Estimate,
@@ -287,32 +287,37 @@ fn output_stats(
 }
 
 /// The values of one quantity over the successful runs, with their outcome codes.
-struct QuantityRuns {
+pub(crate) struct QuantityRuns {
     /// Design indices of the runs with a valid value.
-    rows: Vec<usize>,
+    pub rows: Vec<usize>,
     /// Their values.
-    valid: Vec<f64>,
-    never_hunts: usize,
-    never_stops: usize,
+    pub valid: Vec<f64>,
+    pub never_hunts: usize,
+    pub never_stops: usize,
 }
 
 /// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
-/// its valid run values.
-fn scalar_stats(
+/// its valid run values; quantiles and the density from `density` where given (e.g. the
+/// pooled draws of a nested study), else from the draws the estimate names.
+pub(crate) fn scalar_stats(
     name: &str,
     q: &QoiSpec,
     estimate: &Estimate,
     runs: QuantityRuns,
     settings: &Settings,
+    density: Option<Vec<f64>>,
 ) -> Result<ScalarStats, AnalysisError> {
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
-    let density_samples: Vec<f64> = settings
-        .draws(name, estimate, Some(&data), Use::Scalar)?
-        .column(0)
-        .iter()
-        .copied()
-        .collect();
+    let density_samples: Vec<f64> = match density {
+        Some(d) => d,
+        None => settings
+            .draws(name, estimate, Some(&data), Use::Scalar)?
+            .column(0)
+            .iter()
+            .copied()
+            .collect(),
+    };
     let c = column(&density_samples, &a.quantiles);
     let quantiles = a.quantiles.iter().copied().zip(c.quantiles).collect();
     let magnitude = c.min.abs().max(c.max.abs());
@@ -376,6 +381,7 @@ fn scalar_stats(
             kind: e.kind.name(),
             value: e.values[0],
         }),
+        nested: None,
     })
 }
 
@@ -444,14 +450,14 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
 }
 
 /// The values of the successful runs, in design order.
-struct Runs<'a> {
+pub(crate) struct Runs<'a> {
     /// Design indices.
-    rows: Vec<usize>,
+    pub rows: Vec<usize>,
     values: Vec<&'a [f64]>,
 }
 
 impl<'a> Runs<'a> {
-    fn of(records: &'a [Option<Record>]) -> Runs<'a> {
+    pub(crate) fn of(records: &'a [Option<Record>]) -> Runs<'a> {
         let (rows, values) = records
             .iter()
             .enumerate()
@@ -464,12 +470,12 @@ impl<'a> Runs<'a> {
     }
 
     /// Output `o` (of `nt` times each) as runs × times.
-    fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
+    pub(crate) fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
         DMatrix::from_fn(self.rows.len(), nt, |r, k| self.values[r][o * nt + k])
     }
 
     /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
-    fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
+    pub(crate) fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
         let mut out = QuantityRuns {
             rows: Vec::new(),
             valid: Vec::new(),
@@ -589,7 +595,7 @@ pub fn analyse_runs(
                     source,
                 })
         })?;
-        quantities.push(scalar_stats(&name, q, &estimate, qr, &settings)?);
+        quantities.push(scalar_stats(&name, q, &estimate, qr, &settings, None)?);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
                 name: name.clone(),

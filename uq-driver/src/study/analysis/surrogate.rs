@@ -18,7 +18,7 @@ const ROWS_PER_TASK: usize = 512;
 const COLUMNS_PER_TASK: usize = 32;
 
 /// The basis at the germ points, per basis, grown on demand.
-pub(super) struct Surrogates {
+pub(crate) struct Surrogates {
     seed: u64,
     cache: Mutex<Vec<(Basis, Arc<DMatrix<f64>>)>>,
 }

@@ -85,6 +85,7 @@ methods! {
     nominal::Nominal,
     sparse_grid::SparseGrid,
     pce_regression::PceRegression,
+    nested::Nested,
 }
 
 impl MethodSpec {
@@ -93,7 +94,29 @@ impl MethodSpec {
     pub fn resolve_files(&mut self, base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
         match self {
             MethodSpec::PceRegression(m) => m.resolve_points(base),
+            MethodSpec::Nested(m) => {
+                m.outer.resolve_files(base)?;
+                m.inner.resolve_files(base)
+            }
             _ => Ok(()),
+        }
+    }
+
+    /// Takes the parameters marked `level = "outer"` (names, study order): a nested study
+    /// draws them in its outer design; any other method refuses them.
+    pub fn set_levels(&mut self, outer: &[String]) -> Result<(), InvalidSettings> {
+        match self {
+            MethodSpec::Nested(m) => {
+                m.outer_parameters = outer.to_vec();
+                Ok(())
+            }
+            _ if outer.is_empty() => Ok(()),
+            other => Err(InvalidSettings(format!(
+                "parameter '{}' has level = \"outer\", which only a nested study \
+                 ([method] kind = \"nested\") has; {} draws every parameter in one design",
+                outer[0],
+                other.method().kind()
+            ))),
         }
     }
 }

@@ -4,9 +4,16 @@
 //! The field names of [`Summary`] and [`SuiteSummary`] are a public interface (they are the
 //! keys of `summary.json`): add fields, rename none.
 
+mod nested;
+
 use std::collections::BTreeMap;
 
 use serde::Serialize;
+
+pub use nested::{
+    ConditionalChaos, ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit,
+    VarianceSplit,
+};
 
 use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
@@ -131,6 +138,10 @@ pub struct ScalarStats {
     /// The chaos's estimated relative truncation error (chaos methods).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub chaos_error: Option<ScalarChaosError>,
+    /// A nested study's variance split, intervals and conditional statistics (its keys
+    /// `variance_split`, `mean_ci`, `std_ci`, `exceedance_ci`, ... sit beside the others).
+    #[serde(flatten)]
+    pub nested: Option<NestedScalar>,
 }
 
 /// A scalar quantity's chaos truncation error in `summary.json`:

@@ -1,0 +1,411 @@
+//! The analysis of a two-level (nested) study: for every output and quantity, the inner
+//! method's estimate per outer sample ([`Nested::conditional`]), the variance split with its
+//! bootstrap intervals ([`split`]), and the marginal statistics over both levels.
+//!
+//! - Marginal mean and Std: from the split (the mean of the conditional means; the Std from
+//!   `E[Var_inner] + Var_outer[E_inner]`, the latter corrected for the inner sampling error).
+//! - Marginal P(q > limit): the mean over the outer samples of the conditional probabilities,
+//!   each from the inner runs (sampled inner designs) or from draws of the inner chaos; its
+//!   standard error `sd / sqrt(N)` and a bootstrap interval.
+//! - Marginal quantiles and densities: from the pooled conditional draws, the same number from
+//!   every outer sample (chaos inner methods), or from all runs (sampled inner designs).
+//! - Outputs over time: the marginal mean and Std and the split at every time; quantiles and
+//!   the PDF evolution from at most [`SERIES_DRAWS`] pooled draws.
+
+use nalgebra::DMatrix;
+use rand::RngCore;
+use rayon::prelude::*;
+
+use super::analysis::{
+    output_stats, scalar_stats, Analysed, AnalysisError, QuantityRuns, Runs, Settings, Surrogates,
+    SURROGATE_SEED,
+};
+use super::store::Record;
+use crate::qoi::QoiSpec;
+use crate::results::{
+    ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit, OutputStats, ScalarStats,
+    VarianceSplit,
+};
+use crate::spec::Study;
+use crate::uq::method::nested::split::{self, Split};
+use crate::uq::method::nested::{marginal, Blocks, Conditional, Nested};
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling};
+use crate::uq::{moments, rng};
+
+/// Tag of the streams of the conditional chaos draws.
+const DRAWS_SEED: u64 = 0x6e65_7374_6564_0d00;
+/// Tag of the bootstrap streams.
+const BOOTSTRAP_SEED: u64 = 0x6e65_7374_6564_0b00;
+/// Most pooled draws of an output over time (memory: draws × times).
+pub const SERIES_DRAWS: usize = 4096;
+
+/// What [`analyse`] finds.
+#[derive(Clone, Debug)]
+pub struct NestedAnalysed {
+    /// Marginal statistics of every output and quantity (quantities with their split).
+    pub analysed: Analysed,
+    /// The split of every output over time.
+    pub splits: Vec<OutputSplit>,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Statistics of every output and quantity of a nested study whose points have all been run.
+pub fn analyse(
+    study: &Study,
+    method: &Nested,
+    design: &Design,
+    records: &[Option<Record>],
+) -> Result<NestedAnalysed, AnalysisError> {
+    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let settings = Settings::of(study, &surrogates);
+    let times = study.times();
+    let nt = times.len();
+    let runs = Runs::of(records);
+    if runs.rows.len() < method.min_runs() {
+        return Err(AnalysisError::TooFewRuns {
+            ok: runs.rows.len(),
+        });
+    }
+    let blocks = method
+        .blocks(design)
+        .map_err(|source| AnalysisError::Output {
+            name: "(the nested design)".into(),
+            source,
+        })?;
+    let mut out = NestedAnalysed {
+        analysed: Analysed {
+            outputs: Vec::new(),
+            quantities: Vec::new(),
+            output_chaos: Vec::new(),
+            quantity_chaos: Vec::new(),
+        },
+        splits: Vec::new(),
+        warnings: Vec::new(),
+    };
+    for (o, name) in study.outputs.iter().enumerate() {
+        let data = runs.output(o, nt);
+        let (stats, split) = output(method, &blocks, name, &times, &runs.rows, &data, &settings)?;
+        out.splits.push(split);
+        out.analysed.outputs.push(stats);
+    }
+    let base = study.outputs.len() * nt;
+    let scalars = study
+        .qoi
+        .iter()
+        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
+    for (qi, (name, q)) in scalars.enumerate() {
+        let qr = runs.quantity(base, qi);
+        if qr.valid.is_empty() {
+            return Err(AnalysisError::NoValue {
+                name,
+                never_hunts: qr.never_hunts,
+                never_stops: qr.never_stops,
+            });
+        }
+        let scalar = Scalar { name: &name, q, qi };
+        let (stats, warning) = quantity(study, method, &blocks, scalar, qr, &settings)?;
+        out.warnings.extend(warning);
+        out.analysed.quantities.push(stats);
+    }
+    Ok(out)
+}
+
+/// The marginal statistics of output `name` (its runs `data`, design rows `rows`) and its
+/// split over time.
+fn output(
+    method: &Nested,
+    blocks: &Blocks,
+    name: &str,
+    times: &[f64],
+    rows: &[usize],
+    data: &DMatrix<f64>,
+    settings: &Settings,
+) -> Result<(OutputStats, OutputSplit), AnalysisError> {
+    let nt = data.ncols();
+    let fail = |source| AnalysisError::Output {
+        name: name.to_owned(),
+        source,
+    };
+    let cond = method.conditional(blocks, rows, data).map_err(fail)?;
+    let estimate = marginal(&cond, nt).map_err(fail)?;
+    let splits: Vec<Split> = (0..nt).map(|j| Split::all(&cond.column(j))).collect();
+    let pooled = pooled_series(&cond, data, settings, nt);
+    let mut stats: OutputStats = output_stats(name, times, &estimate, Some(&pooled), settings)?;
+    stats.draws = draws_of(&cond);
+    let split = OutputSplit {
+        name: name.to_owned(),
+        times: times.to_vec(),
+        mean: stats.mean.clone(),
+        std: stats.std.clone(),
+        var_inner: splits.iter().map(|s| s.var_inner).collect(),
+        var_outer: splits.iter().map(|s| s.var_outer).collect(),
+        outer_samples: cond.present().len(),
+    };
+    Ok((stats, split))
+}
+
+/// Where the densities of the conditional estimates come from.
+fn draws_of(cond: &Conditional) -> Draws {
+    match cond.estimates.iter().flatten().next() {
+        Some(e) => e.draws,
+        None => Draws::Runs,
+    }
+}
+
+/// `n` draws of every column of outer sample `k`'s inner estimate: its runs (the rows of
+/// `data` that belong to it, all of them) or draws of its chaos.
+fn draws(cond: &Conditional, k: usize, data: &DMatrix<f64>, n: usize, seed: u64) -> DMatrix<f64> {
+    let e = cond.estimates[k].as_ref().expect("present outer sample");
+    match (&e.chaos, e.draws) {
+        (Some(pce), Draws::Chaos) => {
+            pce.sample(n, rng::stream(seed ^ DRAWS_SEED, k as u64).next_u64())
+        }
+        _ => data.select_rows(&cond.data_rows[k]),
+    }
+}
+
+/// The pooled draws of an output over time: at most [`SERIES_DRAWS`] in all, the same number
+/// from every outer sample (chaos), or every run (sampled inner designs).
+fn pooled_series(
+    cond: &Conditional,
+    data: &DMatrix<f64>,
+    settings: &Settings,
+    nt: usize,
+) -> DMatrix<f64> {
+    let present = cond.present();
+    if draws_of(cond) == Draws::Runs {
+        let rows: Vec<usize> = present
+            .iter()
+            .flat_map(|&k| cond.data_rows[k].iter().copied())
+            .collect();
+        return data.select_rows(&rows);
+    }
+    let total = settings.analysis.surrogate_samples.clamp(2, SERIES_DRAWS);
+    let per = total.div_ceil(present.len()).max(1);
+    let parts: Vec<DMatrix<f64>> = present
+        .par_iter()
+        .map(|&k| draws(cond, k, data, per, settings.seed))
+        .collect();
+    let mut pooled = DMatrix::zeros(per * parts.len(), nt);
+    for (i, p) in parts.iter().enumerate() {
+        pooled.rows_mut(i * per, per).copy_from(p);
+    }
+    pooled
+}
+
+/// One scalar quantity: its name, the `[[qoi]]` that defines it, its number among the
+/// study's scalars.
+#[derive(Clone, Copy)]
+struct Scalar<'a> {
+    name: &'a str,
+    q: &'a QoiSpec,
+    qi: usize,
+}
+
+/// The statistics of a scalar quantity and, when its corrected outer variance is negative, a
+/// note.
+fn quantity(
+    study: &Study,
+    method: &Nested,
+    blocks: &Blocks,
+    scalar: Scalar,
+    qr: QuantityRuns,
+    settings: &Settings,
+) -> Result<(ScalarStats, Option<String>), AnalysisError> {
+    let Scalar { name, q, qi } = scalar;
+    let fail = |source: MethodError| AnalysisError::Quantity {
+        name: name.to_owned(),
+        never_hunts: qr.never_hunts,
+        never_stops: qr.never_stops,
+        source,
+    };
+    let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
+    let cond = method.conditional(blocks, &qr.rows, &data).map_err(fail)?;
+    let estimate: Estimate = marginal(&cond, 1).map_err(fail)?;
+    let present = cond.present();
+    let n_draws = settings.analysis.surrogate_samples.max(2);
+    let per_outer: Vec<Vec<f64>> = present
+        .par_iter()
+        .map(|&k| {
+            draws(&cond, k, &data, n_draws, settings.seed ^ qi as u64)
+                .column(0)
+                .iter()
+                .copied()
+                .collect()
+        })
+        .collect();
+    let limits = q.limits().to_vec();
+    let exceedance: Vec<Vec<f64>> = limits
+        .iter()
+        .map(|&l| {
+            per_outer
+                .iter()
+                .map(|d| moments::exceedance_probability(d, l).0)
+                .collect()
+        })
+        .collect();
+    let c = cond.column(0);
+    let s = Split::all(&c);
+    let ci = split::bootstrap(
+        &c,
+        &exceedance,
+        split::RESAMPLES,
+        settings.seed ^ BOOTSTRAP_SEED ^ qi as u64,
+    );
+    // The same number of draws from every outer sample, so that the pool is the mixture.
+    let equal = per_outer.iter().map(Vec::len).min().unwrap_or(0);
+    let pooled: Vec<f64> = if draws_of(&cond) == Draws::Runs {
+        per_outer.iter().flatten().copied().collect()
+    } else {
+        let per = n_draws.div_ceil(present.len()).clamp(1, equal.max(1));
+        per_outer
+            .iter()
+            .flat_map(|d| d[..per].iter().copied())
+            .collect()
+    };
+    let table = conditional_table(study, blocks, &cond, &limits, &exceedance);
+    let n = present.len() as f64;
+    let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled))?;
+    stats.draws = draws_of(&cond);
+    stats.exceedance = exceedance
+        .iter()
+        .zip(&limits)
+        .map(|(p, &l)| {
+            let m = p.iter().sum::<f64>() / n;
+            let var = p.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+            (l, m, (var / n).sqrt())
+        })
+        .collect();
+    let parts = Parts {
+        split: &s,
+        ci: &ci,
+        limits: &limits,
+        exceedance: &exceedance,
+    };
+    stats.nested = Some(nested_scalar(name, parts, table));
+    let warning = (s.var_outer < 0.0).then(|| {
+        format!(
+            "{}: the estimated variance between outer samples, {:.3e}, is below the inner \
+             sampling error it is corrected for ({:.3e}); the outer share is counted as 0 \
+             (more inner runs or outer samples would resolve it)",
+            name, s.var_outer_plugin, s.correction
+        )
+    });
+    Ok((stats, warning))
+}
+
+/// The split of a quantity with its intervals and the conditional exceedance probabilities
+/// (`exceedance[l][k]`: limit `l`, outer sample `k`).
+struct Parts<'a> {
+    split: &'a Split,
+    ci: &'a split::Intervals,
+    limits: &'a [f64],
+    exceedance: &'a [Vec<f64>],
+}
+
+/// What a nested study adds to the statistics of quantity `name`.
+fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedScalar {
+    let outer = table.mean.len();
+    let Parts {
+        split: s,
+        ci,
+        limits,
+        exceedance,
+    } = parts;
+    let n = exceedance.first().map_or(0, Vec::len);
+    let (fi, fo) = s.fractions();
+    NestedScalar {
+        variance_split: VarianceSplit {
+            inner: fi,
+            outer: fo,
+            inner_ci: ci.inner,
+            outer_ci: ci.outer,
+            var_inner: s.var_inner,
+            var_outer: s.var_outer,
+            var_outer_plugin: s.var_outer_plugin,
+            correction: s.correction,
+        },
+        mean_ci: ci.mean,
+        std_ci: ci.std,
+        exceedance_ci: exceedance
+            .iter()
+            .zip(limits)
+            .zip(&ci.exceedance)
+            .map(|((p, &limit), &ci)| {
+                let mut sorted = p.clone();
+                sorted.sort_by(f64::total_cmp);
+                ExceedanceInterval {
+                    limit,
+                    p: p.iter().sum::<f64>() / n as f64,
+                    ci,
+                    conditional_min: sorted[0],
+                    conditional_median: moments::quantile(&sorted, 0.5),
+                    conditional_max: sorted[sorted.len() - 1],
+                }
+            })
+            .collect(),
+        intervals: format!(
+            "{} % percentile bootstrap over the {} outer samples ({} resamples)",
+            split::LEVEL * 100.0,
+            outer,
+            split::RESAMPLES
+        ),
+        outer_samples: outer,
+        conditional_csv: format!("{name}_conditional.csv"),
+        conditional: table,
+    }
+}
+
+/// One row per outer sample with an estimate.
+fn conditional_table(
+    study: &Study,
+    blocks: &Blocks,
+    cond: &Conditional,
+    limits: &[f64],
+    exceedance: &[Vec<f64>],
+) -> ConditionalTable {
+    let names = |idx: &[usize]| -> Vec<String> {
+        idx.iter()
+            .map(|&j| study.parameters[j].name.clone())
+            .collect()
+    };
+    let present = cond.present();
+    let est: Vec<&Estimate> = cond.estimates.iter().flatten().collect();
+    let all = |f: &dyn Fn(&Estimate) -> Option<f64>| -> Option<Vec<f64>> {
+        est.iter().map(|e| f(e)).collect()
+    };
+    let chaos = est
+        .iter()
+        .map(|e| e.chaos.as_ref())
+        .collect::<Option<Vec<_>>>()
+        .and_then(|c| {
+            let indices = c.first()?.set().indices().to_vec();
+            let coeffs = c
+                .iter()
+                .map(|p| p.coeffs.column(0).iter().copied().collect())
+                .collect();
+            Some((indices, coeffs))
+        });
+    ConditionalTable {
+        outer_names: names(&blocks.levels.outer),
+        inner_names: names(&blocks.levels.inner),
+        outer_index: present.clone(),
+        outer_values: present
+            .iter()
+            .map(|&k| blocks.outer_values[k].clone())
+            .collect(),
+        runs: present.iter().map(|&k| cond.data_rows[k].len()).collect(),
+        mean: est.iter().map(|e| e.mean[0]).collect(),
+        std: est.iter().map(|e| e.std[0]).collect(),
+        std_chaos: all(&|e| e.std_chaos.as_ref().map(|s| s[0])),
+        std_error_mean: all(&|e| e.std_error_mean.as_ref().map(|s| s[0])),
+        limits: limits.to_vec(),
+        exceedance: exceedance.to_vec(),
+        sobol_first: est
+            .iter()
+            .map(|e| e.sobol.as_ref().map(|s| s.first[0].clone()))
+            .collect(),
+        chaos,
+    }
+}

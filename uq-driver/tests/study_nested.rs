@@ -1,0 +1,332 @@
+//! Two-level (nested) studies through uq-driver on the C test FMU `Functions` with
+//! `function = 4`: y = x1 + x2² + h(seed), h a standard normal hashed from the Integer `seed`
+//! (issue 14). The references are computed here, independently of the driver: the hash is
+//! written again below (SplitMix64 + Box–Muller, as in `tests/fmus/README.md`), the inner
+//! moments are those of x1 + x2² with x1, x2 ~ N(0, 1) (mean 1, variance 1 + 2 = 3), and the
+//! exceedance probability is a one-dimensional quadrature over x2 of the normal tail of x1.
+
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+/// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
+const SEEDS: i64 = 20_000;
+
+fn splitmix64_next(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The test FMU's hashed standard normal of `seed`.
+fn hashed_normal(seed: i64) -> f64 {
+    let mut state = seed as u64;
+    let u1 = ((splitmix64_next(&mut state) >> 11) as f64 + 0.5) * 2f64.powi(-53);
+    let u2 = (splitmix64_next(&mut state) >> 11) as f64 * 2f64.powi(-53);
+    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
+}
+
+/// The complementary error function (Numerical Recipes' `erfcc`, fractional error below
+/// 1.2e-7 everywhere).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -z * z - 1.265_512_23
+        + t * (1.000_023_68
+            + t * (0.374_091_96
+                + t * (0.096_784_18
+                    + t * (-0.186_288_06
+                        + t * (0.278_868_07
+                            + t * (-1.135_203_98
+                                + t * (1.488_515_87 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
+    let r = t * poly.exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+/// P(x1 + x2² > c), x1, x2 ~ N(0, 1): ∫ φ(x2) Q(c − x2²) dx2 by the trapezoid rule on
+/// [−9, 9] (the integrand is smooth and negligible beyond).
+fn inner_exceedance(c: f64) -> f64 {
+    let n = 1800;
+    let h = 18.0 / n as f64;
+    (0..=n)
+        .map(|i| {
+            let x = -9.0 + i as f64 * h;
+            let w = if i == 0 || i == n { 0.5 } else { 1.0 };
+            let phi = (-0.5 * x * x).exp() / (2.0 * PI).sqrt();
+            w * phi * 0.5 * erfc((c - x * x) / 2f64.sqrt())
+        })
+        .sum::<f64>()
+        * h
+}
+
+fn run(args: &[&str]) -> Output {
+    let o = Command::new(DRIVER)
+        .args(args)
+        .output()
+        .expect("uq-driver runs");
+    assert!(
+        o.status.success(),
+        "uq-driver {args:?} failed:\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// A two-level study of `Functions` (function 4): `seed` outer, x1 and x2 ~ N(0, 1) inner.
+fn study(dir: &Path, fmu: &Path, name: &str, outer: &str, inner: &str) -> PathBuf {
+    let text = format!(
+        r#"name = "{name}"
+fmu = "{fmu}"
+seed = 3
+[experiment]
+stop = 0.2
+step = 0.1
+[method]
+kind = "nested"
+outer = {outer}
+inner = {inner}
+[[parameters]]
+name = "seed"
+distribution = "integer_uniform"
+low = 1
+high = {SEEDS}
+level = "outer"
+[[parameters]]
+name = "x1"
+mean = 0.0
+std = 1.0
+[[parameters]]
+name = "x2"
+mean = 0.0
+std = 1.0
+[fixed]
+function = 4
+[outputs]
+variables = ["y"]
+[[qoi]]
+kind = "final"
+name = "y_end"
+signal = "y"
+limits = [3.0]
+"#,
+        fmu = fmu.display()
+    );
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn pair(v: &serde_json::Value) -> [f64; 2] {
+    [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]
+}
+
+/// The conditional CSV as (header, rows of numbers).
+fn conditional(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("y_end_conditional.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    // The population of tracks: h over every seed of the range.
+    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let n = h.len() as f64;
+    let h_mean = h.iter().sum::<f64>() / n;
+    let var_outer = h.iter().map(|x| (x - h_mean).powi(2)).sum::<f64>() / n;
+    let var_inner = 3.0;
+    let (f_inner, f_outer) = (
+        var_inner / (var_inner + var_outer),
+        var_outer / (var_inner + var_outer),
+    );
+    let p_exact = h.iter().map(|x| inner_exceedance(3.0 - x)).sum::<f64>() / n;
+    assert!((f_outer - 0.25).abs() < 0.01, "{f_outer}");
+
+    let dir = tempfile::tempdir().unwrap();
+    // Inner collocation on 3 Gauss–Hermite nodes per input is exact for x1 + x2²: the
+    // conditional moments have no inner error, only the 2000 outer samples scatter.
+    let s = study(
+        dir.path(),
+        &fmu,
+        "two-level",
+        "{ kind = \"mc\", samples = 2000 }",
+        "{ kind = \"scm\", nodes = 3 }",
+    );
+    let out = dir.path().join("out");
+    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let q = &summary(&out)["quantities"]["y_end"];
+    let split = &q["variance_split"];
+    let (inner, outer) = (
+        split["inner"].as_f64().unwrap(),
+        split["outer"].as_f64().unwrap(),
+    );
+    let (inner_ci, outer_ci) = (pair(&split["inner_ci"]), pair(&split["outer_ci"]));
+    eprintln!(
+        "exact split {f_inner:.4} / {f_outer:.4}; estimated {inner:.4} {inner_ci:?} / \
+         {outer:.4} {outer_ci:?}; P(y > 3) exact {p_exact:.4}"
+    );
+    assert!((inner + outer - 1.0).abs() < 1e-12);
+    assert!((inner - f_inner).abs() < 0.02, "inner {inner} vs {f_inner}");
+    assert!((outer - f_outer).abs() < 0.02, "outer {outer} vs {f_outer}");
+    assert!(
+        inner_ci[0] <= f_inner && f_inner <= inner_ci[1],
+        "{inner_ci:?}"
+    );
+    assert!(
+        outer_ci[0] <= f_outer && f_outer <= outer_ci[1],
+        "{outer_ci:?}"
+    );
+    // The marginal moments with their intervals.
+    let std_exact = (var_inner + var_outer).sqrt();
+    let std_ci = pair(&q["std_ci"]);
+    assert!(
+        std_ci[0] <= std_exact && std_exact <= std_ci[1],
+        "{std_ci:?}"
+    );
+    let mean_ci = pair(&q["mean_ci"]);
+    assert!(mean_ci[0] <= 1.0 + h_mean && 1.0 + h_mean <= mean_ci[1]);
+    // The marginal P(y > 3): the mean of the conditional probabilities.
+    let e = &q["exceedance_ci"][0];
+    let (p, p_ci) = (e["p"].as_f64().unwrap(), pair(&e["ci"]));
+    assert!((p - p_exact).abs() < 0.02, "P {p} vs {p_exact}");
+    assert!(p_ci[0] <= p_exact && p_exact <= p_ci[1], "{p_ci:?}");
+
+    // Per outer sample: the seed, the exact conditional moments, the conditional P.
+    let (header, rows) = conditional(&out);
+    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    assert_eq!(rows.len(), 2000);
+    for r in rows.iter().take(200) {
+        let seed = r[col("seed")];
+        assert_eq!(seed.fract(), 0.0);
+        let hk = hashed_normal(seed as i64);
+        assert!((r[col("mean")] - (1.0 + hk)).abs() < 1e-9, "{r:?}");
+        assert!((r[col("std")] - 3f64.sqrt()).abs() < 1e-9, "{r:?}");
+        let pk = inner_exceedance(3.0 - hk);
+        // From 20 000 draws of the (exact) conditional chaos.
+        assert!((r[col("p_exceed_3")] - pk).abs() < 0.03, "{r:?} vs {pk}");
+    }
+    assert!(out.join("y_end_conditional_exceedance.svg").exists());
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(page.contains("Two-level split of y_end"));
+}
+
+/// A sampled inner design (Monte Carlo, 6 runs per outer sample) biases the plug-in variance
+/// of the conditional means by the inner sampling error (here 3/6 against a true 1); the
+/// corrected split meets the closed form all the same.
+#[test]
+fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        &fmu,
+        "two-level-mc",
+        "{ kind = \"lhs\", samples = 3000 }",
+        "{ kind = \"mc\", samples = 6 }",
+    );
+    let out = dir.path().join("out");
+    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let n = h.len() as f64;
+    let m = h.iter().sum::<f64>() / n;
+    let var_outer = h.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
+    let f_outer = var_outer / (3.0 + var_outer);
+    let split = &summary(&out)["quantities"]["y_end"]["variance_split"];
+    let outer = split["outer"].as_f64().unwrap();
+    let plugin = split["var_outer_plugin"].as_f64().unwrap();
+    let correction = split["correction"].as_f64().unwrap();
+    eprintln!("outer {outer} vs {f_outer}; plug-in {plugin}, correction {correction}");
+    assert!((correction - 0.5).abs() < 0.1, "{correction}");
+    assert!((outer - f_outer).abs() < 0.03, "outer {outer} vs {f_outer}");
+    let ci = pair(&split["outer_ci"]);
+    assert!(ci[0] <= f_outer && f_outer <= ci[1], "{ci:?}");
+}
+
+/// The same numbers run at once on two threads, interrupted and resumed on one, and split
+/// into three shards and merged: every (outer, inner) point is one record of the store.
+#[test]
+fn a_nested_study_is_the_same_resumed_and_sharded() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        &fmu,
+        "two-level-shards",
+        "{ kind = \"qmc\", samples = 4, replicates = 2 }",
+        "{ kind = \"lhs\", samples = 5 }",
+    );
+    let s = s.to_str().unwrap();
+    let whole = dir.path().join("whole");
+    run(&["run", s, "--out", whole.to_str().unwrap(), "-t", "2"]);
+    let files = [
+        "y_end_conditional.csv",
+        "y_end_samples.csv",
+        "y_end_pdf.csv",
+        "y.csv",
+        "y_split.csv",
+        "points.csv",
+    ];
+    let read = |d: &Path, f: &str| std::fs::read_to_string(d.join(f)).unwrap();
+    let split = |d: &Path| summary(d)["quantities"]["y_end"]["variance_split"].clone();
+
+    let resumed = dir.path().join("resumed");
+    let r = resumed.to_str().unwrap();
+    let o = Command::new(DRIVER)
+        .args(["run", s, "--out", r, "--max-points", "17"])
+        .output()
+        .unwrap();
+    assert!(!resumed.join("y_end_conditional.csv").exists(), "{o:?}");
+    let o = run(&["run", s, "--out", r, "-t", "1"]);
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(17 resumed)"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+
+    let plan = dir.path().join("plan");
+    let p = plan.to_str().unwrap();
+    run(&["plan", s, "--shards", "3", "--out", p]);
+    for k in ["0", "1", "2"] {
+        run(&["run-shard", p, "--shard", k]);
+    }
+    let merged = dir.path().join("merged");
+    run(&["merge", p, "--out", merged.to_str().unwrap()]);
+
+    for other in [&resumed, &merged] {
+        for f in files {
+            assert_eq!(
+                read(&whole, f),
+                read(other, f),
+                "{f} in {}",
+                other.display()
+            );
+        }
+        assert_eq!(split(&whole), split(other));
+    }
+    assert_eq!(summary(&whole)["model_runs"], 40);
+}
