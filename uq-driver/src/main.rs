@@ -146,9 +146,10 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Slurm(args) => slurm(args),
         Command::List => {
             let mut o = std::io::stdout().lock();
+            let w = BUILTINS.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
             for (name, text) in BUILTINS {
                 let s = Study::parse(text, name, None)?;
-                writeln!(o, "builtin:{name:<24} {}", s.description)?;
+                writeln!(o, "builtin:{name:<w$} {}", s.description)?;
             }
             Ok(())
         }
