@@ -785,6 +785,7 @@ def bench_parse_description(work, repeats):
              f"10 000: {fmt_s(results[10_000])} s (the Wheel as built: {fmt_s(results[0])} s). "
              f"Goal < {GOAL_PARSE_1E5:g} s for 100 000: "
              f"{goal(results[100_000] < GOAL_PARSE_1E5)}.")
+    return sec
 
 
 # ------------------------------------------------------------------ 7. VehicleTrack stepping
