@@ -17,8 +17,8 @@ use rand::RngCore;
 use rayon::prelude::*;
 
 use super::analysis::{
-    output_stats, scalar_stats, Analysed, AnalysisError, QuantityRuns, Runs, Settings, Surrogates,
-    SURROGATE_SEED,
+    output_stats, scalar_stats, surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs,
+    Settings,
 };
 use super::store::Record;
 use crate::qoi::QoiSpec;
@@ -57,7 +57,7 @@ pub fn analyse(
     design: &Design,
     records: &[Option<Record>],
 ) -> Result<NestedAnalysed, AnalysisError> {
-    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let surrogates = surrogates_of(study);
     let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();

@@ -160,6 +160,17 @@ impl<'a> Settings<'a> {
     }
 }
 
+/// The surrogate draws of `study`: streams independent of the design's, and, when the study
+/// has scalar quantities, `surrogate_samples` germ points computed at once.
+pub(crate) fn surrogates_of(study: &Study) -> Surrogates {
+    let rows = if study.qoi.is_empty() {
+        0
+    } else {
+        study.analysis.surrogate_samples
+    };
+    Surrogates::new(study.seed ^ SURROGATE_SEED).with_min_rows(rows)
+}
+
 /// Column indices of at most `max` evenly spaced columns out of `n`, always with the last.
 fn thinned(n: usize, max: usize) -> Vec<usize> {
     if n <= max {
@@ -517,7 +528,7 @@ pub fn analyse_runs(
     design: &Design,
     records: &[Option<Record>],
 ) -> Result<Analysed, AnalysisError> {
-    let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
+    let surrogates = surrogates_of(study);
     let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();
@@ -618,6 +629,7 @@ pub fn analyse_solution(
     study: &Study,
     solution: &Solution,
 ) -> Result<Vec<OutputStats>, AnalysisError> {
+    // No scalar quantities here: only the series' draws.
     let surrogates = Surrogates::new(study.seed ^ SURROGATE_SEED);
     let settings = Settings::of(study, &surrogates);
     let times = study.times();

@@ -20,6 +20,10 @@ const COLUMNS_PER_TASK: usize = 32;
 /// The basis at the germ points, per basis, grown on demand.
 pub(crate) struct Surrogates {
     seed: u64,
+    /// Rows computed at least, whatever is asked first: a study that will ask for the
+    /// scalar quantities' `surrogate_samples` draws after the series' fewer ones computes
+    /// the basis at the germ points once.
+    min_rows: usize,
     cache: Mutex<Vec<(Basis, Arc<DMatrix<f64>>)>>,
 }
 
@@ -28,7 +32,16 @@ impl Surrogates {
     pub fn new(seed: u64) -> Surrogates {
         Surrogates {
             seed,
+            min_rows: 0,
             cache: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The same, computing at least `rows` germ points whenever it computes any.
+    pub fn with_min_rows(self, rows: usize) -> Surrogates {
+        Surrogates {
+            min_rows: rows,
+            ..self
         }
     }
 
@@ -56,7 +69,7 @@ impl Surrogates {
         if let Some((_, psi)) = cache.iter().find(|(b, psi)| b == basis && psi.nrows() >= n) {
             return Arc::clone(psi);
         }
-        let psi = Arc::new(basis_at_germs(basis, n, self.seed));
+        let psi = Arc::new(basis_at_germs(basis, n.max(self.min_rows), self.seed));
         cache.retain(|(b, _)| b != basis);
         cache.push((basis.clone(), Arc::clone(&psi)));
         psi
@@ -73,8 +86,9 @@ fn basis_at_germs(basis: &Basis, n: usize, seed: u64) -> DMatrix<f64> {
         .map(|task| {
             let (i0, i1) = (task * ROWS_PER_TASK, ((task + 1) * ROWS_PER_TASK).min(n));
             let mut block = vec![0.0; (i1 - i0) * terms];
+            let mut z = vec![0.0; basis.families().len()];
             for (i, row) in (i0..i1).zip(block.chunks_exact_mut(terms.max(1))) {
-                let z = germ_draw(basis.families(), &laws, seed, i);
+                germ_draw(basis.families(), &laws, seed, i, &mut z);
                 basis.eval(&z, row);
             }
             block
@@ -120,5 +134,8 @@ mod tests {
             coeffs: DMatrix::from_element(4, 1, 1.0),
         };
         assert_eq!(s.draws(&small, 5), small.sample(5, 11));
+        // Computing more rows up front changes no draw.
+        let ahead = Surrogates::new(11).with_min_rows(2_000);
+        assert_eq!(ahead.draws(&pce, 300), s.draws(&pce, 300));
     }
 }

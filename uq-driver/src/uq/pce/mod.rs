@@ -328,22 +328,24 @@ impl Pce {
 pub fn germ_draws(families: &[Family], n: usize, seed: u64) -> Vec<Vec<f64>> {
     let laws: Vec<_> = families.iter().map(Family::law).collect();
     (0..n)
-        .map(|i| germ_draw(families, &laws, seed, i))
+        .map(|i| {
+            let mut z = vec![0.0; families.len()];
+            germ_draw(families, &laws, seed, i, &mut z);
+            z
+        })
         .collect()
 }
 
-/// Point `i` of [`germ_draws`] (`laws[j]` is `families[j].law()`): a function of
-/// `(seed, i)` only.
-pub fn germ_draw(families: &[Family], laws: &[Distribution], seed: u64, i: usize) -> Vec<f64> {
+/// Point `i` of [`germ_draws`] into `out` (`laws[j]` is `families[j].law()`): a function
+/// of `(seed, i)` only.
+pub fn germ_draw(families: &[Family], laws: &[Distribution], seed: u64, i: usize, out: &mut [f64]) {
     let mut r = rng::stream(seed, i as u64);
-    families
-        .iter()
-        .zip(laws)
-        .map(|(f, law)| match f {
+    for ((o, f), law) in out.iter_mut().zip(families).zip(laws) {
+        *o = match f {
             Family::Hermite => rng::standard_normal(&mut r),
             _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
-        })
-        .collect()
+        };
+    }
 }
 
 fn dot_column(c: &DMatrix<f64>, col: usize, psi: &[f64]) -> f64 {
