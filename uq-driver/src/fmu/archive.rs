@@ -66,19 +66,26 @@ pub fn extract_to_temp(archive: &Path) -> Result<tempfile::TempDir, FmuError> {
     Ok(dir)
 }
 
-/// Extracts what this host can use of the `.fmu` archive `archive` into the existing folder
-/// `dest`, with the default limits: every entry is checked as by [`extract`], but the binaries
-/// of other platforms (`binaries/<folder>/…` for a folder other than `host_folder`, e.g. the
-/// `win64` DLL on Linux) are not written, which saves unpacking megabytes the host cannot load.
+/// Extracts what this host needs to run the `.fmu` archive `archive` into the existing folder
+/// `dest`, with the default limits. Every entry is checked as by [`extract`], but these are
+/// not written: the binaries of other platforms (`binaries/<folder>/…` for a folder other
+/// than `host_folder`, e.g. the `win64` DLL on Linux), `documentation/`, `sources/` and the
+/// icon `model.png`, which no importer runs. That saves unpacking megabytes, and creating
+/// and deleting folders (slow on some file systems), on every opening of the FMU.
 pub fn extract_for_host(archive: &Path, dest: &Path, host_folder: &str) -> Result<(), FmuError> {
     extract_filtered(archive, dest, ExtractLimits::default(), &|relative| {
-        let mut parts = relative.components();
-        let top = parts.next().map(|c| c.as_os_str());
-        let folder = parts.next().map(|c| c.as_os_str());
-        // A file directly in binaries/ (no platform folder) is kept.
-        !(top == Some("binaries".as_ref())
-            && parts.next().is_some()
-            && folder.is_some_and(|f| f != host_folder))
+        let mut parts = relative.components().map(|c| c.as_os_str());
+        let top = parts.next();
+        let second = parts.next();
+        let nested = parts.next().is_some();
+        let other_binary =
+            top == Some("binaries".as_ref()) && nested && second.is_some_and(|f| f != host_folder);
+        let unused = match top.and_then(|t| t.to_str()) {
+            Some("documentation" | "sources") => second.is_some(),
+            Some("model.png") => second.is_none(),
+            _ => false,
+        };
+        !(other_binary || unused)
     })
 }
 
@@ -372,7 +379,7 @@ mod tests {
     }
 
     #[test]
-    fn other_platforms_binaries_are_not_unpacked() {
+    fn what_no_importer_runs_is_not_unpacked() {
         let dir = tempfile::tempdir().unwrap();
         let fmu = dir.path().join("a.fmu");
         write_zip(
@@ -384,6 +391,11 @@ mod tests {
                 ("binaries/darwin64/sub/m.dylib", b"dylib"),
                 ("binaries/notes.txt", b"n"),
                 ("resources/win64/data.txt", b"r"),
+                ("resources/documentation/d.txt", b"r"),
+                ("documentation/index.html", b"d"),
+                ("sources/m.c", b"c"),
+                ("model.png", b"p"),
+                ("extra/x.txt", b"x"),
             ],
         );
         let out = tempfile::tempdir().unwrap();
@@ -391,7 +403,9 @@ mod tests {
         let has = |p: &str| out.path().join(p).exists();
         assert!(has("modelDescription.xml") && has("binaries/linux64/m.so"));
         assert!(has("binaries/notes.txt") && has("resources/win64/data.txt"));
+        assert!(has("resources/documentation/d.txt") && has("extra/x.txt"));
         assert!(!has("binaries/win64") && !has("binaries/darwin64"));
+        assert!(!has("documentation") && !has("sources") && !has("model.png"));
         // Entries that are not unpacked are still checked.
         let bad = dir.path().join("bad.fmu");
         write_zip(&bad, &[("binaries/win64/../../../evil.dll", b"x")]);
