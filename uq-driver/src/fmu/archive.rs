@@ -72,12 +72,27 @@ pub fn extract_to_temp(archive: &Path) -> Result<tempfile::TempDir, FmuError> {
 /// than `host_folder`, e.g. the `win64` DLL on Linux), `documentation/`, `sources/` and the
 /// icon `model.png`, which no importer runs. That saves unpacking megabytes, and creating
 /// and deleting folders (slow on some file systems), on every opening of the FMU.
-pub fn extract_for_host(archive: &Path, dest: &Path, host_folder: &str) -> Result<(), FmuError> {
+///
+/// Returns the platform folders the archive has binaries in (`binaries/<folder>/…`), sorted,
+/// for a message when this host's binary is missing.
+pub fn extract_for_host(
+    archive: &Path,
+    dest: &Path,
+    host_folder: &str,
+) -> Result<Vec<String>, FmuError> {
+    let platforms = std::cell::RefCell::new(std::collections::BTreeSet::new());
     extract_filtered(archive, dest, ExtractLimits::default(), &|relative| {
         let mut parts = relative.components().map(|c| c.as_os_str());
         let top = parts.next();
         let second = parts.next();
         let nested = parts.next().is_some();
+        if let (Some("binaries"), Some(folder), true) =
+            (top.and_then(|t| t.to_str()), second, nested)
+        {
+            platforms
+                .borrow_mut()
+                .insert(folder.to_string_lossy().into_owned());
+        }
         let other_binary =
             top == Some("binaries".as_ref()) && nested && second.is_some_and(|f| f != host_folder);
         let unused = match top.and_then(|t| t.to_str()) {
@@ -86,7 +101,8 @@ pub fn extract_for_host(archive: &Path, dest: &Path, host_folder: &str) -> Resul
             _ => false,
         };
         !(other_binary || unused)
-    })
+    })?;
+    Ok(platforms.into_inner().into_iter().collect())
 }
 
 /// Extracts `archive` into the existing folder `dest`, refusing unsafe entries and archives that
@@ -399,7 +415,8 @@ mod tests {
             ],
         );
         let out = tempfile::tempdir().unwrap();
-        extract_for_host(&fmu, out.path(), "linux64").unwrap();
+        let platforms = extract_for_host(&fmu, out.path(), "linux64").unwrap();
+        assert_eq!(platforms, ["darwin64", "linux64", "win64"]);
         let has = |p: &str| out.path().join(p).exists();
         assert!(has("modelDescription.xml") && has("binaries/linux64/m.so"));
         assert!(has("binaries/notes.txt") && has("resources/win64/data.txt"));

@@ -105,7 +105,7 @@ impl Fmu {
         };
         let metadata = fs::metadata(path).map_err(io)?;
         if metadata.is_dir() {
-            return Self::load(path, path, None);
+            return Self::load(path, path, None, None);
         }
         // Registered as it is created: a signal during a long extraction still removes it.
         let dir = cleanup::temp_dir("uq-fmu-").map_err(|source| FmuError::Io {
@@ -113,26 +113,35 @@ impl Fmu {
             source,
         })?;
         let dir = Extracted(Some(dir));
-        {
+        let archived_platforms = {
             let _filling = cleanup::filling();
             match binary::platform() {
-                Ok((host, _)) => archive::extract_for_host(path, dir.path(), host)?,
+                Ok((host, _)) => Some(archive::extract_for_host(path, dir.path(), host)?),
                 // No binary folder is this host's: extract all, loading reports it.
-                Err(_) => archive::extract(path, dir.path())?,
+                Err(_) => {
+                    archive::extract(path, dir.path())?;
+                    None
+                }
             }
-        }
+        };
         let root = dir.path().to_path_buf();
-        Self::load(path, &root, Some(dir))
+        Self::load(path, &root, Some(dir), archived_platforms)
     }
 
     /// Opens the FMU extracted in the folder `root` (used in place), naming it `shown` in
     /// messages and in [`Fmu::path`] (e.g. the `.fmu` another process extracted it from).
     pub fn open_extracted(root: &Path, shown: &Path) -> Result<Fmu, FmuError> {
-        Self::load(shown, root, None)
+        Self::load(shown, root, None, None)
     }
 
-    /// Loads the FMU extracted in `root`; `path` is what the user gave.
-    fn load(path: &Path, root: &Path, extracted: Option<Extracted>) -> Result<Fmu, FmuError> {
+    /// Loads the FMU extracted in `root`; `path` is what the user gave; `archived_platforms`,
+    /// the platform folders of its archive's binaries when not all were unpacked.
+    fn load(
+        path: &Path,
+        root: &Path,
+        extracted: Option<Extracted>,
+        archived_platforms: Option<Vec<String>>,
+    ) -> Result<Fmu, FmuError> {
         let io = |source| FmuError::Io {
             path: path.to_path_buf(),
             source,
@@ -170,7 +179,7 @@ impl Fmu {
             return Err(FmuError::MissingBinary {
                 path: path.to_path_buf(),
                 expected: relative,
-                available: platform_folders(&root),
+                available: archived_platforms.unwrap_or_else(|| platform_folders(&root)),
             });
         }
         // Name the binary by its place in the FMU, not in the temporary folder.
