@@ -20,7 +20,7 @@ use super::analysis::{
     output_stats, scalar_stats, surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs,
     Settings,
 };
-use super::store::Record;
+use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
 use crate::results::{
     ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit, OutputStats, ScalarStats,
@@ -55,7 +55,7 @@ pub fn analyse(
     study: &Study,
     method: &Nested,
     design: &Design,
-    records: &[Option<Record>],
+    records: &StoredRuns,
 ) -> Result<NestedAnalysed, AnalysisError> {
     let surrogates = surrogates_of(study);
     let settings = Settings::of(study, &surrogates);
