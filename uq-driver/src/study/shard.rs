@@ -17,10 +17,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::lock::FolderLock;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::single::{finish, open_fmu};
-use super::lock::FolderLock;
 use super::store::{Manifest, Store, StoreError, StoredRuns};
 use crate::spec::Study;
 use crate::uq::method::{Design, Evaluation, Sampling};
@@ -262,8 +262,8 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
             continue;
         }
         shard_runs.resize_with(k + 1, || None);
-        let opened = Store::open_in_place(&sdir, &p.manifest, false)
-            .and_then(|(store, _)| store.runs(n));
+        let opened =
+            Store::open_in_place(&sdir, &p.manifest, false).and_then(|(store, _)| store.runs(n));
         let recs = opened.map_err(|e| match e {
             StoreError::Mismatch { what, .. } => ShardError::Shard(format!(
                 "shard {k} ({}) does not belong to this plan: {what}",

@@ -62,7 +62,10 @@ pub fn merge(mut parts: Vec<Estimate>) -> Result<Estimate, MethodError> {
             ))
         });
     }
-    fn cat<T: Clone>(parts: &[Estimate], f: impl Fn(&Estimate) -> Option<&Vec<T>>) -> Option<Vec<T>> {
+    fn cat<T: Clone>(
+        parts: &[Estimate],
+        f: impl Fn(&Estimate) -> Option<&Vec<T>>,
+    ) -> Option<Vec<T>> {
         let mut out = Vec::new();
         for p in parts {
             out.extend_from_slice(f(p)?);
@@ -186,7 +189,10 @@ mod tests {
 
     #[test]
     fn blocks_cover_the_columns_in_aligned_widths() {
-        assert_eq!(blocks(70, 32).collect::<Vec<_>>(), vec![(0, 32), (32, 32), (64, 6)]);
+        assert_eq!(
+            blocks(70, 32).collect::<Vec<_>>(),
+            vec![(0, 32), (32, 32), (64, 6)]
+        );
         assert_eq!(blocks(5, 5).collect::<Vec<_>>(), vec![(0, 5)]);
         // A block of 10 000 rows of 501 columns fits the default budget: one block.
         if std::env::var_os("RAILUQ_ANALYSIS_BLOCK_BYTES").is_none() {
@@ -203,7 +209,10 @@ mod tests {
         let sets: Vec<(Vec<Vec<usize>>, Vec<f64>)> = vec![
             (vec![vec![0, 0], vec![1, 0]], vec![1.0, 0.5]),
             (vec![vec![0, 0], vec![0, 2]], vec![2.0, -0.25]),
-            (vec![vec![0, 0], vec![1, 1], vec![1, 0]], vec![3.0, 0.125, 0.75]),
+            (
+                vec![vec![0, 0], vec![1, 1], vec![1, 0]],
+                vec![3.0, 0.125, 0.75],
+            ),
         ];
         let families = vec![Family::Hermite, Family::Legendre];
         let all = Pce::from_columns(families.clone(), &sets).unwrap();

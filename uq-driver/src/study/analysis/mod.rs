@@ -197,7 +197,8 @@ pub(crate) fn output_stats(
         (Draws::Runs, None) => return Err(AnalysisError::NoDraws(name.to_owned())),
         (Draws::Chaos, _) => chaos_columns(name, estimate, settings, &mut cols)?,
     }
-    let run_column = |k: usize| runs.map_or_else(Vec::new, |r| r.column(k).iter().copied().collect());
+    let run_column =
+        |k: usize| runs.map_or_else(Vec::new, |r| r.column(k).iter().copied().collect());
     summarise(name, times, estimate, cols, &run_column, settings)
 }
 
@@ -605,7 +606,8 @@ pub fn analyse_runs(
     let mut outputs = Vec::new();
     let mut output_chaos = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let (estimate, stats) = output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
+        let (estimate, stats) =
+            output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
         outputs.push(stats);
         if let Some(pce) = estimate.chaos {
             output_chaos.push(NamedChaos {

@@ -231,7 +231,12 @@ pub fn values_of(payload: &[u8]) -> Vec<f64> {
 }
 
 /// The record a checksummed frame at `pos` holds, or why it cannot be used.
-fn interpret(f: &Frame<'_>, pos: usize, head: usize, n_values: usize) -> Result<(usize, Slot), String> {
+fn interpret(
+    f: &Frame<'_>,
+    pos: usize,
+    head: usize,
+    n_values: usize,
+) -> Result<(usize, Slot), String> {
     let index = usize::try_from(f.index).map_err(|_| format!("point {} out of range", f.index))?;
     match f.kind {
         0 if Some(f.payload.len()) == n_values.checked_mul(8) => {

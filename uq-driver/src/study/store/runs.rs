@@ -185,7 +185,10 @@ mod tests {
             (0, Record::Failed("b".into())),
             (7, Record::Ok(vec![0.0, 0.0])),
         ];
-        let bytes: Vec<u8> = recs.iter().flat_map(|(i, r)| format::encode(*i, r)).collect();
+        let bytes: Vec<u8> = recs
+            .iter()
+            .flat_map(|(i, r)| format::encode(*i, r))
+            .collect();
         std::fs::write(&path, &bytes).unwrap();
         let runs = StoredRuns::open(&path, 4, 2).unwrap();
         assert_eq!(runs.record(0), Some(Record::Failed("b".into())));
@@ -200,6 +203,9 @@ mod tests {
         let same = StoredRuns::from_records(&runs.records(), 2);
         assert_eq!(same.records(), runs.records());
         std::fs::write(&path, b"").unwrap();
-        assert_eq!(StoredRuns::open(&path, 2, 2).unwrap().records(), vec![None, None]);
+        assert_eq!(
+            StoredRuns::open(&path, 2, 2).unwrap().records(),
+            vec![None, None]
+        );
     }
 }
