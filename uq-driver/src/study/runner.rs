@@ -216,7 +216,7 @@ pub struct RunOutcome {
 
 impl RunOutcome {
     /// Every record read into memory (small studies and tests: this holds every series).
-    pub fn records(&self) -> Vec<Option<Record>> {
+    pub fn records(&self) -> Result<Vec<Option<Record>>, StoreError> {
         self.runs.records()
     }
 }
@@ -256,7 +256,8 @@ pub fn run_points(
             out_dir.display()
         );
     }
-    let (store, records) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
+    let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
+    let records = runs.entries();
     if let Some(note) = store.recovery().summary() {
         eprintln!("warning: {note}");
     }
@@ -266,7 +267,7 @@ pub fn run_points(
     };
     let failed_before = wanted
         .iter()
-        .filter(|&&i| records[i] == Some(false))
+        .filter(|&&i| matches!(records[i], Some(Entry::Failed(_))))
         .count();
     if failed_before > 0 && !opts.retry_failed {
         eprintln!(
@@ -282,8 +283,8 @@ pub fn run_points(
         .copied()
         .filter(|&i| match records[i] {
             None => true,
-            Some(false) => opts.retry_failed,
-            Some(true) => false,
+            Some(Entry::Failed(_)) => opts.retry_failed,
+            Some(Entry::Ok(_)) => false,
         })
         .collect();
     let threads = opts
@@ -336,10 +337,14 @@ pub fn run_points(
         new
     })?;
     progress.finish();
+    let n_new = new.len();
+    for (i, e) in new {
+        runs.set(i, e);
+    }
     Ok(RunOutcome {
-        runs: store.runs(design.len())?,
+        runs,
         lock: Some(lock),
-        n_new: new,
+        n_new,
         n_resumed: wanted.len() - missing.len(),
         wall_time: started.elapsed().as_secs_f64(),
         threads,
@@ -406,8 +411,9 @@ struct Batch<'a> {
 }
 
 impl Batch<'_> {
-    /// Runs `points`; returns how many finished (their records are in the store only).
-    fn run(&self, points: &[usize], progress: &Progress) -> Result<usize, RunError> {
+    /// Runs `points`; returns where the result of each finished one is in the store (the
+    /// values are not kept).
+    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Entry)>, RunError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
         points
@@ -415,14 +421,14 @@ impl Batch<'_> {
             .with_min_len(1)
             .map_init(
                 || None::<Instance>,
-                |slot, &i| -> Result<usize, RunError> {
+                |slot, &i| -> Result<Option<(usize, Entry)>, RunError> {
                     if stop.load(Ordering::Relaxed) {
-                        return Ok(0);
+                        return Ok(None);
                     }
                     if let Some(max) = self.max_new {
                         if started.fetch_add(1, Ordering::SeqCst) >= max {
                             stop.store(true, Ordering::Relaxed);
-                            return Ok(0);
+                            return Ok(None);
                         }
                     }
                     let rec = match self.run_one(slot, i) {
@@ -435,12 +441,13 @@ impl Batch<'_> {
                     if matches!(rec, Record::Failed(_)) && self.stop_on_failure {
                         stop.store(true, Ordering::Relaxed);
                     }
-                    self.store.append(i, &rec)?;
+                    let entry = self.store.append(i, &rec)?;
                     progress.inc();
-                    Ok(1)
+                    Ok(Some((i, entry)))
                 },
             )
-            .try_reduce(|| 0, |a, b| Ok(a + b))
+            .filter_map(Result::transpose)
+            .collect()
     }
 
     /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.

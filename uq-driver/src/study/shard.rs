@@ -262,8 +262,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
             continue;
         }
         shard_runs.resize_with(k + 1, || None);
-        let opened =
-            Store::open_in_place(&sdir, &p.manifest, false).and_then(|(store, _)| store.runs(n));
+        let opened = Store::open_in_place(&sdir, &p.manifest, false).map(|(_, runs)| runs);
         let recs = opened.map_err(|e| match e {
             StoreError::Mismatch { what, .. } => ShardError::Shard(format!(
                 "shard {k} ({}) does not belong to this plan: {what}",
@@ -311,17 +310,19 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     // The merged store makes `out` look like (and resume like) a single-machine run.
     runner::prepare_out_dir(out).map_err(StudyRunError::Run)?;
     let lock = FolderLock::acquire(out).map_err(|e| StudyRunError::Run(e.into()))?;
-    let (store, _) = Store::open_in_place(out, &p.manifest, true).map_err(RunError::from)?;
+    let (store, mut runs) = Store::open_in_place(out, &p.manifest, true).map_err(RunError::from)?;
     for (i, k) in owner.iter().enumerate() {
-        let rec = k
-            .and_then(|k| shard_runs[k].as_ref())
-            .and_then(|r| r.record(i))
-            .expect("checked complete");
-        store.append(i, &rec).map_err(RunError::from)?;
+        let shard = k.and_then(|k| shard_runs[k].as_ref());
+        let rec = shard
+            .map(|r| r.record(i))
+            .transpose()
+            .map_err(RunError::from)?;
+        let rec = rec.flatten().expect("checked complete");
+        runs.set(i, store.append(i, &rec).map_err(RunError::from)?);
     }
     drop(shard_runs);
     let outcome = RunOutcome {
-        runs: store.runs(n).map_err(RunError::from)?,
+        runs,
         lock: Some(lock),
         n_new: 0,
         n_resumed: n,

@@ -188,7 +188,8 @@ impl fmt::Display for Recovery {
 #[derive(Debug)]
 pub struct Store {
     path: PathBuf,
-    file: Mutex<File>,
+    /// The file, and its length (where the next record starts).
+    file: Mutex<(File, usize)>,
     n_values: usize,
     recovery: Recovery,
 }
@@ -218,19 +219,20 @@ impl Store {
         manifest: &Manifest,
         fresh: bool,
     ) -> Result<(Store, Vec<Option<Record>>), StoreError> {
-        let (store, _) = Store::open_in_place(dir, manifest, fresh)?;
-        let runs = store.runs(manifest.n_points)?;
-        Ok((store, runs.records()))
+        let (store, runs) = Store::open_in_place(dir, manifest, fresh)?;
+        let records = runs.records()?;
+        Ok((store, records))
     }
 
-    /// Like [`Store::open`], but only says which points are finished (`Some(true)`), failed
-    /// (`Some(false)`) or not run (`None`): nothing of the values is held (the file is
-    /// read through a memory map).
+    /// Like [`Store::open`], but the values stay in the file: the runs found say where
+    /// ([`StoredRuns`]). The file is scanned through a memory map (its pages are the page
+    /// cache's, not this process's heap), and copied into memory only to repair a damaged
+    /// or convert an old store.
     pub fn open_in_place(
         dir: &Path,
         manifest: &Manifest,
         fresh: bool,
-    ) -> Result<(Store, Vec<Option<bool>>), StoreError> {
+    ) -> Result<(Store, StoredRuns), StoreError> {
         let sdir = dir.join("store");
         if fresh && sdir.exists() {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
@@ -255,7 +257,7 @@ impl Store {
         let bytes: &[u8] = map.as_deref().unwrap_or_default();
 
         let fmt = format::detect_format(bytes);
-        let (done, kept, skipped) = read_records(bytes, fmt, manifest);
+        let (mut done, kept, skipped) = read_records(bytes, fmt, manifest);
         let mut recovery = Recovery {
             path: path.clone(),
             kept: kept.len(),
@@ -265,18 +267,23 @@ impl Store {
         let valid_end = kept.last().map_or(0, |(_, r)| r.end);
         let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
         let found = bytes.len();
+        let mut len = found;
         if fmt == Format::V1 || damage_inside {
             let out = kept_bytes(bytes, fmt, &kept, &done);
             drop(map);
             let (new_file, backup) = rewrite(&path, &label(fmt), &out)?;
             file = new_file;
             recovery.backup = Some(backup);
+            // Where each point's values are now.
+            done = read_records(&out, Format::V2, manifest).0;
+            len = out.len();
         } else if valid_end < found {
             drop(map);
             // A torn tail from an interrupted write (or a damaged last record): cut it off.
             file.set_len(valid_end as u64).map_err(io_err(&path))?;
             file.seek(SeekFrom::End(0)).map_err(io_err(&path))?;
             recovery.truncated = Some((found - valid_end) as u64);
+            len = valid_end;
         }
 
         let mut rerun: Vec<usize> = skipped
@@ -289,26 +296,17 @@ impl Store {
         recovery.rerun = rerun;
         recovery.skipped = skipped;
         recovery.missing = done.iter().filter(|r| r.is_none()).count();
-        let status = done
-            .iter()
-            .map(|d| d.as_ref().map(|s| matches!(s, Slot::Ok(_))))
-            .collect();
+        let entries = done.into_iter().map(|d| d.map(Entry::of)).collect();
+        let runs = StoredRuns::in_file(&path, manifest.n_values, entries)?;
         Ok((
             Store {
                 path,
-                file: Mutex::new(file),
+                file: Mutex::new((file, len)),
                 n_values: manifest.n_values,
                 recovery,
             },
-            status,
+            runs,
         ))
-    }
-
-    /// The results in the store now, read in place (see [`StoredRuns`]), for a design of
-    /// `n_points` points.
-    pub fn runs(&self, n_points: usize) -> Result<StoredRuns, StoreError> {
-        // Everything appended is in the file: each record is one write.
-        StoredRuns::open(&self.path, n_points, self.n_values)
     }
 
     /// What opening skipped or repaired (empty for an intact store).
@@ -316,14 +314,22 @@ impl Store {
         &self.recovery
     }
 
-    /// Appends one record (one write call per record, under a lock).
-    pub fn append(&self, index: usize, rec: &Record) -> Result<(), StoreError> {
+    /// Appends one record (one write call per record, under a lock); returns where it is
+    /// (for [`StoredRuns::set`]).
+    pub fn append(&self, index: usize, rec: &Record) -> Result<Entry, StoreError> {
         if let Record::Ok(v) = rec {
             debug_assert_eq!(v.len(), self.n_values);
         }
         let bytes = encode(index, rec);
         let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
-        f.write_all(&bytes).map_err(io_err(&self.path))
+        let (file, len) = &mut *f;
+        file.write_all(&bytes).map_err(io_err(&self.path))?;
+        let start = *len;
+        *len += bytes.len();
+        Ok(match rec {
+            Record::Ok(_) => Entry::Ok(format::payload_range(start, bytes.len())),
+            Record::Failed(m) => Entry::Failed(m.clone()),
+        })
     }
 }
 

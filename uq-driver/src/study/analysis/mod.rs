@@ -100,6 +100,9 @@ pub enum AnalysisError {
         /// Further advice.
         more: &'static str,
     },
+    /// The results store could not be read.
+    #[error(transparent)]
+    Store(#[from] super::store::StoreError),
     /// An estimate asks for draws it cannot give.
     #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
     NoDraws(String),
@@ -198,7 +201,7 @@ pub(crate) fn output_stats(
         (Draws::Chaos, _) => chaos_columns(name, estimate, settings, &mut cols)?,
     }
     let run_column =
-        |k: usize| runs.map_or_else(Vec::new, |r| r.column(k).iter().copied().collect());
+        |k: usize| Ok(runs.map_or_else(Vec::new, |r| r.column(k).iter().copied().collect()));
     summarise(name, times, estimate, cols, &run_column, settings)
 }
 
@@ -243,7 +246,7 @@ fn summarise(
     times: &[f64],
     estimate: &Estimate,
     series: SeriesColumns,
-    run_column: &dyn Fn(usize) -> Vec<f64>,
+    run_column: &dyn Fn(usize) -> Result<Vec<f64>, AnalysisError>,
     settings: &Settings,
 ) -> Result<OutputStats, AnalysisError> {
     let a = settings.analysis;
@@ -303,13 +306,11 @@ fn summarise(
     let k_max = (0..estimate.std.len())
         .max_by(|&i, &j| estimate.std[i].total_cmp(&estimate.std[j]))
         .filter(|_| !deterministic);
-    let convergence = k_max.and_then(|k| {
-        let runs = match estimate.draws {
-            Draws::Runs => run_column(k),
-            Draws::Chaos => Vec::new(),
-        };
-        convergence(estimate, k, &runs)
-    });
+    let convergence = match (k_max, estimate.draws) {
+        (Some(k), Draws::Runs) => convergence(estimate, k, &run_column(k)?),
+        (Some(k), Draws::Chaos) => convergence(estimate, k, &[]),
+        (None, _) => None,
+    };
     Ok(OutputStats {
         name: name.to_owned(),
         times: times.to_vec(),
@@ -512,44 +513,66 @@ impl<'a> Runs<'a> {
     }
 
     /// Output `o` (of `nt` times each) as runs × times.
-    pub(crate) fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
+    pub(crate) fn output(&self, o: usize, nt: usize) -> Result<DMatrix<f64>, AnalysisError> {
         self.block(o, nt, 0, nt)
     }
 
-    /// Columns `j0..j0 + w` of output `o` (of `nt` times each) as runs × times; groups of
-    /// columns are read in parallel, each run's values of a group at once.
-    pub(crate) fn block(&self, o: usize, nt: usize, j0: usize, w: usize) -> DMatrix<f64> {
+    /// Columns `j0..j0 + w` of output `o` (of `nt` times each) as runs × times: each run's
+    /// values read at once (runs in parallel), then turned column-major (groups of columns
+    /// in parallel).
+    pub(crate) fn block(
+        &self,
+        o: usize,
+        nt: usize,
+        j0: usize,
+        w: usize,
+    ) -> Result<DMatrix<f64>, AnalysisError> {
+        const ROWS: usize = 256;
         const GROUP: usize = 64;
         let n = self.rows.len();
         let mut m = DMatrix::<f64>::zeros(n, w);
         if n == 0 || w == 0 {
-            return m;
+            return Ok(m);
         }
         let first = o * nt + j0;
+        let mut by_row = vec![0.0; n * w];
+        by_row
+            .par_chunks_mut(ROWS * w)
+            .zip(self.values.par_chunks(ROWS))
+            .try_for_each(|(out, values)| {
+                for (row, v) in out.chunks_exact_mut(w).zip(values) {
+                    v.try_read_into(first..first + w, row)?;
+                }
+                Ok::<(), AnalysisError>(())
+            })?;
         m.as_mut_slice()
             .par_chunks_mut(n * GROUP)
             .enumerate()
             .for_each(|(g, out)| {
                 let c0 = g * GROUP;
-                let gw = out.len() / n;
-                let mut buf = [0.0; GROUP];
-                for (r, v) in self.values.iter().enumerate() {
-                    v.read_into(first + c0..first + c0 + gw, &mut buf[..gw]);
-                    for (k, x) in buf[..gw].iter().enumerate() {
-                        out[k * n + r] = *x;
+                for (k, col) in out.chunks_exact_mut(n).enumerate() {
+                    for (r, x) in col.iter_mut().enumerate() {
+                        *x = by_row[r * w + c0 + k];
                     }
                 }
             });
-        m
+        Ok(m)
     }
 
     /// Column `k` of output `o` (of `nt` times each) over the runs.
-    pub(crate) fn column(&self, o: usize, nt: usize, k: usize) -> Vec<f64> {
-        self.values.iter().map(|v| v.get(o * nt + k)).collect()
+    pub(crate) fn column(&self, o: usize, nt: usize, k: usize) -> Result<Vec<f64>, AnalysisError> {
+        self.values
+            .iter()
+            .map(|v| {
+                let mut x = [0.0];
+                v.try_read_into(o * nt + k..o * nt + k + 1, &mut x)?;
+                Ok(x[0])
+            })
+            .collect()
     }
 
     /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
-    pub(crate) fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
+    pub(crate) fn quantity(&self, base: usize, qi: usize) -> Result<QuantityRuns, AnalysisError> {
         let mut out = QuantityRuns {
             rows: Vec::new(),
             valid: Vec::new(),
@@ -557,16 +580,18 @@ impl<'a> Runs<'a> {
             never_stops: 0,
         };
         for (&row, v) in self.rows.iter().zip(&self.values) {
-            match Code::from_f64(v.get(base + 2 * qi + 1)) {
+            let mut pair = [0.0; 2];
+            v.try_read_into(base + 2 * qi..base + 2 * qi + 2, &mut pair)?;
+            match Code::from_f64(pair[1]) {
                 Code::Ok => {
                     out.rows.push(row);
-                    out.valid.push(v.get(base + 2 * qi));
+                    out.valid.push(pair[0]);
                 }
                 Code::NeverHunts => out.never_hunts += 1,
                 Code::NeverStops => out.never_stops += 1,
             }
         }
-        out
+        Ok(out)
     }
 }
 
@@ -626,7 +651,7 @@ pub fn analyse_runs(
         .iter()
         .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
     for (qi, (name, q)) in scalars.enumerate() {
-        let qr = runs.quantity(base, qi);
+        let qr = runs.quantity(base, qi)?;
         let outside = |more| match q {
             QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
                 name: name.clone(),
@@ -695,7 +720,7 @@ fn output_in_blocks(
     let mut cols = series_columns(nt, settings);
     let mut parts = Vec::new();
     for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
-        let data = runs.block(o, nt, j0, w);
+        let data = runs.block(o, nt, j0, w)?;
         let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
         if estimate.draws == Draws::Runs {
             cols.add(j0, &data);

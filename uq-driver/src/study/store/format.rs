@@ -93,6 +93,11 @@ pub fn encode(index: usize, rec: &Record) -> Vec<u8> {
     out
 }
 
+/// The payload bytes of a format-2 record of `len` bytes that starts at `start`.
+pub fn payload_range(start: usize, len: usize) -> Range<usize> {
+    start + HEADER..start + len - TRAILER
+}
+
 /// One framed record, checksums verified.
 struct Frame<'a> {
     index: u64,

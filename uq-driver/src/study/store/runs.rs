@@ -1,13 +1,13 @@
-//! The finished points of a study read in place: the store file is memory-mapped and only
-//! the position of each point's values is held, so the runs of a study need not fit in memory
-//! (issue 12). The analysis reads the values it needs, a block of time columns at a time
-//! ([`StoredRuns::values`]); the operating system pages the file in and out.
+//! The finished points of a study, their values left in the store file: only the position
+//! of each point's values is held, so the runs of a study need not fit in memory (issue 12).
+//! The analysis reads the values it needs, a block of time columns at a time
+//! ([`Values::read_into`], positioned reads of the file: they go through the page cache and
+//! count in no process's memory).
 
 use std::fs::File;
 use std::ops::Range;
+use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
-
-use memmap2::Mmap;
 
 use super::format::{self, Format, Slot};
 use super::{Record, StoreError};
@@ -21,46 +21,51 @@ pub enum Entry {
     Failed(String),
 }
 
-/// The bytes the entries point into.
-#[derive(Debug)]
-enum Bytes {
-    /// The store file, mapped.
-    Mapped(Mmap),
-    /// Bytes in memory (records built in memory, an empty file).
-    Owned(Vec<u8>),
+impl Entry {
+    /// The entry of a record found at `slot`.
+    pub fn of(slot: Slot) -> Entry {
+        match slot {
+            Slot::Ok(r) => Entry::Ok(r),
+            Slot::Failed(m) => Entry::Failed(m),
+        }
+    }
 }
 
-/// The result of every point of a design, read in place from a results store.
+/// Where the values are.
+#[derive(Debug)]
+enum Source {
+    /// The store file (read with positioned reads).
+    File(File, PathBuf),
+    /// Bytes in memory (records built in memory).
+    Bytes(Vec<u8>),
+}
+
+/// The result of every point of a design, the values read from the results store on demand.
 #[derive(Debug)]
 pub struct StoredRuns {
-    bytes: Bytes,
+    source: Source,
     n_values: usize,
     entries: Vec<Option<Entry>>,
 }
 
 impl StoredRuns {
-    /// The store file `path` of a design of `n_points` points recording `n_values` values
-    /// each: per point, its first successful record, else its last failure (the rule of
-    /// [`Store::open`](super::Store::open)); damaged stretches are skipped. The file must not
-    /// be shortened while this is alive (the study holds its folder's lock; see
-    /// [`super::super::lock`]).
-    pub fn open(path: &Path, n_points: usize, n_values: usize) -> Result<StoredRuns, StoreError> {
-        let io = |source| StoreError::Io {
-            path: PathBuf::from(path),
+    /// The runs of the store file `path` whose points have these `entries` (from
+    /// [`Store::open_in_place`](super::Store::open_in_place) and the appends since). The
+    /// file must keep the bytes the entries name (the study holds its folder's lock).
+    pub fn in_file(
+        path: &Path,
+        n_values: usize,
+        entries: Vec<Option<Entry>>,
+    ) -> Result<StoredRuns, StoreError> {
+        let file = File::open(path).map_err(|source| StoreError::Io {
+            path: path.to_path_buf(),
             source,
-        };
-        let file = File::open(path).map_err(io)?;
-        let len = file.metadata().map_err(io)?.len();
-        let bytes = if len == 0 {
-            Bytes::Owned(Vec::new())
-        } else {
-            // SAFETY: the map is read-only and only read as bytes; the store file is only
-            // appended to (never shortened or rewritten in place) while a study holds its
-            // folder's lock, which the caller holds (or, for a finished shard, no run writes).
-            // Bytes appended after mapping are not seen.
-            Bytes::Mapped(unsafe { Mmap::map(&file) }.map_err(io)?)
-        };
-        Ok(StoredRuns::index(bytes, n_points, n_values))
+        })?;
+        Ok(StoredRuns {
+            source: Source::File(file, path.to_path_buf()),
+            n_values,
+            entries,
+        })
     }
 
     /// The same from records in memory (one per point of a design).
@@ -71,39 +76,21 @@ impl StoredRuns {
                 bytes.extend_from_slice(&format::encode(i, r));
             }
         }
-        StoredRuns::index(Bytes::Owned(bytes), records.len(), n_values)
-    }
-
-    fn index(bytes: Bytes, n_points: usize, n_values: usize) -> StoredRuns {
-        let data: &[u8] = match &bytes {
-            Bytes::Mapped(m) => m,
-            Bytes::Owned(v) => v,
-        };
-        let scanned = format::scan_format(data, n_values, Format::V2);
-        let mut entries: Vec<Option<Entry>> = vec![None; n_points];
+        let scanned = format::scan_format(&bytes, n_values, Format::V2);
+        let mut entries: Vec<Option<Entry>> = vec![None; records.len()];
         for (i, slot, _) in scanned.records {
-            let Some(e) = entries.get_mut(i) else {
-                continue;
-            };
-            if matches!(e, None | Some(Entry::Failed(_))) {
-                *e = Some(match slot {
-                    Slot::Ok(r) => Entry::Ok(r),
-                    Slot::Failed(m) => Entry::Failed(m),
-                });
-            }
+            entries[i] = Some(Entry::of(slot));
         }
         StoredRuns {
-            bytes,
+            source: Source::Bytes(bytes),
             n_values,
             entries,
         }
     }
 
-    fn data(&self) -> &[u8] {
-        match &self.bytes {
-            Bytes::Mapped(m) => m,
-            Bytes::Owned(v) => v,
-        }
+    /// Sets the result of point `i` (a run appended to the store).
+    pub fn set(&mut self, i: usize, entry: Entry) {
+        self.entries[i] = Some(entry);
     }
 
     /// Points of the design.
@@ -126,45 +113,81 @@ impl StoredRuns {
         &self.entries
     }
 
-    /// The values of point `i` as bytes (8 per value, little endian), if it succeeded.
+    /// The values of point `i` (in the file), if it succeeded.
     pub fn values(&self, i: usize) -> Option<Values<'_>> {
         match self.entries.get(i)? {
-            Some(Entry::Ok(r)) => Some(Values(&self.data()[r.clone()])),
+            Some(Entry::Ok(r)) => Some(Values {
+                source: &self.source,
+                bytes: r.clone(),
+            }),
             _ => None,
         }
     }
 
     /// The record of point `i`, its values read into memory.
-    pub fn record(&self, i: usize) -> Option<Record> {
-        match self.entries.get(i)?.as_ref()? {
-            Entry::Ok(r) => Some(Record::Ok(format::values_of(&self.data()[r.clone()]))),
-            Entry::Failed(m) => Some(Record::Failed(m.clone())),
-        }
+    pub fn record(&self, i: usize) -> Result<Option<Record>, StoreError> {
+        Ok(match self.entries.get(i).and_then(Option::as_ref) {
+            None => None,
+            Some(Entry::Failed(m)) => Some(Record::Failed(m.clone())),
+            Some(Entry::Ok(_)) => {
+                let v = self.values(i).expect("a finished point");
+                let mut out = vec![0.0; self.n_values];
+                v.try_read_into(0..self.n_values, &mut out)?;
+                Some(Record::Ok(out))
+            }
+        })
     }
 
     /// Every record read into memory (for small studies and tests).
-    pub fn records(&self) -> Vec<Option<Record>> {
+    pub fn records(&self) -> Result<Vec<Option<Record>>, StoreError> {
         (0..self.len()).map(|i| self.record(i)).collect()
     }
 }
 
 /// The values of one run, in the file.
-#[derive(Clone, Copy, Debug)]
-pub struct Values<'a>(&'a [u8]);
+#[derive(Clone, Debug)]
+pub struct Values<'a> {
+    source: &'a Source,
+    bytes: Range<usize>,
+}
 
 impl Values<'_> {
-    /// Value `k`.
-    pub fn get(&self, k: usize) -> f64 {
-        let b = &self.0[8 * k..8 * k + 8];
-        f64::from_le_bytes(b.try_into().unwrap_or([0; 8]))
-    }
-
     /// Values `range` written into `out` (of the same length).
-    pub fn read_into(&self, range: Range<usize>, out: &mut [f64]) {
-        let bytes = &self.0[8 * range.start..8 * range.end];
-        for (o, c) in out.iter_mut().zip(bytes.chunks_exact(8)) {
-            *o = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+    pub fn try_read_into(&self, range: Range<usize>, out: &mut [f64]) -> Result<(), StoreError> {
+        let (a, b) = (
+            self.bytes.start + 8 * range.start,
+            self.bytes.start + 8 * range.end,
+        );
+        assert!(
+            b <= self.bytes.end && out.len() == range.len(),
+            "values out of range"
+        );
+        match self.source {
+            Source::Bytes(v) => decode_into(&v[a..b], out),
+            Source::File(f, path) => {
+                // Read in pieces of at most 64 KiB on the stack.
+                let mut buf = [0u8; 1 << 16];
+                let mut done = 0;
+                while done < out.len() {
+                    let take = (out.len() - done).min(buf.len() / 8);
+                    let at = (a + 8 * done) as u64;
+                    f.read_exact_at(&mut buf[..8 * take], at)
+                        .map_err(|source| StoreError::Io {
+                            path: path.clone(),
+                            source,
+                        })?;
+                    decode_into(&buf[..8 * take], &mut out[done..done + take]);
+                    done += take;
+                }
+            }
         }
+        Ok(())
+    }
+}
+
+fn decode_into(bytes: &[u8], out: &mut [f64]) {
+    for (o, c) in out.iter_mut().zip(bytes.chunks_exact(8)) {
+        *o = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
     }
 }
 
@@ -173,39 +196,39 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reads_in_place_what_was_appended() {
+    fn reads_the_values_of_each_point_from_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("records.bin");
         let recs = [
             (2, Record::Failed("first".into())),
             (1, Record::Ok(vec![1.5, -2.0])),
             (2, Record::Ok(vec![3.0, 4.0])),
-            (1, Record::Ok(vec![9.0, 9.0])),
-            (0, Record::Failed("a".into())),
-            (0, Record::Failed("b".into())),
-            (7, Record::Ok(vec![0.0, 0.0])),
         ];
         let bytes: Vec<u8> = recs
             .iter()
             .flat_map(|(i, r)| format::encode(*i, r))
             .collect();
         std::fs::write(&path, &bytes).unwrap();
-        let runs = StoredRuns::open(&path, 4, 2).unwrap();
-        assert_eq!(runs.record(0), Some(Record::Failed("b".into())));
-        assert_eq!(runs.record(1), Some(Record::Ok(vec![1.5, -2.0])));
-        assert_eq!(runs.record(2), Some(Record::Ok(vec![3.0, 4.0])));
-        assert_eq!(runs.record(3), None);
-        let v = runs.values(2).unwrap();
-        assert_eq!(v.get(1), 4.0);
-        let mut out = [0.0; 2];
-        v.read_into(0..2, &mut out);
-        assert_eq!(out, [3.0, 4.0]);
-        let same = StoredRuns::from_records(&runs.records(), 2);
-        assert_eq!(same.records(), runs.records());
-        std::fs::write(&path, b"").unwrap();
-        assert_eq!(
-            StoredRuns::open(&path, 2, 2).unwrap().records(),
-            vec![None, None]
-        );
+        let scanned = format::scan_format(&bytes, 2, Format::V2);
+        let mut entries = vec![None; 4];
+        for (i, slot, _) in scanned.records {
+            entries[i] = Some(Entry::of(slot));
+        }
+        let runs = StoredRuns::in_file(&path, 2, entries).unwrap();
+        assert_eq!(runs.record(0).unwrap(), None);
+        assert_eq!(runs.record(1).unwrap(), Some(Record::Ok(vec![1.5, -2.0])));
+        assert_eq!(runs.record(2).unwrap(), Some(Record::Ok(vec![3.0, 4.0])));
+        let mut one = [0.0];
+        runs.values(2)
+            .unwrap()
+            .try_read_into(1..2, &mut one)
+            .unwrap();
+        assert_eq!(one, [4.0]);
+        let same = StoredRuns::from_records(&runs.records().unwrap(), 2);
+        assert_eq!(same.records().unwrap(), runs.records().unwrap());
+        // A file shortened under the reader: an error, not a panic.
+        std::fs::write(&path, &bytes[..10]).unwrap();
+        let runs = StoredRuns::in_file(&path, 2, runs.entries().to_vec()).unwrap();
+        assert!(runs.record(1).is_err());
     }
 }
