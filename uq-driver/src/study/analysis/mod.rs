@@ -517,9 +517,9 @@ impl<'a> Runs<'a> {
         self.block(o, nt, 0, nt)
     }
 
-    /// Columns `j0..j0 + w` of output `o` (of `nt` times each) as runs × times: each run's
-    /// values read at once (runs in parallel), then turned column-major (groups of columns
-    /// in parallel).
+    /// Columns `j0..j0 + w` of output `o` (of `nt` times each) as runs × times. Chunks of
+    /// runs are read in parallel, one read per run, into column-major pieces; the pieces are
+    /// then copied into the matrix (groups of columns in parallel).
     pub(crate) fn block(
         &self,
         o: usize,
@@ -530,29 +530,33 @@ impl<'a> Runs<'a> {
         const ROWS: usize = 256;
         const GROUP: usize = 64;
         let n = self.rows.len();
-        let mut m = DMatrix::<f64>::zeros(n, w);
         if n == 0 || w == 0 {
-            return Ok(m);
+            return Ok(DMatrix::zeros(n, w));
         }
         let first = o * nt + j0;
-        let mut by_row = vec![0.0; n * w];
-        by_row
-            .par_chunks_mut(ROWS * w)
-            .zip(self.values.par_chunks(ROWS))
-            .try_for_each(|(out, values)| {
-                for (row, v) in out.chunks_exact_mut(w).zip(values) {
-                    v.try_read_into(first..first + w, row)?;
+        let pieces: Vec<DMatrix<f64>> = self
+            .values
+            .par_chunks(ROWS)
+            .map(|values| {
+                let mut piece = DMatrix::<f64>::zeros(values.len(), w);
+                let mut row = vec![0.0; w];
+                for (r, v) in values.iter().enumerate() {
+                    v.try_read_into(first..first + w, &mut row)?;
+                    for (k, x) in row.iter().enumerate() {
+                        piece[(r, k)] = *x;
+                    }
                 }
-                Ok::<(), AnalysisError>(())
-            })?;
+                Ok(piece)
+            })
+            .collect::<Result<_, AnalysisError>>()?;
+        let mut m = DMatrix::<f64>::zeros(n, w);
         m.as_mut_slice()
             .par_chunks_mut(n * GROUP)
             .enumerate()
             .for_each(|(g, out)| {
-                let c0 = g * GROUP;
                 for (k, col) in out.chunks_exact_mut(n).enumerate() {
-                    for (r, x) in col.iter_mut().enumerate() {
-                        *x = by_row[r * w + c0 + k];
+                    for (p, part) in pieces.iter().zip(col.chunks_mut(ROWS)) {
+                        part.copy_from_slice(p.column(g * GROUP + k).as_slice());
                     }
                 }
             });

@@ -165,25 +165,29 @@ impl Values<'_> {
         match self.source {
             Source::Bytes(v) => decode_into(&v[a..b], out),
             Source::File(f, path) => {
-                // Read in pieces of at most 64 KiB on the stack.
-                let mut buf = [0u8; 1 << 16];
-                let mut done = 0;
-                while done < out.len() {
-                    let take = (out.len() - done).min(buf.len() / 8);
-                    let at = (a + 8 * done) as u64;
-                    f.read_exact_at(&mut buf[..8 * take], at)
+                // Straight into the f64 memory (the file is little endian, like the target
+                // almost always is), in pieces of at most READ_PIECE bytes.
+                for (k, piece) in out.chunks_mut(READ_PIECE / 8).enumerate() {
+                    let at = (a + k * READ_PIECE) as u64;
+                    f.read_exact_at(bytemuck::cast_slice_mut(piece), at)
                         .map_err(|source| StoreError::Io {
                             path: path.clone(),
                             source,
                         })?;
-                    decode_into(&buf[..8 * take], &mut out[done..done + take]);
-                    done += take;
+                    if cfg!(target_endian = "big") {
+                        for x in piece.iter_mut() {
+                            *x = f64::from_bits(u64::from_le(x.to_bits()));
+                        }
+                    }
                 }
             }
         }
         Ok(())
     }
 }
+
+/// The most bytes read at once (1 MiB).
+const READ_PIECE: usize = 1 << 20;
 
 fn decode_into(bytes: &[u8], out: &mut [f64]) {
     for (o, c) in out.iter_mut().zip(bytes.chunks_exact(8)) {
