@@ -158,6 +158,7 @@ fn peak_memory(args: &[&str], env: &[(&str, &str)]) -> u64 {
     for (k, v) in env {
         c.env(k, v);
     }
+    #[allow(clippy::zombie_processes)] // reaped by wait4 below
     let child = c.spawn().unwrap();
     let mut status = 0;
     // SAFETY: an all-zero rusage is a valid value of this plain C struct.
