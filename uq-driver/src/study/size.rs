@@ -50,6 +50,8 @@
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
 
+mod disk;
+
 use std::fmt;
 use std::path::Path;
 use std::time::Instant;
@@ -82,9 +84,26 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+pub use disk::Disk;
+
 /// Why a study does not start.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SizeError {
+    /// The study's results store needs more disk space than there is.
+    #[error(
+        "the study cannot run: {footprint}; its results store needs about {store} on disk, more \
+         than the {free} free for it, so it is refused even with --yes. Use fewer samples, a \
+         coarser communication step, a shorter experiment, fewer outputs or an --out folder on \
+         a larger disk"
+    )]
+    NoDisk {
+        /// The estimate.
+        footprint: Box<Footprint>,
+        /// The store's size (formatted).
+        store: String,
+        /// The free space (formatted).
+        free: String,
+    },
     /// The study needs more memory than there is.
     #[error(
         "the study cannot run: {footprint}; it needs more memory than the {limit} available \
@@ -141,6 +160,8 @@ pub struct Footprint {
     pub available: (f64, bool),
     /// Time estimate, if measured.
     pub time: Option<TimeEstimate>,
+    /// The results store against the free disk space, where known.
+    pub disk: Option<Disk>,
 }
 
 /// The memory estimate by part (bytes).
@@ -410,6 +431,13 @@ fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footpri
         .max(1);
     let shape = Shape::of(study, threads);
     let mut footprint = estimate(&shape, shape.runs);
+    if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
+        let values = shape.outputs as f64 * shape.time_points + 2.0 * shape.quantities as f64;
+        footprint.disk = disk::free_bytes(out_dir).map(|free| Disk {
+            store: disk::store_bytes(n, values),
+            free,
+        });
+    }
     judge(&footprint, true)?;
     let timed = opts.isolate.is_none() && opts.timeout_per_run.is_none();
     if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
@@ -459,6 +487,7 @@ pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, Si
             None => (ASSUMED_MEMORY, false),
         },
         time: None,
+        disk: None,
     };
     judge(&footprint, true)?;
     Ok(footprint)
@@ -475,6 +504,7 @@ pub fn estimate(shape: &Shape, runs: Option<f64>) -> Footprint {
             None => (ASSUMED_MEMORY, false),
         },
         time: None,
+        disk: None,
     }
 }
 
@@ -487,6 +517,13 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
             footprint: Box::new(f.clone()),
             limit: bytes(available),
             suggest: Suggestion,
+        });
+    }
+    if let Some(d) = f.disk.filter(|d| d.store.is_nan() || d.store > d.free) {
+        return Err(SizeError::NoDisk {
+            footprint: Box::new(f.clone()),
+            store: bytes(d.store),
+            free: bytes(d.free),
         });
     }
     if yes {
@@ -717,6 +754,34 @@ mod tests {
             ..shape
         };
         assert!(judge(&footprint(&nested, 1.0 * GIB), true).is_err());
+    }
+
+    #[test]
+    fn a_store_larger_than_the_free_disk_is_refused_even_with_yes() {
+        // The series are not held in memory: the disk is what long series run out of.
+        let shape = Shape {
+            time_points: 2e7,
+            ..wheel_shape(2000.0)
+        };
+        let mut f = footprint(&shape, 1e15);
+        f.disk = Some(Disk {
+            store: disk::store_bytes(2000.0, 2e7),
+            free: 40e9,
+        });
+        let e = judge(&f, true).unwrap_err();
+        assert!(matches!(e, SizeError::NoDisk { .. }));
+        let text = e.to_string();
+        assert!(text.contains("2000 model runs"), "{text}");
+        assert!(
+            text.contains("298.0 GiB on disk, more than the 37.3 GiB free"),
+            "{text}"
+        );
+        assert!(text.contains("refused even with --yes"), "{text}");
+        f.disk = Some(Disk {
+            store: 1e9,
+            free: 40e9,
+        });
+        assert!(judge(&f, true).is_ok());
     }
 
     #[test]
