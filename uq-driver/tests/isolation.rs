@@ -448,7 +448,8 @@ fn integral_design_values_set_an_integer_random_parameter() {
     let outcome =
         runner::run_points(&study, &fmu, &design, dir.path(), &RunOptions::default()).unwrap();
     let got: Vec<Vec<f64>> = outcome
-        .records
+        .records()
+        .unwrap()
         .iter()
         .map(|r| match r {
             Some(uq_driver::study::store::Record::Ok(v)) => v.clone(),

@@ -20,7 +20,7 @@ use super::analysis::{
     output_stats, scalar_stats, surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs,
     Settings,
 };
-use super::store::Record;
+use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
 use crate::results::{
     ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit, OutputStats, ScalarStats,
@@ -55,7 +55,7 @@ pub fn analyse(
     study: &Study,
     method: &Nested,
     design: &Design,
-    records: &[Option<Record>],
+    records: &StoredRuns,
 ) -> Result<NestedAnalysed, AnalysisError> {
     let surrogates = surrogates_of(study);
     let settings = Settings::of(study, &surrogates);
@@ -84,7 +84,7 @@ pub fn analyse(
         warnings: Vec::new(),
     };
     for (o, name) in study.outputs.iter().enumerate() {
-        let data = runs.output(o, nt);
+        let data = runs.output(o, nt)?;
         let (stats, split) = output(method, &blocks, name, &times, &runs.rows, &data, &settings)?;
         out.splits.push(split);
         out.analysed.outputs.push(stats);
@@ -95,7 +95,7 @@ pub fn analyse(
         .iter()
         .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
     for (qi, (name, q)) in scalars.enumerate() {
-        let qr = runs.quantity(base, qi);
+        let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
             return Err(AnalysisError::NoValue {
                 name,

@@ -14,7 +14,7 @@ use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
 use super::lock::{FolderLock, LockError};
 pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
-use super::store::{Manifest, Record, Store, StoreError};
+use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
 use crate::uq::method::{Design, MethodError};
@@ -194,11 +194,14 @@ pub fn study_hash(study: &Study) -> String {
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
 }
 
-/// What a run produced: every point's record, in design order.
+/// What a run produced: every point's record, in design order, read in place from the
+/// results store (the series of the runs are not held in memory).
 #[derive(Debug)]
 pub struct RunOutcome {
     /// Records by point index (all present unless stopped early).
-    pub records: Vec<Option<Record>>,
+    pub runs: StoredRuns,
+    /// The output folder's lock, held while the records are read (None: not locked).
+    pub lock: Option<FolderLock>,
     /// Points run in this invocation.
     pub n_new: usize,
     /// Points found finished in the store.
@@ -209,6 +212,13 @@ pub struct RunOutcome {
     pub threads: usize,
     /// SHA-256 of the FMU.
     pub fmu_sha256: String,
+}
+
+impl RunOutcome {
+    /// Every record read into memory (small studies and tests: this holds every series).
+    pub fn records(&self) -> Result<Vec<Option<Record>>, StoreError> {
+        self.runs.records()
+    }
 }
 
 /// The store manifest of `study` on `fmu` with `design`.
@@ -246,7 +256,8 @@ pub fn run_points(
             out_dir.display()
         );
     }
-    let (store, mut records) = Store::open(out_dir, &manifest, opts.fresh)?;
+    let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
+    let records = runs.entries();
     if let Some(note) = store.recovery().summary() {
         eprintln!("warning: {note}");
     }
@@ -256,7 +267,7 @@ pub fn run_points(
     };
     let failed_before = wanted
         .iter()
-        .filter(|&&i| matches!(records[i], Some(Record::Failed(_))))
+        .filter(|&&i| matches!(records[i], Some(Entry::Failed(_))))
         .count();
     if failed_before > 0 && !opts.retry_failed {
         eprintln!(
@@ -270,10 +281,10 @@ pub fn run_points(
     let missing: Vec<usize> = wanted
         .iter()
         .copied()
-        .filter(|&i| match &records[i] {
+        .filter(|&i| match records[i] {
             None => true,
-            Some(Record::Failed(_)) => opts.retry_failed,
-            Some(Record::Ok(_)) => false,
+            Some(Entry::Failed(_)) => opts.retry_failed,
+            Some(Entry::Ok(_)) => false,
         })
         .collect();
     let threads = opts
@@ -327,11 +338,12 @@ pub fn run_points(
     })?;
     progress.finish();
     let n_new = new.len();
-    for (i, r) in new {
-        records[i] = Some(r);
+    for (i, e) in new {
+        runs.set(i, e);
     }
     Ok(RunOutcome {
-        records,
+        runs,
+        lock: Some(lock),
         n_new,
         n_resumed: wanted.len() - missing.len(),
         wall_time: started.elapsed().as_secs_f64(),
@@ -399,7 +411,9 @@ struct Batch<'a> {
 }
 
 impl Batch<'_> {
-    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Record)>, RunError> {
+    /// Runs `points`; returns where the result of each finished one is in the store (the
+    /// values are not kept).
+    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Entry)>, RunError> {
         let stop = AtomicBool::new(false);
         let started = AtomicUsize::new(0);
         points
@@ -407,7 +421,7 @@ impl Batch<'_> {
             .with_min_len(1)
             .map_init(
                 || None::<Instance>,
-                |slot, &i| -> Result<Option<(usize, Record)>, RunError> {
+                |slot, &i| -> Result<Option<(usize, Entry)>, RunError> {
                     if stop.load(Ordering::Relaxed) {
                         return Ok(None);
                     }
@@ -427,9 +441,9 @@ impl Batch<'_> {
                     if matches!(rec, Record::Failed(_)) && self.stop_on_failure {
                         stop.store(true, Ordering::Relaxed);
                     }
-                    self.store.append(i, &rec)?;
+                    let entry = self.store.append(i, &rec)?;
                     progress.inc();
-                    Ok(Some((i, rec)))
+                    Ok(Some((i, entry)))
                 },
             )
             .filter_map(Result::transpose)
@@ -472,14 +486,14 @@ fn describe_values(study: &Study, values: &[f64]) -> String {
 pub fn check_failures(
     study: &Study,
     design: &Design,
-    records: &[Option<Record>],
+    records: &[Option<Entry>],
     allow: bool,
 ) -> Result<usize, RunError> {
     let failed: Vec<(usize, &String)> = records
         .iter()
         .enumerate()
         .filter_map(|(i, r)| match r {
-            Some(Record::Failed(m)) => Some((i, m)),
+            Some(Entry::Failed(m)) => Some((i, m)),
             _ => None,
         })
         .collect();

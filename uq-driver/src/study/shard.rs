@@ -17,10 +17,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::lock::FolderLock;
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::single::{finish, open_fmu};
-use super::store::{Manifest, Record, Store, StoreError};
+use super::store::{Manifest, Store, StoreError, StoredRuns};
 use crate::spec::Study;
 use crate::uq::method::{Design, Evaluation, Sampling};
 
@@ -233,7 +234,7 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
     runner::check_failures(
         &study,
         &design,
-        &outcome.records,
+        outcome.runs.entries(),
         opts.allow_failures(&study),
     )?;
     Ok(outcome)
@@ -247,7 +248,8 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     let fmu = open_fmu(&study)?;
     let design = design(&study)?;
     let n = design.len();
-    let mut records: Vec<Option<Record>> = vec![None; n];
+    // Each shard's results, read in place: the merge holds no series in memory.
+    let mut shard_runs: Vec<Option<StoredRuns>> = Vec::new();
     let mut owner: Vec<Option<usize>> = vec![None; n];
     let mut incomplete = Vec::new();
     for k in 0..p.shards {
@@ -259,7 +261,9 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
             ));
             continue;
         }
-        let (_, recs) = Store::open(&sdir, &p.manifest, false).map_err(|e| match e {
+        shard_runs.resize_with(k + 1, || None);
+        let opened = Store::open_in_place(&sdir, &p.manifest, false).map(|(_, runs)| runs);
+        let recs = opened.map_err(|e| match e {
             StoreError::Mismatch { what, .. } => ShardError::Shard(format!(
                 "shard {k} ({}) does not belong to this plan: {what}",
                 sdir.display()
@@ -268,12 +272,14 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         })?;
         let mut missing = 0;
         for i in shard_points(n, p.shards, k) {
-            if recs[i].is_none() {
+            if recs.entries()[i].is_none() {
                 missing += 1;
             }
         }
-        for (i, r) in recs.into_iter().enumerate() {
-            let Some(r) = r else { continue };
+        for (i, r) in recs.entries().iter().enumerate() {
+            if r.is_none() {
+                continue;
+            }
             if i % p.shards != k {
                 return Err(ShardError::Shard(format!(
                     "point {i} appears in shard {k}, but belongs to shard {}",
@@ -286,8 +292,8 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
                 )));
             }
             owner[i] = Some(k);
-            records[i] = Some(r);
         }
+        shard_runs[k] = Some(recs);
         if missing > 0 {
             incomplete.push(format!(
                 "shard {k}: {missing} points not finished (run it again: it resumes)"
@@ -302,14 +308,22 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         )));
     }
     // The merged store makes `out` look like (and resume like) a single-machine run.
-    let (store, _) = Store::open(out, &p.manifest, true).map_err(RunError::from)?;
-    for (i, r) in records.iter().enumerate() {
-        store
-            .append(i, r.as_ref().expect("checked complete"))
+    runner::prepare_out_dir(out).map_err(StudyRunError::Run)?;
+    let lock = FolderLock::acquire(out).map_err(|e| StudyRunError::Run(e.into()))?;
+    let (store, mut runs) = Store::open_in_place(out, &p.manifest, true).map_err(RunError::from)?;
+    for (i, k) in owner.iter().enumerate() {
+        let shard = k.and_then(|k| shard_runs[k].as_ref());
+        let rec = shard
+            .map(|r| r.record(i))
+            .transpose()
             .map_err(RunError::from)?;
+        let rec = rec.flatten().expect("checked complete");
+        runs.set(i, store.append(i, &rec).map_err(RunError::from)?);
     }
+    drop(shard_runs);
     let outcome = RunOutcome {
-        records,
+        runs,
+        lock: Some(lock),
         n_new: 0,
         n_resumed: n,
         wall_time: 0.0,

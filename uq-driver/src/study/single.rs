@@ -9,7 +9,7 @@ use super::analysis::{self, Analysed, AnalysisError};
 use super::outcome::{StudyResult, StudyRunError};
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
-use super::store::Record;
+use super::store::{Entry, StoredRuns};
 use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
@@ -130,9 +130,9 @@ pub(crate) fn finish(
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<StudyResult, StudyRunError> {
-    let done = outcome.records.iter().filter(|r| r.is_some()).count();
-    let failed =
-        runner::check_failures(study, design, &outcome.records, opts.allow_failures(study))?;
+    let entries = outcome.runs.entries();
+    let done = entries.iter().filter(|r| r.is_some()).count();
+    let failed = runner::check_failures(study, design, entries, opts.allow_failures(study))?;
     if done < design.len() {
         return Err(StudyRunError::Incomplete {
             done,
@@ -140,7 +140,7 @@ pub(crate) fn finish(
         });
     }
     let started = Instant::now();
-    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.records)?;
+    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.runs)?;
     let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
@@ -182,7 +182,7 @@ pub(crate) fn finish(
         out_dir,
     )?;
     summary.units = units;
-    let points = point_table(study, design, &outcome.records);
+    let points = point_table(study, design, entries);
     let extra = report::nested::write(out_dir, &quantities, &splits, !opts.no_report)?;
     summary.timing.report_s = report::study::write(
         out_dir,
@@ -209,7 +209,7 @@ fn analyse(
     study: &Study,
     method: &dyn Sampling,
     design: &Design,
-    records: &[Option<Record>],
+    records: &StoredRuns,
 ) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
     Ok(match &study.method {
         MethodSpec::Nested(nested) => {
@@ -326,7 +326,7 @@ fn write_surrogate(
 }
 
 /// The design with the status of each point.
-fn point_table(study: &Study, design: &Design, records: &[Option<Record>]) -> PointTable {
+fn point_table(study: &Study, design: &Design, records: &[Option<Entry>]) -> PointTable {
     PointTable {
         names: study.parameters.iter().map(|p| p.name.clone()).collect(),
         weights: design.weights.clone(),
@@ -334,8 +334,8 @@ fn point_table(study: &Study, design: &Design, records: &[Option<Record>]) -> Po
         status: records
             .iter()
             .map(|r| match r {
-                Some(Record::Ok(_)) => PointStatus::Ok,
-                Some(Record::Failed(m)) => PointStatus::Failed(m.clone()),
+                Some(Entry::Ok(_)) => PointStatus::Ok,
+                Some(Entry::Failed(m)) => PointStatus::Failed(m.clone()),
                 None => PointStatus::Missing,
             })
             .collect(),

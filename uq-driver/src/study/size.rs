@@ -9,17 +9,30 @@
 //!   exceeds [`MAX_SECONDS`].
 //!
 //! Memory (bytes), with `n` runs, `nt` communication points, `s` stored outputs, `q` scalar
-//! quantities, `g` signals read per step, `d` random parameters, `T` threads:
-//! - the records of every run, held until the analysis: `n (8 (s nt + 2 q) + 64)`;
-//! - the results store read back whole when a study resumes: `n (8 (s nt + 2 q) + 48)`;
-//! - the analysis of one output: its matrix and the estimators' copies, `1.5 × 8 n nt`, and,
-//!   for a method that may build a chaos, its surrogate draws `8 × surrogate_samples × nt`;
+//! quantities, `g` signals read per step, `d` random parameters, `T` threads, `P` columns
+//! whose densities are shown (`pdf_times + 1`), `k` quantile levels, `S` surrogate draws of
+//! a series (`min(series_samples, surrogate_samples)`, for a method that may build a chaos;
+//! else 0), `B` the analysis's block budget ([`blocks::block_bytes`], 256 MiB unless
+//! `RAILUQ_ANALYSIS_BLOCK_BYTES` says otherwise):
+//! - the records: the series of the runs are written to the results store as each run
+//!   finishes and are not held; per run, where its values are and its place in the analysis,
+//!   `n (96 + 16 q)` ([`Memory::records`]);
+//! - the results store is read in place (a resumed study scans it through a memory map: page
+//!   cache, not the process's memory), so nothing is counted for it ([`Memory::store`] is 0);
+//!   only repairing a damaged store copies its valid records into memory;
+//! - the analysis of one output, a block of `w` time columns at a time
+//!   ([`blocks::block_width`]: `w = nt` when `2 × 8 n nt ≤ B`, else the largest multiple of
+//!   32 columns within `B`, at least 32): the block, the buffer it is read through and the
+//!   estimator's copy, `3 × 8 n w`; for a method that may build a chaos, a block of surrogate
+//!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; and the
+//!   statistics of every column of every output, `8 s nt (12 + k + 6 d)`. A nested study
+//!   analyses the whole series of an output at once: `1.5 × 8 n nt` instead of the blocks.
+//!   (The coefficients of a chaos, terms × nt per output, are not counted.)
 //! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
 //! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
 //! - the time grid (a few copies): `4 × 8 nt`.
 //!
-//! The peak is the design, grid and records plus the larger of the store read and the
-//! analysis (with the worker buffers).
+//! The peak is the design, grid and records plus the analysis (with the worker buffers).
 //!
 //! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
 //! (runs × steps; a smaller study reaches an hour only if one step costs more than 0.36 ms on
@@ -37,17 +50,20 @@
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
 
+mod disk;
+
 use std::fmt;
 use std::path::Path;
 use std::time::Instant;
 
+use super::analysis::blocks;
 use super::guard::StudyGuard;
 use super::interface::Interface;
 use super::runner::{self, RunOptions};
 use crate::fmu::Instance;
 use crate::qoi::QoiSpec;
 use crate::spec::Study;
-use crate::uq::method::Evaluation;
+use crate::uq::method::{Evaluation, MethodSpec};
 
 /// More model runs than this need `--yes`.
 pub const MAX_RUNS: f64 = 100_000.0;
@@ -68,9 +84,26 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+pub use disk::Disk;
+
 /// Why a study does not start.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SizeError {
+    /// The study's results store needs more disk space than there is.
+    #[error(
+        "the study cannot run: {footprint}; its results store needs about {store} on disk, more \
+         than the {free} free for it, so it is refused even with --yes. Use fewer samples, a \
+         coarser communication step, a shorter experiment, fewer outputs or an --out folder on \
+         a larger disk"
+    )]
+    NoDisk {
+        /// The estimate.
+        footprint: Box<Footprint>,
+        /// The store's size (formatted).
+        store: String,
+        /// The free space (formatted).
+        free: String,
+    },
     /// The study needs more memory than there is.
     #[error(
         "the study cannot run: {footprint}; it needs more memory than the {limit} available \
@@ -127,16 +160,18 @@ pub struct Footprint {
     pub available: (f64, bool),
     /// Time estimate, if measured.
     pub time: Option<TimeEstimate>,
+    /// The results store against the free disk space, where known.
+    pub disk: Option<Disk>,
 }
 
 /// The memory estimate by part (bytes).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Memory {
-    /// The records of every run.
+    /// Where the records of the runs are (their values stay in the store).
     pub records: f64,
-    /// The store read back on resume.
+    /// The store read back on resume: 0, it is read in place (kept for the summary's shape).
     pub store: f64,
-    /// The analysis of one output, with the workers' buffers.
+    /// The analysis of one output in blocks, the statistics of all, and the workers' buffers.
     pub analysis: f64,
     /// The design and its copies.
     pub design: f64,
@@ -265,6 +300,17 @@ pub struct Shape {
     /// Simulated time of a point over that of its run: 1, plus the runs of its own of each
     /// `hunting_speed` quantity.
     pub cost_factor: f64,
+    /// Surrogate draws of a time series (`min(series_samples, surrogate_samples)`; 0 for a
+    /// method that draws from its runs).
+    pub series_draws: usize,
+    /// Columns whose densities are shown (`pdf_times + 1`).
+    pub pdf_columns: usize,
+    /// Quantile levels.
+    pub quantile_levels: usize,
+    /// The analysis's block budget (bytes; [`blocks::block_bytes`]).
+    pub block_bytes: f64,
+    /// Whether the whole series of an output is analysed at once (nested studies).
+    pub whole_series: bool,
 }
 
 impl Shape {
@@ -305,28 +351,58 @@ impl Shape {
                 0
             },
             cost_factor: 1.0 + own_runs / (e.stop - e.start),
+            series_draws: if chaos {
+                study
+                    .analysis
+                    .series_samples
+                    .min(study.analysis.surrogate_samples)
+            } else {
+                0
+            },
+            pdf_columns: study.analysis.pdf_times + 1,
+            quantile_levels: study.analysis.quantiles.len(),
+            block_bytes: blocks::block_bytes() as f64,
+            whole_series: matches!(study.method, MethodSpec::Nested(_)),
         }
     }
 
     /// The memory estimate for `runs` runs (see the module documentation).
     pub fn memory(&self, runs: f64) -> Memory {
         let (n, nt) = (runs, self.time_points);
-        let values = self.outputs as f64 * nt + 2.0 * self.quantities as f64;
-        let draws = if self.outputs > 0 {
-            8.0 * self.surrogate_samples as f64 * nt
-        } else {
+        let (s, d) = (self.outputs as f64, self.dim as f64);
+        let draws = self.series_draws as f64;
+        let scalars = 1.5 * 8.0 * n + 8.0 * self.surrogate_samples as f64;
+        let series = if self.outputs == 0 {
             0.0
+        } else if self.whole_series {
+            1.5 * 8.0 * n * nt + 8.0 * draws * nt
+        } else {
+            let w = block_columns(nt, n, self.block_bytes);
+            let w_draws = block_columns(nt, draws, self.block_bytes);
+            3.0 * 8.0 * n * w
+                + 2.0 * 8.0 * draws * w_draws
+                + 8.0 * self.pdf_columns as f64 * n.max(draws)
+                + 8.0 * s * nt * (12.0 + self.quantile_levels as f64 + 6.0 * d)
         };
         Memory {
-            records: n * (8.0 * values + 64.0),
-            store: n * (8.0 * values + 48.0),
-            analysis: 1.5 * 8.0 * n * if self.outputs > 0 { nt } else { 1.0 }
-                + draws
-                + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
-            design: 4.0 * n * (8.0 * self.dim as f64 + 24.0),
+            records: n * (96.0 + 16.0 * self.quantities as f64),
+            store: 0.0,
+            analysis: series.max(scalars) + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
+            design: 4.0 * n * (8.0 * d + 24.0),
             grid: 4.0 * 8.0 * nt,
         }
     }
+}
+
+/// The columns of a block of `rows` rows out of `nt` within `budget` bytes: as
+/// [`blocks::block_width`], in floating point (the counts may be beyond any integer type).
+fn block_columns(nt: f64, rows: f64, budget: f64) -> f64 {
+    let align = blocks::BLOCK_ALIGN as f64;
+    let w = (budget / (2.0 * 8.0 * rows.max(1.0))).floor();
+    if w >= nt {
+        return nt.max(1.0);
+    }
+    ((w / align).floor() * align).max(align)
 }
 
 /// Checks `study` (to be written to `out_dir`) before anything is allocated or run (a suite:
@@ -355,6 +431,13 @@ fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footpri
         .max(1);
     let shape = Shape::of(study, threads);
     let mut footprint = estimate(&shape, shape.runs);
+    if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
+        let values = shape.outputs as f64 * shape.time_points + 2.0 * shape.quantities as f64;
+        footprint.disk = disk::free_bytes(out_dir).map(|free| Disk {
+            store: disk::store_bytes(n, values),
+            free,
+        });
+    }
     judge(&footprint, true)?;
     let timed = opts.isolate.is_none() && opts.timeout_per_run.is_none();
     if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
@@ -404,6 +487,7 @@ pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, Si
             None => (ASSUMED_MEMORY, false),
         },
         time: None,
+        disk: None,
     };
     judge(&footprint, true)?;
     Ok(footprint)
@@ -420,6 +504,7 @@ pub fn estimate(shape: &Shape, runs: Option<f64>) -> Footprint {
             None => (ASSUMED_MEMORY, false),
         },
         time: None,
+        disk: None,
     }
 }
 
@@ -432,6 +517,13 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
             footprint: Box::new(f.clone()),
             limit: bytes(available),
             suggest: Suggestion,
+        });
+    }
+    if let Some(d) = f.disk.filter(|d| d.store.is_nan() || d.store > d.free) {
+        return Err(SizeError::NoDisk {
+            footprint: Box::new(f.clone()),
+            store: bytes(d.store),
+            free: bytes(d.free),
         });
     }
     if yes {
@@ -526,7 +618,9 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
 /// (`MemAvailable` of `/proc/meminfo`), the room left under a cgroup limit
 /// (`memory.max` − `memory.current`, v2; `memory.limit_in_bytes` − `memory.usage_in_bytes`,
 /// v1) and the room left in the address-space limit (`ulimit -v`: `Max address space` of
-/// `/proc/self/limits` − `VmSize` of `/proc/self/status`). `None` where none is known.
+/// `/proc/self/limits` − `VmSize` of `/proc/self/status`), and `RAILUQ_MEMORY_LIMIT`
+/// (bytes) where set (to keep studies within a budget of one's own, or to test the guard).
+/// `None` where none is known.
 pub fn available_memory() -> Option<f64> {
     let read = |p: &str| std::fs::read_to_string(p).ok();
     let number = |s: Option<String>| -> Option<f64> { s?.trim().parse::<f64>().ok() };
@@ -564,6 +658,13 @@ pub fn available_memory() -> Option<f64> {
             limits.push((limit - size).max(0.0));
         }
     }
+    if let Some(m) = std::env::var("RAILUQ_MEMORY_LIMIT")
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|m| *m >= 0.0)
+    {
+        limits.push(m);
+    }
     limits.into_iter().reduce(f64::min)
 }
 
@@ -582,6 +683,11 @@ mod tests {
             threads: 2,
             surrogate_samples: 20_000,
             cost_factor: 1.0,
+            series_draws: 4_000,
+            pdf_columns: 151,
+            quantile_levels: 3,
+            block_bytes: 256.0 * 1024.0 * 1024.0,
+            whole_series: false,
         }
     }
 
@@ -607,9 +713,15 @@ mod tests {
     #[test]
     fn memory_estimate_counts_records_analysis_and_design() {
         let m = wheel_shape(1000.0).memory(1000.0);
-        // 1000 records of 501 values.
-        assert_eq!(m.records, 1000.0 * (8.0 * 501.0 + 64.0));
-        assert!(m.analysis >= 1.5 * 8.0 * 1000.0 * 501.0 + 8.0 * 20_000.0 * 501.0);
+        // Where the 1000 records are (their values stay in the store).
+        assert_eq!(m.records, 1000.0 * 96.0);
+        assert_eq!(m.store, 0.0);
+        // One block of all 501 columns, the draws likewise, the kept draws, the statistics.
+        let blocks = 3.0 * 8.0 * 1000.0 * 501.0 + 2.0 * 8.0 * 4000.0 * 501.0;
+        let kept = 8.0 * 151.0 * 4000.0;
+        let stats = 8.0 * 501.0 * (12.0 + 3.0 + 12.0);
+        let workers = 3.0 * 8.0 * 2.0 * 501.0;
+        assert_eq!(m.analysis, blocks + kept + stats + workers);
         assert_eq!(m.design, 4.0 * 1000.0 * (16.0 + 24.0));
         assert_eq!(m.total(), m.design + m.grid + m.records + m.analysis);
         // Quantities only (no output): no surrogate draws over time.
@@ -619,6 +731,69 @@ mod tests {
             ..wheel_shape(10.0)
         };
         assert!(q.memory(10.0).analysis < 1e7);
+    }
+
+    #[test]
+    fn series_larger_than_memory_are_accepted_when_their_blocks_fit() {
+        // 20 000 runs of 200 001 points: 32 GB of series; the analysis reads blocks of 192
+        // columns under a 64 MiB budget (31 MB each).
+        let shape = Shape {
+            time_points: 200_001.0,
+            surrogate_samples: 0,
+            series_draws: 0,
+            block_bytes: 64.0 * 1024.0 * 1024.0,
+            ..wheel_shape(20_000.0)
+        };
+        let m = shape.memory(20_000.0);
+        assert_eq!(block_columns(200_001.0, 20_000.0, shape.block_bytes), 192.0);
+        assert!(m.total() < 0.5 * GIB, "{}", bytes(m.total()));
+        assert!(judge(&footprint(&shape, 1.0 * GIB), true).is_ok());
+        // A nested study still holds the series of one output.
+        let nested = Shape {
+            whole_series: true,
+            ..shape
+        };
+        assert!(judge(&footprint(&nested, 1.0 * GIB), true).is_err());
+    }
+
+    #[test]
+    fn a_store_larger_than_the_free_disk_is_refused_even_with_yes() {
+        // The series are not held in memory: the disk is what long series run out of.
+        let shape = Shape {
+            time_points: 2e7,
+            ..wheel_shape(2000.0)
+        };
+        let mut f = footprint(&shape, 1e15);
+        f.disk = Some(Disk {
+            store: disk::store_bytes(2000.0, 2e7),
+            free: 40e9,
+        });
+        let e = judge(&f, true).unwrap_err();
+        assert!(matches!(e, SizeError::NoDisk { .. }));
+        let text = e.to_string();
+        assert!(text.contains("2000 model runs"), "{text}");
+        assert!(
+            text.contains("298.0 GiB on disk, more than the 37.3 GiB free"),
+            "{text}"
+        );
+        assert!(text.contains("refused even with --yes"), "{text}");
+        f.disk = Some(Disk {
+            store: 1e9,
+            free: 40e9,
+        });
+        assert!(judge(&f, true).is_ok());
+    }
+
+    #[test]
+    fn block_columns_agree_with_the_analysis() {
+        for (nt, rows) in [(501, 10_000), (100_000, 1_000_000), (70_000, 3_000), (5, 1)] {
+            let budget = blocks::block_bytes() as f64;
+            assert_eq!(
+                block_columns(nt as f64, rows as f64, budget),
+                blocks::block_width(nt, rows) as f64,
+                "{nt} x {rows}"
+            );
+        }
     }
 
     #[test]

@@ -14,16 +14,18 @@
 //! issue 12) is read and converted, the old file kept as `records.v1.bin`.
 
 pub mod format;
+mod runs;
 
 use std::fmt;
 use std::fs::{self, File, OpenOptions};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use serde::{Deserialize, Serialize};
 
-pub use format::{decode, encode, Decoded, Format, Skipped};
+pub use format::{decode, encode, Decoded, Format, Skipped, Slot};
+pub use runs::{Entry, StoredRuns, Values};
 
 /// What the store is for; a store written for another study is refused.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -186,7 +188,8 @@ impl fmt::Display for Recovery {
 #[derive(Debug)]
 pub struct Store {
     path: PathBuf,
-    file: Mutex<File>,
+    /// The file, and its length (where the next record starts).
+    file: Mutex<(File, usize)>,
     n_values: usize,
     recovery: Recovery,
 }
@@ -209,13 +212,27 @@ pub fn decode_all(bytes: &[u8], n_values: usize) -> (Vec<(usize, Record)>, usize
 impl Store {
     /// Opens (or creates) the store in `dir/store` for `manifest`. Returns the store and the
     /// records already finished, by point index (the first success, else the last failure, of
-    /// each point). What was skipped or
-    /// repaired on the way is in [`Store::recovery`].
+    /// each point), read into memory. What was skipped or repaired on the way is in
+    /// [`Store::recovery`]. [`Store::open_in_place`] leaves the values in the file.
     pub fn open(
         dir: &Path,
         manifest: &Manifest,
         fresh: bool,
     ) -> Result<(Store, Vec<Option<Record>>), StoreError> {
+        let (store, runs) = Store::open_in_place(dir, manifest, fresh)?;
+        let records = runs.records()?;
+        Ok((store, records))
+    }
+
+    /// Like [`Store::open`], but the values stay in the file: the runs found say where
+    /// ([`StoredRuns`]). The file is scanned through a memory map (its pages are the page
+    /// cache's, not this process's heap), and copied into memory only to repair a damaged
+    /// or convert an old store.
+    pub fn open_in_place(
+        dir: &Path,
+        manifest: &Manifest,
+        fresh: bool,
+    ) -> Result<(Store, StoredRuns), StoreError> {
         let sdir = dir.join("store");
         if fresh && sdir.exists() {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
@@ -229,11 +246,18 @@ impl Store {
             .append(true)
             .open(&path)
             .map_err(io_err(&path))?;
-        let mut bytes = Vec::new();
-        file.read_to_end(&mut bytes).map_err(io_err(&path))?;
+        let len = file.metadata().map_err(io_err(&path))?.len();
+        let map = if len == 0 {
+            None
+        } else {
+            // SAFETY: read-only map of a file that no other run writes meanwhile (the caller
+            // holds the folder's lock); it is dropped before this function writes the file.
+            Some(unsafe { memmap2::Mmap::map(&file) }.map_err(io_err(&path))?)
+        };
+        let bytes: &[u8] = map.as_deref().unwrap_or_default();
 
-        let fmt = format::detect_format(&bytes);
-        let (done, kept, skipped) = read_records(&bytes, fmt, manifest);
+        let fmt = format::detect_format(bytes);
+        let (mut done, kept, skipped) = read_records(bytes, fmt, manifest);
         let mut recovery = Recovery {
             path: path.clone(),
             kept: kept.len(),
@@ -242,15 +266,24 @@ impl Store {
         };
         let valid_end = kept.last().map_or(0, |(_, r)| r.end);
         let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
+        let found = bytes.len();
+        let mut len = found;
         if fmt == Format::V1 || damage_inside {
-            let (new_file, backup) = rewrite_kept(&path, &bytes, fmt, &kept, &done)?;
+            let out = kept_bytes(bytes, fmt, &kept, &done);
+            drop(map);
+            let (new_file, backup) = rewrite(&path, &label(fmt), &out)?;
             file = new_file;
             recovery.backup = Some(backup);
-        } else if valid_end < bytes.len() {
+            // Where each point's values are now.
+            done = read_records(&out, Format::V2, manifest).0;
+            len = out.len();
+        } else if valid_end < found {
+            drop(map);
             // A torn tail from an interrupted write (or a damaged last record): cut it off.
             file.set_len(valid_end as u64).map_err(io_err(&path))?;
             file.seek(SeekFrom::End(0)).map_err(io_err(&path))?;
-            recovery.truncated = Some((bytes.len() - valid_end) as u64);
+            recovery.truncated = Some((found - valid_end) as u64);
+            len = valid_end;
         }
 
         let mut rerun: Vec<usize> = skipped
@@ -263,14 +296,16 @@ impl Store {
         recovery.rerun = rerun;
         recovery.skipped = skipped;
         recovery.missing = done.iter().filter(|r| r.is_none()).count();
+        let entries = done.into_iter().map(|d| d.map(Entry::of)).collect();
+        let runs = StoredRuns::in_file(&path, manifest.n_values, entries)?;
         Ok((
             Store {
                 path,
-                file: Mutex::new(file),
+                file: Mutex::new((file, len)),
                 n_values: manifest.n_values,
                 recovery,
             },
-            done,
+            runs,
         ))
     }
 
@@ -279,33 +314,41 @@ impl Store {
         &self.recovery
     }
 
-    /// Appends one record (one write call per record, under a lock).
-    pub fn append(&self, index: usize, rec: &Record) -> Result<(), StoreError> {
+    /// Appends one record (one write call per record, under a lock); returns where it is
+    /// (for [`StoredRuns::set`]).
+    pub fn append(&self, index: usize, rec: &Record) -> Result<Entry, StoreError> {
         if let Record::Ok(v) = rec {
             debug_assert_eq!(v.len(), self.n_values);
         }
         let bytes = encode(index, rec);
         let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
-        f.write_all(&bytes).map_err(io_err(&self.path))
+        let (file, len) = &mut *f;
+        file.write_all(&bytes).map_err(io_err(&self.path))?;
+        let start = *len;
+        *len += bytes.len();
+        Ok(match rec {
+            Record::Ok(_) => Entry::Ok(format::payload_range(start, bytes.len())),
+            Record::Failed(m) => Entry::Failed(m.clone()),
+        })
     }
 }
 
 /// A valid record's point and its bytes in the file.
 type Kept = (usize, std::ops::Range<usize>);
 
-/// Decodes `bytes` for `manifest`: the first record of each point, every valid record of the
-/// design (in file order), and the skipped stretches (in file order; a valid record of a point
-/// beyond the design counts as skipped).
+/// Scans `bytes` for `manifest`: the first record of each point (a later one replaces a
+/// failure), every valid record of the design (in file order), and the skipped stretches (in
+/// file order; a valid record of a point beyond the design counts as skipped).
 fn read_records(
     bytes: &[u8],
     fmt: Format,
     manifest: &Manifest,
-) -> (Vec<Option<Record>>, Vec<Kept>, Vec<Skipped>) {
-    let decoded = format::decode_format(bytes, manifest.n_values, fmt);
-    let mut done: Vec<Option<Record>> = vec![None; manifest.n_points];
-    let mut kept = Vec::with_capacity(decoded.records.len());
-    let mut skipped = decoded.skipped;
-    for (i, rec, range) in decoded.records {
+) -> (Vec<Option<Slot>>, Vec<Kept>, Vec<Skipped>) {
+    let scanned = format::scan_format(bytes, manifest.n_values, fmt);
+    let mut done: Vec<Option<Slot>> = vec![None; manifest.n_points];
+    let mut kept = Vec::with_capacity(scanned.records.len());
+    let mut skipped = scanned.skipped;
+    for (i, slot, range) in scanned.records {
         if i >= manifest.n_points {
             skipped.push(Skipped {
                 bytes: range.start as u64..range.end as u64,
@@ -319,8 +362,8 @@ fn read_records(
         }
         // The first result of a point is kept, except that a later record replaces a failure
         // (a point run again by `--retry-failed`).
-        if matches!(done[i], None | Some(Record::Failed(_))) {
-            done[i] = Some(rec);
+        if matches!(done[i], None | Some(Slot::Failed(_))) {
+            done[i] = Some(slot);
         }
         kept.push((i, range));
     }
@@ -328,37 +371,40 @@ fn read_records(
     (done, kept, skipped)
 }
 
-/// Rewrites `records.bin` with the `kept` records only, in format 2: a format-1 store is
-/// re-encoded (and kept as `records.v1.bin`), a damaged one keeps the valid records' bytes (and
-/// the file as found as `records.damaged-<unix seconds>.bin`).
-fn rewrite_kept(
-    path: &Path,
-    bytes: &[u8],
-    fmt: Format,
-    kept: &[Kept],
-    done: &[Option<Record>],
-) -> Result<(File, PathBuf), StoreError> {
+/// The name of the kept copy of a store rewritten from format `fmt`.
+fn label(fmt: Format) -> String {
+    match fmt {
+        Format::V1 => "v1".to_string(),
+        Format::V2 => format!("damaged-{}", unix_seconds()),
+    }
+}
+
+/// The `kept` records only, in format 2: a format-1 store is re-encoded (the first record of
+/// each point), a damaged one keeps the valid records' bytes.
+fn kept_bytes(bytes: &[u8], fmt: Format, kept: &[Kept], done: &[Option<Slot>]) -> Vec<u8> {
     let mut out = Vec::with_capacity(bytes.len());
-    let label = match fmt {
+    match fmt {
         Format::V1 => {
             // The first record of each point (later ones are never read).
             let mut written = vec![false; done.len()];
             for &(i, _) in kept {
-                if let (Some(rec), false) = (&done[i], written[i]) {
-                    out.extend_from_slice(&encode(i, rec));
+                if let (Some(slot), false) = (&done[i], written[i]) {
+                    let rec = match slot {
+                        Slot::Ok(r) => Record::Ok(format::values_of(&bytes[r.clone()])),
+                        Slot::Failed(m) => Record::Failed(m.clone()),
+                    };
+                    out.extend_from_slice(&encode(i, &rec));
                     written[i] = true;
                 }
             }
-            "v1".to_string()
         }
         Format::V2 => {
             for (_, r) in kept {
                 out.extend_from_slice(&bytes[r.clone()]);
             }
-            format!("damaged-{}", unix_seconds())
         }
-    };
-    rewrite(path, &label, &out)
+    }
+    out
 }
 
 /// Writes the manifest of a new store, or checks that an existing one is `manifest`.

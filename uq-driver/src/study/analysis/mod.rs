@@ -8,17 +8,21 @@ use std::borrow::Cow;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
+pub mod blocks;
 mod columns;
 mod exceedance;
+mod runs;
 mod surrogate;
 
 pub use exceedance::{clopper_pearson, exceedance_count};
 
+use blocks::SeriesColumns;
 use columns::{column, Column};
 pub(crate) use surrogate::Surrogates;
 
-use super::store::Record;
-use crate::qoi::scalar::Code;
+pub(crate) use runs::{QuantityRuns, Runs};
+
+use super::store::StoredRuns;
 use crate::qoi::{kde, QoiSpec};
 use crate::results::{
     Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
@@ -98,6 +102,9 @@ pub enum AnalysisError {
         /// Further advice.
         more: &'static str,
     },
+    /// The results store could not be read.
+    #[error(transparent)]
+    Store(#[from] super::store::StoreError),
     /// An estimate asks for draws it cannot give.
     #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
     NoDraws(String),
@@ -115,14 +122,6 @@ pub struct Settings<'a> {
     surrogates: &'a Surrogates,
 }
 
-/// What quantiles and densities are taken from.
-enum Use {
-    /// The time series of an output.
-    Series,
-    /// A scalar quantity.
-    Scalar,
-}
-
 impl<'a> Settings<'a> {
     /// The settings of `study`, drawing from `surrogates`.
     pub(crate) fn of(study: &'a Study, surrogates: &'a Surrogates) -> Settings<'a> {
@@ -134,24 +133,17 @@ impl<'a> Settings<'a> {
         }
     }
 
-    /// The matrix quantiles and densities are taken from: `runs`, or draws of the chaos
-    /// (`series_samples` of them for a time series, `surrogate_samples` for a scalar).
+    /// The matrix the quantiles and density of a scalar quantity are taken from: `runs`, or
+    /// `surrogate_samples` draws of the chaos (a time series: [`chaos_columns`]).
     fn draws<'m>(
         &self,
         name: &str,
         estimate: &Estimate,
         runs: Option<&'m DMatrix<f64>>,
-        what: Use,
     ) -> Result<Cow<'m, DMatrix<f64>>, AnalysisError> {
         match (estimate.draws, &estimate.chaos, runs) {
             (Draws::Chaos, Some(pce), _) => {
-                let n = match what {
-                    Use::Series => self
-                        .analysis
-                        .series_samples
-                        .min(self.analysis.surrogate_samples),
-                    Use::Scalar => self.analysis.surrogate_samples,
-                };
+                let n = self.analysis.surrogate_samples;
                 Ok(Cow::Owned(self.surrogates.draws(pce, n.max(2))))
             }
             (Draws::Runs, _, Some(r)) => Ok(Cow::Borrowed(r)),
@@ -204,14 +196,63 @@ pub(crate) fn output_stats(
     runs: Option<&DMatrix<f64>>,
     settings: &Settings,
 ) -> Result<OutputStats, AnalysisError> {
+    let mut cols = series_columns(times.len(), settings);
+    match (estimate.draws, runs) {
+        (Draws::Runs, Some(r)) => cols.add(0, r),
+        (Draws::Runs, None) => return Err(AnalysisError::NoDraws(name.to_owned())),
+        (Draws::Chaos, _) => chaos_columns(name, estimate, settings, &mut cols)?,
+    }
+    let run_column =
+        |k: usize| Ok(runs.map_or_else(Vec::new, |r| r.column(k).iter().copied().collect()));
+    summarise(name, times, estimate, cols, &run_column, settings)
+}
+
+/// An empty summary of `nt` columns under the settings.
+fn series_columns(nt: usize, settings: &Settings) -> SeriesColumns {
     let a = settings.analysis;
-    let samples = settings.draws(name, estimate, runs, Use::Series)?;
-    let rows = samples.nrows();
-    let all = samples.as_slice();
-    let cols: Vec<Column> = (0..samples.ncols())
-        .into_par_iter()
-        .map(|k| column(&all[k * rows..(k + 1) * rows], &a.quantiles))
-        .collect();
+    SeriesColumns::new(nt, thinned(nt, a.pdf_times), &a.quantiles)
+}
+
+/// The column summaries of a chaos estimate's surrogate draws, a block of columns at a time.
+fn chaos_columns(
+    name: &str,
+    estimate: &Estimate,
+    settings: &Settings,
+    cols: &mut SeriesColumns,
+) -> Result<(), AnalysisError> {
+    let Some(pce) = &estimate.chaos else {
+        return Err(AnalysisError::NoDraws(name.to_owned()));
+    };
+    let a = settings.analysis;
+    let n = a.series_samples.min(a.surrogate_samples).max(2);
+    let nt = pce.coeffs.ncols();
+    let width = blocks::block_width(nt, n);
+    if width >= nt {
+        cols.add(0, &settings.surrogates.draws(pce, n));
+        return Ok(());
+    }
+    for (j0, w) in blocks::blocks(nt, width) {
+        let part = crate::uq::pce::Pce {
+            basis: pce.basis.clone(),
+            coeffs: pce.coeffs.columns(j0, w).into_owned(),
+        };
+        cols.add(j0, &settings.surrogates.draws(&part, n));
+    }
+    Ok(())
+}
+
+/// The statistics of an output from its estimate and the summaries of its draws;
+/// `run_column(k)` gives the runs of column `k` (for the convergence of a sampled estimate).
+fn summarise(
+    name: &str,
+    times: &[f64],
+    estimate: &Estimate,
+    series: SeriesColumns,
+    run_column: &dyn Fn(usize) -> Result<Vec<f64>, AnalysisError>,
+    settings: &Settings,
+) -> Result<OutputStats, AnalysisError> {
+    let a = settings.analysis;
+    let cols = &series.cols;
     let quantiles = a
         .quantiles
         .iter()
@@ -225,10 +266,10 @@ pub(crate) fn output_stats(
         .fold(0.0, f64::max);
     let spread = |c: &Column| c.max - c.min > ZERO_SPREAD * magnitude;
     let deterministic = !cols.iter().any(spread);
-    let picked = if deterministic {
-        Vec::new()
+    let (picked, kept): (Vec<usize>, Vec<Vec<f64>>) = if deterministic {
+        (Vec::new(), Vec::new())
     } else {
-        thinned(times.len(), a.pdf_times)
+        (series.candidates, series.kept)
     };
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &k in &picked {
@@ -248,9 +289,9 @@ pub(crate) fn output_stats(
     let step = (g1 - g0) / grid.len().saturating_sub(1).max(1) as f64;
     let pdf = picked
         .par_iter()
-        .map(|&k| {
+        .zip(&kept)
+        .map(|(&k, col)| {
             if spread(&cols[k]) {
-                let col = &all[k * rows..(k + 1) * rows];
                 let h = cols[k].bandwidth;
                 if h < 2.0 * step {
                     // Narrower than the grid: averages over the grid cells keep its mass.
@@ -267,13 +308,11 @@ pub(crate) fn output_stats(
     let k_max = (0..estimate.std.len())
         .max_by(|&i, &j| estimate.std[i].total_cmp(&estimate.std[j]))
         .filter(|_| !deterministic);
-    let convergence = k_max.and_then(|k| {
-        let runs = match estimate.draws {
-            Draws::Runs => &all[k * rows..(k + 1) * rows],
-            Draws::Chaos => &[],
-        };
-        convergence(estimate, k, runs)
-    });
+    let convergence = match (k_max, estimate.draws) {
+        (Some(k), Draws::Runs) => convergence(estimate, k, &run_column(k)?),
+        (Some(k), Draws::Chaos) => convergence(estimate, k, &[]),
+        (None, _) => None,
+    };
     Ok(OutputStats {
         name: name.to_owned(),
         times: times.to_vec(),
@@ -297,16 +336,6 @@ pub(crate) fn output_stats(
     })
 }
 
-/// The values of one quantity over the successful runs, with their outcome codes.
-pub(crate) struct QuantityRuns {
-    /// Design indices of the runs with a valid value.
-    pub rows: Vec<usize>,
-    /// Their values.
-    pub valid: Vec<f64>,
-    pub never_hunts: usize,
-    pub never_stops: usize,
-}
-
 /// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
 /// its valid run values; quantiles and the density from `density` where given (e.g. the
 /// pooled draws of a nested study), else from the draws the estimate names.
@@ -323,7 +352,7 @@ pub(crate) fn scalar_stats(
     let density_samples: Vec<f64> = match density {
         Some(d) => d,
         None => settings
-            .draws(name, estimate, Some(&data), Use::Scalar)?
+            .draws(name, estimate, Some(&data))?
             .column(0)
             .iter()
             .copied()
@@ -460,53 +489,6 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
     })
 }
 
-/// The values of the successful runs, in design order.
-pub(crate) struct Runs<'a> {
-    /// Design indices.
-    pub rows: Vec<usize>,
-    values: Vec<&'a [f64]>,
-}
-
-impl<'a> Runs<'a> {
-    pub(crate) fn of(records: &'a [Option<Record>]) -> Runs<'a> {
-        let (rows, values) = records
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| match r {
-                Some(Record::Ok(v)) => Some((i, v.as_slice())),
-                _ => None,
-            })
-            .unzip();
-        Runs { rows, values }
-    }
-
-    /// Output `o` (of `nt` times each) as runs × times.
-    pub(crate) fn output(&self, o: usize, nt: usize) -> DMatrix<f64> {
-        DMatrix::from_fn(self.rows.len(), nt, |r, k| self.values[r][o * nt + k])
-    }
-
-    /// Quantity `qi`, stored after `base` series values as (value, code) pairs.
-    pub(crate) fn quantity(&self, base: usize, qi: usize) -> QuantityRuns {
-        let mut out = QuantityRuns {
-            rows: Vec::new(),
-            valid: Vec::new(),
-            never_hunts: 0,
-            never_stops: 0,
-        };
-        for (&row, v) in self.rows.iter().zip(&self.values) {
-            match Code::from_f64(v[base + 2 * qi + 1]) {
-                Code::Ok => {
-                    out.rows.push(row);
-                    out.valid.push(v[base + 2 * qi]);
-                }
-                Code::NeverHunts => out.never_hunts += 1,
-                Code::NeverStops => out.never_stops += 1,
-            }
-        }
-        out
-    }
-}
-
 /// What [`analyse_runs`] finds.
 #[derive(Clone, Debug)]
 pub struct Analysed {
@@ -522,11 +504,13 @@ pub struct Analysed {
 
 /// Statistics of every output and quantity of a study whose points have all been run
 /// (`records` holds one record per point of `design`), and the chaoses of a chaos method.
+/// Each output is analysed in blocks of time columns ([`blocks`]): its runs need not fit in
+/// memory.
 pub fn analyse_runs(
     study: &Study,
     method: &dyn Sampling,
     design: &Design,
-    records: &[Option<Record>],
+    records: &StoredRuns,
 ) -> Result<Analysed, AnalysisError> {
     let surrogates = surrogates_of(study);
     let settings = Settings::of(study, &surrogates);
@@ -541,20 +525,9 @@ pub fn analyse_runs(
     let mut outputs = Vec::new();
     let mut output_chaos = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let data = runs.output(o, nt);
-        let estimate = method
-            .estimate(design, &runs.rows, &data)
-            .map_err(|source| AnalysisError::Output {
-                name: name.clone(),
-                source,
-            })?;
-        outputs.push(output_stats(
-            name,
-            &times,
-            &estimate,
-            Some(&data),
-            &settings,
-        )?);
+        let (estimate, stats) =
+            output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
+        outputs.push(stats);
         if let Some(pce) = estimate.chaos {
             output_chaos.push(NamedChaos {
                 name: name.clone(),
@@ -572,7 +545,7 @@ pub fn analyse_runs(
         .iter()
         .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
     for (qi, (name, q)) in scalars.enumerate() {
-        let qr = runs.quantity(base, qi);
+        let qr = runs.quantity(base, qi)?;
         let outside = |more| match q {
             QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
                 name: name.clone(),
@@ -622,6 +595,39 @@ pub fn analyse_runs(
         output_chaos,
         quantity_chaos,
     })
+}
+
+/// The estimate and the statistics of output `o`, estimated a block of time columns at a
+/// time (see [`blocks`]).
+fn output_in_blocks(
+    method: &dyn Sampling,
+    design: &Design,
+    runs: &Runs,
+    (o, name, times): (usize, &str, &[f64]),
+    settings: &Settings,
+) -> Result<(Estimate, OutputStats), AnalysisError> {
+    let nt = times.len();
+    let fail = |source| AnalysisError::Output {
+        name: name.to_owned(),
+        source,
+    };
+    let mut cols = series_columns(nt, settings);
+    let mut parts = Vec::new();
+    for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
+        let data = runs.block(o, nt, j0, w)?;
+        let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
+        if estimate.draws == Draws::Runs {
+            cols.add(j0, &data);
+        }
+        parts.push(estimate);
+    }
+    let estimate = blocks::merge(parts).map_err(fail)?;
+    if estimate.draws == Draws::Chaos {
+        chaos_columns(name, &estimate, settings, &mut cols)?;
+    }
+    let run_column = |k: usize| runs.column(o, nt, k);
+    let stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
+    Ok((estimate, stats))
 }
 
 /// Statistics of every output of an intrusive method's solution.

@@ -93,6 +93,11 @@ pub fn encode(index: usize, rec: &Record) -> Vec<u8> {
     out
 }
 
+/// The payload bytes of a format-2 record of `len` bytes that starts at `start`.
+pub fn payload_range(start: usize, len: usize) -> Range<usize> {
+    start + HEADER..start + len - TRAILER
+}
+
 /// One framed record, checksums verified.
 struct Frame<'a> {
     index: u64,
@@ -203,19 +208,45 @@ fn frame_v1_at(bytes: &[u8], pos: usize) -> Result<Frame<'_>, NoFrame> {
 /// Reads the frame at a position: [`frame_at`] or [`frame_v1_at`].
 type FrameReader = fn(&[u8], usize) -> Result<Frame<'_>, NoFrame>;
 
-/// The record a checksummed frame holds, or why it cannot be used.
-fn interpret(f: &Frame<'_>, n_values: usize) -> Result<(usize, Record), String> {
+/// A valid record found by [`scan_format`], its values not read: where they are.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// A finished run: its `n_values` little-endian f64 values are these bytes of the file.
+    Ok(Range<usize>),
+    /// A failed run, with the reason.
+    Failed(String),
+}
+
+/// What [`scan_format`] found in a store file: like [`Decoded`], with the values left in the
+/// file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scanned {
+    /// The valid records, in file order, with their byte ranges.
+    pub records: Vec<(usize, Slot, Range<usize>)>,
+    /// The damaged stretches, in file order.
+    pub skipped: Vec<Skipped>,
+}
+
+/// The values of a record's payload (`n_values` little-endian f64).
+pub fn values_of(payload: &[u8]) -> Vec<f64> {
+    payload
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+        .collect()
+}
+
+/// The record a checksummed frame at `pos` holds, or why it cannot be used.
+fn interpret(
+    f: &Frame<'_>,
+    pos: usize,
+    head: usize,
+    n_values: usize,
+) -> Result<(usize, Slot), String> {
     let index = usize::try_from(f.index).map_err(|_| format!("point {} out of range", f.index))?;
     match f.kind {
-        0 if Some(f.payload.len()) == n_values.checked_mul(8) => Ok((
-            index,
-            Record::Ok(
-                f.payload
-                    .chunks_exact(8)
-                    .map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-                    .collect(),
-            ),
-        )),
+        0 if Some(f.payload.len()) == n_values.checked_mul(8) => {
+            Ok((index, Slot::Ok(pos + head..pos + head + f.payload.len())))
+        }
         0 => Err(format!(
             "{} bytes of values where the study records {n_values} values ({} bytes)",
             f.payload.len(),
@@ -223,7 +254,7 @@ fn interpret(f: &Frame<'_>, n_values: usize) -> Result<(usize, Record), String> 
         )),
         1 => Ok((
             index,
-            Record::Failed(String::from_utf8_lossy(f.payload).into_owned()),
+            Slot::Failed(String::from_utf8_lossy(f.payload).into_owned()),
         )),
         k => Err(format!("unknown record kind {k}")),
     }
@@ -233,17 +264,36 @@ fn interpret(f: &Frame<'_>, n_values: usize) -> Result<(usize, Record), String> 
 /// each. Never panics: damaged stretches are skipped (and listed) and decoding resumes at the
 /// next valid record.
 pub fn decode_format(bytes: &[u8], n_values: usize, format: Format) -> Decoded {
-    let (frame, magic): (FrameReader, [u8; 4]) = match format {
-        Format::V1 => (frame_v1_at, MAGIC_V1),
-        Format::V2 => (frame_at, MAGIC),
+    let scanned = scan_format(bytes, n_values, format);
+    Decoded {
+        records: scanned
+            .records
+            .into_iter()
+            .map(|(i, slot, range)| {
+                let rec = match slot {
+                    Slot::Ok(r) => Record::Ok(values_of(&bytes[r])),
+                    Slot::Failed(m) => Record::Failed(m),
+                };
+                (i, rec, range)
+            })
+            .collect(),
+        skipped: scanned.skipped,
+    }
+}
+
+/// [`decode_format`] without reading the values: where each valid record's values are.
+pub fn scan_format(bytes: &[u8], n_values: usize, format: Format) -> Scanned {
+    let (frame, magic, head): (FrameReader, [u8; 4], usize) = match format {
+        Format::V1 => (frame_v1_at, MAGIC_V1, HEADER_V1),
+        Format::V2 => (frame_at, MAGIC, HEADER),
     };
-    let mut out = Decoded::default();
+    let mut out = Scanned::default();
     let mut pos = 0;
     while pos < bytes.len() {
         match frame(bytes, pos) {
             Ok(f) => {
-                match interpret(&f, n_values) {
-                    Ok((i, rec)) => out.records.push((i, rec, pos..f.end)),
+                match interpret(&f, pos, head, n_values) {
+                    Ok((i, slot)) => out.records.push((i, slot, pos..f.end)),
                     Err(reason) => out.skipped.push(Skipped {
                         bytes: pos as u64..f.end as u64,
                         point: usize::try_from(f.index).ok(),

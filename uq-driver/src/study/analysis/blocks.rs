@@ -1,0 +1,231 @@
+//! The analysis of a time series in blocks of time columns, so that the runs of an output
+//! need not fit in memory (issue 12).
+//!
+//! Every estimator works column by column, so an output is estimated on `n × B` blocks of
+//! its runs (read from the results store) and the per-column results are concatenated
+//! ([`merge`]); the column summaries (quantiles, range, bandwidth) are taken per block, and
+//! the densities from the draws of at most `pdf_times` columns kept on the way
+//! ([`SeriesColumns`]). A chaos's surrogate draws are taken per block of its columns too.
+//!
+//! Block size: a block and one copy of it by the estimator stay within [`block_bytes`]
+//! (default [`BLOCK_BYTES`], 256 MiB; `RAILUQ_ANALYSIS_BLOCK_BYTES` overrides it). A block
+//! is a whole multiple of [`BLOCK_ALIGN`] columns (at least that many, even beyond the
+//! budget), or the whole series: the surrogate draws multiply the basis by the coefficients
+//! in tasks of 32 columns (`surrogate.rs`), and blocks that split at the same columns give the
+//! same products bit for bit. The results do not depend on the block size.
+
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+use super::columns::{column, Column};
+use crate::uq::method::{ChaosError, Estimate, MethodError, Sobol, SobolIntervals};
+use crate::uq::pce::Pce;
+
+/// Bytes of a block of runs (or draws) and of its copy, by default (256 MiB).
+pub const BLOCK_BYTES: usize = 256 << 20;
+/// Blocks are whole multiples of this many columns.
+pub const BLOCK_ALIGN: usize = 32;
+
+/// The block budget: `RAILUQ_ANALYSIS_BLOCK_BYTES` if set to a number, else [`BLOCK_BYTES`].
+pub fn block_bytes() -> usize {
+    std::env::var("RAILUQ_ANALYSIS_BLOCK_BYTES")
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(BLOCK_BYTES)
+}
+
+/// Columns per block of `rows` rows out of `nt` columns (see the module documentation).
+pub fn block_width(nt: usize, rows: usize) -> usize {
+    let per_column = 2 * 8 * rows.max(1);
+    let w = block_bytes() / per_column;
+    if w >= nt {
+        return nt.max(1);
+    }
+    (w / BLOCK_ALIGN * BLOCK_ALIGN).max(BLOCK_ALIGN)
+}
+
+/// The blocks `(first column, width)` of `nt` columns, `width` wide (the last narrower).
+pub fn blocks(nt: usize, width: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..nt)
+        .step_by(width.max(1))
+        .map(move |j0| (j0, width.min(nt - j0)))
+}
+
+/// The estimate of every column from the estimates of consecutive blocks of columns: per
+/// column values concatenated, the chaoses joined into one over the union of their bases
+/// (the same chaos as an estimate of all columns at once gives).
+pub fn merge(mut parts: Vec<Estimate>) -> Result<Estimate, MethodError> {
+    if parts.len() <= 1 {
+        return parts.pop().ok_or_else(|| {
+            MethodError::Invalid(crate::uq::method::InvalidSettings(
+                "no column to estimate".into(),
+            ))
+        });
+    }
+    fn cat<T: Clone>(
+        parts: &[Estimate],
+        f: impl Fn(&Estimate) -> Option<&Vec<T>>,
+    ) -> Option<Vec<T>> {
+        let mut out = Vec::new();
+        for p in parts {
+            out.extend_from_slice(f(p)?);
+        }
+        Some(out)
+    }
+    let first = &parts[0];
+    let sobol = first.sobol.as_ref().map(|s0| Sobol {
+        first: cat(&parts, |p| p.sobol.as_ref().map(|s| &s.first)).unwrap_or_default(),
+        total: cat(&parts, |p| p.sobol.as_ref().map(|s| &s.total)).unwrap_or_default(),
+        intervals: s0.intervals.as_ref().map(|i0| SobolIntervals {
+            level: i0.level,
+            first: cat(&parts, |p| {
+                p.sobol.as_ref()?.intervals.as_ref().map(|i| &i.first)
+            })
+            .unwrap_or_default(),
+            total: cat(&parts, |p| {
+                p.sobol.as_ref()?.intervals.as_ref().map(|i| &i.total)
+            })
+            .unwrap_or_default(),
+        }),
+    });
+    let chaos_error = first.chaos_error.as_ref().map(|e0| ChaosError {
+        kind: e0.kind,
+        values: cat(&parts, |p| p.chaos_error.as_ref().map(|e| &e.values)).unwrap_or_default(),
+    });
+    let chaos = match first.chaos {
+        Some(_) => {
+            let pces: Vec<&Pce> = parts.iter().filter_map(|p| p.chaos.as_ref()).collect();
+            Some(merge_chaos(&pces)?)
+        }
+        None => None,
+    };
+    Ok(Estimate {
+        mean: cat(&parts, |p| Some(&p.mean)).unwrap_or_default(),
+        std: cat(&parts, |p| Some(&p.std)).unwrap_or_default(),
+        std_error_mean: cat(&parts, |p| p.std_error_mean.as_ref()),
+        std_chaos: cat(&parts, |p| p.std_chaos.as_ref()),
+        chaos,
+        sobol,
+        draws: first.draws,
+        chaos_error,
+    })
+}
+
+/// One chaos of the columns of `pces` side by side: the coefficients joined when the bases
+/// agree, else placed on the union of the bases (graded order, as [`Pce::from_columns`]
+/// orders a union of per-column sets).
+fn merge_chaos(pces: &[&Pce]) -> Result<Pce, MethodError> {
+    let basis = &pces[0].basis;
+    let cols: usize = pces.iter().map(|p| p.coeffs.ncols()).sum();
+    if pces.iter().all(|p| &p.basis == basis) {
+        let mut coeffs = DMatrix::<f64>::zeros(basis.len(), cols);
+        let mut j = 0;
+        for p in pces {
+            let w = p.coeffs.ncols();
+            coeffs.columns_mut(j, w).copy_from(&p.coeffs);
+            j += w;
+        }
+        return Ok(Pce::new(basis.clone(), coeffs)?);
+    }
+    let columns: Vec<(Vec<Vec<usize>>, Vec<f64>)> = pces
+        .iter()
+        .flat_map(|p| {
+            let indices = p.basis.set().indices().to_vec();
+            p.coeffs
+                .column_iter()
+                .map(move |c| (indices.clone(), c.iter().copied().collect()))
+        })
+        .collect();
+    Ok(Pce::from_columns(basis.families().to_vec(), &columns)?)
+}
+
+/// The column summaries of a series taken block by block, and the draws of the columns
+/// whose densities are shown (at most `pdf_times + 1`, evenly spaced, with the last).
+pub(super) struct SeriesColumns {
+    /// Summaries of the columns seen so far, in order.
+    pub(super) cols: Vec<Column>,
+    /// The columns whose densities may be shown.
+    pub(super) candidates: Vec<usize>,
+    /// Their draws, in the order of `candidates` (as far as seen).
+    pub(super) kept: Vec<Vec<f64>>,
+    quantiles: Vec<f64>,
+}
+
+impl SeriesColumns {
+    /// For `nt` columns, densities at `candidates`, quantiles at `quantiles`.
+    pub(super) fn new(nt: usize, candidates: Vec<usize>, quantiles: &[f64]) -> SeriesColumns {
+        SeriesColumns {
+            cols: Vec::with_capacity(nt),
+            candidates,
+            kept: Vec::new(),
+            quantiles: quantiles.to_vec(),
+        }
+    }
+
+    /// Adds the next block of columns (draws in rows), starting at column `j0`; every column
+    /// is summarised in parallel.
+    pub(super) fn add(&mut self, j0: usize, samples: &DMatrix<f64>) {
+        debug_assert_eq!(j0, self.cols.len());
+        let rows = samples.nrows();
+        let all = samples.as_slice();
+        let qs = &self.quantiles;
+        let new: Vec<Column> = (0..samples.ncols())
+            .into_par_iter()
+            .map(|k| column(&all[k * rows..(k + 1) * rows], qs))
+            .collect();
+        self.cols.extend(new);
+        let end = j0 + samples.ncols();
+        for &c in self.candidates.iter().filter(|&&c| (j0..end).contains(&c)) {
+            self.kept
+                .push(all[(c - j0) * rows..(c - j0 + 1) * rows].to_vec());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::pce::{Basis, Family, MultiIndexSet};
+
+    #[test]
+    fn blocks_cover_the_columns_in_aligned_widths() {
+        assert_eq!(
+            blocks(70, 32).collect::<Vec<_>>(),
+            vec![(0, 32), (32, 32), (64, 6)]
+        );
+        assert_eq!(blocks(5, 5).collect::<Vec<_>>(), vec![(0, 5)]);
+        // A block of 10 000 rows of 501 columns fits the default budget: one block.
+        if std::env::var_os("RAILUQ_ANALYSIS_BLOCK_BYTES").is_none() {
+            assert_eq!(block_width(501, 10_000), 501);
+            // 10^6 rows: 16 MB per column, 16 columns fit; at least 32 are taken.
+            assert_eq!(block_width(100_000, 1_000_000), 32);
+            assert_eq!(block_width(100_000, 10_000) % BLOCK_ALIGN, 0);
+        }
+    }
+
+    #[test]
+    fn sparse_chaoses_of_column_blocks_join_into_the_chaos_of_all_columns() {
+        // Per-column sets, as sparse regression gives them.
+        let sets: Vec<(Vec<Vec<usize>>, Vec<f64>)> = vec![
+            (vec![vec![0, 0], vec![1, 0]], vec![1.0, 0.5]),
+            (vec![vec![0, 0], vec![0, 2]], vec![2.0, -0.25]),
+            (
+                vec![vec![0, 0], vec![1, 1], vec![1, 0]],
+                vec![3.0, 0.125, 0.75],
+            ),
+        ];
+        let families = vec![Family::Hermite, Family::Legendre];
+        let all = Pce::from_columns(families.clone(), &sets).unwrap();
+        let a = Pce::from_columns(families.clone(), &sets[..1]).unwrap();
+        let b = Pce::from_columns(families.clone(), &sets[1..]).unwrap();
+        assert_ne!(a.basis, b.basis);
+        assert_eq!(merge_chaos(&[&a, &b]).unwrap(), all);
+        // The same basis: coefficients side by side.
+        let basis = Basis::new(families, MultiIndexSet::total_degree(2, 2).unwrap()).unwrap();
+        let c = DMatrix::from_fn(basis.len(), 3, |t, k| (t * 3 + k) as f64);
+        let whole = Pce::new(basis.clone(), c.clone()).unwrap();
+        let left = Pce::new(basis.clone(), c.columns(0, 2).into_owned()).unwrap();
+        let right = Pce::new(basis, c.columns(2, 1).into_owned()).unwrap();
+        assert_eq!(merge_chaos(&[&left, &right]).unwrap(), whole);
+    }
+}
