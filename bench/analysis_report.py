@@ -53,17 +53,25 @@ def share_table(h, work, driver, all_builtins):
             continue
         out = work / "builtins" / name
         cmd = [str(driver), "run", f"builtin:{name}", "--out", str(out), "--fresh"]
-        wall, _, _ = h.run_cmd(cmd)
-        runs, analysis, report = timings(out)
+        # The best of up to 5 runs of a short study (one run of a study of 5 s or more),
+        # with the stage times of that same run.
+        best = None
+        for _ in range(5):
+            wall, _, _ = h.run_cmd(cmd)
+            if best is None or wall < best[0]:
+                best = (wall, timings(out))
+            if wall >= 5.0:
+                break
+        wall, (runs, analysis, report) = best
         share = (analysis + report) / wall
         worst = max(worst, (share, name), key=lambda x: x[0])
         sec.row(name, h.fmt_s(wall), h.fmt_s(runs), h.fmt_s(analysis), h.fmt_s(report),
                 f"{100 * share:.1f} %")
     sec.cmd(f"target/release/uq-driver run builtin:NAME --out {h.rel(work / 'builtins')}/NAME "
             f"--fresh   # for NAME in `uq-driver list`")
-    sec.note("Whole command: the wall time of the process, measured here. Runs, analysis and "
-             "report: `timing` in the study's summary.json (a suite: summed over its "
-             "variants). The rest of the command is starting the process, reading the study, "
+    sec.note("Whole command: the wall time of the process, measured here (the best of 5 "
+             "for a study that takes under 5 s). Runs, analysis and report: `timing` in the "
+             "study's summary.json of that same run (a suite: summed over its variants). The rest of the command is starting the process, reading the study, "
              "opening (unzipping) the FMU and hashing it.")
     if skipped:
         sec.note("Not run here (their runs take 15 minutes to an hour or more on 2 cores; "

@@ -222,10 +222,19 @@ pub fn package(
         source,
     };
     let mut zip = zip::ZipWriter::new(file);
-    let opts = zip::write::SimpleFileOptions::default()
+    let deflated = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .unix_permissions(0o644);
+    // The binaries are stored, not deflated (an FMU may use either method): an
+    // importer then copies them out instead of inflating megabytes on every load (about
+    // 10 ms per opening of the FMU), for an FMU about twice the size.
+    let stored = deflated.compression_method(zip::CompressionMethod::Stored);
     for (name, data) in entries {
+        let opts = if name.starts_with("binaries/") {
+            stored
+        } else {
+            deflated
+        };
         zip.start_file(name, opts).map_err(zerr)?;
         zip.write_all(&data).map_err(io(&path))?;
     }

@@ -66,12 +66,46 @@ pub fn extract_to_temp(archive: &Path) -> Result<tempfile::TempDir, FmuError> {
     Ok(dir)
 }
 
+/// Extracts what this host needs to run the `.fmu` archive `archive` into the existing folder
+/// `dest`, with the default limits. Every entry is checked as by [`extract`], but these are
+/// not written: the binaries of other platforms (`binaries/<folder>/…` for a folder other
+/// than `host_folder`, e.g. the `win64` DLL on Linux), `documentation/`, `sources/` and the
+/// icon `model.png`, which no importer runs. That saves unpacking megabytes, and creating
+/// and deleting folders (slow on some file systems), on every opening of the FMU.
+pub fn extract_for_host(archive: &Path, dest: &Path, host_folder: &str) -> Result<(), FmuError> {
+    extract_filtered(archive, dest, ExtractLimits::default(), &|relative| {
+        let mut parts = relative.components().map(|c| c.as_os_str());
+        let top = parts.next();
+        let second = parts.next();
+        let nested = parts.next().is_some();
+        let other_binary =
+            top == Some("binaries".as_ref()) && nested && second.is_some_and(|f| f != host_folder);
+        let unused = match top.and_then(|t| t.to_str()) {
+            Some("documentation" | "sources") => second.is_some(),
+            Some("model.png") => second.is_none(),
+            _ => false,
+        };
+        !(other_binary || unused)
+    })
+}
+
 /// Extracts `archive` into the existing folder `dest`, refusing unsafe entries and archives that
 /// exceed `limits`. On error, `dest` may hold part of the archive.
 pub fn extract_with_limits(
     archive: &Path,
     dest: &Path,
     limits: ExtractLimits,
+) -> Result<(), FmuError> {
+    extract_filtered(archive, dest, limits, &|_| true)
+}
+
+/// [`extract_with_limits`], writing only the entries whose relative path `keep` accepts (all
+/// are checked).
+fn extract_filtered(
+    archive: &Path,
+    dest: &Path,
+    limits: ExtractLimits,
+    keep: &dyn Fn(&Path) -> bool,
 ) -> Result<(), FmuError> {
     let io_err = |path: &Path| {
         let path = path.to_path_buf();
@@ -134,6 +168,9 @@ pub fn extract_with_limits(
             return Err(unsafe_entry("not a regular file or folder"));
         }
         let target = dest.join(&relative);
+        if !keep(&relative) {
+            continue;
+        }
 
         if entry.is_dir() {
             fs::create_dir_all(&target).map_err(io_err(&target))?;
@@ -339,6 +376,42 @@ mod tests {
             fs::read(out.path().join("resources/a/b.txt")).unwrap(),
             b"hi"
         );
+    }
+
+    #[test]
+    fn what_no_importer_runs_is_not_unpacked() {
+        let dir = tempfile::tempdir().unwrap();
+        let fmu = dir.path().join("a.fmu");
+        write_zip(
+            &fmu,
+            &[
+                ("modelDescription.xml", b"<x/>"),
+                ("binaries/linux64/m.so", b"so"),
+                ("binaries/win64/m.dll", b"dll"),
+                ("binaries/darwin64/sub/m.dylib", b"dylib"),
+                ("binaries/notes.txt", b"n"),
+                ("resources/win64/data.txt", b"r"),
+                ("resources/documentation/d.txt", b"r"),
+                ("documentation/index.html", b"d"),
+                ("sources/m.c", b"c"),
+                ("model.png", b"p"),
+                ("extra/x.txt", b"x"),
+            ],
+        );
+        let out = tempfile::tempdir().unwrap();
+        extract_for_host(&fmu, out.path(), "linux64").unwrap();
+        let has = |p: &str| out.path().join(p).exists();
+        assert!(has("modelDescription.xml") && has("binaries/linux64/m.so"));
+        assert!(has("binaries/notes.txt") && has("resources/win64/data.txt"));
+        assert!(has("resources/documentation/d.txt") && has("extra/x.txt"));
+        assert!(!has("binaries/win64") && !has("binaries/darwin64"));
+        assert!(!has("documentation") && !has("sources") && !has("model.png"));
+        // Entries that are not unpacked are still checked.
+        let bad = dir.path().join("bad.fmu");
+        write_zip(&bad, &[("binaries/win64/../../../evil.dll", b"x")]);
+        let out = tempfile::tempdir().unwrap();
+        let err = extract_for_host(&bad, out.path(), "linux64").unwrap_err();
+        assert!(matches!(err, FmuError::UnsafeEntry { .. }), "{err}");
     }
 
     #[test]

@@ -115,7 +115,11 @@ impl Fmu {
         let dir = Extracted(Some(dir));
         {
             let _filling = cleanup::filling();
-            archive::extract(path, dir.path())?;
+            match binary::platform() {
+                Ok((host, _)) => archive::extract_for_host(path, dir.path(), host)?,
+                // No binary folder is this host's: extract all, loading reports it.
+                Err(_) => archive::extract(path, dir.path())?,
+            }
         }
         let root = dir.path().to_path_buf();
         Self::load(path, &root, Some(dir))

@@ -84,12 +84,24 @@ pub fn write_grid(
 
     let mut out = String::with_capacity(32 * (times.len() * grid.len() + 1));
     push_header(&mut out, &["time", "x", "density"]);
+    // Each time and grid value is formatted once ("x," is the same on every time's rows).
+    let xs: Vec<String> = grid
+        .iter()
+        .map(|&x| {
+            let mut s = String::new();
+            push_number(&mut s, x);
+            s.push(',');
+            s
+        })
+        .collect();
+    let mut t_text = String::new();
     for (&t, row) in times.iter().zip(density) {
-        for (&x, &d) in grid.iter().zip(row) {
-            push_number(&mut out, t);
-            out.push(',');
-            push_number(&mut out, x);
-            out.push(',');
+        t_text.clear();
+        push_number(&mut t_text, t);
+        t_text.push(',');
+        for (x, &d) in xs.iter().zip(row) {
+            out.push_str(&t_text);
+            out.push_str(x);
             push_number(&mut out, d);
             out.push('\n');
         }

@@ -86,6 +86,31 @@ impl Heatmap {
         (pixels(nx, MIN_W), pixels(ny, MIN_H))
     }
 
+    /// The RGBA color of cell `(ix, iy)` (transparent outside the grid or without a value).
+    fn cell_color(
+        &self,
+        ix: Option<usize>,
+        iy: Option<usize>,
+        scale: Option<&ColorScale>,
+    ) -> [u8; 4] {
+        let v = match (ix, iy) {
+            (Some(ix), Some(iy)) => self
+                .z
+                .get(ix)
+                .and_then(|r| r.get(iy))
+                .copied()
+                .unwrap_or(f64::NAN),
+            _ => f64::NAN,
+        };
+        match scale.and_then(|s| s.t(v)) {
+            Some(t) => {
+                let [r, g, b] = viridis(t);
+                [r, g, b, 255]
+            }
+            None => [0, 0, 0, 0],
+        }
+    }
+
     /// Encodes the heat map as an RGBA PNG (no text; the top row is the largest `y`).
     pub fn to_png(&self) -> Result<Vec<u8>, png::EncodingError> {
         let (w, h) = self.png_size();
@@ -94,26 +119,29 @@ impl Heatmap {
         let col: Vec<Option<usize>> = (0..w as usize)
             .map(|i| xc.at((i as f64 + 0.5) / w as f64))
             .collect();
-        let mut data = Vec::with_capacity(w as usize * h as usize * 4);
+        let row_bytes = w as usize * 4;
+        let mut data = Vec::with_capacity(row_bytes * h as usize);
+        let mut prev_iy = None;
         for j in 0..h as usize {
             let iy = yc.at(1.0 - (j as f64 + 0.5) / h as f64);
+            if j > 0 && iy == prev_iy {
+                // Pixel rows of one grid cell are equal: copy the previous one.
+                data.extend_from_within(data.len() - row_bytes..);
+                continue;
+            }
+            prev_iy = iy;
+            // Pixels of one cell share its color: computed once per cell.
+            let mut last: Option<(Option<usize>, [u8; 4])> = None;
             for &ix in &col {
-                let v = match (ix, iy) {
-                    (Some(ix), Some(iy)) => self
-                        .z
-                        .get(ix)
-                        .and_then(|r| r.get(iy))
-                        .copied()
-                        .unwrap_or(f64::NAN),
-                    _ => f64::NAN,
-                };
-                match scale.as_ref().and_then(|s| s.t(v)) {
-                    Some(t) => {
-                        data.extend_from_slice(&viridis(t));
-                        data.push(255);
+                let rgba = match last {
+                    Some((cell, rgba)) if cell == ix => rgba,
+                    _ => {
+                        let rgba = self.cell_color(ix, iy, scale.as_ref());
+                        last = Some((ix, rgba));
+                        rgba
                     }
-                    None => data.extend_from_slice(&[0, 0, 0, 0]),
-                }
+                };
+                data.extend_from_slice(&rgba);
             }
         }
         let mut bytes = Vec::new();

@@ -8,6 +8,8 @@ mod plots;
 use std::path::Path;
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use super::inputs;
 use super::units::with_unit;
 use super::{write_bytes, ReportError, ReportPage, Section, Table};
@@ -50,28 +52,47 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
         .iter()
         .map(|p| p.name.as_str())
         .collect();
-    let mut sections = Vec::new();
-    for s in r.outputs {
-        files::output_csv(dir, s)?;
-        files::pdf_csv(dir, s)?;
-        files::sobol_csv(dir, s, &names)?;
-        if let Some(c) = &s.convergence {
-            files::convergence_csv(dir, &s.name, c)?;
-        }
-        if r.plots {
-            sections.push(output_section(dir, s, r.summary, &names)?);
-        }
-    }
-    for q in r.quantities {
-        files::scalar_pdf_csv(dir, q)?;
-        files::scalar_samples(dir, q)?;
-        if let Some(c) = &q.convergence {
-            files::convergence_csv(dir, &q.name, c)?;
-        }
-        if r.plots {
-            sections.push(quantity_section(dir, q, &r.summary.study, &names)?);
-        }
-    }
+    // Each output and quantity writes its own files: in parallel, the data files beside the
+    // plots; the sections are kept in order.
+    let outputs: Vec<Option<Section>> = r
+        .outputs
+        .par_iter()
+        .map(|s| {
+            let (files, section) = rayon::join(
+                || -> Result<(), ReportError> {
+                    files::output_csv(dir, s)?;
+                    files::pdf_csv(dir, s)?;
+                    files::sobol_csv(dir, s, &names)?;
+                    if let Some(c) = &s.convergence {
+                        files::convergence_csv(dir, &s.name, c)?;
+                    }
+                    Ok(())
+                },
+                || {
+                    r.plots
+                        .then(|| output_section(dir, s, r.summary, &names))
+                        .transpose()
+                },
+            );
+            files?;
+            section
+        })
+        .collect::<Result<_, _>>()?;
+    let quantities: Vec<Option<Section>> = r
+        .quantities
+        .par_iter()
+        .map(|q| {
+            files::scalar_pdf_csv(dir, q)?;
+            files::scalar_samples(dir, q)?;
+            if let Some(c) = &q.convergence {
+                files::convergence_csv(dir, &q.name, c)?;
+            }
+            r.plots
+                .then(|| quantity_section(dir, q, &r.summary.study, &names))
+                .transpose()
+        })
+        .collect::<Result<_, _>>()?;
+    let mut sections: Vec<Section> = outputs.into_iter().chain(quantities).flatten().collect();
     if r.plots {
         for spec in r.qoi {
             if let Some(file) = plots::speed_plot(dir, spec, r.outputs, &r.summary.study)? {

@@ -2,6 +2,8 @@
 //! linear passes: range, mean, Std, exact type-7 quantiles by selection, Silverman's
 //! bandwidth.
 
+use std::borrow::Cow;
+
 use crate::qoi::kde;
 use crate::uq::moments;
 
@@ -16,9 +18,9 @@ pub(super) struct Column {
     pub bandwidth: f64,
 }
 
-/// Quantiles, range and bandwidth of the finite values of `col`, in three passes over it
-/// (range and sum; squared deviations and bin counts; the members of the bins that hold
-/// the order statistics needed).
+/// Quantiles, range and bandwidth of the finite values of `col`, in a few linear passes over
+/// it (range and sum; squared deviations; bin counts; the members of the bins that hold the
+/// order statistics needed).
 pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
     let mut levels = ps.to_vec();
     levels.extend([0.25, 0.75]);
@@ -48,7 +50,13 @@ pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
         hi.iter().copied().fold(f64::NEG_INFINITY, f64::max),
     );
     let mean = sum.iter().sum::<f64>() / n.max(1) as f64;
-    let (q, ss) = select_quantiles(col, &levels, n, min, max, mean);
+    // The finite values (the column itself when all are).
+    let finite: Cow<[f64]> = if n == col.len() {
+        Cow::Borrowed(col)
+    } else {
+        Cow::Owned(col.iter().copied().filter(|x| x.is_finite()).collect())
+    };
+    let (q, ss) = select_quantiles(&finite, &levels, min, max, mean);
     let std = if n > 1 {
         (ss / (n - 1) as f64).sqrt()
     } else {
@@ -63,80 +71,53 @@ pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
     }
 }
 
-/// Type-7 quantiles (as [`moments::quantile`] of the sorted finite values) of `values` at
-/// the levels `ps`, without sorting, and the sum of squared deviations from `mean`: one
-/// pass counts the `n` finite values (within `[min, max]`) into equal-width bins, and only
-/// the bins holding the order statistics needed are sorted. `O(n)` unless most values fall
-/// into one bin (then it costs a sort of those). NaN for no finite value or a level outside
-/// [0, 1].
-fn select_quantiles(
-    values: &[f64],
-    ps: &[f64],
-    n: usize,
-    min: f64,
-    max: f64,
-    mean: f64,
-) -> (Vec<f64>, f64) {
-    let finite = || values.iter().copied().filter(|x| x.is_finite());
+/// Type-7 quantiles (as [`moments::quantile`] of the sorted values) of the finite `values`
+/// (within `[min, max]`) at the levels `ps`, without sorting them all, and the sum of squared
+/// deviations from `mean`. NaN for no value or a level outside [0, 1].
+fn select_quantiles(values: &[f64], ps: &[f64], min: f64, max: f64, mean: f64) -> (Vec<f64>, f64) {
+    let n = values.len();
     if n == 0 || max == min || !(max - min).is_finite() {
-        let mut sorted: Vec<f64> = finite().collect();
+        let mut sorted = values.to_vec();
         sorted.sort_by(f64::total_cmp);
-        let ss = finite().map(|x| (x - mean) * (x - mean)).sum();
+        let ss = values.iter().map(|x| (x - mean) * (x - mean)).sum();
         return (
             ps.iter().map(|&p| moments::quantile(&sorted, p)).collect(),
             ss,
         );
     }
-    let bins = (n / 8).clamp(16, 1 << 14);
-    let scale = bins as f64 / (max - min);
-    let bin = |x: f64| (((x - min) * scale) as usize).min(bins - 1);
-    let mut start = vec![0usize; bins + 1];
     let mut ss = [0.0; 4];
-    for (i, x) in finite().enumerate() {
-        ss[i % 4] += (x - mean) * (x - mean);
-        start[bin(x) + 1] += 1;
+    let mut chunks = values.chunks_exact(4);
+    for c in &mut chunks {
+        for i in 0..4 {
+            ss[i] += (c[i] - mean) * (c[i] - mean);
+        }
+    }
+    for (i, x) in chunks.remainder().iter().enumerate() {
+        ss[i] += (x - mean) * (x - mean);
     }
     let ss: f64 = ss.iter().sum();
-    for b in 0..bins {
-        start[b + 1] += start[b];
-    }
-    // The bin holding the order statistic of (0-based) rank r.
-    let bin_of_rank = |r: usize| start.partition_point(|&s| s <= r) - 1;
     let rank_pairs = |p: f64| {
         let h = (n - 1) as f64 * p;
         let r = h.floor() as usize;
         (r, (r + 1).min(n - 1), h - r as f64)
     };
-    // slot[b]: where the members of a needed bin b are gathered.
-    const NONE: u32 = u32::MAX;
-    let mut slot = vec![NONE; bins];
-    let mut members: Vec<Vec<f64>> = Vec::new();
-    for &p in ps.iter().filter(|p| (0.0..=1.0).contains(*p)) {
-        let (r0, r1, _) = rank_pairs(p);
-        for b in [bin_of_rank(r0), bin_of_rank(r1)] {
-            if slot[b] == NONE {
-                slot[b] = members.len() as u32;
-                members.push(Vec::with_capacity(start[b + 1] - start[b]));
-            }
-        }
-    }
-    for x in finite() {
-        let s = slot[bin(x)];
-        if s != NONE {
-            members[s as usize].push(x);
-        }
-    }
-    for m in &mut members {
-        m.sort_by(f64::total_cmp);
-    }
-    let order_statistic = |r: usize| {
-        let b = bin_of_rank(r);
-        members[slot[b] as usize][r - start[b]]
-    };
+    let valid = |p: &f64| (0.0..=1.0).contains(p);
+    let mut ranks: Vec<usize> = ps
+        .iter()
+        .filter(|p| valid(p))
+        .flat_map(|&p| {
+            let (r0, r1, _) = rank_pairs(p);
+            [r0, r1]
+        })
+        .collect();
+    ranks.sort_unstable();
+    ranks.dedup();
+    let at = select_ranks(values, min, max, &ranks, 0);
+    let order_statistic = |r: usize| at[ranks.binary_search(&r).expect("rank selected")];
     let q = ps
         .iter()
         .map(|&p| {
-            if !(0.0..=1.0).contains(&p) {
+            if !valid(&p) {
                 return f64::NAN;
             }
             let (r0, r1, frac) = rank_pairs(p);
@@ -149,6 +130,85 @@ fn select_quantiles(
         })
         .collect();
     (q, ss)
+}
+
+/// Below this many values, [`select_ranks`] sorts.
+const SORT_BELOW: usize = 64;
+/// Levels of rebinning before [`select_ranks`] sorts a bin whatever its size.
+const MAX_DEPTH: usize = 4;
+
+/// The order statistics of (0-based, ascending, distinct) `ranks` of the finite `values`,
+/// whose range is `[min, max]`, as a sorted copy would give them (by `f64::total_cmp`).
+///
+/// The values are counted into `n / 8` equal-width bins; only the bins holding a rank are
+/// gathered, and each is solved the same way on its own range (so heavy tails, which crowd
+/// most values into a few bins, cost a few more linear passes, not a sort), or sorted when
+/// small, constant or [`MAX_DEPTH`] levels down. `O(n)` in all but pathological cases.
+fn select_ranks(values: &[f64], min: f64, max: f64, ranks: &[usize], depth: usize) -> Vec<f64> {
+    let n = values.len();
+    if n <= SORT_BELOW || depth >= MAX_DEPTH || max == min || !(max - min).is_finite() {
+        let mut sorted = values.to_vec();
+        sorted.sort_unstable_by(f64::total_cmp);
+        return ranks.iter().map(|&r| sorted[r]).collect();
+    }
+    let bins = (n / 8).clamp(16, 1 << 14);
+    let scale = bins as f64 / (max - min);
+    // Bin of each value (u16: at most 2^14 bins), and the counts in four interleaved
+    // histograms, so that equal neighbours do not wait on one counter.
+    let top = (bins - 1) as f64;
+    let index: Vec<u16> = values
+        .iter()
+        .map(|&x| ((x - min) * scale).min(top) as u16)
+        .collect();
+    let mut counts = vec![0u32; 4 * bins];
+    let mut quads = index.chunks_exact(4);
+    for q in &mut quads {
+        for (lane, &b) in q.iter().enumerate() {
+            counts[4 * b as usize + lane] += 1;
+        }
+    }
+    for &b in quads.remainder() {
+        counts[4 * b as usize] += 1;
+    }
+    // start[b]: the rank of the first value of bin b.
+    let mut start = vec![0usize; bins + 1];
+    for b in 0..bins {
+        let c = &counts[4 * b..4 * b + 4];
+        start[b + 1] = start[b] + (c[0] + c[1] + c[2] + c[3]) as usize;
+    }
+    let bin_of_rank = |r: usize| start.partition_point(|&s| s <= r) - 1;
+    // The bins needed, in ascending order, each with the ranks it holds.
+    const NONE: u32 = u32::MAX;
+    let mut slot = vec![NONE; bins];
+    let mut needed: Vec<(usize, Vec<usize>)> = Vec::new();
+    for &r in ranks {
+        let b = bin_of_rank(r);
+        if slot[b] == NONE {
+            slot[b] = needed.len() as u32;
+            needed.push((b, Vec::new()));
+        }
+        needed[slot[b] as usize].1.push(r - start[b]);
+    }
+    let mut members: Vec<Vec<f64>> = needed
+        .iter()
+        .map(|&(b, _)| Vec::with_capacity(start[b + 1] - start[b]))
+        .collect();
+    for (&x, &b) in values.iter().zip(&index) {
+        let s = slot[b as usize];
+        if s != NONE {
+            members[s as usize].push(x);
+        }
+    }
+    let mut out = Vec::with_capacity(ranks.len());
+    for ((_, local), m) in needed.iter().zip(&members) {
+        let (lo, hi) = m
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        out.extend(select_ranks(m, lo, hi, local, depth + 1));
+    }
+    out
 }
 
 #[cfg(test)]
@@ -173,12 +233,25 @@ mod tests {
         let ties: Vec<f64> = normal.iter().map(|z| (z * 2.0).round()).collect();
         let mut clustered = vec![1.0; 5000];
         clustered.extend([-1e9, 2.0, 1e12]);
+        // Crowded into ever smaller bins (rebinning several levels down, then sorting).
+        let cubed: Vec<f64> = normal.iter().map(|z| z.powi(3)).collect();
+        let geometric: Vec<f64> = (0..3000).map(|i| 0.8f64.powi(i)).collect();
+        let signed_zeros: Vec<f64> = (0..3000)
+            .map(|i| match i % 3 {
+                0 => -0.0,
+                1 => 0.0,
+                _ => f64::from(i % 7) * 1e-300,
+            })
+            .collect();
         let with_nan = [f64::NAN, 3.0, 1.0, f64::INFINITY, 2.0];
         for xs in [
             &normal[..],
             &heavy,
             &ties,
             &clustered,
+            &cubed,
+            &geometric,
+            &signed_zeros,
             &normal[..7],
             &[5.0][..],
             &with_nan,
@@ -193,6 +266,30 @@ mod tests {
         }
         assert!(column(&[], &[0.5]).quantiles[0].is_nan());
         assert!(column(&[1.0, 2.0], &[1.5]).quantiles[0].is_nan());
+    }
+
+    /// The cost of summarising a chaos study's draws (501 columns of 4 000):
+    /// `cargo test --release -p uq-driver --lib -- --ignored column_timing --nocapture`.
+    #[test]
+    #[ignore = "prints timings"]
+    fn column_timing() {
+        let normal: Vec<f64> = (0..501 * 4_000u64)
+            .map(|i| rng::standard_normal(&mut rng::stream(5, i)))
+            .collect();
+        let cubed: Vec<f64> = normal.iter().map(|z| z.powi(3)).collect();
+        for (what, draws) in [("normal", normal), ("cubed normal", cubed)] {
+            let t = std::time::Instant::now();
+            let mut sink = 0.0;
+            for _ in 0..20 {
+                for col in draws.chunks_exact(4_000) {
+                    sink += column(col, &[0.01, 0.5, 0.99]).bandwidth;
+                }
+            }
+            eprintln!(
+                "{what}: 501 columns of 4000: {:?} ({sink})",
+                t.elapsed() / 20
+            );
+        }
     }
 
     #[test]

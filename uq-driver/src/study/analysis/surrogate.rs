@@ -7,7 +7,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DMatrixViewMut};
 use rayon::prelude::*;
 
 use crate::uq::pce::{germ_draw, Basis, Pce};
@@ -57,8 +57,9 @@ impl Surrogates {
             .for_each(|(b, block)| {
                 let j0 = b * COLUMNS_PER_TASK;
                 let w = block.len() / n.max(1);
-                let part = psi.rows(0, n) * pce.coeffs.columns(j0, w);
-                block.copy_from_slice(part.as_slice());
+                // The product written straight into the output's columns.
+                let mut part = DMatrixViewMut::from_slice(block, n, w);
+                part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j0, w), 0.0);
             });
         out
     }
