@@ -444,8 +444,8 @@ pub struct SupportCache {
 type Factors = HashMap<Vec<usize>, Arc<LeastSquares>>;
 
 impl SupportCache {
-    /// Most numbers kept (matrices of the factorisations), about 256 MB.
-    pub const BUDGET: usize = 1 << 25;
+    /// Most numbers kept (matrices of the factorisations), 64 MB.
+    pub const BUDGET: usize = 1 << 23;
 
     /// The factorisation of the columns `cols` of `psi` (`psi` must be the cache's design).
     fn factor(
