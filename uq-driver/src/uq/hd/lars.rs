@@ -13,9 +13,12 @@
 //! is active, when `N - 2` columns are active (the refit needs `N > P`), when the
 //! remaining correlation vanishes, or when the active Gram matrix becomes singular.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use nalgebra::{DMatrix, DVector};
 
-use super::regression::{columns, least_squares, LeastSquaresFit, RegressionError};
+use super::regression::{columns, LeastSquares, LeastSquaresFit, RegressionError};
 
 /// Path algorithm.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,6 +69,44 @@ fn standardize(psi: &DMatrix<f64>, constant: Option<usize>) -> (DMatrix<f64>, Ve
     (x, idx)
 }
 
+/// What the paths need of a design, whatever the response: the standardised columns, their
+/// transpose, their Gram matrix and squared norms. Computed once for any number of responses
+/// on the same design (the paths are then those of [`lars_path`] and [`omp_path`], bit for
+/// bit: the same operations on the same numbers).
+#[derive(Clone, Debug)]
+pub struct PathDesign {
+    constant: Option<usize>,
+    x: DMatrix<f64>,
+    xt: DMatrix<f64>,
+    idx: Vec<usize>,
+    /// `x_k . x_j` at `k * m + j`.
+    gram: Vec<f64>,
+    norms2: Vec<f64>,
+}
+
+impl PathDesign {
+    /// The design `psi` with its constant column (the intercept), if any.
+    pub fn new(psi: &DMatrix<f64>, constant: Option<usize>) -> PathDesign {
+        let (x, idx) = standardize(psi, constant);
+        let m = x.ncols();
+        let mut gram = vec![0.0; m * m];
+        for k in 0..m {
+            for j in 0..m {
+                gram[k * m + j] = x.column(k).dot(&x.column(j));
+            }
+        }
+        let norms2 = (0..m).map(|j| x.column(j).norm_squared()).collect();
+        PathDesign {
+            constant,
+            xt: x.transpose(),
+            x,
+            idx,
+            gram,
+            norms2,
+        }
+    }
+}
+
 /// Active columns of LARS with their entry signs and the Cholesky factor of the Gram
 /// matrix of the signed columns `s_j x_j`, extended by one row per added column
 /// (without the lasso modification the active correlations keep their signs).
@@ -78,21 +119,21 @@ struct ActiveSet {
 }
 
 impl ActiveSet {
-    /// Adds column `j` of `x` with `sign`; false if it is (numerically) dependent.
-    fn add(&mut self, x: &DMatrix<f64>, j: usize, sign: f64) -> bool {
-        let xj = x.column(j);
+    /// Adds column `j` of the design with `sign`; false if it is (numerically) dependent.
+    fn add(&mut self, design: &PathDesign, j: usize, sign: f64) -> bool {
+        let m = design.x.ncols();
         let g: Vec<f64> = self
             .cols
             .iter()
             .zip(&self.signs)
-            .map(|(&k, &sk)| sk * sign * x.column(k).dot(&xj))
+            .map(|(&k, &sk)| sk * sign * design.gram[k * m + j])
             .collect();
         let mut l = vec![0.0; g.len()];
         for i in 0..g.len() {
             let s: f64 = (0..i).map(|k| self.chol[i][k] * l[k]).sum();
             l[i] = (g[i] - s) / self.chol[i][i];
         }
-        let d2 = xj.norm_squared() - l.iter().map(|v| v * v).sum::<f64>();
+        let d2 = design.norms2[j] - l.iter().map(|v| v * v).sum::<f64>();
         if d2 <= 1e-12 {
             return false;
         }
@@ -128,7 +169,12 @@ pub fn lars_path(
     constant: Option<usize>,
     max_active: usize,
 ) -> Vec<Vec<usize>> {
-    let (x, idx) = standardize(psi, constant);
+    lars_path_on(&PathDesign::new(psi, constant), y, max_active)
+}
+
+/// [`lars_path`] on a prepared design.
+pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
+    let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
     let (n, m) = x.shape();
     let ym = if constant.is_some() {
         y.iter().sum::<f64>() / n as f64
@@ -139,7 +185,7 @@ pub fn lars_path(
     let limit = max_active.min(m).min(n.saturating_sub(2));
     let mut in_active = vec![false; m];
     let mut path: Vec<Vec<usize>> = Vec::new();
-    let mut c = x.transpose() * &r;
+    let mut c = xt * &r;
     let first = (0..m).max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()));
     let Some(first) = first else {
         return path;
@@ -148,7 +194,7 @@ pub fn lars_path(
         return path;
     }
     let mut act = ActiveSet::default();
-    if !act.add(&x, first, c[first].signum()) {
+    if !act.add(design, first, c[first].signum()) {
         return path;
     }
     in_active[first] = true;
@@ -167,7 +213,7 @@ pub fn lars_path(
         for (i, &j) in act.cols.iter().enumerate() {
             u.axpy(aa * gi1[i] * act.signs[i], &x.column(j), 1.0);
         }
-        let a = x.transpose() * &u;
+        let a = xt * &u;
         let mut gamma = big_c / aa;
         let mut next = None;
         for j in 0..m {
@@ -182,9 +228,9 @@ pub fn lars_path(
             }
         }
         r -= &u * gamma;
-        c = x.transpose() * &r;
+        c = xt * &r;
         match next {
-            Some(j) if act.add(&x, j, c[j].signum()) => {
+            Some(j) if act.add(design, j, c[j].signum()) => {
                 in_active[j] = true;
             }
             _ => break,
@@ -200,7 +246,12 @@ pub fn omp_path(
     constant: Option<usize>,
     max_active: usize,
 ) -> Vec<Vec<usize>> {
-    let (x, idx) = standardize(psi, constant);
+    omp_path_on(&PathDesign::new(psi, constant), y, max_active)
+}
+
+/// [`omp_path`] on a prepared design.
+pub fn omp_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
+    let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
     let (n, m) = x.shape();
     let ym = if constant.is_some() {
         y.iter().sum::<f64>() / n as f64
@@ -214,7 +265,7 @@ pub fn omp_path(
     let mut in_active = vec![false; m];
     let mut path = Vec::new();
     while active.len() < limit {
-        let c = x.transpose() * &r;
+        let c = xt * &r;
         let best = (0..m)
             .filter(|&j| !in_active[j])
             .max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()));
@@ -253,6 +304,7 @@ pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<
     let mut tr = 0.0;
     let mut res = DVector::from_column_slice(y);
     let mut lev = vec![0.0; n];
+    let yv = DVector::from_column_slice(y);
     let mut out = Vec::with_capacity(order.len());
     for (k, &col) in order.iter().enumerate() {
         let mut v = psi.column(col).into_owned();
@@ -282,7 +334,7 @@ pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<
         tr += t.iter().map(|x| x * x).sum::<f64>();
         rinv.push(t);
         rcols.push(r);
-        let qy = q.dot(&DVector::from_column_slice(y));
+        let qy = q.dot(&yv);
         res.axpy(-qy, &q, 1.0);
         for (h, qi) in lev.iter_mut().zip(q.iter()) {
             *h += qi * qi;
@@ -326,6 +378,19 @@ pub fn select_by_loo(
     constant: Option<usize>,
     path: &[Vec<usize>],
 ) -> Result<SparseFit, RegressionError> {
+    select_by_loo_cached(psi, y, constant, path, None)
+}
+
+/// [`select_by_loo`] taking the factorisation of the chosen columns from `cache` when
+/// another response chose the same ones (the same numbers: the factorisation depends on
+/// the columns only).
+fn select_by_loo_cached(
+    psi: &DMatrix<f64>,
+    y: &[f64],
+    constant: Option<usize>,
+    path: &[Vec<usize>],
+    cache: Option<&SupportCache>,
+) -> Result<SparseFit, RegressionError> {
     // Column order: the constant, then each set's new column.
     let mut order: Vec<usize> = constant.into_iter().collect();
     for set in path {
@@ -356,12 +421,51 @@ pub fn select_by_loo(
     let mut rest: Vec<usize> = order[usize::from(constant.is_some())..=best].to_vec();
     rest.sort_unstable();
     cols.extend(rest);
-    let fit = least_squares(&columns(psi, &cols), y)?;
+    let fit = match cache {
+        Some(cache) => cache.factor(psi, &cols)?.fit(y)?,
+        None => LeastSquares::new(&columns(psi, &cols))?.fit(y)?,
+    };
     Ok(SparseFit {
         columns: cols,
         fit,
         path_errors: errors,
     })
+}
+
+/// Least-squares factorisations of column subsets of one design, shared by the responses
+/// fitted on it (a time-resolved output chooses the same few supports again and again).
+/// Holds at most [`SupportCache::BUDGET`] numbers; past that it factors without keeping.
+#[derive(Debug, Default)]
+pub struct SupportCache {
+    map: Mutex<(usize, Factors)>,
+}
+
+/// Factorisations by column set.
+type Factors = HashMap<Vec<usize>, Arc<LeastSquares>>;
+
+impl SupportCache {
+    /// Most numbers kept (matrices of the factorisations), 64 MB.
+    pub const BUDGET: usize = 1 << 23;
+
+    /// The factorisation of the columns `cols` of `psi` (`psi` must be the cache's design).
+    fn factor(
+        &self,
+        psi: &DMatrix<f64>,
+        cols: &[usize],
+    ) -> Result<Arc<LeastSquares>, RegressionError> {
+        let lock = || self.map.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(ls) = lock().1.get(cols) {
+            return Ok(Arc::clone(ls));
+        }
+        let ls = Arc::new(LeastSquares::new(&columns(psi, cols))?);
+        let size = psi.nrows() * (2 * cols.len() + 1) + cols.len() * cols.len();
+        let mut guard = lock();
+        if guard.0 + size <= Self::BUDGET {
+            guard.0 += size;
+            guard.1.insert(cols.to_vec(), Arc::clone(&ls));
+        }
+        Ok(ls)
+    }
 }
 
 /// Hybrid sparse regression: the `kind` path, then selection by corrected LOO.
@@ -371,6 +475,20 @@ pub fn sparse_regression(
     constant: Option<usize>,
     kind: PathKind,
 ) -> Result<SparseFit, RegressionError> {
+    let design = PathDesign::new(psi, constant);
+    sparse_regression_on(&design, psi, y, kind, None)
+}
+
+/// [`sparse_regression`] on a prepared design (`design` must be that of `psi`), with the
+/// refits shared through `cache` if given: the same fit, bit for bit, for any number of
+/// responses on one design.
+pub fn sparse_regression_on(
+    design: &PathDesign,
+    psi: &DMatrix<f64>,
+    y: &[f64],
+    kind: PathKind,
+    cache: Option<&SupportCache>,
+) -> Result<SparseFit, RegressionError> {
     if y.len() != psi.nrows() {
         return Err(RegressionError::Shape {
             rows: psi.nrows(),
@@ -378,15 +496,20 @@ pub fn sparse_regression(
         });
     }
     let path = match kind {
-        PathKind::Lars => lars_path(psi, y, constant, usize::MAX),
-        PathKind::Omp => omp_path(psi, y, constant, usize::MAX),
+        PathKind::Lars => lars_path_on(design, y, usize::MAX),
+        PathKind::Omp => omp_path_on(design, y, usize::MAX),
     };
-    select_by_loo(psi, y, constant, &path)
+    select_by_loo_cached(psi, y, design.constant, &path, cache)
 }
+
+#[cfg(test)]
+#[path = "lars_reference.rs"]
+mod reference;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::uq::hd::regression::least_squares;
     use crate::uq::pce::askey::Family;
     use crate::uq::pce::basis::{Basis, MultiIndexSet};
     use crate::uq::rng::{standard_normal, stream, uniform_open01};
@@ -485,6 +608,62 @@ mod tests {
                 "{k}: {} vs {want}",
                 inc[k - 1]
             );
+        }
+    }
+
+    #[test]
+    fn a_design_prepared_once_gives_every_response_the_per_response_fit_bit_for_bit() {
+        // Issue 15: a time-resolved sparse chaos re-standardised the design, transposed it
+        // twice per step and refactored the chosen columns for every time column. The
+        // prepared design and the shared refits must not change a bit: the paths equal those
+        // of the per-response LARS kept in `reference`, and the fits those refitted alone.
+        use crate::uq::hd::sobol_seq::Sobol;
+        use crate::uq::special::norm_ppf;
+        let pts: Vec<Vec<f64>> = Sobol::scrambled(2, 42, 0)
+            .unwrap()
+            .points(0, 60)
+            .unwrap()
+            .into_iter()
+            .map(|p| p.iter().map(|&u| norm_ppf(u)).collect())
+            .collect();
+        // A damped oscillator's displacement over time (stiffness and damping from the
+        // points): smooth early, oscillating late; plus an exact polynomial and a constant.
+        let mut responses: Vec<Vec<f64>> = (0..40)
+            .map(|i| {
+                let t = 0.1 * i as f64;
+                pts.iter()
+                    .map(|p| {
+                        let (k, c) = (100.0 + 10.0 * p[0], 20.0 + 2.0 * p[1]);
+                        let w = (k / 10.0 - (c / 20.0).powi(2)).sqrt();
+                        (-c * t / 20.0).exp() * (w * t).cos()
+                    })
+                    .collect()
+            })
+            .collect();
+        responses.push(
+            pts.iter()
+                .map(|p| p[0] * p[1] - 0.5 * p[1].powi(3))
+                .collect(),
+        );
+        responses.push(vec![1.5; pts.len()]);
+        for degree in [3, 6, 9] {
+            let set = MultiIndexSet::total_degree(2, degree).unwrap();
+            let psi = Basis::new(vec![Family::Hermite; 2], set)
+                .unwrap()
+                .design_matrix(&pts);
+            let design = PathDesign::new(&psi, Some(0));
+            let cache = SupportCache::default();
+            // Twice over: the second pass takes every refit from the cache.
+            for pass in 0..2 {
+                for (i, y) in responses.iter().enumerate() {
+                    let want = reference::lars_path_reference(&psi, y, Some(0), usize::MAX);
+                    assert_eq!(lars_path_on(&design, y, usize::MAX), want, "{degree} {i}");
+                    let alone = select_by_loo(&psi, y, Some(0), &want);
+                    let shared =
+                        sparse_regression_on(&design, &psi, y, PathKind::Lars, Some(&cache));
+                    assert_eq!(shared, alone, "degree {degree}, response {i}, pass {pass}");
+                }
+            }
         }
     }
 

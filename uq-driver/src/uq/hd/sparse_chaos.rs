@@ -8,10 +8,11 @@
 //! the germ of that input's family.
 
 use std::ops::RangeInclusive;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::DMatrix;
 
-use super::lars::{sparse_regression, PathKind};
+use super::lars::{sparse_regression_on, PathDesign, PathKind, SupportCache};
 use super::regression::{least_squares, RegressionError};
 use crate::uq::pce::askey::Family;
 use crate::uq::pce::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
@@ -87,6 +88,9 @@ pub fn fit_chaos(
 pub struct Candidates {
     /// `(degree, basis, design matrix)` by increasing degree.
     levels: Vec<(usize, Basis, DMatrix<f64>)>,
+    /// Per degree, what every sparse fit needs of the design (built by the first one) and the
+    /// refits shared between responses.
+    sparse: Vec<(OnceLock<PathDesign>, Arc<SupportCache>)>,
     families: Vec<Family>,
 }
 
@@ -102,7 +106,7 @@ impl Candidates {
             return Err(ChaosFitError::Empty);
         }
         let d = families.len();
-        let levels = degrees
+        let levels: Vec<(usize, Basis, DMatrix<f64>)> = degrees
             .map(|p| {
                 let set = MultiIndexSet::hyperbolic(d, p, q)?;
                 let basis = Basis::new(families.to_vec(), set)?;
@@ -111,6 +115,7 @@ impl Candidates {
             })
             .collect::<Result<_, ChaosFitError>>()?;
         Ok(Candidates {
+            sparse: levels.iter().map(|_| Default::default()).collect(),
             levels,
             families: families.to_vec(),
         })
@@ -125,13 +130,17 @@ impl Candidates {
         let mut tried = Vec::new();
         let mut first_err = None;
         let mut worse = 0;
-        for (p, basis, psi) in &self.levels {
+        for ((p, basis, psi), (design, cache)) in self.levels.iter().zip(&self.sparse) {
             let result = match kind {
                 FitKind::Full => least_squares(psi, y).map(|f| {
                     let loo = f.corrected_relative_loo();
                     (basis.clone(), f.coeffs, loo)
                 }),
-                FitKind::Sparse(path) => sparse_regression(psi, y, Some(0), path).map(|f| {
+                FitKind::Sparse(path) => {
+                    let design = design.get_or_init(|| PathDesign::new(psi, Some(0)));
+                    sparse_regression_on(design, psi, y, path, Some(cache))
+                }
+                .map(|f| {
                     let loo = f.fit.corrected_relative_loo();
                     let sub = basis.set().select(&f.columns).expect("distinct columns");
                     let b = Basis::new(self.families.clone(), sub).expect("same families");

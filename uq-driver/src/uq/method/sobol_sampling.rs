@@ -211,10 +211,7 @@ impl Sampling for SobolSampling {
         }
         let ab: Vec<usize> = blocks.block_rows(0).chain(blocks.block_rows(1)).collect();
         let moments = Estimate::from_sample(&data.select_rows(&ab));
-        let columns: Vec<ColumnIndices> = (0..data.ncols())
-            .into_par_iter()
-            .map(|c| self.column(&blocks, data, c))
-            .collect::<Result<_, _>>()?;
+        let columns = self.columns(&blocks, data)?;
         let intervals = (self.bootstrap > 0).then(|| SobolIntervals {
             level: self.confidence,
             first: columns.iter().map(|c| c.first_ci.clone()).collect(),
@@ -248,53 +245,82 @@ struct ColumnIndices {
 }
 
 impl SobolSampling {
-    fn column(
+    /// The indices of every column: the bootstrap resamples drawn once and applied to all
+    /// the columns with variance together.
+    fn columns(
         &self,
         blocks: &PickFreezeRows,
         data: &DMatrix<f64>,
-        c: usize,
-    ) -> Result<ColumnIndices, MethodError> {
+    ) -> Result<Vec<ColumnIndices>, MethodError> {
         let (m, d) = (blocks.complete.len(), blocks.d);
-        let mut values: Vec<f64> = (0..d + 2)
-            .flat_map(|b| blocks.block_rows(b))
-            .map(|r| data[(r, c)])
+        let values: Vec<Option<Vec<f64>>> = (0..data.ncols())
+            .into_par_iter()
+            .map(|c| centred_values(blocks, data, c))
             .collect();
-        if !has_variance(&values[..2 * m]) {
-            return Ok(ColumnIndices {
-                first: vec![0.0; d],
-                total: vec![0.0; d],
-                first_ci: vec![(0.0, 0.0); d],
-                total_ci: vec![(0.0, 0.0); d],
-            });
+        let varying: Vec<&Vec<f64>> = values.iter().flatten().collect();
+        let mut indices = if self.bootstrap == 0 {
+            varying
+                .par_iter()
+                .map(|v| {
+                    let e = sensitivity::pick_freeze(v, m, d)?;
+                    Ok(ColumnIndices {
+                        first: e.first,
+                        total: e.total,
+                        first_ci: Vec::new(),
+                        total_ci: Vec::new(),
+                    })
+                })
+                .collect::<Result<Vec<_>, SensitivityError>>()?
+        } else {
+            sensitivity::pick_freeze_bootstrap_columns(
+                &varying,
+                m,
+                d,
+                self.bootstrap,
+                self.confidence,
+                BOOTSTRAP_SEED,
+            )?
+            .into_iter()
+            .map(|e| ColumnIndices {
+                first: e.estimate.first,
+                total: e.estimate.total,
+                first_ci: e.first_ci,
+                total_ci: e.total_ci,
+            })
+            .collect()
         }
-        // Centred values: the same indices in expectation, a far smaller variance of the
-        // first-order estimator f(B) (f(AB_i) - f(A)) when the mean is large against the spread.
-        let mean = values[..2 * m].iter().sum::<f64>() / (2 * m) as f64;
-        values.iter_mut().for_each(|v| *v -= mean);
-        if self.bootstrap == 0 {
-            let e = sensitivity::pick_freeze(&values, m, d)?;
-            return Ok(ColumnIndices {
-                first: e.first,
-                total: e.total,
-                first_ci: Vec::new(),
-                total_ci: Vec::new(),
-            });
-        }
-        let e = sensitivity::pick_freeze_bootstrap(
-            &values,
-            m,
-            d,
-            self.bootstrap,
-            self.confidence,
-            BOOTSTRAP_SEED,
-        )?;
-        Ok(ColumnIndices {
-            first: e.estimate.first,
-            total: e.estimate.total,
-            first_ci: e.first_ci,
-            total_ci: e.total_ci,
-        })
+        .into_iter();
+        Ok(values
+            .iter()
+            .map(|v| match v {
+                Some(_) => indices.next().expect("one result per varying column"),
+                None => ColumnIndices {
+                    first: vec![0.0; d],
+                    total: vec![0.0; d],
+                    first_ci: vec![(0.0, 0.0); d],
+                    total_ci: vec![(0.0, 0.0); d],
+                },
+            })
+            .collect())
     }
+}
+
+/// The values of column `c` in the blocks `A`, `B`, `AB_1`, ... at the complete rows, less
+/// their mean over `A` and `B`; `None` for a column without variance.
+fn centred_values(blocks: &PickFreezeRows, data: &DMatrix<f64>, c: usize) -> Option<Vec<f64>> {
+    let (m, d) = (blocks.complete.len(), blocks.d);
+    let mut values: Vec<f64> = (0..d + 2)
+        .flat_map(|b| blocks.block_rows(b))
+        .map(|r| data[(r, c)])
+        .collect();
+    if !has_variance(&values[..2 * m]) {
+        return None;
+    }
+    // Centred values: the same indices in expectation, a far smaller variance of the
+    // first-order estimator f(B) (f(AB_i) - f(A)) when the mean is large against the spread.
+    let mean = values[..2 * m].iter().sum::<f64>() / (2 * m) as f64;
+    values.iter_mut().for_each(|v| *v -= mean);
+    Some(values)
 }
 
 /// Whether `values` vary beyond rounding: not all equal, and a variance (two-pass, with the
