@@ -165,16 +165,20 @@ impl SeriesColumns {
     /// Adds the next block of columns (draws in rows), starting at column `j0`; every column
     /// is summarised in parallel.
     pub(super) fn add(&mut self, j0: usize, samples: &DMatrix<f64>) {
+        self.add_slice(j0, samples.nrows(), samples.as_slice());
+    }
+
+    /// [`SeriesColumns::add`] of a column-major block of `rows` rows held in `all`.
+    pub(super) fn add_slice(&mut self, j0: usize, rows: usize, all: &[f64]) {
         debug_assert_eq!(j0, self.cols.len());
-        let rows = samples.nrows();
-        let all = samples.as_slice();
+        let ncols = all.len() / rows.max(1);
         let qs = &self.quantiles;
-        let new: Vec<Column> = (0..samples.ncols())
+        let new: Vec<Column> = (0..ncols)
             .into_par_iter()
             .map(|k| column(&all[k * rows..(k + 1) * rows], qs))
             .collect();
         self.cols.extend(new);
-        let end = j0 + samples.ncols();
+        let end = j0 + ncols;
         for &c in self.candidates.iter().filter(|&&c| (j0..end).contains(&c)) {
             self.kept
                 .push(all[(c - j0) * rows..(c - j0 + 1) * rows].to_vec());

@@ -226,20 +226,22 @@ fn chaos_columns(
     let a = settings.analysis;
     let n = a.series_samples.min(a.surrogate_samples).max(2);
     let nt = pce.coeffs.ncols();
-    let width = blocks::block_width(nt, n);
-    if width >= nt {
-        cols.add(0, &settings.surrogates.draws(pce, n));
-        return Ok(());
-    }
+    // Draws in blocks of whole 32-column tasks of about DRAW_BLOCK_BYTES (and within the
+    // analysis's block budget), into one buffer reused for every block: the draws stay in
+    // cache while summarised, and no matrix of every column is allocated and zeroed.
+    let fit = (DRAW_BLOCK_BYTES / (8 * n)) / blocks::BLOCK_ALIGN * blocks::BLOCK_ALIGN;
+    let width = blocks::block_width(nt, n).min(fit.max(blocks::BLOCK_ALIGN));
+    let mut buf = vec![0.0; n * width.min(nt)];
     for (j0, w) in blocks::blocks(nt, width) {
-        let part = crate::uq::pce::Pce {
-            basis: pce.basis.clone(),
-            coeffs: pce.coeffs.columns(j0, w).into_owned(),
-        };
-        cols.add(j0, &settings.surrogates.draws(&part, n));
+        let block = &mut buf[..n * w];
+        settings.surrogates.draws_into(pce, n, j0, block);
+        cols.add_slice(j0, n, block);
     }
     Ok(())
 }
+
+/// Bytes of the surrogate draws taken and summarised at a time (4 MiB).
+const DRAW_BLOCK_BYTES: usize = 4 << 20;
 
 /// The statistics of an output from its estimate and the summaries of its draws;
 /// `run_column(k)` gives the runs of column `k` (for the convergence of a sampled estimate).

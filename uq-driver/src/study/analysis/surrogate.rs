@@ -48,20 +48,26 @@ impl Surrogates {
     /// The first `n` draws of `pce` (one row per draw, one column per output of the chaos):
     /// equal to `pce.sample(n, seed)`.
     pub fn draws(&self, pce: &Pce, n: usize) -> DMatrix<f64> {
-        let psi = self.basis_at_germs(&pce.basis, n);
         let cols = pce.coeffs.ncols();
         let mut out = DMatrix::<f64>::zeros(n, cols);
-        out.as_mut_slice()
-            .par_chunks_mut(n * COLUMNS_PER_TASK)
+        self.draws_into(pce, n, 0, out.as_mut_slice());
+        out
+    }
+
+    /// The columns `j0..j0 + w` of [`Surrogates::draws`] written into `out` (`n` rows, `w`
+    /// columns, column-major; `w = out.len() / n`). With `j0` a multiple of 32 the values are
+    /// those of `draws` bit for bit (the product is split into the same 32-column tasks).
+    pub fn draws_into(&self, pce: &Pce, n: usize, j0: usize, out: &mut [f64]) {
+        let psi = self.basis_at_germs(&pce.basis, n);
+        out.par_chunks_mut(n.max(1) * COLUMNS_PER_TASK)
             .enumerate()
             .for_each(|(b, block)| {
-                let j0 = b * COLUMNS_PER_TASK;
+                let j = j0 + b * COLUMNS_PER_TASK;
                 let w = block.len() / n.max(1);
                 // The product written straight into the output's columns.
                 let mut part = DMatrixViewMut::from_slice(block, n, w);
-                part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j0, w), 0.0);
+                part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
             });
-        out
     }
 
     /// The basis at the first `n` germ points (rows), computed at most once per size.
@@ -135,6 +141,14 @@ mod tests {
             coeffs: DMatrix::from_element(4, 1, 1.0),
         };
         assert_eq!(s.draws(&small, 5), small.sample(5, 11));
+        // Blocks of columns starting at multiples of 32 are the same draws bit for bit.
+        let all = s.draws(&pce, 700);
+        let mut buf = vec![f64::NAN; 700 * 64];
+        for j0 in [0, 32] {
+            let w = 64.min(70 - j0);
+            s.draws_into(&pce, 700, j0, &mut buf[..700 * w]);
+            assert_eq!(&buf[..700 * w], all.columns(j0, w).into_owned().as_slice());
+        }
         // Computing more rows up front changes no draw.
         let ahead = Surrogates::new(11).with_min_rows(2_000);
         assert_eq!(ahead.draws(&pce, 300), s.draws(&pce, 300));
