@@ -32,15 +32,19 @@ fn run_ok(args: &[&str], env: &[(&str, &str)]) {
     );
 }
 
-fn run_study(study: &Path, out: &Path, env: &[(&str, &str)]) {
-    let args = [
+/// `uq-driver run STUDY --out OUT --no-report`.
+fn run_args<'a>(study: &'a Path, out: &'a Path) -> [&'a str; 5] {
+    [
         "run",
         study.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
         "--no-report",
-    ];
-    run_ok(&args, env);
+    ]
+}
+
+fn run_study(study: &Path, out: &Path, env: &[(&str, &str)]) {
+    run_ok(&run_args(study, out), env);
 }
 
 /// Every file of an output folder but the store and the lock, with `summary.json` stripped of
@@ -183,13 +187,7 @@ fn series_larger_than_the_memory_limit_are_run_and_analysed_in_blocks() {
     let method = format!("kind = \"lhs\"\nsamples = {n}");
     let study = wheel::write_study(dir.path(), "big", "big", 5, experiment, &method, "");
     let out = dir.path().join("out");
-    let args = [
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--no-report",
-    ];
+    let args = run_args(&study, &out);
     let limit = ("RAILUQ_MEMORY_LIMIT", "268435456");
     let budget = ("RAILUQ_ANALYSIS_BLOCK_BYTES", "8388608");
     let peak = peak_memory(&args, &[limit, budget]);

@@ -80,29 +80,24 @@ pub fn extract_for_host(
     dest: &Path,
     host_folder: &str,
 ) -> Result<Vec<String>, FmuError> {
-    let platforms = std::cell::RefCell::new(std::collections::BTreeSet::new());
-    extract_filtered(archive, dest, ExtractLimits::default(), &|relative| {
+    let mut platforms = std::collections::BTreeSet::new();
+    extract_filtered(archive, dest, ExtractLimits::default(), &mut |relative| {
         let mut parts = relative.components().map(|c| c.as_os_str());
-        let top = parts.next();
+        let top = parts.next().and_then(|t| t.to_str());
         let second = parts.next();
         let nested = parts.next().is_some();
-        if let (Some("binaries"), Some(folder), true) =
-            (top.and_then(|t| t.to_str()), second, nested)
-        {
-            platforms
-                .borrow_mut()
-                .insert(folder.to_string_lossy().into_owned());
+        match (top, second) {
+            // binaries/<folder>/…: kept for this host only.
+            (Some("binaries"), Some(folder)) if nested => {
+                platforms.insert(folder.to_string_lossy().into_owned());
+                folder == host_folder
+            }
+            (Some("documentation" | "sources"), Some(_)) => false,
+            (Some("model.png"), None) => false,
+            _ => true,
         }
-        let other_binary =
-            top == Some("binaries".as_ref()) && nested && second.is_some_and(|f| f != host_folder);
-        let unused = match top.and_then(|t| t.to_str()) {
-            Some("documentation" | "sources") => second.is_some(),
-            Some("model.png") => second.is_none(),
-            _ => false,
-        };
-        !(other_binary || unused)
     })?;
-    Ok(platforms.into_inner().into_iter().collect())
+    Ok(platforms.into_iter().collect())
 }
 
 /// Extracts `archive` into the existing folder `dest`, refusing unsafe entries and archives that
@@ -112,7 +107,7 @@ pub fn extract_with_limits(
     dest: &Path,
     limits: ExtractLimits,
 ) -> Result<(), FmuError> {
-    extract_filtered(archive, dest, limits, &|_| true)
+    extract_filtered(archive, dest, limits, &mut |_| true)
 }
 
 /// [`extract_with_limits`], writing only the entries whose relative path `keep` accepts (all
@@ -121,7 +116,7 @@ fn extract_filtered(
     archive: &Path,
     dest: &Path,
     limits: ExtractLimits,
-    keep: &dyn Fn(&Path) -> bool,
+    keep: &mut dyn FnMut(&Path) -> bool,
 ) -> Result<(), FmuError> {
     let io_err = |path: &Path| {
         let path = path.to_path_buf();
