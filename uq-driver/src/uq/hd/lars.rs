@@ -107,56 +107,79 @@ impl PathDesign {
     }
 }
 
-/// Active columns of LARS with their entry signs and the Cholesky factor of the Gram
+/// Active columns of LARS with their entry signs and the Cholesky factor `L` of the Gram
 /// matrix of the signed columns `s_j x_j`, extended by one row per added column
 /// (without the lasso modification the active correlations keep their signs).
-#[derive(Default)]
+/// `L` is kept by rows and by columns (each solve reads it contiguously), and with it
+/// `z = L^-1 1`, which only grows by one entry per added column.
 struct ActiveSet {
     cols: Vec<usize>,
     signs: Vec<f64>,
-    /// Lower-triangular rows.
-    chol: Vec<Vec<f64>>,
+    /// Most columns.
+    cap: usize,
+    /// `L[i][j]` at `i * cap + j`.
+    rows: Vec<f64>,
+    /// `L[i][j]` at `j * cap + i`.
+    by_col: Vec<f64>,
+    z: Vec<f64>,
 }
 
 impl ActiveSet {
-    /// Adds column `j` of the design with `sign`; false if it is (numerically) dependent.
-    fn add(&mut self, design: &PathDesign, j: usize, sign: f64) -> bool {
-        let m = design.x.ncols();
-        let g: Vec<f64> = self
-            .cols
-            .iter()
-            .zip(&self.signs)
-            .map(|(&k, &sk)| sk * sign * design.gram[k * m + j])
-            .collect();
-        let mut l = vec![0.0; g.len()];
-        for i in 0..g.len() {
-            let s: f64 = (0..i).map(|k| self.chol[i][k] * l[k]).sum();
-            l[i] = (g[i] - s) / self.chol[i][i];
+    /// An empty set for up to `cap` columns.
+    fn new(cap: usize) -> ActiveSet {
+        ActiveSet {
+            cols: Vec::with_capacity(cap),
+            signs: Vec::with_capacity(cap),
+            cap,
+            rows: vec![0.0; cap * cap],
+            by_col: vec![0.0; cap * cap],
+            z: Vec::with_capacity(cap),
         }
-        let d2 = design.norms2[j] - l.iter().map(|v| v * v).sum::<f64>();
+    }
+
+    /// Adds column `j` of the design with `sign`; false if it is (numerically) dependent
+    /// or the set is full.
+    fn add(&mut self, design: &PathDesign, j: usize, sign: f64) -> bool {
+        let (m, k, cap) = (design.x.ncols(), self.cols.len(), self.cap);
+        if k == cap {
+            return false;
+        }
+        // The new row l solves L l = g (the signed Gram entries), written in place.
+        let (done, row) = self.rows.split_at_mut(k * cap);
+        let l = &mut row[..k + 1];
+        for (i, (&c, &sc)) in self.cols.iter().zip(&self.signs).enumerate() {
+            let g = sc * sign * design.gram[c * m + j];
+            let li = &done[i * cap..i * cap + i + 1];
+            let s: f64 = li[..i].iter().zip(&l[..i]).map(|(a, b)| a * b).sum();
+            l[i] = (g - s) / li[i];
+        }
+        let d2 = design.norms2[j] - l[..k].iter().map(|v| v * v).sum::<f64>();
         if d2 <= 1e-12 {
             return false;
         }
-        l.push(d2.sqrt());
-        self.chol.push(l);
+        l[k] = d2.sqrt();
+        for (i, &v) in l.iter().enumerate() {
+            self.by_col[i * cap + k] = v;
+        }
+        let s: f64 = l[..k].iter().zip(&self.z).map(|(a, b)| a * b).sum();
+        self.z.push((1.0 - s) / l[k]);
         self.cols.push(j);
         self.signs.push(sign);
         true
     }
 
-    /// `G^-1 1` by two triangular solves.
+    /// `G^-1 1 = L^-T z`.
     fn gram_solve_ones(&self) -> Vec<f64> {
-        let k = self.cols.len();
-        let l = &self.chol;
-        let mut z = vec![0.0; k];
-        for i in 0..k {
-            let s: f64 = (0..i).map(|j| l[i][j] * z[j]).sum();
-            z[i] = (1.0 - s) / l[i][i];
-        }
+        let (k, cap) = (self.cols.len(), self.cap);
         let mut w = vec![0.0; k];
         for i in (0..k).rev() {
-            let s: f64 = (i + 1..k).map(|j| l[j][i] * w[j]).sum();
-            w[i] = (z[i] - s) / l[i][i];
+            let col = &self.by_col[i * cap..i * cap + k];
+            let s: f64 = col[i + 1..]
+                .iter()
+                .zip(&w[i + 1..])
+                .map(|(a, b)| a * b)
+                .sum();
+            w[i] = (self.z[i] - s) / col[i];
         }
         w
     }
@@ -174,6 +197,7 @@ pub fn lars_path(
 
 /// [`lars_path`] on a prepared design.
 pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
+    use kernels::{combine, mat_vec, Start};
     let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
     let (n, m) = x.shape();
     let ym = if constant.is_some() {
@@ -181,39 +205,45 @@ pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Ve
     } else {
         0.0
     };
-    let mut r = DVector::from_iterator(n, y.iter().map(|v| v - ym));
+    let mut r: Vec<f64> = y.iter().map(|v| v - ym).collect();
+    let norm = |r: &[f64]| nalgebra::DVectorView::from_slice(r, r.len()).norm();
     let limit = max_active.min(m).min(n.saturating_sub(2));
     let mut in_active = vec![false; m];
     let mut path: Vec<Vec<usize>> = Vec::new();
-    let mut c = xt * &r;
+    let mut c = vec![0.0; m];
+    mat_vec(xt, &r, &mut c);
     let first = (0..m).max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()));
     let Some(first) = first else {
         return path;
     };
-    if c[first].abs() <= 1e-14 * r.norm().max(f64::MIN_POSITIVE) {
+    if c[first].abs() <= 1e-14 * norm(&r).max(f64::MIN_POSITIVE) {
         return path;
     }
-    let mut act = ActiveSet::default();
+    let mut act = ActiveSet::new(limit.max(1));
     if !act.add(design, first, c[first].signum()) {
         return path;
     }
     in_active[first] = true;
+    let (mut u, mut a) = (vec![0.0; n], vec![0.0; m]);
     while act.cols.len() <= limit {
         path.push(act.cols.iter().map(|&k| idx[k]).collect());
         if act.cols.len() == limit {
             break;
         }
         let big_c = act.cols.iter().map(|&k| c[k].abs()).fold(0.0, f64::max);
-        if big_c <= 1e-13 * r.norm().max(1e-300) {
+        if big_c <= 1e-13 * norm(&r).max(1e-300) {
             break;
         }
         let gi1 = act.gram_solve_ones();
         let aa = 1.0 / gi1.iter().sum::<f64>().sqrt();
-        let mut u = DVector::<f64>::zeros(n);
-        for (i, &j) in act.cols.iter().enumerate() {
-            u.axpy(aa * gi1[i] * act.signs[i], &x.column(j), 1.0);
-        }
-        let a = xt * &u;
+        let terms = act
+            .cols
+            .iter()
+            .zip(&gi1)
+            .zip(&act.signs)
+            .map(|((&j, &g), &s)| (&x.as_slice()[j * n..(j + 1) * n], aa * g * s));
+        combine(&mut u, Start::Zero, terms);
+        mat_vec(xt, &u, &mut a);
         let mut gamma = big_c / aa;
         let mut next = None;
         for j in 0..m {
@@ -227,8 +257,10 @@ pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Ve
                 }
             }
         }
-        r -= &u * gamma;
-        c = xt * &r;
+        for (ri, &ui) in r.iter_mut().zip(&u) {
+            *ri -= ui * gamma;
+        }
+        mat_vec(xt, &r, &mut c);
         match next {
             Some(j) if act.add(design, j, c[j].signum()) => {
                 in_active[j] = true;
@@ -295,51 +327,70 @@ pub fn omp_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec
 /// re-orthogonalisation), leverages, residuals and `|R^-1|_F^2` updated per column
 /// (`O(N P)` per step instead of a refit). Infinite from the first dependent column on.
 pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<f64> {
-    let n = psi.nrows();
+    fn view(v: &[f64]) -> nalgebra::DVectorView<'_, f64> {
+        nalgebra::DVectorView::from_slice(v, v.len())
+    }
+    let (n, cap) = (psi.nrows(), order.len());
     let var = super::regression::sample_variance(y);
     let negligible = super::regression::negligible_variance(y);
-    let mut qs: Vec<DVector<f64>> = Vec::new();
-    let mut rinv: Vec<Vec<f64>> = Vec::new(); // columns of R^-1 (upper triangular)
-    let mut rcols: Vec<Vec<f64>> = Vec::new(); // columns of R
+    // q_j at j * n; column j of R^-1 (upper triangular) at j * cap.
+    let mut qs = vec![0.0; n * cap];
+    let mut rinv = vec![0.0; cap * cap];
+    let (mut r, mut s) = (vec![0.0; cap], vec![0.0; cap]);
     let mut tr = 0.0;
-    let mut res = DVector::from_column_slice(y);
+    let mut res = y.to_vec();
     let mut lev = vec![0.0; n];
-    let yv = DVector::from_column_slice(y);
     let mut out = Vec::with_capacity(order.len());
     for (k, &col) in order.iter().enumerate() {
-        let mut v = psi.column(col).into_owned();
-        let norm0 = v.norm();
-        let mut r = vec![0.0; k + 1];
-        for _ in 0..2 {
-            for (j, q) in qs.iter().enumerate() {
-                let d = q.dot(&v);
-                r[j] += d;
-                v.axpy(-d, q, 1.0);
+        let (done, rest) = qs.split_at_mut(k * n);
+        let v = &mut rest[..n];
+        v.copy_from_slice(psi.column(col).as_slice());
+        let norm0 = view(v).norm();
+        r[..=k].fill(0.0);
+        // Modified Gram-Schmidt twice: d = q_j . v, v -= d q_j for each j in turn, each
+        // update fused with the next product.
+        if k > 0 {
+            let q = |j: usize| &done[(j % k) * n..(j % k + 1) * n];
+            let mut d = kernels::dot(q(0), v);
+            for step in 0..2 * k {
+                r[step % k] += d;
+                if step + 1 < 2 * k {
+                    d = kernels::axpy_dot(v, -d, q(step), q(step + 1));
+                } else {
+                    for (vi, &qi) in v.iter_mut().zip(q(step)) {
+                        *vi += -d * qi;
+                    }
+                }
             }
         }
-        let rkk = v.norm();
+        let rkk = view(v).norm();
         if rkk.is_nan() || rkk <= 1e-10 * norm0.max(f64::MIN_POSITIVE) {
             out.resize(order.len(), f64::INFINITY);
             return out;
         }
         r[k] = rkk;
-        let q = v / rkk;
-        // New column of R^-1: t_i = -(sum_j Rinv[i][j] r_j) / rkk, t_k = 1 / rkk.
-        let mut t = vec![0.0; k + 1];
-        for (i, ti) in t.iter_mut().enumerate().take(k) {
-            let s: f64 = (i..k).map(|j| rinv[j][i] * r[j]).sum();
-            *ti = -s / rkk;
+        v.iter_mut().for_each(|vi| *vi /= rkk);
+        let q = &*v;
+        // New column of R^-1: t_i = -(sum_{j >= i} Rinv[i][j] r_j) / rkk, t_k = 1 / rkk;
+        // the sums over j in order, all i at once.
+        s[..k].fill(-0.0);
+        for j in 0..k {
+            let rj = r[j];
+            for (si, &ri) in s[..=j].iter_mut().zip(&rinv[j * cap..j * cap + j + 1]) {
+                *si += ri * rj;
+            }
+        }
+        let t = &mut rinv[k * cap..k * cap + k + 1];
+        for (ti, &si) in t.iter_mut().zip(&s[..k]) {
+            *ti = -si / rkk;
         }
         t[k] = 1.0 / rkk;
         tr += t.iter().map(|x| x * x).sum::<f64>();
-        rinv.push(t);
-        rcols.push(r);
-        let qy = q.dot(&yv);
-        res.axpy(-qy, &q, 1.0);
-        for (h, qi) in lev.iter_mut().zip(q.iter()) {
+        let qy = view(q).dot(&view(y));
+        for ((ri, h), &qi) in res.iter_mut().zip(lev.iter_mut()).zip(q) {
+            *ri += -qy * qi;
             *h += qi * qi;
         }
-        qs.push(q);
         let p = k + 1;
         let err = if n > p {
             let loo = (0..n)
@@ -502,6 +553,9 @@ pub fn sparse_regression_on(
     select_by_loo_cached(psi, y, design.constant, &path, cache)
 }
 
+#[path = "lars_kernels.rs"]
+mod kernels;
+
 #[cfg(test)]
 #[path = "lars_reference.rs"]
 mod reference;
@@ -612,6 +666,30 @@ mod tests {
     }
 
     #[test]
+    fn fused_gram_schmidt_loo_errors_equal_the_reference_bit_for_bit() {
+        // Issue 15: the nested LOO errors decide the chosen model, so fusing the
+        // Gram-Schmidt steps and keeping them in flat buffers must not change a bit, also
+        // past a dependent column (a repeated one) and with more columns than samples.
+        let (psi, mut y, _) = sparse_problem(60);
+        let mut r = stream(4, 1);
+        for v in y.iter_mut() {
+            *v += 0.1 * standard_normal(&mut r);
+        }
+        let orders: [&[usize]; 4] = [
+            &[0, 5, 17, 3, 40, 100, 7, 250, 12],
+            &[0, 5, 17, 5, 40],
+            &[3],
+            &(0..70).map(|k| (k * 37) % 286).collect::<Vec<_>>(),
+        ];
+        for order in orders {
+            let got = nested_loo_errors(&psi, &y, order);
+            let want = reference::nested_loo_errors_reference(&psi, &y, order);
+            let bits = |v: &[f64]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "{order:?}");
+        }
+    }
+
+    #[test]
     fn a_design_prepared_once_gives_every_response_the_per_response_fit_bit_for_bit() {
         // Issue 15: a time-resolved sparse chaos re-standardised the design, transposed it
         // twice per step and refactored the chosen columns for every time column. The
@@ -658,6 +736,19 @@ mod tests {
                 for (i, y) in responses.iter().enumerate() {
                     let want = reference::lars_path_reference(&psi, y, Some(0), usize::MAX);
                     assert_eq!(lars_path_on(&design, y, usize::MAX), want, "{degree} {i}");
+                    if let Some(last) = want.last() {
+                        let mut order = vec![0];
+                        for set in &want {
+                            let new: Vec<usize> =
+                                set.iter().copied().filter(|j| !order.contains(j)).collect();
+                            order.extend(new);
+                        }
+                        assert_eq!(order.len(), last.len() + 1);
+                        let got = nested_loo_errors(&psi, y, &order);
+                        let old = reference::nested_loo_errors_reference(&psi, y, &order);
+                        let bits = |v: &[f64]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&got), bits(&old), "degree {degree}, response {i}");
+                    }
                     let alone = select_by_loo(&psi, y, Some(0), &want);
                     let shared =
                         sparse_regression_on(&design, &psi, y, PathKind::Lars, Some(&cache));

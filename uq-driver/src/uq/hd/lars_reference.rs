@@ -1,6 +1,8 @@
 //! The LARS path as it was before the design was prepared once for every response
 //! (issue 15): standardisation, transposes and Gram entries recomputed for each response.
-//! Kept for the tests, which pin the prepared path to it bit for bit.
+//! Kept for the tests, which pin the prepared path to it bit for bit; likewise the nested
+//! leave-one-out errors as they were before the Gram-Schmidt steps were fused and kept in
+//! flat buffers.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -131,4 +133,79 @@ pub fn lars_path_reference(
         }
     }
     path
+}
+
+/// The corrected relative LOO errors of the nested fits on the prefixes of `order`, one
+/// vector per orthonormal column.
+pub fn nested_loo_errors_reference(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<f64> {
+    let n = psi.nrows();
+    let var = crate::uq::hd::regression::sample_variance(y);
+    let negligible = crate::uq::hd::regression::negligible_variance(y);
+    let mut qs: Vec<DVector<f64>> = Vec::new();
+    let mut rinv: Vec<Vec<f64>> = Vec::new(); // columns of R^-1 (upper triangular)
+    let mut rcols: Vec<Vec<f64>> = Vec::new(); // columns of R
+    let mut tr = 0.0;
+    let mut res = DVector::from_column_slice(y);
+    let mut lev = vec![0.0; n];
+    let yv = DVector::from_column_slice(y);
+    let mut out = Vec::with_capacity(order.len());
+    for (k, &col) in order.iter().enumerate() {
+        let mut v = psi.column(col).into_owned();
+        let norm0 = v.norm();
+        let mut r = vec![0.0; k + 1];
+        for _ in 0..2 {
+            for (j, q) in qs.iter().enumerate() {
+                let d = q.dot(&v);
+                r[j] += d;
+                v.axpy(-d, q, 1.0);
+            }
+        }
+        let rkk = v.norm();
+        if rkk.is_nan() || rkk <= 1e-10 * norm0.max(f64::MIN_POSITIVE) {
+            out.resize(order.len(), f64::INFINITY);
+            return out;
+        }
+        r[k] = rkk;
+        let q = v / rkk;
+        // New column of R^-1: t_i = -(sum_j Rinv[i][j] r_j) / rkk, t_k = 1 / rkk.
+        let mut t = vec![0.0; k + 1];
+        for (i, ti) in t.iter_mut().enumerate().take(k) {
+            let s: f64 = (i..k).map(|j| rinv[j][i] * r[j]).sum();
+            *ti = -s / rkk;
+        }
+        t[k] = 1.0 / rkk;
+        tr += t.iter().map(|x| x * x).sum::<f64>();
+        rinv.push(t);
+        rcols.push(r);
+        let qy = q.dot(&yv);
+        res.axpy(-qy, &q, 1.0);
+        for (h, qi) in lev.iter_mut().zip(q.iter()) {
+            *h += qi * qi;
+        }
+        qs.push(q);
+        let p = k + 1;
+        let err = if n > p {
+            let loo = (0..n)
+                .map(|i| {
+                    let d = 1.0 - lev[i];
+                    if d <= 1e-12 {
+                        if res[i] == 0.0 {
+                            0.0
+                        } else {
+                            f64::INFINITY
+                        }
+                    } else {
+                        (res[i] / d).powi(2)
+                    }
+                })
+                .sum::<f64>()
+                / n as f64;
+            let t = n as f64 / (n - p) as f64 * (1.0 + tr);
+            crate::uq::hd::regression::relative(t * loo, var, negligible)
+        } else {
+            f64::INFINITY
+        };
+        out.push(err);
+    }
+    out
 }
