@@ -14,7 +14,7 @@
 //! remaining correlation vanishes, or when the active Gram matrix becomes singular.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -72,15 +72,16 @@ fn standardize(psi: &DMatrix<f64>, constant: Option<usize>) -> (DMatrix<f64>, Ve
 /// What the paths need of a design, whatever the response: the standardised columns, their
 /// transpose, their Gram matrix and squared norms. Computed once for any number of responses
 /// on the same design (the paths are then those of [`lars_path`] and [`omp_path`], bit for
-/// bit: the same operations on the same numbers).
+/// bit: the same operations on the same numbers). A row of the Gram matrix is computed the
+/// first time its column enters a path: a path reads only the rows of its active columns.
 #[derive(Clone, Debug)]
 pub struct PathDesign {
     constant: Option<usize>,
     x: DMatrix<f64>,
     xt: DMatrix<f64>,
     idx: Vec<usize>,
-    /// `x_k . x_j` at `k * m + j`.
-    gram: Vec<f64>,
+    /// Row `j`: `x_k . x_j` at `k`, filled on first use.
+    gram: Vec<OnceLock<Vec<f64>>>,
     norms2: Vec<f64>,
 }
 
@@ -89,21 +90,25 @@ impl PathDesign {
     pub fn new(psi: &DMatrix<f64>, constant: Option<usize>) -> PathDesign {
         let (x, idx) = standardize(psi, constant);
         let m = x.ncols();
-        let mut gram = vec![0.0; m * m];
-        for k in 0..m {
-            for j in 0..m {
-                gram[k * m + j] = x.column(k).dot(&x.column(j));
-            }
-        }
         let norms2 = (0..m).map(|j| x.column(j).norm_squared()).collect();
         PathDesign {
             constant,
             xt: x.transpose(),
             x,
             idx,
-            gram,
+            gram: (0..m).map(|_| OnceLock::new()).collect(),
             norms2,
         }
+    }
+
+    /// `x_k . x_j` for every `k`.
+    fn gram_row(&self, j: usize) -> &[f64] {
+        self.gram[j].get_or_init(|| {
+            let xj = self.x.column(j);
+            (0..self.x.ncols())
+                .map(|k| self.x.column(k).dot(&xj))
+                .collect()
+        })
     }
 }
 
@@ -140,15 +145,16 @@ impl ActiveSet {
     /// Adds column `j` of the design with `sign`; false if it is (numerically) dependent
     /// or the set is full.
     fn add(&mut self, design: &PathDesign, j: usize, sign: f64) -> bool {
-        let (m, k, cap) = (design.x.ncols(), self.cols.len(), self.cap);
+        let (k, cap) = (self.cols.len(), self.cap);
         if k == cap {
             return false;
         }
+        let gram_j = design.gram_row(j);
         // The new row l solves L l = g (the signed Gram entries), written in place.
         let (done, row) = self.rows.split_at_mut(k * cap);
         let l = &mut row[..k + 1];
         for (i, (&c, &sc)) in self.cols.iter().zip(&self.signs).enumerate() {
-            let g = sc * sign * design.gram[c * m + j];
+            let g = sc * sign * gram_j[c];
             let li = &done[i * cap..i * cap + i + 1];
             let s: f64 = li[..i].iter().zip(&l[..i]).map(|(a, b)| a * b).sum();
             l[i] = (g - s) / li[i];
