@@ -203,7 +203,7 @@ pub fn lars_path(
 
 /// [`lars_path`] on a prepared design.
 pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
-    use kernels::{combine, mat_vec, Start};
+    use kernels::{combine_columns, mat_vec};
     let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
     let (n, m) = x.shape();
     let ym = if constant.is_some() {
@@ -231,6 +231,7 @@ pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Ve
     }
     in_active[first] = true;
     let (mut u, mut a) = (vec![0.0; n], vec![0.0; m]);
+    let mut coef = Vec::with_capacity(limit);
     while act.cols.len() <= limit {
         path.push(act.cols.iter().map(|&k| idx[k]).collect());
         if act.cols.len() == limit {
@@ -242,13 +243,9 @@ pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Ve
         }
         let gi1 = act.gram_solve_ones();
         let aa = 1.0 / gi1.iter().sum::<f64>().sqrt();
-        let terms = act
-            .cols
-            .iter()
-            .zip(&gi1)
-            .zip(&act.signs)
-            .map(|((&j, &g), &s)| (&x.as_slice()[j * n..(j + 1) * n], aa * g * s));
-        combine(&mut u, Start::Zero, terms);
+        coef.clear();
+        coef.extend(gi1.iter().zip(&act.signs).map(|(&g, &s)| aa * g * s));
+        combine_columns(x.as_slice(), &act.cols, &coef, &mut u);
         mat_vec(xt, &u, &mut a);
         let mut gamma = big_c / aa;
         let mut next = None;

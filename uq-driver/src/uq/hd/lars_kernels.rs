@@ -1,8 +1,11 @@
 //! Linear combinations of columns for the LARS path, summed in the same order and with
 //! the same roundings as nalgebra's matrix-vector product and `axpy` (so the path stays
 //! the same, bit for bit), but a block of rows at a time in registers instead of one
-//! pass over the output per column (issue 15).
+//! pass over the output per column (issue 15). The products and the Gram-Schmidt step are
+//! also compiled for AVX2 and AVX-512 and chosen at run time: the same operations lane by
+//! lane (no fused multiply-add), so the same bits on every machine.
 
+use multiversion::multiversion;
 use nalgebra::DMatrix;
 
 /// How the sum starts.
@@ -16,6 +19,7 @@ pub(super) enum Start {
 
 /// `out = sum_t coef_t * column_t` over the terms, each column of `out.len()` entries,
 /// in term order; `out` is zero when there are no terms.
+#[inline(always)]
 pub(super) fn combine<'a>(
     out: &mut [f64],
     start: Start,
@@ -30,6 +34,7 @@ pub(super) fn combine<'a>(
 }
 
 /// [`combine`] on the rows from `i` on, `B` at a time while `B` remain; the next row.
+#[inline(always)]
 fn blocks<'a, const B: usize, I>(out: &mut [f64], mut i: usize, start: Start, terms: &I) -> usize
 where
     I: Iterator<Item = (&'a [f64], f64)> + Clone,
@@ -57,6 +62,18 @@ where
     i
 }
 
+/// `out = sum_i coef_i x_{cols_i}` (`x` column-major with `out.len()` rows), as repeated
+/// nalgebra `axpy` into a zeroed vector; compiled as [`mat_vec_slices`].
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
+pub(super) fn combine_columns(x: &[f64], cols: &[usize], coef: &[f64], out: &mut [f64]) {
+    let n = out.len();
+    let terms = cols
+        .iter()
+        .zip(coef)
+        .map(|(&j, &w)| (&x[j * n..(j + 1) * n], w));
+    combine(out, Start::Zero, terms);
+}
+
 /// `out = a v` (`a` column-major), as `&a * &v` in nalgebra.
 pub(super) fn mat_vec(a: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
     let m = a.nrows();
@@ -64,12 +81,21 @@ pub(super) fn mat_vec(a: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
     if m == 0 {
         return;
     }
-    let cols = a.as_slice().chunks_exact(m).zip(v.iter().copied());
+    mat_vec_slices(a.as_slice(), m, v, out);
+}
+
+/// [`mat_vec`] on the column-major entries, compiled for the baseline and for wider vector
+/// units, chosen at run time (the same sums, so the same bits, in every version: no fused
+/// multiply-add).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
+fn mat_vec_slices(a: &[f64], m: usize, v: &[f64], out: &mut [f64]) {
+    let cols = a.chunks_exact(m).zip(v.iter().copied());
     combine(out, Start::FirstTerm, cols);
 }
 
 /// `a . b` summed as nalgebra's `dot`: eight running sums over the rows in blocks of
 /// eight, combined as `((s0 + s4) + (s1 + s5)) ...`, then the remaining rows one by one.
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
 pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     debug_assert_eq!(a.len(), b.len());
     let mut acc = [0.0; 8];
@@ -83,6 +109,7 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// nalgebra's way of ending a dot product: the eight sums, then the remaining products.
+#[inline(always)]
 fn finish(acc: [f64; 8], a: &[f64], b: &[f64]) -> f64 {
     let mut res = 0.0;
     res += acc[0] + acc[4];
@@ -97,6 +124,7 @@ fn finish(acc: [f64; 8], a: &[f64], b: &[f64]) -> f64 {
 
 /// `v = alpha x + v` (as nalgebra's `axpy(alpha, x, 1)`), then `next . v` (as [`dot`]),
 /// in one pass over `v`.
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
 pub(super) fn axpy_dot(v: &mut [f64], alpha: f64, x: &[f64], next: &[f64]) -> f64 {
     debug_assert!(v.len() == x.len() && v.len() == next.len());
     let mut acc = [0.0; 8];
@@ -189,6 +217,11 @@ mod tests {
             for (g, w) in got.iter().zip(want.iter()) {
                 assert_eq!(g.to_bits(), w.to_bits(), "{n} x {k}");
             }
+            let (cols, coef): (Vec<usize>, Vec<f64>) = picks.iter().copied().unzip();
+            let mut by_cols = vec![f64::NAN; n];
+            combine_columns(x.as_slice(), &cols, &coef, &mut by_cols);
+            let bits = |v: &[f64]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&by_cols), bits(&got), "{n} x {k}");
         }
     }
 }
