@@ -92,10 +92,10 @@ impl<'a> Runs<'a> {
         Ok(DMatrix::from_vec(n, w, data))
     }
 
-    /// Column `k` of output `o` (of `nt` times each) over the runs.
+    /// Column `k` of output `o` (of `nt` times each) over the runs (read in parallel).
     pub(crate) fn column(&self, o: usize, nt: usize, k: usize) -> Result<Vec<f64>, AnalysisError> {
         self.values
-            .iter()
+            .par_iter()
             .map(|v| {
                 let mut x = [0.0];
                 v.try_read_into(o * nt + k..o * nt + k + 1, &mut x)?;
@@ -112,9 +112,17 @@ impl<'a> Runs<'a> {
             never_hunts: 0,
             never_stops: 0,
         };
-        for (&row, v) in self.rows.iter().zip(&self.values) {
-            let mut pair = [0.0; 2];
-            v.try_read_into(base + 2 * qi..base + 2 * qi + 2, &mut pair)?;
+        // The pairs read in parallel, then sorted out in order.
+        let pairs = self
+            .values
+            .par_iter()
+            .map(|v| {
+                let mut pair = [0.0; 2];
+                v.try_read_into(base + 2 * qi..base + 2 * qi + 2, &mut pair)?;
+                Ok(pair)
+            })
+            .collect::<Result<Vec<_>, AnalysisError>>()?;
+        for (&row, pair) in self.rows.iter().zip(pairs) {
             match Code::from_f64(pair[1]) {
                 Code::Ok => {
                     out.rows.push(row);

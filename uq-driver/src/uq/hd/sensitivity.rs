@@ -184,7 +184,7 @@ fn bootstrap_columns<V: AsRef<[f64]> + Sync>(
     (group_values, batch_rows): (usize, usize),
 ) -> Result<Vec<SobolWithCi>, SensitivityError> {
     let estimates = columns
-        .iter()
+        .par_iter()
         .map(|v| pick_freeze(v.as_ref(), n, d))
         .collect::<Result<Vec<_>, _>>()?;
     let stats = 2 * d;
@@ -215,14 +215,21 @@ fn bootstrap_columns<V: AsRef<[f64]> + Sync>(
                 });
         }
         let base = g * group;
-        for (c, r) in reps.into_iter().enumerate() {
-            let ci = |s: usize| percentile_interval(&r[s * resamples..(s + 1) * resamples], level);
-            out.push(SobolWithCi {
-                estimate: estimates[base + c].clone(),
-                first_ci: (0..d).map(ci).collect(),
-                total_ci: (d..stats).map(ci).collect(),
-            });
-        }
+        let intervals: Vec<SobolWithCi> = reps
+            .par_iter_mut()
+            .enumerate()
+            .map(|(c, r)| {
+                let mut ci = |s: usize| {
+                    percentile_interval(&mut r[s * resamples..(s + 1) * resamples], level)
+                };
+                SobolWithCi {
+                    estimate: estimates[base + c].clone(),
+                    first_ci: (0..d).map(&mut ci).collect(),
+                    total_ci: (d..stats).map(&mut ci).collect(),
+                }
+            })
+            .collect();
+        out.extend(intervals);
     }
     Ok(out)
 }
@@ -246,23 +253,40 @@ fn resample_rows(n: usize, ks: std::ops::Range<usize>, seed: u64) -> Vec<usize> 
     rows
 }
 
-/// Percentile interval at `level` of the finite values (NaN when there are none).
-fn percentile_interval(values: &[f64], level: f64) -> (f64, f64) {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+/// Percentile interval at `level` of the finite values (NaN when there are none); `values`
+/// is reordered. The order statistics are found by selection: the same values as from the
+/// sorted data (equal under `total_cmp` means the same bits).
+fn percentile_interval(values: &mut [f64], level: f64) -> (f64, f64) {
+    let mut finite = 0;
+    for i in 0..values.len() {
+        if values[i].is_finite() {
+            values.swap(finite, i);
+            finite += 1;
+        }
+    }
+    let v = &mut values[..finite];
     if v.is_empty() {
         return (f64::NAN, f64::NAN);
     }
-    v.sort_by(f64::total_cmp);
     let alpha = 0.5 * (1.0 - level);
-    (percentile(&v, alpha), percentile(&v, 1.0 - alpha))
+    (
+        selected_percentile(v, alpha),
+        selected_percentile(v, 1.0 - alpha),
+    )
 }
 
-/// Linear-interpolation percentile of sorted data, `q` in [0, 1].
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    let pos = q * (sorted.len() - 1) as f64;
-    let lo = pos.floor() as usize;
-    let hi = pos.ceil() as usize;
-    sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
+/// [`percentile`] of `values` as if sorted, by selection (`values` is reordered).
+fn selected_percentile(values: &mut [f64], q: f64) -> f64 {
+    let pos = q * (values.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    let (_, &mut low, above) = values.select_nth_unstable_by(lo, f64::total_cmp);
+    // The next order statistic is the least of those above.
+    let high = if hi == lo {
+        low
+    } else {
+        above.iter().copied().min_by(f64::total_cmp).unwrap_or(low)
+    };
+    low + (pos - lo as f64) * (high - low)
 }
 
 /// Summary of `R` independent replicate estimates of one statistic (replicated LHS,
@@ -424,6 +448,14 @@ mod tests {
         }
     }
 
+    /// Linear-interpolation percentile of sorted data, `q` in [0, 1].
+    fn percentile(sorted: &[f64], q: f64) -> f64 {
+        let pos = q * (sorted.len() - 1) as f64;
+        let lo = pos.floor() as usize;
+        let hi = pos.ceil() as usize;
+        sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
+    }
+
     /// Bit patterns, so that NaN equals NaN and 0.0 differs from -0.0.
     fn bits(e: &SobolWithCi) -> Vec<u64> {
         let pairs = e
@@ -496,6 +528,49 @@ mod tests {
                 seed
             ))
         );
+    }
+
+    #[test]
+    fn percentile_intervals_by_selection_equal_those_of_the_sorted_values() {
+        // Issue 15: the intervals take their order statistics by selection, not by sorting.
+        // Ties, signed zeros, infinities and NaN (left out), odd and even counts, levels
+        // that fall on an order statistic and between two.
+        let mut s = 7u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f64 / (1u64 << 24) as f64
+        };
+        for len in [1, 2, 3, 10, 37, 200] {
+            let mut values: Vec<f64> = (0..len)
+                .map(|i| match i % 9 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => 0.25,
+                    3 if len > 3 => f64::NAN,
+                    4 if len > 3 => f64::INFINITY,
+                    _ => next() - 0.5,
+                })
+                .collect();
+            for level in [0.0, 0.5, 0.9, 0.95, 1.0] {
+                let mut sorted: Vec<f64> =
+                    values.iter().copied().filter(|x| x.is_finite()).collect();
+                sorted.sort_by(f64::total_cmp);
+                let alpha = 0.5 * (1.0 - level);
+                let (lo, hi) = percentile_interval(&mut values, level);
+                assert_eq!(
+                    (lo.to_bits(), hi.to_bits()),
+                    (
+                        percentile(&sorted, alpha).to_bits(),
+                        percentile(&sorted, 1.0 - alpha).to_bits()
+                    ),
+                    "{len} values at level {level}"
+                );
+            }
+        }
+        let (lo, hi) = percentile_interval(&mut [f64::NAN, f64::NEG_INFINITY], 0.9);
+        assert!(lo.is_nan() && hi.is_nan());
     }
 
     #[test]
