@@ -182,7 +182,8 @@ pub fn gaussian_kde_binned(
         let u = (x - origin) / delta;
         // Also false for NaN and infinities.
         if u >= 0.0 && u <= (m - 1) as f64 {
-            let j = u.floor() as usize;
+            // u >= 0: truncation is the floor (and no call to libm's floor).
+            let j = u as usize;
             let f = u - j as f64;
             mass[j] += 1.0 - f;
             mass[j + 1] += f;
@@ -266,7 +267,8 @@ pub fn gaussian_kde_cell_average(
     let mut mass = vec![0.0; m + 2 * taps + 1];
     for x in finite() {
         let u = (x - origin) / delta;
-        let j = u.floor() as usize;
+        // u >= taps >= 0: truncation is the floor.
+        let j = u as usize;
         let f = u - j as f64;
         mass[taps + j] += 1.0 - f;
         mass[taps + j + 1] += f;
@@ -293,7 +295,7 @@ pub fn gaussian_kde_cell_average(
         }
         let at = |x: f64| -> f64 {
             let u = ((x - origin) / delta).clamp(0.0, (m - 1) as f64);
-            let j = (u.floor() as usize).min(m - 2);
+            let j = (u as usize).min(m - 2);
             let f = u - j as f64;
             prefix[j] + f * delta * (density[j] + 0.5 * f * (density[j + 1] - density[j]))
         };

@@ -184,6 +184,44 @@ impl SeriesColumns {
                 .push(all[(c - j0) * rows..(c - j0 + 1) * rows].to_vec());
         }
     }
+
+    /// Adds the next `ncols` columns of `rows` draws, starting at column `j0`, generated in
+    /// parallel tasks of `task` columns: `fill(j, buf)` writes columns `j..j + w` (column-major)
+    /// into a buffer of the thread, and they are summarised while still in cache. The same
+    /// summaries as [`SeriesColumns::add_slice`] of all the columns at once.
+    pub(super) fn add_generated(
+        &mut self,
+        j0: usize,
+        rows: usize,
+        ncols: usize,
+        task: usize,
+        fill: &(dyn Fn(usize, &mut [f64]) + Sync),
+    ) {
+        debug_assert_eq!(j0, self.cols.len());
+        let task = task.max(1);
+        let (qs, candidates) = (&self.quantiles, &self.candidates);
+        let parts: Vec<(Vec<Column>, Vec<Vec<f64>>)> = (0..ncols.div_ceil(task))
+            .into_par_iter()
+            .map_init(Vec::new, |buf: &mut Vec<f64>, t| {
+                let (j, w) = (j0 + t * task, task.min(ncols - t * task));
+                buf.resize(rows * w, 0.0);
+                fill(j, &mut buf[..rows * w]);
+                let cols = (0..w)
+                    .map(|k| column(&buf[k * rows..(k + 1) * rows], qs))
+                    .collect();
+                let kept = candidates
+                    .iter()
+                    .filter(|&&c| (j..j + w).contains(&c))
+                    .map(|&c| buf[(c - j) * rows..(c - j + 1) * rows].to_vec())
+                    .collect();
+                (cols, kept)
+            })
+            .collect();
+        for (cols, kept) in parts {
+            self.cols.extend(cols);
+            self.kept.extend(kept);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -205,6 +243,25 @@ mod tests {
             assert_eq!(block_width(100_000, 1_000_000), 32);
             assert_eq!(block_width(100_000, 10_000) % BLOCK_ALIGN, 0);
         }
+    }
+
+    #[test]
+    fn generated_column_tasks_summarise_as_the_whole_block() {
+        // 70 columns of 50 rows: tasks of 32 (the last one short), candidates across tasks.
+        let (rows, nt) = (50, 70);
+        let all: Vec<f64> = (0..rows * nt)
+            .map(|i| ((i * 7919) % 1013) as f64 / 17.0 - (i / rows) as f64)
+            .collect();
+        let candidates = vec![0, 31, 32, 63, 64, 69];
+        let mut whole = SeriesColumns::new(nt, candidates.clone(), &[0.01, 0.5, 0.99]);
+        whole.add_slice(0, rows, &all);
+        let mut tasks = SeriesColumns::new(nt, candidates, &[0.01, 0.5, 0.99]);
+        tasks.add_generated(0, rows, nt, 32, &|j, buf| {
+            buf.copy_from_slice(&all[j * rows..j * rows + buf.len()])
+        });
+        assert_eq!(format!("{:?}", whole.cols), format!("{:?}", tasks.cols));
+        assert_eq!(whole.kept, tasks.kept);
+        assert_eq!(tasks.kept.len(), 6);
     }
 
     #[test]

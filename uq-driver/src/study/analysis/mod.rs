@@ -226,22 +226,19 @@ fn chaos_columns(
     let a = settings.analysis;
     let n = a.series_samples.min(a.surrogate_samples).max(2);
     let nt = pce.coeffs.ncols();
-    // Draws in blocks of whole 32-column tasks of about DRAW_BLOCK_BYTES (and within the
-    // analysis's block budget), into one buffer reused for every block: the draws stay in
-    // cache while summarised, and no matrix of every column is allocated and zeroed.
-    let fit = (DRAW_BLOCK_BYTES / (8 * n)) / blocks::BLOCK_ALIGN * blocks::BLOCK_ALIGN;
-    let width = blocks::block_width(nt, n).min(fit.max(blocks::BLOCK_ALIGN));
-    let mut buf = vec![0.0; n * width.min(nt)];
+    // Each task of 32 columns draws into a buffer of its thread and summarises the columns
+    // while they are in cache: no matrix of every column is allocated. The tasks run in
+    // groups of the analysis's block width, so that the buffers in use at once stay within
+    // its budget.
+    let task = surrogate::COLUMNS_PER_TASK;
+    let width = blocks::block_width(nt, n).div_ceil(task) * task;
     for (j0, w) in blocks::blocks(nt, width) {
-        let block = &mut buf[..n * w];
-        settings.surrogates.draws_into(pce, n, j0, block);
-        cols.add_slice(j0, n, block);
+        cols.add_generated(j0, n, w, task, &|j, buf| {
+            settings.surrogates.draws_task(pce, n, j, buf)
+        });
     }
     Ok(())
 }
-
-/// Bytes of the surrogate draws taken and summarised at a time (4 MiB).
-const DRAW_BLOCK_BYTES: usize = 4 << 20;
 
 /// The statistics of an output from its estimate and the summaries of its draws;
 /// `run_column(k)` gives the runs of column `k` (for the convergence of a sampled estimate).

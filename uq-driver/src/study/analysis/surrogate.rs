@@ -15,7 +15,7 @@ use crate::uq::pce::{germ_draw, Basis, Pce};
 /// Rows of germ points evaluated per parallel task.
 const ROWS_PER_TASK: usize = 512;
 /// Columns of the product per parallel task.
-const COLUMNS_PER_TASK: usize = 32;
+pub(super) const COLUMNS_PER_TASK: usize = 32;
 
 /// The basis at the germ points, per basis, grown on demand.
 pub(crate) struct Surrogates {
@@ -68,6 +68,16 @@ impl Surrogates {
                 let mut part = DMatrixViewMut::from_slice(block, n, w);
                 part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
             });
+    }
+
+    /// One task of [`Surrogates::draws_into`], on the calling thread: the columns
+    /// `j..j + w` of the draws into `out` (`n` rows, `w = out.len() / n` columns). With `j`
+    /// a multiple of 32 and `w` at most 32 the values are those of `draws` bit for bit.
+    pub fn draws_task(&self, pce: &Pce, n: usize, j: usize, out: &mut [f64]) {
+        let psi = self.basis_at_germs(&pce.basis, n);
+        let w = out.len() / n.max(1);
+        let mut part = DMatrixViewMut::from_slice(out, n, w);
+        part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
     }
 
     /// The basis at the first `n` germ points (rows), computed at most once per size.
@@ -149,6 +159,10 @@ mod tests {
             s.draws_into(&pce, 700, j0, &mut buf[..700 * w]);
             assert_eq!(&buf[..700 * w], all.columns(j0, w).into_owned().as_slice());
         }
+        // One task on the calling thread: the same draws bit for bit.
+        let mut task = vec![f64::NAN; 700 * 6];
+        s.draws_task(&pce, 700, 64, &mut task);
+        assert_eq!(&task[..], all.columns(64, 6).into_owned().as_slice());
         // Computing more rows up front changes no draw.
         let ahead = Surrogates::new(11).with_min_rows(2_000);
         assert_eq!(ahead.draws(&pce, 300), s.draws(&pce, 300));
