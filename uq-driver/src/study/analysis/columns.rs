@@ -4,6 +4,8 @@
 
 use std::borrow::Cow;
 
+use multiversion::multiversion;
+
 use crate::qoi::kde;
 use crate::uq::moments;
 
@@ -24,26 +26,7 @@ pub(super) struct Column {
 pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
     let mut levels = ps.to_vec();
     levels.extend([0.25, 0.75]);
-    // Four independent accumulators each, so that the loop is not one dependency chain.
-    let (mut n, mut sum) = ([0usize; 4], [0.0f64; 4]);
-    let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
-    let mut chunks = col.chunks_exact(4);
-    for c in &mut chunks {
-        for i in 0..4 {
-            let x = c[i];
-            let ok = x.is_finite();
-            n[i] += usize::from(ok);
-            sum[i] += if ok { x } else { 0.0 };
-            lo[i] = if ok && x < lo[i] { x } else { lo[i] };
-            hi[i] = if ok && x > hi[i] { x } else { hi[i] };
-        }
-    }
-    for &x in chunks.remainder().iter().filter(|x| x.is_finite()) {
-        n[0] += 1;
-        sum[0] += x;
-        lo[0] = lo[0].min(x);
-        hi[0] = hi[0].max(x);
-    }
+    let (n, sum, lo, hi) = count_sum_range(col);
     let n: usize = n.iter().sum();
     let (min, max) = (
         lo.iter().copied().fold(f64::INFINITY, f64::min),
@@ -71,6 +54,52 @@ pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
     }
 }
 
+/// Per lane of four (value `i` in lane `i % 4`, the remainder in lane 0): the count, sum,
+/// least and greatest of the finite values. Four independent accumulators each, so that
+/// the loop is not one dependency chain; compiled for the baseline and for wider vector
+/// units, chosen at run time (the same sums in every version).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
+#[allow(clippy::type_complexity)]
+fn count_sum_range(col: &[f64]) -> ([usize; 4], [f64; 4], [f64; 4], [f64; 4]) {
+    let (mut n, mut sum) = ([0usize; 4], [0.0f64; 4]);
+    let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
+    let mut chunks = col.chunks_exact(4);
+    for c in &mut chunks {
+        for i in 0..4 {
+            let x = c[i];
+            let ok = x.is_finite();
+            n[i] += usize::from(ok);
+            sum[i] += if ok { x } else { 0.0 };
+            lo[i] = if ok && x < lo[i] { x } else { lo[i] };
+            hi[i] = if ok && x > hi[i] { x } else { hi[i] };
+        }
+    }
+    for &x in chunks.remainder().iter().filter(|x| x.is_finite()) {
+        n[0] += 1;
+        sum[0] += x;
+        lo[0] = lo[0].min(x);
+        hi[0] = hi[0].max(x);
+    }
+    (n, sum, lo, hi)
+}
+
+/// The sum of `(x - mean)²` over `values`, in four lanes (value `i` in lane `i % 4`, the
+/// remainder in lanes `0..`), compiled for the baseline and for wider vector units.
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
+fn squared_deviations(values: &[f64], mean: f64) -> f64 {
+    let mut ss = [0.0; 4];
+    let mut chunks = values.chunks_exact(4);
+    for c in &mut chunks {
+        for i in 0..4 {
+            ss[i] += (c[i] - mean) * (c[i] - mean);
+        }
+    }
+    for (i, x) in chunks.remainder().iter().enumerate() {
+        ss[i] += (x - mean) * (x - mean);
+    }
+    ss.iter().sum()
+}
+
 /// Type-7 quantiles (as [`moments::quantile`] of the sorted values) of the finite `values`
 /// (within `[min, max]`) at the levels `ps`, without sorting them all, and the sum of squared
 /// deviations from `mean`. NaN for no value or a level outside [0, 1].
@@ -85,17 +114,7 @@ fn select_quantiles(values: &[f64], ps: &[f64], min: f64, max: f64, mean: f64) -
             ss,
         );
     }
-    let mut ss = [0.0; 4];
-    let mut chunks = values.chunks_exact(4);
-    for c in &mut chunks {
-        for i in 0..4 {
-            ss[i] += (c[i] - mean) * (c[i] - mean);
-        }
-    }
-    for (i, x) in chunks.remainder().iter().enumerate() {
-        ss[i] += (x - mean) * (x - mean);
-    }
-    let ss: f64 = ss.iter().sum();
+    let ss = squared_deviations(values, mean);
     let rank_pairs = |p: f64| {
         let h = (n - 1) as f64 * p;
         let r = h.floor() as usize;
@@ -137,6 +156,21 @@ const SORT_BELOW: usize = 64;
 /// Levels of rebinning before [`select_ranks`] sorts a bin whatever its size.
 const MAX_DEPTH: usize = 4;
 
+/// The bin of each value in `[min, max]`: `y = ((x - min) * scale).min(top)` rounded to the
+/// nearest integer (`0..=top`, `top < 2^16`). Rounding is monotone, which is all the
+/// selection needs; it is taken as the low bits of `y + 1.5 · 2^52` (exact: the sum's unit
+/// in the last place is 1), which vectorises, unlike a saturating conversion. Compiled for
+/// the baseline and for wider vector units, chosen at run time (the same bins in every
+/// version).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+avx+sse4.2", "x86_64+avx2+avx+sse4.2"))]
+fn bin_indices(values: &[f64], min: f64, scale: f64, top: f64) -> Vec<u16> {
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    values
+        .iter()
+        .map(|&x| (((x - min) * scale).min(top) + MAGIC).to_bits() as u16)
+        .collect()
+}
+
 /// The order statistics of (0-based, ascending, distinct) `ranks` of the finite `values`,
 /// whose range is `[min, max]`, as a sorted copy would give them (by `f64::total_cmp`).
 ///
@@ -156,10 +190,7 @@ fn select_ranks(values: &[f64], min: f64, max: f64, ranks: &[usize], depth: usiz
     // Bin of each value (u16: at most 2^14 bins), and the counts in four interleaved
     // histograms, so that equal neighbours do not wait on one counter.
     let top = (bins - 1) as f64;
-    let index: Vec<u16> = values
-        .iter()
-        .map(|&x| ((x - min) * scale).min(top) as u16)
-        .collect();
+    let index = bin_indices(values, min, scale, top);
     let mut counts = vec![0u32; 4 * bins];
     let mut quads = index.chunks_exact(4);
     for q in &mut quads {
@@ -290,6 +321,27 @@ mod tests {
                 t.elapsed() / 20
             );
         }
+    }
+
+    #[test]
+    fn bins_are_monotone_and_within_range() {
+        // Sorted values, with the ends and neighbours of rounding ties.
+        let (min, max, bins) = (-3.0, 5.0, 500usize);
+        let scale = bins as f64 / (max - min);
+        let mut xs: Vec<f64> = (0..=80_000)
+            .map(|i| min + (max - min) * i as f64 / 8e4)
+            .collect();
+        xs.extend((0..bins).map(|b| min + (b as f64 + 0.5) / scale));
+        xs.push(max);
+        xs.sort_by(f64::total_cmp);
+        let index = bin_indices(&xs, min, scale, (bins - 1) as f64);
+        assert!(index.windows(2).all(|w| w[0] <= w[1]));
+        assert_eq!((index[0], *index.last().unwrap()), (0, (bins - 1) as u16));
+        // Rounded to the nearest bin.
+        assert_eq!(
+            bin_indices(&[min + 2.4 / scale, min + 2.6 / scale], min, scale, 499.0),
+            [2, 3]
+        );
     }
 
     #[test]
