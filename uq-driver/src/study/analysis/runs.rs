@@ -8,6 +8,12 @@ use super::AnalysisError;
 use crate::qoi::scalar::Code;
 use crate::study::store::{StoredRuns, Values};
 
+/// Runs read by one task of [`Runs::block`].
+const CHUNK_RUNS: usize = 256;
+/// Runs read before their values are transposed into the block (8 values of a column make
+/// one cache line).
+const STEP_RUNS: usize = 8;
+
 /// The values of one quantity over the successful runs, with their outcome codes.
 pub(crate) struct QuantityRuns {
     /// Design indices of the runs with a valid value.
@@ -39,8 +45,9 @@ impl<'a> Runs<'a> {
     }
 
     /// Columns `j0..j0 + w` of output `o` (of `nt` times each) as runs × times. Chunks of
-    /// runs are read in parallel, one read per run, into column-major pieces; the pieces are
-    /// then copied into the matrix (groups of columns in parallel).
+    /// runs are read in parallel, one positioned read per run, a few runs at a time into a
+    /// small buffer, and each buffer is transposed straight into the chunk's rows of the
+    /// matrix (no intermediate copy of the block).
     pub(crate) fn block(
         &self,
         o: usize,
@@ -48,46 +55,47 @@ impl<'a> Runs<'a> {
         j0: usize,
         w: usize,
     ) -> Result<DMatrix<f64>, AnalysisError> {
-        const ROWS: usize = 256;
-        const GROUP: usize = 64;
         let n = self.rows.len();
         if n == 0 || w == 0 {
             return Ok(DMatrix::zeros(n, w));
         }
         let first = o * nt + j0;
-        let pieces: Vec<DMatrix<f64>> = self
-            .values
-            .par_chunks(ROWS)
-            .map(|values| {
-                let mut piece = DMatrix::<f64>::zeros(values.len(), w);
-                let mut row = vec![0.0; w];
-                for (r, v) in values.iter().enumerate() {
-                    v.try_read_into(first..first + w, &mut row)?;
-                    for (k, x) in row.iter().enumerate() {
-                        piece[(r, k)] = *x;
+        let mut data = vec![0.0; n * w];
+        // Per chunk of runs, its part of every column (disjoint borrows of the matrix).
+        let mut parts: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(CHUNK_RUNS))
+            .map(|_| Vec::with_capacity(w))
+            .collect();
+        for col in data.chunks_exact_mut(n) {
+            for (c, part) in col.chunks_mut(CHUNK_RUNS).enumerate() {
+                parts[c].push(part);
+            }
+        }
+        self.values
+            .par_chunks(CHUNK_RUNS)
+            .zip(parts.par_iter_mut())
+            .try_for_each(|(values, parts)| {
+                let mut buf = vec![0.0; STEP_RUNS * w];
+                for (s, step) in values.chunks(STEP_RUNS).enumerate() {
+                    for (v, row) in step.iter().zip(buf.chunks_exact_mut(w)) {
+                        v.try_read_into(first..first + w, row)?;
+                    }
+                    let r0 = s * STEP_RUNS;
+                    for (k, part) in parts.iter_mut().enumerate() {
+                        let out = &mut part[r0..r0 + step.len()];
+                        for (i, x) in out.iter_mut().enumerate() {
+                            *x = buf[i * w + k];
+                        }
                     }
                 }
-                Ok(piece)
-            })
-            .collect::<Result<_, AnalysisError>>()?;
-        let mut m = DMatrix::<f64>::zeros(n, w);
-        m.as_mut_slice()
-            .par_chunks_mut(n * GROUP)
-            .enumerate()
-            .for_each(|(g, out)| {
-                for (k, col) in out.chunks_exact_mut(n).enumerate() {
-                    for (p, part) in pieces.iter().zip(col.chunks_mut(ROWS)) {
-                        part.copy_from_slice(p.column(g * GROUP + k).as_slice());
-                    }
-                }
-            });
-        Ok(m)
+                Ok::<(), AnalysisError>(())
+            })?;
+        Ok(DMatrix::from_vec(n, w, data))
     }
 
-    /// Column `k` of output `o` (of `nt` times each) over the runs.
+    /// Column `k` of output `o` (of `nt` times each) over the runs (read in parallel).
     pub(crate) fn column(&self, o: usize, nt: usize, k: usize) -> Result<Vec<f64>, AnalysisError> {
         self.values
-            .iter()
+            .par_iter()
             .map(|v| {
                 let mut x = [0.0];
                 v.try_read_into(o * nt + k..o * nt + k + 1, &mut x)?;
@@ -104,9 +112,17 @@ impl<'a> Runs<'a> {
             never_hunts: 0,
             never_stops: 0,
         };
-        for (&row, v) in self.rows.iter().zip(&self.values) {
-            let mut pair = [0.0; 2];
-            v.try_read_into(base + 2 * qi..base + 2 * qi + 2, &mut pair)?;
+        // The pairs read in parallel, then sorted out in order.
+        let pairs = self
+            .values
+            .par_iter()
+            .map(|v| {
+                let mut pair = [0.0; 2];
+                v.try_read_into(base + 2 * qi..base + 2 * qi + 2, &mut pair)?;
+                Ok(pair)
+            })
+            .collect::<Result<Vec<_>, AnalysisError>>()?;
+        for (&row, pair) in self.rows.iter().zip(pairs) {
             match Code::from_f64(pair[1]) {
                 Code::Ok => {
                     out.rows.push(row);
@@ -117,5 +133,48 @@ impl<'a> Runs<'a> {
             }
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::store::Record;
+
+    #[test]
+    fn blocks_read_in_steps_of_runs_hold_every_value_in_its_place() {
+        // Issue 15: a block is read a few runs at a time and transposed straight into the
+        // matrix. Every entry must be the run's value at that column: 601 points (not a
+        // multiple of the chunk or step), some failed or not run, 2 outputs of 7 times,
+        // blocks at either output, of any width.
+        let (outputs, nt) = (2, 7);
+        let value = |i: usize, v: usize| (i * 1000 + v) as f64 + 0.5;
+        let records: Vec<Option<Record>> = (0..601)
+            .map(|i| match i % 11 {
+                3 => None,
+                7 => Some(Record::Failed("diverged".into())),
+                _ => Some(Record::Ok((0..outputs * nt).map(|v| value(i, v)).collect())),
+            })
+            .collect();
+        let stored = StoredRuns::from_records(&records, outputs * nt);
+        let runs = Runs::of(&stored);
+        let ok = (0..601).filter(|i| i % 11 != 3 && i % 11 != 7).count();
+        assert_eq!(runs.rows.len(), ok);
+        for (o, j0, w) in [(0, 0, 7), (1, 0, 7), (1, 2, 3), (0, 6, 1), (1, 3, 0)] {
+            let m = runs.block(o, nt, j0, w).unwrap();
+            assert_eq!((m.nrows(), m.ncols()), (runs.rows.len(), w));
+            for (r, &i) in runs.rows.iter().enumerate() {
+                for k in 0..w {
+                    assert_eq!(m[(r, k)], value(i, o * nt + j0 + k), "run {i}, column {k}");
+                }
+            }
+        }
+        assert_eq!(
+            runs.column(1, nt, 4).unwrap(),
+            runs.rows
+                .iter()
+                .map(|&i| value(i, nt + 4))
+                .collect::<Vec<_>>()
+        );
     }
 }

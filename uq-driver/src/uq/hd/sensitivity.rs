@@ -23,6 +23,9 @@
 use rayon::prelude::*;
 
 use crate::uq::rng::{stream, uniform_below};
+use lanes::{Lanes, LANES};
+
+mod lanes;
 
 /// Errors of the estimators.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -181,7 +184,7 @@ fn bootstrap_columns<V: AsRef<[f64]> + Sync>(
     (group_values, batch_rows): (usize, usize),
 ) -> Result<Vec<SobolWithCi>, SensitivityError> {
     let estimates = columns
-        .iter()
+        .par_iter()
         .map(|v| pick_freeze(v.as_ref(), n, d))
         .collect::<Result<Vec<_>, _>>()?;
     let stats = 2 * d;
@@ -208,33 +211,28 @@ fn bootstrap_columns<V: AsRef<[f64]> + Sync>(
             cols.par_chunks(LANES)
                 .zip(reps.par_chunks_mut(LANES))
                 .for_each(|(chunk, reps)| {
-                    let lanes = Lanes::new(chunk, n, d);
-                    let mut scratch = Scratch::new(stats);
-                    for (b, k) in ks.clone().enumerate() {
-                        lanes.replicate(&rows[b * n..(b + 1) * n], &mut scratch);
-                        for (lane, r) in reps.iter_mut().enumerate() {
-                            for (s, acc) in scratch.stats.iter().enumerate() {
-                                r[k + resamples * s] = acc[lane];
-                            }
-                        }
-                    }
+                    Lanes::new(chunk, n, d).replicates(rows, ks.clone(), resamples, reps);
                 });
         }
         let base = g * group;
-        for (c, r) in reps.into_iter().enumerate() {
-            let ci = |s: usize| percentile_interval(&r[s * resamples..(s + 1) * resamples], level);
-            out.push(SobolWithCi {
-                estimate: estimates[base + c].clone(),
-                first_ci: (0..d).map(ci).collect(),
-                total_ci: (d..stats).map(ci).collect(),
-            });
-        }
+        let intervals: Vec<SobolWithCi> = reps
+            .par_iter_mut()
+            .enumerate()
+            .map(|(c, r)| {
+                let mut ci = |s: usize| {
+                    percentile_interval(&mut r[s * resamples..(s + 1) * resamples], level)
+                };
+                SobolWithCi {
+                    estimate: estimates[base + c].clone(),
+                    first_ci: (0..d).map(&mut ci).collect(),
+                    total_ci: (d..stats).map(&mut ci).collect(),
+                }
+            })
+            .collect();
+        out.extend(intervals);
     }
     Ok(out)
 }
-
-/// Outputs evaluated together by [`pick_freeze_bootstrap_columns`] (one lane each).
-const LANES: usize = 4;
 
 /// Most replicate estimates kept at once (a group of columns).
 const GROUP_VALUES: usize = 1 << 22;
@@ -255,169 +253,40 @@ fn resample_rows(n: usize, ks: std::ops::Range<usize>, seed: u64) -> Vec<usize> 
     rows
 }
 
-/// Percentile interval at `level` of the finite values (NaN when there are none).
-fn percentile_interval(values: &[f64], level: f64) -> (f64, f64) {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+/// Percentile interval at `level` of the finite values (NaN when there are none); `values`
+/// is reordered. The order statistics are found by selection: the same values as from the
+/// sorted data (equal under `total_cmp` means the same bits).
+fn percentile_interval(values: &mut [f64], level: f64) -> (f64, f64) {
+    let mut finite = 0;
+    for i in 0..values.len() {
+        if values[i].is_finite() {
+            values.swap(finite, i);
+            finite += 1;
+        }
+    }
+    let v = &mut values[..finite];
     if v.is_empty() {
         return (f64::NAN, f64::NAN);
     }
-    v.sort_by(f64::total_cmp);
     let alpha = 0.5 * (1.0 - level);
-    (percentile(&v, alpha), percentile(&v, 1.0 - alpha))
+    (
+        selected_percentile(v, alpha),
+        selected_percentile(v, 1.0 - alpha),
+    )
 }
 
-/// The per-row summands of [`estimate_rows`] for up to `LANES` outputs (one lane each, unused
-/// lanes hold zeros), computed by the same operations, in one table per pass over the rows
-/// (row-major, the lanes innermost): the sums `f(A)_j + f(B)_j` with the first statistics'
-/// summands, then the other statistics' summands a few at a time, then `f(A)_j`, `f(B)_j`
-/// for the variance. The statistics are `f(B)_j (f(AB_i)_j - f(A)_j)` for each `i`, then
-/// `(f(A)_j - f(AB_i)_j)^2` for each `i`.
-struct Lanes {
-    d: usize,
-    /// Per pass: the first statistic, the number of statistics, the table.
-    passes: Vec<(usize, usize, Vec<[f64; LANES]>)>,
-    /// `f(A)_j`, `f(B)_j`.
-    ab: Vec<[f64; LANES]>,
-}
-
-/// Accumulators of one replicate, reused.
-struct Scratch {
-    /// First-order then total estimates of one replicate, per lane.
-    stats: Vec<[f64; LANES]>,
-}
-
-impl Scratch {
-    fn new(stats: usize) -> Scratch {
-        Scratch {
-            stats: vec![[0.0; LANES]; stats],
-        }
-    }
-}
-
-/// Sums per pass over the rows (their accumulators stay in registers).
-const FIELDS_PER_PASS: usize = 3;
-
-impl Lanes {
-    fn new<V: AsRef<[f64]>>(columns: &[V], n: usize, d: usize) -> Lanes {
-        // Pass 0: the sum and statistics 0..2; then statistics k..k + 3.
-        let mut bounds = vec![(0, 2.min(2 * d))];
-        let mut k = 2.min(2 * d);
-        while k < 2 * d {
-            let len = (2 * d - k).min(FIELDS_PER_PASS);
-            bounds.push((k, len));
-            k += len;
-        }
-        let mut passes: Vec<(usize, usize, Vec<[f64; LANES]>)> = bounds
-            .iter()
-            .enumerate()
-            .map(|(p, &(k, len))| {
-                let width = len + usize::from(p == 0);
-                (k, len, vec![[0.0; LANES]; n * width])
-            })
-            .collect();
-        let mut ab = vec![[0.0; LANES]; 2 * n];
-        let mut stat = vec![0.0; 2 * d];
-        for (lane, col) in columns.iter().enumerate() {
-            let values = col.as_ref();
-            let (fa, fb) = (&values[..n], &values[n..2 * n]);
-            for j in 0..n {
-                for i in 0..d {
-                    let fab = values[(2 + i) * n + j];
-                    stat[i] = fb[j] * (fab - fa[j]);
-                    stat[d + i] = (fa[j] - fab).powi(2);
-                }
-                for (p, (k, len, table)) in passes.iter_mut().enumerate() {
-                    let width = *len + usize::from(p == 0);
-                    let row = &mut table[j * width..(j + 1) * width];
-                    let mut f = 0;
-                    if p == 0 {
-                        row[0][lane] = fa[j] + fb[j];
-                        f = 1;
-                    }
-                    for (r, v) in row[f..].iter_mut().zip(&stat[*k..*k + *len]) {
-                        r[lane] = *v;
-                    }
-                }
-                ab[2 * j][lane] = fa[j];
-                ab[2 * j + 1][lane] = fb[j];
-            }
-        }
-        Lanes { d, passes, ab }
-    }
-
-    /// Sums of the `K` fields of `table` over `rows`, field `k` from `init[k]`, in row order,
-    /// every lane on its own.
-    fn sums<const K: usize>(
-        table: &[[f64; LANES]],
-        rows: &[usize],
-        init: [f64; K],
-    ) -> [[f64; LANES]; K] {
-        let mut acc = init.map(|v| [v; LANES]);
-        for &j in rows {
-            let t = &table[j * K..(j + 1) * K];
-            for (a, v) in acc.iter_mut().zip(t) {
-                for (a, v) in a.iter_mut().zip(v) {
-                    *a += *v;
-                }
-            }
-        }
-        acc
-    }
-
-    /// `sum_j (f(A)_j - mean)^2 + (f(B)_j - mean)^2` over `rows`, from -0.0 (as `Sum`).
-    fn squares(&self, rows: &[usize], mean: &[f64; LANES]) -> [f64; LANES] {
-        let mut acc = [-0.0f64; LANES];
-        for &j in rows {
-            let (a, b) = (&self.ab[2 * j], &self.ab[2 * j + 1]);
-            for l in 0..LANES {
-                acc[l] += (a[l] - mean[l]).powi(2) + (b[l] - mean[l]).powi(2);
-            }
-        }
-        acc
-    }
-
-    /// The indices of the resample `rows` in every lane, into `scratch.stats` (the
-    /// arithmetic of [`estimate_rows`], lane by lane).
-    fn replicate(&self, rows: &[usize], scratch: &mut Scratch) {
-        let d = self.d;
-        let m = rows.len() as f64;
-        let stats = &mut scratch.stats;
-        // The sum for the mean (`Sum` of f64 folds from -0.0), the statistics' sums from 0.
-        let mut sum = [0.0; LANES];
-        for (p, (k, len, table)) in self.passes.iter().enumerate() {
-            let out = &mut stats[*k..*k + *len];
-            match (p, len) {
-                (0, 0) => [sum] = Self::sums::<1>(table, rows, [-0.0]),
-                (0, _) => {
-                    let [s, v0, v1] = Self::sums::<3>(table, rows, [-0.0, 0.0, 0.0]);
-                    sum = s;
-                    out.copy_from_slice(&[v0, v1]);
-                }
-                (_, 1) => out.copy_from_slice(&Self::sums::<1>(table, rows, [0.0])),
-                (_, 2) => out.copy_from_slice(&Self::sums::<2>(table, rows, [0.0; 2])),
-                _ => out.copy_from_slice(&Self::sums::<3>(table, rows, [0.0; 3])),
-            }
-        }
-        let mean = sum.map(|a| a / (2.0 * m));
-        let variance = self.squares(rows, &mean).map(|v| v / (2.0 * m - 1.0));
-        for (i, s) in stats.iter_mut().enumerate() {
-            for l in 0..LANES {
-                s[l] = if i < d {
-                    s[l] / m / variance[l]
-                } else {
-                    s[l] / (2.0 * m) / variance[l]
-                };
-            }
-        }
-    }
-}
-
-/// Linear-interpolation percentile of sorted data, `q` in [0, 1].
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    let pos = q * (sorted.len() - 1) as f64;
-    let lo = pos.floor() as usize;
-    let hi = pos.ceil() as usize;
-    sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
+/// [`percentile`] of `values` as if sorted, by selection (`values` is reordered).
+fn selected_percentile(values: &mut [f64], q: f64) -> f64 {
+    let pos = q * (values.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    let (_, &mut low, above) = values.select_nth_unstable_by(lo, f64::total_cmp);
+    // The next order statistic is the least of those above.
+    let high = if hi == lo {
+        low
+    } else {
+        above.iter().copied().min_by(f64::total_cmp).unwrap_or(low)
+    };
+    low + (pos - lo as f64) * (high - low)
 }
 
 /// Summary of `R` independent replicate estimates of one statistic (replicated LHS,
@@ -579,6 +448,14 @@ mod tests {
         }
     }
 
+    /// Linear-interpolation percentile of sorted data, `q` in [0, 1].
+    fn percentile(sorted: &[f64], q: f64) -> f64 {
+        let pos = q * (sorted.len() - 1) as f64;
+        let lo = pos.floor() as usize;
+        let hi = pos.ceil() as usize;
+        sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
+    }
+
     /// Bit patterns, so that NaN equals NaN and 0.0 differs from -0.0.
     fn bits(e: &SobolWithCi) -> Vec<u64> {
         let pairs = e
@@ -651,6 +528,49 @@ mod tests {
                 seed
             ))
         );
+    }
+
+    #[test]
+    fn percentile_intervals_by_selection_equal_those_of_the_sorted_values() {
+        // Issue 15: the intervals take their order statistics by selection, not by sorting.
+        // Ties, signed zeros, infinities and NaN (left out), odd and even counts, levels
+        // that fall on an order statistic and between two.
+        let mut s = 7u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f64 / (1u64 << 24) as f64
+        };
+        for len in [1, 2, 3, 10, 37, 200] {
+            let mut values: Vec<f64> = (0..len)
+                .map(|i| match i % 9 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => 0.25,
+                    3 if len > 3 => f64::NAN,
+                    4 if len > 3 => f64::INFINITY,
+                    _ => next() - 0.5,
+                })
+                .collect();
+            for level in [0.0, 0.5, 0.9, 0.95, 1.0] {
+                let mut sorted: Vec<f64> =
+                    values.iter().copied().filter(|x| x.is_finite()).collect();
+                sorted.sort_by(f64::total_cmp);
+                let alpha = 0.5 * (1.0 - level);
+                let (lo, hi) = percentile_interval(&mut values, level);
+                assert_eq!(
+                    (lo.to_bits(), hi.to_bits()),
+                    (
+                        percentile(&sorted, alpha).to_bits(),
+                        percentile(&sorted, 1.0 - alpha).to_bits()
+                    ),
+                    "{len} values at level {level}"
+                );
+            }
+        }
+        let (lo, hi) = percentile_interval(&mut [f64::NAN, f64::NEG_INFINITY], 0.9);
+        assert!(lo.is_nan() && hi.is_nan());
     }
 
     #[test]

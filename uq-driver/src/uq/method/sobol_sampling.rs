@@ -209,9 +209,7 @@ impl Sampling for SobolSampling {
         if blocks.complete.len() < 2 {
             return Err(SensitivityError::TooFew(blocks.complete.len()).into());
         }
-        let ab: Vec<usize> = blocks.block_rows(0).chain(blocks.block_rows(1)).collect();
-        let moments = Estimate::from_sample(&data.select_rows(&ab));
-        let columns = self.columns(&blocks, data)?;
+        let (moments, columns) = self.columns(&blocks, data)?;
         let intervals = (self.bootstrap > 0).then(|| SobolIntervals {
             level: self.confidence,
             first: columns.iter().map(|c| c.first_ci.clone()).collect(),
@@ -245,18 +243,42 @@ struct ColumnIndices {
 }
 
 impl SobolSampling {
-    /// The indices of every column: the bootstrap resamples drawn once and applied to all
-    /// the columns with variance together.
+    /// The moments of every column over the blocks `A` and `B`, and the indices of every
+    /// column: the bootstrap resamples drawn once and applied to all the columns with
+    /// variance together. Each column is gathered once (in parallel) for both.
     fn columns(
         &self,
         blocks: &PickFreezeRows,
         data: &DMatrix<f64>,
-    ) -> Result<Vec<ColumnIndices>, MethodError> {
+    ) -> Result<(Estimate, Vec<ColumnIndices>), MethodError> {
         let (m, d) = (blocks.complete.len(), blocks.d);
-        let values: Vec<Option<Vec<f64>>> = (0..data.ncols())
-            .into_par_iter()
-            .map(|c| centred_values(blocks, data, c))
-            .collect();
+        let order: Vec<usize> = (0..d + 2).flat_map(|b| blocks.block_rows(b)).collect();
+        let contiguous = order.iter().enumerate().all(|(i, &r)| i == r);
+        let (moments, values): (Vec<Estimate>, Vec<Option<Vec<f64>>>) = data
+            .as_slice()
+            .par_chunks(data.nrows().max(1))
+            .map(|col| {
+                let values: Vec<f64> = if contiguous {
+                    col[..order.len()].to_vec()
+                } else {
+                    order.iter().map(|&r| col[r]).collect()
+                };
+                // The moments of the column over A and B, as of the whole matrix's rows.
+                let ab = DMatrix::from_column_slice(2 * m, 1, &values[..2 * m]);
+                (Estimate::from_sample(&ab), centred(values, m))
+            })
+            .unzip();
+        let mut moments = moments.into_iter();
+        let mut all = moments
+            .next()
+            .unwrap_or_else(|| Estimate::from_sample(&DMatrix::zeros(2 * m, 0)));
+        for e in moments {
+            all.mean.extend(e.mean);
+            all.std.extend(e.std);
+            if let (Some(a), Some(b)) = (&mut all.std_error_mean, e.std_error_mean) {
+                a.extend(b);
+            }
+        }
         let varying: Vec<&Vec<f64>> = values.iter().flatten().collect();
         let mut indices = if self.bootstrap == 0 {
             varying
@@ -290,7 +312,7 @@ impl SobolSampling {
             .collect()
         }
         .into_iter();
-        Ok(values
+        let indices = values
             .iter()
             .map(|v| match v {
                 Some(_) => indices.next().expect("one result per varying column"),
@@ -301,18 +323,14 @@ impl SobolSampling {
                     total_ci: vec![(0.0, 0.0); d],
                 },
             })
-            .collect())
+            .collect();
+        Ok((all, indices))
     }
 }
 
-/// The values of column `c` in the blocks `A`, `B`, `AB_1`, ... at the complete rows, less
-/// their mean over `A` and `B`; `None` for a column without variance.
-fn centred_values(blocks: &PickFreezeRows, data: &DMatrix<f64>, c: usize) -> Option<Vec<f64>> {
-    let (m, d) = (blocks.complete.len(), blocks.d);
-    let mut values: Vec<f64> = (0..d + 2)
-        .flat_map(|b| blocks.block_rows(b))
-        .map(|r| data[(r, c)])
-        .collect();
+/// The `values` of a column in the blocks `A`, `B`, `AB_1`, ... at the `m` complete rows,
+/// less their mean over `A` and `B`; `None` for a column without variance.
+fn centred(mut values: Vec<f64>, m: usize) -> Option<Vec<f64>> {
     if !has_variance(&values[..2 * m]) {
         return None;
     }
@@ -452,6 +470,48 @@ mod tests {
         // Too few complete rows is an error, not a panic.
         let e = m.estimate(&design, &rows[..3], &data.rows(0, 3).into_owned());
         assert!(e.is_err());
+    }
+
+    #[test]
+    fn moments_from_the_gathered_columns_are_those_of_the_selected_rows_bit_for_bit() {
+        // Issue 15: the moments are taken from each column as gathered for the indices (in
+        // parallel), no longer from a copy of the A and B rows of the whole matrix. Every
+        // point run (rows in place) and every 5th point failed (rows gathered), columns of
+        // several magnitudes and a constant one.
+        let params = uniform_params(2, 0.0, 1.0);
+        let m = SobolSampling {
+            samples: 128,
+            base: Base::Qmc,
+            bootstrap: 10,
+            confidence: 0.9,
+        };
+        let design = m.design(&params, 5).unwrap();
+        for skip in [usize::MAX, 5] {
+            let rows: Vec<usize> = (0..design.len()).filter(|i| i % skip != 2).collect();
+            let data = DMatrix::from_fn(rows.len(), 7, |r, c| {
+                let x = &design.values[rows[r]];
+                let c = c as f64;
+                if c == 3.0 {
+                    2.5
+                } else {
+                    10f64.powf(c - 2.0) * (x[0] + c * x[1] * x[1]) + 1e3 * c
+                }
+            });
+            let e = m.estimate(&design, &rows, &data).unwrap();
+            // The old computation: the A and B rows selected, then the moments.
+            let blocks = PickFreezeRows::new(m.samples, 2, &rows);
+            let ab: Vec<usize> = blocks.block_rows(0).chain(blocks.block_rows(1)).collect();
+            let want = Estimate::from_sample(&data.select_rows(&ab));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&e.mean), bits(&want.mean), "skip {skip}");
+            assert_eq!(bits(&e.std), bits(&want.std), "skip {skip}");
+            assert_eq!(
+                bits(e.std_error_mean.as_ref().unwrap()),
+                bits(want.std_error_mean.as_ref().unwrap()),
+                "skip {skip}"
+            );
+            assert_eq!(e.draws, want.draws);
+        }
     }
 
     #[test]
