@@ -78,10 +78,15 @@ def share_table(h, work, driver, all_builtins):
              "one Galerkin solve) of a few ms in all, then take 4 000 draws of the chaos at "
              "each of 501 times (exact quantiles at every time, densities at 150): about 2 "
              "million values. wheel-pce-lars fits a sparse LARS chaos with leave-one-out "
-             "selection at each of the 501 times: that is its analysis. vehicle-track-defect "
-             "draws its chaos at 5 001 times. The quantile columns are public output "
-             "(`<V>.csv`), so they are computed at every time, from the draws the study "
-             "names (`series_samples`).")
+             "selection at each of the 501 times: that is its analysis (about 117 000 LARS "
+             "steps). The quantile columns are public output (`<V>.csv`), so they are "
+             "computed at every time, from the draws the study names (`series_samples`). "
+             "For wheel-scm, 20 % of the command leaves about 4 ms for analysis and report; "
+             "the exact quantiles of those 2 million values alone take longer (about 9 ms on "
+             "one core here: `cargo test --release -p uq-driver --lib -- --ignored "
+             "column_timing --nocapture`), before the chaos is drawn, the densities taken "
+             "or a file written. The goal is out of reach for these studies without fewer "
+             "draws or fewer times, which would change their results.")
     if skipped:
         sec.note("Not run here (their runs take 15 minutes to an hour or more on 2 cores; "
                  "`make paper` runs them): " + ", ".join(skipped) +
