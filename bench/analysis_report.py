@@ -82,8 +82,8 @@ def share_table(h, work, driver, all_builtins):
              "steps). The quantile columns are public output (`<V>.csv`), so they are "
              "computed at every time, from the draws the study names (`series_samples`). "
              "For wheel-scm, 20 % of the command leaves about 4 ms for analysis and report; "
-             "the exact quantiles of those 2 million values alone take longer (about 9 ms on "
-             "one core here: `cargo test --release -p uq-driver --lib -- --ignored "
+             "the exact quantiles of those 2 million values alone take longer (about 9 ms of CPU, "
+             "over 4 ms even split over both cores: `cargo test --release -p uq-driver --lib -- --ignored "
              "column_timing --nocapture`), before the chaos is drawn, the densities taken "
              "or a file written. The goal is out of reach for these studies without fewer "
              "draws or fewer times, which would change their results.")
