@@ -144,6 +144,7 @@ fn a_single_run_has_no_density_and_says_so() {
         "q_end_pdf.svg",
         "q_peak_pdf.svg",
         "q_sobol.svg",
+        "q_sobol_overall.svg",
     ] {
         assert!(!out.join(f).exists(), "{f} drawn for a single run");
     }
@@ -232,6 +233,7 @@ fn units_reach_axes_summary_and_sidecar() {
         "q.csv,q99,m",
         "q_pdf.csv,density,1/m",
         "q_sobol.csv,S_K,1",
+        "q_sobol_overall.csv,ST_C,1",
         "q_peak_samples.csv,q_peak,m",
         "points.csv,K,N/m",
     ] {
@@ -249,6 +251,15 @@ fn units_reach_axes_summary_and_sidecar() {
     let bars = std::fs::read_to_string(out.join("q_peak_sobol.svg")).unwrap();
     assert!(bars.contains(">K</text>") && bars.contains(">C</text>"));
     assert!(bars.contains("first order S") && bars.contains("total ST"));
+    // And of the whole series of q: shares in [0, 1], first order at most total.
+    let overall = std::fs::read_to_string(out.join("q_sobol_overall.svg")).unwrap();
+    assert!(overall.contains(">K</text>") && overall.contains("whole series"));
+    let csv = std::fs::read_to_string(out.join("q_sobol_overall.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "S_K,S_C,ST_K,ST_C");
+    let v: Vec<f64> = lines[1].split(',').map(|x| x.parse().unwrap()).collect();
+    assert!(v.iter().all(|x| (0.0..=1.0 + 1e-12).contains(x)), "{v:?}");
+    assert!(v[0] <= v[2] + 1e-12 && v[1] <= v[3] + 1e-12, "{v:?}");
     // Inputs as written.
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(

@@ -92,6 +92,40 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
     write_columns(&dir.join(format!("{}_sobol.csv", s.name)), &hdr, &cols)
 }
 
+/// `<V>_sobol_overall.csv`: one row, `S_<p>...,ST_<p>...`, the Sobol' indices of the whole
+/// series ([`Sobol::integrated`]); not written where the output has no indices or no spread.
+pub(super) fn sobol_overall_csv(
+    dir: &Path,
+    s: &OutputStats,
+    names: &[&str],
+) -> Result<(), ReportError> {
+    let Some((first, total)) = overall_sobol(s) else {
+        return Ok(());
+    };
+    let header: Vec<String> = names
+        .iter()
+        .map(|n| format!("S_{n}"))
+        .chain(names.iter().map(|n| format!("ST_{n}")))
+        .collect();
+    let values: Vec<[f64; 1]> = first.iter().chain(&total).map(|&v| [v]).collect();
+    let cols: Vec<&[f64]> = values.iter().map(|v| &v[..]).collect();
+    let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
+    write_columns(
+        &dir.join(format!("{}_sobol_overall.csv", s.name)),
+        &hdr,
+        &cols,
+    )
+}
+
+/// The Sobol' indices of the whole series of `s` (variance-weighted over time), where it has
+/// indices over time and some spread.
+pub(super) fn overall_sobol(s: &OutputStats) -> Option<(Vec<f64>, Vec<f64>)> {
+    s.sobol
+        .as_ref()
+        .filter(|_| !s.deterministic)?
+        .integrated(&s.times, &s.std)
+}
+
 /// `<q>_pdf.csv`: `x,density` (header only for a deterministic quantity).
 pub(super) fn scalar_pdf_csv(dir: &Path, q: &ScalarStats) -> Result<(), ReportError> {
     write_columns(
@@ -188,6 +222,13 @@ pub(super) fn units_csv(
         if s.sobol.is_some() {
             let file = format!("{}_sobol.csv", s.name);
             push(&file, "time", Some("s"));
+            for n in names {
+                push(&file, &format!("S_{n}"), Some("1"));
+                push(&file, &format!("ST_{n}"), Some("1"));
+            }
+        }
+        if overall_sobol(s).is_some() {
+            let file = format!("{}_sobol_overall.csv", s.name);
             for n in names {
                 push(&file, &format!("S_{n}"), Some("1"));
                 push(&file, &format!("ST_{n}"), Some("1"));

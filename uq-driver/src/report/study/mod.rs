@@ -63,6 +63,7 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
                     files::output_csv(dir, s)?;
                     files::pdf_csv(dir, s)?;
                     files::sobol_csv(dir, s, &names)?;
+                    files::sobol_overall_csv(dir, s, &names)?;
                     if let Some(c) = &s.convergence {
                         files::convergence_csv(dir, &s.name, c)?;
                     }
@@ -233,6 +234,16 @@ fn output_section(
              total indices are in the CSV file.",
         );
     }
+    if let Some((first, total)) = files::overall_sobol(s) {
+        plots::sobol_overall_bars(dir, v, names, &first, &total)?;
+        images.push(format!("{v}_sobol_overall.svg"));
+        text.push_str(&format!(
+            "\n\nSobol' indices of the whole series: each time's indices weighted by its \
+             variance, S = ∫ Var(t) S(t) dt / ∫ Var(t) dt, the share of the variance of {v} \
+             over the whole run that each parameter causes alone (S) and with its \
+             interactions (ST)."
+        ));
+    }
     if let Some(c) = &s.convergence {
         images.extend(plots::convergence(dir, v, s.unit.as_deref(), c)?);
         text.push_str(&format!(
@@ -247,6 +258,9 @@ fn output_section(
     images.push(format!("{v}_pdf.csv"));
     if s.sobol.is_some() {
         images.push(format!("{v}_sobol.csv"));
+    }
+    if files::overall_sobol(s).is_some() {
+        images.push(format!("{v}_sobol_overall.csv"));
     }
     Ok(Section {
         heading: format!("Output {v}"),

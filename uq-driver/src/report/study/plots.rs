@@ -253,8 +253,40 @@ pub(super) fn sobol_bars(
         Some((f, t)) => (f.to_vec(), t.to_vec()),
         None => (vec![None; first.len()], vec![None; total.len()]),
     };
+    let title = format!("Sobol' indices of {}", q.name);
+    let file = dir.join(format!("{}_sobol.svg", q.name));
+    bars(&title, names, (first, fi), (total, ti), &file)?;
+    Ok(true)
+}
+
+/// `<V>_sobol_overall.svg`: the bar chart of the Sobol' indices of the whole series of an
+/// output (`first`, `total`: [`Sobol::integrated`](crate::uq::method::Sobol::integrated)).
+pub(super) fn sobol_overall_bars(
+    dir: &Path,
+    output: &str,
+    names: &[&str],
+    first: &[f64],
+    total: &[f64],
+) -> Result<(), ReportError> {
+    let title = format!("Sobol' indices of {output} over the whole series");
+    let none = vec![None; first.len()];
+    let file = dir.join(format!("{output}_sobol_overall.svg"));
+    bars(&title, names, (first, none.clone()), (total, none), &file)
+}
+
+/// Indices per parameter with their intervals (`None` where there are none).
+type Indices<'a> = (&'a [f64], Vec<Option<(f64, f64)>>);
+
+/// Bars of first-order and total indices per parameter, with intervals where given.
+fn bars(
+    title: &str,
+    names: &[&str],
+    first: Indices,
+    total: Indices,
+    file: &Path,
+) -> Result<(), ReportError> {
     BarChart {
-        title: format!("Sobol' indices of {}", q.name),
+        title: title.to_owned(),
         y_label: "share of the variance [-]".into(),
         x_label: "parameter".into(),
         categories: names.iter().map(|n| n.to_string()).collect(),
@@ -262,20 +294,20 @@ pub(super) fn sobol_bars(
             BarGroup {
                 label: "first order S".into(),
                 color: palette(0).into(),
-                values: first.clone(),
-                intervals: fi,
+                values: first.0.to_vec(),
+                intervals: first.1,
             },
             BarGroup {
                 label: "total ST".into(),
                 color: palette(1).into(),
-                values: total.clone(),
-                intervals: ti,
+                values: total.0.to_vec(),
+                intervals: total.1,
             },
         ],
         y_range: Some((0.0, 1.0)),
     }
-    .write(&dir.join(format!("{}_sobol.svg", q.name)))?;
-    Ok(true)
+    .write(file)?;
+    Ok(())
 }
 
 /// Convergence plots; returns the files written. Runs: `<name>_convergence.svg`, the running

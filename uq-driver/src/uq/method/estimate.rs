@@ -93,6 +93,54 @@ impl Sobol {
         }
     }
 
+    /// The indices of a whole series (generalised, time-integrated Sobol' indices): each
+    /// column's index weighted by its variance `std²` and its share of the time axis (the
+    /// trapezoid rule over `times`), `S_i = ∫ Var(t) S_i(t) dt / ∫ Var(t) dt`, the share of
+    /// the series' integrated variance that parameter `i` causes (alone, or with
+    /// interactions for the total index). Columns with zero or non-finite variance or
+    /// indices are left out. `None` when no column is left or the lengths disagree.
+    pub fn integrated(&self, times: &[f64], std: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let n = times.len();
+        if n == 0 || std.len() != n || self.first.len() != n || self.total.len() != n {
+            return None;
+        }
+        let d = self.first[0].len();
+        let (mut first, mut total, mut weight) = (vec![0.0; d], vec![0.0; d], 0.0);
+        for k in 0..n {
+            // Trapezoid weight of column k (1 for a single column).
+            let dt = match (k.checked_sub(1).map(|j| times[j]), times.get(k + 1)) {
+                (Some(a), Some(&b)) => 0.5 * (b - a),
+                (None, Some(&b)) => 0.5 * (b - times[k]),
+                (Some(a), None) => 0.5 * (times[k] - a),
+                (None, None) => 1.0,
+            };
+            let w = dt * std[k] * std[k];
+            let (f, t) = (&self.first[k], &self.total[k]);
+            let usable = w.is_finite()
+                && w > 0.0
+                && f.len() == d
+                && t.len() == d
+                && f.iter().chain(t).all(|x| x.is_finite());
+            if !usable {
+                continue;
+            }
+            weight += w;
+            for i in 0..d {
+                first[i] += w * f[i];
+                total[i] += w * t[i];
+            }
+        }
+        // Every weight added is positive: the sum is 0 only when no column was usable.
+        if weight == 0.0 {
+            return None;
+        }
+        first
+            .iter_mut()
+            .chain(&mut total)
+            .for_each(|x| *x /= weight);
+        Some((first, total))
+    }
+
     /// The indices of every column of a chaos (variance shares of its terms).
     pub fn from_chaos(pce: &Pce) -> Sobol {
         let cols = 0..pce.outputs();
@@ -224,6 +272,40 @@ mod tests {
         assert!((e.std[0] - std).abs() < 1e-15);
         assert!((e.std_error_mean.unwrap()[0] - std / 2.0).abs() < 1e-15);
         assert_eq!(e.draws, Draws::Runs);
+    }
+
+    #[test]
+    fn integrated_indices_weigh_each_time_by_its_variance() {
+        // Y(t) = t X1 + X2 + 0.5 X1 X2 (X1, X2 independent standard normals): Var = t² + 1.25,
+        // S1 = t² / Var, S2 = 1 / Var, ST1 = (t² + 0.25) / Var, ST2 = 1.25 / Var. Over the
+        // times 0, 0.5, 2 the trapezoid weights are 0.25, 1, 0.75: ∫Var = 5.75, ∫t² = 3.25,
+        // ∫(t² + 0.25) = 3.75, ∫1 = 2, ∫1.25 = 2.5.
+        // A fourth column without variance and a fifth with undefined indices add nothing.
+        let times = [0.0, 0.5, 2.0, 2.0, 2.0];
+        let var = |t: f64| t * t + 1.25;
+        let mut first: Vec<Vec<f64>> = times[..3]
+            .iter()
+            .map(|&t| vec![t * t / var(t), 1.0 / var(t)])
+            .collect();
+        let mut total: Vec<Vec<f64>> = times[..3]
+            .iter()
+            .map(|&t| vec![(t * t + 0.25) / var(t), 1.25 / var(t)])
+            .collect();
+        first.extend([vec![0.3, 0.3], vec![f64::NAN, 0.5]]);
+        total.extend([vec![0.3, 0.3], vec![f64::NAN, 0.5]]);
+        let mut std: Vec<f64> = times[..3].iter().map(|&t| var(t).sqrt()).collect();
+        std.extend([0.0, 1.0]);
+        let (s, st) = Sobol::new(first, total).integrated(&times, &std).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-14;
+        assert!(close(s[0], 3.25 / 5.75) && close(s[1], 2.0 / 5.75), "{s:?}");
+        assert!(
+            close(st[0], 3.75 / 5.75) && close(st[1], 2.5 / 5.75),
+            "{st:?}"
+        );
+        // No variance anywhere, or lengths that disagree: no indices.
+        let flat = Sobol::new(vec![vec![0.5]; 2], vec![vec![0.5]; 2]);
+        assert_eq!(flat.integrated(&[0.0, 1.0], &[0.0, 0.0]), None);
+        assert_eq!(flat.integrated(&[0.0], &[1.0]), None);
     }
 
     #[test]
