@@ -234,8 +234,9 @@ fn output_section(
              total indices are in the CSV file.",
         );
     }
-    if let Some((first, total)) = files::overall_sobol(s) {
-        plots::sobol_overall_bars(dir, v, names, &first, &total)?;
+    let overall = files::overall_sobol(s);
+    if let Some((first, total)) = &overall {
+        plots::sobol_overall_bars(dir, v, names, first, total)?;
         images.push(format!("{v}_sobol_overall.svg"));
         text.push_str(&format!(
             "\n\nSobol' indices of the whole series: each time's indices weighted by its \
@@ -259,7 +260,7 @@ fn output_section(
     if s.sobol.is_some() {
         images.push(format!("{v}_sobol.csv"));
     }
-    if files::overall_sobol(s).is_some() {
+    if overall.is_some() {
         images.push(format!("{v}_sobol_overall.csv"));
     }
     Ok(Section {

@@ -61,23 +61,14 @@ impl Surrogates {
         let psi = self.basis_at_germs(&pce.basis, n);
         out.par_chunks_mut(n.max(1) * COLUMNS_PER_TASK)
             .enumerate()
-            .for_each(|(b, block)| {
-                let j = j0 + b * COLUMNS_PER_TASK;
-                let w = block.len() / n.max(1);
-                // The product written straight into the output's columns.
-                let mut part = DMatrixViewMut::from_slice(block, n, w);
-                part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
-            });
+            .for_each(|(b, block)| product(&psi, pce, n, j0 + b * COLUMNS_PER_TASK, block));
     }
 
     /// One task of [`Surrogates::draws_into`], on the calling thread: the columns
     /// `j..j + w` of the draws into `out` (`n` rows, `w = out.len() / n` columns). With `j`
     /// a multiple of 32 and `w` at most 32 the values are those of `draws` bit for bit.
     pub fn draws_task(&self, pce: &Pce, n: usize, j: usize, out: &mut [f64]) {
-        let psi = self.basis_at_germs(&pce.basis, n);
-        let w = out.len() / n.max(1);
-        let mut part = DMatrixViewMut::from_slice(out, n, w);
-        part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
+        product(&self.basis_at_germs(&pce.basis, n), pce, n, j, out);
     }
 
     /// The basis at the first `n` germ points (rows), computed at most once per size.
@@ -91,6 +82,14 @@ impl Surrogates {
         cache.push((basis.clone(), Arc::clone(&psi)));
         psi
     }
+}
+
+/// The columns `j..j + w` of the draws, the first `n` rows of `psi` times the coefficients,
+/// written straight into `out` (`n` rows, `w = out.len() / n` columns, column-major).
+fn product(psi: &DMatrix<f64>, pce: &Pce, n: usize, j: usize, out: &mut [f64]) {
+    let w = out.len() / n.max(1);
+    let mut part = DMatrixViewMut::from_slice(out, n, w);
+    part.gemm(1.0, &psi.rows(0, n), &pce.coeffs.columns(j, w), 0.0);
 }
 
 /// `basis.design_matrix(&germ_draws(basis.families(), n, seed))`, rows computed in parallel.
