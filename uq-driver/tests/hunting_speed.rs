@@ -262,6 +262,34 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
 }
 
 #[test]
+fn a_nested_study_whose_bracket_misses_the_transition_names_the_bracket() {
+    // Before: the nested path said only "N of M weighted points have no value".
+    let dir = tempfile::tempdir().unwrap();
+    let study = dir.path().join("s.toml");
+    let text = study_text(
+        "kind = \"nested\"\nouter = { kind = \"mc\", samples = 2 }\n\
+         inner = { kind = \"scm\", nodes = 2, order = 1 }",
+        60.0,
+        69.0,
+    )
+    .replace(
+        "name = \"K_phi\"\nmean = 2.71e6\ncov = 0.1\n",
+        "name = \"K_phi\"\nmean = 2.71e6\ncov = 0.1\nlevel = \"outer\"\n",
+    );
+    assert!(text.contains("level = \"outer\""));
+    std::fs::write(&study, text).unwrap();
+    let o = run(&study, &dir.path().join("nested"), &[]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("quantity 'v_hunt'")
+            && err.contains("the top of the bracket (high = 69)")
+            && err.contains("widen the bracket (or use a method that can leave points out"),
+        "{err}"
+    );
+}
+
+#[test]
 fn settings_that_do_not_fit_the_fmu_are_refused_before_any_run() {
     let dir = tempfile::tempdir().unwrap();
     let study = dir.path().join("s.toml");

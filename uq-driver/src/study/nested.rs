@@ -17,8 +17,8 @@ use rand::RngCore;
 use rayon::prelude::*;
 
 use super::analysis::{
-    output_stats, scalar_stats, surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs,
-    Settings,
+    output_stats, quantity_error, scalar_stats, surrogates_of, Analysed, AnalysisError,
+    QuantityRuns, Runs, Settings,
 };
 use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
@@ -97,11 +97,7 @@ pub fn analyse(
     for (qi, (name, q)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
-            return Err(AnalysisError::NoValue {
-                name,
-                never_hunts: qr.never_hunts,
-                never_stops: qr.never_stops,
-            });
+            return Err(quantity_error(&name, q, &qr, None));
         }
         let scalar = Scalar { name: &name, q, qi };
         let (stats, warning) = quantity(study, method, &blocks, scalar, qr, &settings)?;
@@ -214,12 +210,7 @@ fn quantity(
     settings: &Settings,
 ) -> Result<(ScalarStats, Option<String>), AnalysisError> {
     let Scalar { name, q, qi } = scalar;
-    let fail = |source: MethodError| AnalysisError::Quantity {
-        name: name.to_owned(),
-        never_hunts: qr.never_hunts,
-        never_stops: qr.never_stops,
-        source,
-    };
+    let fail = |source: MethodError| quantity_error(name, q, &qr, Some(source));
     let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
     let cond = method.conditional(blocks, &qr.rows, &data).map_err(fail)?;
     let estimate: Estimate = marginal(&cond, 1).map_err(fail)?;

@@ -545,39 +545,13 @@ pub fn analyse_runs(
         .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
     for (qi, (name, q)) in scalars.enumerate() {
         let qr = runs.quantity(base, qi)?;
-        let outside = |more| match q {
-            QoiSpec::HuntingSpeed(h) => Some(AnalysisError::OutsideBracket {
-                name: name.clone(),
-                low: h.low,
-                high: h.high,
-                decays_at_high: qr.never_hunts,
-                hunts_at_low: qr.never_stops,
-                more,
-            }),
-            _ => None,
-        };
         if qr.valid.is_empty() {
-            if let Some(e) = outside("") {
-                return Err(e);
-            }
-            return Err(AnalysisError::NoValue {
-                name,
-                never_hunts: qr.never_hunts,
-                never_stops: qr.never_stops,
-            });
+            return Err(quantity_error(&name, q, &qr, None));
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate = method.estimate(design, &qr.rows, &data).map_err(|source| {
-            let more = " (or use a method that can leave points out, such as LHS or MC)";
-            outside(more)
-                .filter(|_| qr.never_hunts + qr.never_stops > 0)
-                .unwrap_or(AnalysisError::Quantity {
-                    name: name.clone(),
-                    never_hunts: qr.never_hunts,
-                    never_stops: qr.never_stops,
-                    source,
-                })
-        })?;
+        let estimate = method
+            .estimate(design, &qr.rows, &data)
+            .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
         quantities.push(scalar_stats(&name, q, &estimate, qr, &settings, None)?);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
@@ -594,6 +568,46 @@ pub fn analyse_runs(
         output_chaos,
         quantity_chaos,
     })
+}
+
+/// The error of scalar quantity `name` (its runs `qr`) that has no value at any run
+/// (`source` `None`) or whose estimator refused its values (`source`, e.g. a weighted design
+/// with points left without a value). A `hunting_speed` whose runs missed the transition names
+/// its bracket and how many points fell outside it on each side.
+pub(crate) fn quantity_error(
+    name: &str,
+    q: &QoiSpec,
+    qr: &QuantityRuns,
+    source: Option<MethodError>,
+) -> AnalysisError {
+    let missed = qr.never_hunts + qr.never_stops > 0;
+    match (q, source) {
+        (QoiSpec::HuntingSpeed(h), source) if source.is_none() || missed => {
+            AnalysisError::OutsideBracket {
+                name: name.to_owned(),
+                low: h.low,
+                high: h.high,
+                decays_at_high: qr.never_hunts,
+                hunts_at_low: qr.never_stops,
+                more: if source.is_some() {
+                    " (or use a method that can leave points out, such as LHS or MC)"
+                } else {
+                    ""
+                },
+            }
+        }
+        (_, None) => AnalysisError::NoValue {
+            name: name.to_owned(),
+            never_hunts: qr.never_hunts,
+            never_stops: qr.never_stops,
+        },
+        (_, Some(source)) => AnalysisError::Quantity {
+            name: name.to_owned(),
+            never_hunts: qr.never_hunts,
+            never_stops: qr.never_stops,
+            source,
+        },
+    }
 }
 
 /// The estimate and the statistics of output `o`, estimated a block of time columns at a
