@@ -312,6 +312,41 @@ fn no_report_export_and_compare() {
     let first = f64::from_le_bytes(q[10 + hlen..10 + hlen + 8].try_into().unwrap());
     assert_eq!(first, 0.1);
 
+    // Every value of runs.npz is the one runs.csv gives (the npz's series are copied from the
+    // store without decoding).
+    let data = &q[10 + hlen..];
+    for (n, line) in csv.lines().skip(1).enumerate() {
+        let v: f64 = line.split(',').nth(2).unwrap().parse().unwrap();
+        let w = f64::from_le_bytes(data[8 * n..8 * n + 8].try_into().unwrap());
+        assert_eq!(v, w, "row {n}");
+    }
+    // A second record of point 0 (as a resumed or re-merged store may hold) is not exported:
+    // the first success of each point is.
+    let records = a.join("store/records.bin");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("store/manifest.json")).unwrap()).unwrap();
+    let n_values = manifest["n_values"].as_u64().unwrap() as usize;
+    let extra = uq_driver::study::store::encode(
+        0,
+        &uq_driver::study::store::Record::Ok(vec![42.0; n_values]),
+    );
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&records)
+        .unwrap();
+    std::io::Write::write_all(&mut f, &extra).unwrap();
+    drop(f);
+    run_ok(&["export", a.to_str().unwrap(), "--runs"]);
+    let again = std::fs::read_to_string(a.join("runs/runs.csv")).unwrap();
+    assert_eq!(again, csv);
+    // While a run holds the folder, export refuses instead of reading a store being written.
+    let held = uq_driver::study::lock::FolderLock::acquire(&a).unwrap();
+    let o = run(&["export", a.to_str().unwrap(), "--runs"]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("the folder is in use"), "{err}");
+    drop(held);
+
     let b = dir.path().join("b");
     run_ok(&["run", s.to_str().unwrap(), "--out", b.to_str().unwrap()]);
     let page = dir.path().join("page");

@@ -12,12 +12,15 @@
 
 use std::fmt::Write as _;
 use std::io::Write as _;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use super::store::{self, Manifest, Record};
-use crate::report::{write_bytes, ReportError};
+use super::lock::{FolderLock, LockError};
+use super::store::format::{self, Slot};
+use super::store::Manifest;
+use crate::report::ReportError;
 use crate::spec::Experiment;
 
 /// Why the runs cannot be exported.
@@ -43,6 +46,15 @@ pub enum ExportError {
     /// Writing failed.
     #[error(transparent)]
     Report(#[from] ReportError),
+    /// A run holds the folder (or its lock file cannot be written).
+    #[error("cannot export {}: the folder is in use", path.display())]
+    Locked {
+        /// The study folder.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: LockError,
+    },
     /// Writing the zip failed.
     #[error("cannot write {}", path.display())]
     Zip {
@@ -113,26 +125,57 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
         ));
     }
     let rp = dir.join("store").join("records.bin");
-    let (_, decoded) = store::decode(&read(&rp)?, manifest.n_values);
-    let mut ok: Vec<(usize, Vec<f64>)> = decoded
-        .records
-        .into_iter()
-        .filter_map(|(i, r, _)| match r {
-            Record::Ok(v) => Some((i, v)),
-            Record::Failed(_) => None,
-        })
-        .collect();
-    ok.sort_by_key(|(i, _)| *i);
-    ok.dedup_by_key(|(i, _)| *i);
     let parameters = read_points(&dir.join("points.csv"))?;
     std::fs::create_dir_all(out).map_err(|source| ReportError::Io {
         path: out.to_path_buf(),
         source,
     })?;
+    // A run writing the folder meanwhile could cut the store under the map: take its lock.
+    let _lock = FolderLock::acquire(dir).map_err(|source| ExportError::Locked {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let file = std::fs::File::open(&rp).map_err(|source| ExportError::Read {
+        path: rp.clone(),
+        source,
+    })?;
+    let len = file
+        .metadata()
+        .map_err(|source| ExportError::Read {
+            path: rp.clone(),
+            source,
+        })?
+        .len();
+    let map = if len == 0 {
+        None
+    } else {
+        // SAFETY: a read-only map of the store while this process holds the folder's lock,
+        // under which alone `run` appends to, repairs or truncates the file.
+        Some(
+            unsafe { memmap2::Mmap::map(&file) }.map_err(|source| ExportError::Read {
+                path: rp.clone(),
+                source,
+            })?,
+        )
+    };
+    let bytes: &[u8] = map.as_deref().unwrap_or_default();
+    let scanned = format::scan_format(bytes, manifest.n_values, format::detect_format(bytes));
+    // The first success of each point, in design order; the values stay in the map.
+    let mut ok: Vec<(usize, Range<usize>)> = scanned
+        .records
+        .into_iter()
+        .filter_map(|(i, slot, _)| match slot {
+            Slot::Ok(r) => Some((i, r)),
+            Slot::Failed(_) => None,
+        })
+        .collect();
+    ok.sort_by_key(|(i, _)| *i);
+    ok.dedup_by_key(|(i, _)| *i);
+    let runs = StoredValues { bytes, ok: &ok, nt };
     let csv = out.join("runs.csv");
-    write_csv(&csv, &outputs, &times, &ok)?;
+    write_csv(&csv, &outputs, &times, &runs)?;
     let npz = out.join("runs.npz");
-    write_npz(&npz, &outputs, &times, &ok, &parameters)?;
+    write_npz(&npz, &outputs, &times, &runs, &parameters)?;
     Ok(Exported {
         runs: ok.len(),
         times: nt,
@@ -140,6 +183,31 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
         csv,
         npz,
     })
+}
+
+/// The successful runs of a store file, read where they lie: `ok` holds each run's design
+/// index and the byte range of its values (little-endian f64, output after output, `nt`
+/// times each).
+struct StoredValues<'a> {
+    bytes: &'a [u8],
+    ok: &'a [(usize, Range<usize>)],
+    nt: usize,
+}
+
+impl StoredValues<'_> {
+    /// The raw little-endian bytes of output `o` of run `r` (`nt` values).
+    fn output_bytes(&self, r: usize, o: usize) -> &[u8] {
+        let start = self.ok[r].1.start + 8 * o * self.nt;
+        &self.bytes[start..start + 8 * self.nt]
+    }
+
+    /// Value `k` of the record of run `r`.
+    fn value(&self, r: usize, k: usize) -> f64 {
+        let at = self.ok[r].1.start + 8 * k;
+        let mut le = [0; 8];
+        le.copy_from_slice(&self.bytes[at..at + 8]);
+        f64::from_le_bytes(le)
+    }
 }
 
 /// The parameter columns of `points.csv` by design index: (name, values).
@@ -171,50 +239,46 @@ fn write_csv(
     path: &Path,
     outputs: &[String],
     times: &[f64],
-    runs: &[(usize, Vec<f64>)],
+    runs: &StoredValues,
 ) -> Result<(), ExportError> {
-    let nt = times.len();
-    let mut text = String::with_capacity(24 * runs.len() * nt * (2 + outputs.len()));
-    text.push_str("run,time");
+    let io = |source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    let mut line = String::with_capacity(64);
+    line.push_str("run,time");
     for o in outputs {
-        text.push(',');
-        text.push_str(o);
+        line.push(',');
+        line.push_str(o);
     }
-    text.push('\n');
-    for (i, v) in runs {
+    line.push('\n');
+    w.write_all(line.as_bytes()).map_err(io)?;
+    let nt = times.len();
+    for (r, (i, _)) in runs.ok.iter().enumerate() {
         for (k, t) in times.iter().enumerate() {
-            let _ = write!(text, "{i},{t}");
+            line.clear();
+            let _ = write!(line, "{i},{t}");
             for o in 0..outputs.len() {
-                let _ = write!(text, ",{}", v[o * nt + k]);
+                let _ = write!(line, ",{}", runs.value(r, o * nt + k));
             }
-            text.push('\n');
+            line.push('\n');
+            w.write_all(line.as_bytes()).map_err(io)?;
         }
     }
-    Ok(write_bytes(path, text.as_bytes())?)
+    w.flush().map_err(io)?;
+    Ok(())
 }
 
 /// One `.npy` file (format 1.0) of a C-ordered array with `shape`, of `<f8` or `<i8`.
 pub fn npy(shape: &[usize], data: Npy) -> Vec<u8> {
-    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
-    let shape = if dims.len() == 1 {
-        format!("({},)", dims[0])
-    } else {
-        format!("({})", dims.join(", "))
-    };
     let descr = match data {
         Npy::F64(_) => "<f8",
         Npy::I64(_) => "<i8",
     };
-    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
-    // Magic (6) + version (2) + length (2) + header, padded with spaces to a multiple of 64
-    // and ended by a newline.
-    let total = 10 + header.len() + 1;
-    header.push_str(&" ".repeat(total.next_multiple_of(64) - total));
-    header.push('\n');
-    let mut out = Vec::with_capacity(10 + header.len() + 8 * data.len());
-    out.extend_from_slice(b"\x93NUMPY\x01\x00");
-    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    out.extend_from_slice(header.as_bytes());
+    let mut out = npy_header(shape, descr);
+    out.reserve(8 * data.len());
     match data {
         Npy::F64(v) => v
             .iter()
@@ -223,6 +287,28 @@ pub fn npy(shape: &[usize], data: Npy) -> Vec<u8> {
             .iter()
             .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
     }
+    out
+}
+
+/// The magic, version and header of a `.npy` file (format 1.0) of a C-ordered array with
+/// `shape` of dtype `descr` (`<f8`, `<i8`): its data follows.
+fn npy_header(shape: &[usize], descr: &str) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape = if dims.len() == 1 {
+        format!("({},)", dims[0])
+    } else {
+        format!("({})", dims.join(", "))
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    // Magic (6) + version (2) + length (2) + header, padded with spaces to a multiple of 64
+    // and ended by a newline.
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.next_multiple_of(64) - total));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
     out
 }
 
@@ -248,51 +334,53 @@ fn write_npz(
     path: &Path,
     outputs: &[String],
     times: &[f64],
-    runs: &[(usize, Vec<f64>)],
+    runs: &StoredValues,
     parameters: &[(String, Vec<f64>)],
 ) -> Result<(), ExportError> {
     let nt = times.len();
+    let n = runs.ok.len();
     let zip_err = |source| ExportError::Zip {
         path: path.to_path_buf(),
         source,
     };
-    let file = std::fs::File::create(path).map_err(|source| ReportError::Io {
+    let io = |source| ReportError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    let mut z = zip::ZipWriter::new(file);
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut z = zip::ZipWriter::new(std::io::BufWriter::with_capacity(1 << 20, file));
     let opts = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Stored)
         .large_file(true);
     let mut add = |name: &str, bytes: Vec<u8>| -> Result<(), ExportError> {
         z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
-        z.write_all(&bytes).map_err(|source| ReportError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        z.write_all(&bytes).map_err(io)?;
         Ok(())
     };
     add("time", npy(&[nt], Npy::F64(times)))?;
-    let index: Vec<i64> = runs.iter().map(|(i, _)| *i as i64).collect();
-    add("run", npy(&[runs.len()], Npy::I64(&index)))?;
+    let index: Vec<i64> = runs.ok.iter().map(|(i, _)| *i as i64).collect();
+    add("run", npy(&[n], Npy::I64(&index)))?;
+    // The series, a run at a time straight from the store (already little-endian f64).
     for (o, name) in outputs.iter().enumerate() {
-        let data: Vec<f64> = runs
-            .iter()
-            .flat_map(|(_, v)| v[o * nt..(o + 1) * nt].iter().copied())
-            .collect();
-        add(name, npy(&[runs.len(), nt], Npy::F64(&data)))?;
+        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.write_all(&npy_header(&[n, nt], "<f8")).map_err(io)?;
+        for r in 0..n {
+            z.write_all(runs.output_bytes(r, o)).map_err(io)?;
+        }
     }
     for (name, values) in parameters {
         if outputs.contains(name) || name == "time" || name == "run" {
             continue;
         }
         let per_run: Vec<f64> = runs
+            .ok
             .iter()
             .map(|(i, _)| values.get(*i).copied().unwrap_or(f64::NAN))
             .collect();
-        add(name, npy(&[runs.len()], Npy::F64(&per_run)))?;
+        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.write_all(&npy(&[n], Npy::F64(&per_run))).map_err(io)?;
     }
-    z.finish().map_err(zip_err)?;
+    z.finish().map_err(zip_err)?.flush().map_err(io)?;
     Ok(())
 }
 
