@@ -344,7 +344,7 @@ fn no_report_export_and_compare() {
     let o = run(&["export", a.to_str().unwrap(), "--runs"]);
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("the folder is in use"), "{err}");
+    assert!(err.contains("is in use by another uq-driver run"), "{err}");
     drop(held);
 
     let b = dir.path().join("b");

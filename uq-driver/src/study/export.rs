@@ -47,7 +47,7 @@ pub enum ExportError {
     #[error(transparent)]
     Report(#[from] ReportError),
     /// A run holds the folder (or its lock file cannot be written).
-    #[error("cannot export {}: the folder is in use", path.display())]
+    #[error("cannot export {}: cannot take the folder's lock", path.display())]
     Locked {
         /// The study folder.
         path: PathBuf,
