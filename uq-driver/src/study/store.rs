@@ -269,14 +269,25 @@ impl Store {
         let found = bytes.len();
         let mut len = found;
         if fmt == Format::V1 || damage_inside {
-            let out = kept_bytes(bytes, fmt, &kept, &done);
+            // The kept records go to a new file straight from the map, a record at a time:
+            // a store larger than the memory is repaired too.
+            let tmp = write_tmp(&path, |w| write_kept(w, bytes, fmt, &kept, &done))?;
             drop(map);
-            let (new_file, backup) = rewrite(&path, &label(fmt), &out)?;
+            let (new_file, backup) = replace(&path, &tmp, &label(fmt))?;
             file = new_file;
             recovery.backup = Some(backup);
             // Where each point's values are now.
-            done = read_records(&out, Format::V2, manifest).0;
-            len = out.len();
+            let new_len = file.metadata().map_err(io_err(&path))?.len();
+            let new_map = if new_len == 0 {
+                None
+            } else {
+                // SAFETY: as above, a read-only map of the file this run just wrote under the
+                // folder's lock; dropped before anything appends to it.
+                Some(unsafe { memmap2::Mmap::map(&file) }.map_err(io_err(&path))?)
+            };
+            let written: &[u8] = new_map.as_deref().unwrap_or_default();
+            done = read_records(written, Format::V2, manifest).0;
+            len = written.len();
         } else if valid_end < found {
             drop(map);
             // A torn tail from an interrupted write (or a damaged last record): cut it off.
@@ -379,10 +390,15 @@ fn label(fmt: Format) -> String {
     }
 }
 
-/// The `kept` records only, in format 2: a format-1 store is re-encoded (the first record of
-/// each point), a damaged one keeps the valid records' bytes.
-fn kept_bytes(bytes: &[u8], fmt: Format, kept: &[Kept], done: &[Option<Slot>]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(bytes.len());
+/// Writes the `kept` records only, in format 2: a format-1 store is re-encoded (the first
+/// record of each point), a damaged one keeps the valid records' bytes.
+fn write_kept(
+    w: &mut dyn Write,
+    bytes: &[u8],
+    fmt: Format,
+    kept: &[Kept],
+    done: &[Option<Slot>],
+) -> std::io::Result<()> {
     match fmt {
         Format::V1 => {
             // The first record of each point (later ones are never read).
@@ -393,18 +409,18 @@ fn kept_bytes(bytes: &[u8], fmt: Format, kept: &[Kept], done: &[Option<Slot>]) -
                         Slot::Ok(r) => Record::Ok(format::values_of(&bytes[r.clone()])),
                         Slot::Failed(m) => Record::Failed(m.clone()),
                     };
-                    out.extend_from_slice(&encode(i, &rec));
+                    w.write_all(&encode(i, &rec))?;
                     written[i] = true;
                 }
             }
         }
         Format::V2 => {
             for (_, r) in kept {
-                out.extend_from_slice(&bytes[r.clone()]);
+                w.write_all(&bytes[r.clone()])?;
             }
         }
     }
-    out
+    Ok(())
 }
 
 /// Writes the manifest of a new store, or checks that an existing one is `manifest`.
@@ -438,11 +454,32 @@ fn unix_seconds() -> u64 {
         .map_or(0, |d| d.as_secs())
 }
 
-/// Replaces `path` by `bytes` atomically (a new file renamed over it), after keeping the old
-/// file as `records.<label>.bin` beside it (a hard link, or a copy where links are not
-/// supported; `-2`, `-3`, ... appended if taken). Returns the new file opened for appending and
-/// the backup's path. At every moment `path` is either the old or the new file.
-fn rewrite(path: &Path, label: &str, bytes: &[u8]) -> Result<(File, PathBuf), StoreError> {
+/// Writes the new content of the store file `path` to a temporary file beside it (synced to
+/// the disk) and returns that file's path; the temporary file is removed if writing fails.
+fn write_tmp(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<PathBuf, StoreError> {
+    let tmp = path.with_extension("bin.tmp");
+    let written = (|| {
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
+        write(&mut w)?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()
+    })();
+    if let Err(e) = written {
+        let _ = fs::remove_file(&tmp);
+        return Err(StoreError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        });
+    }
+    Ok(tmp)
+}
+
+/// Replaces the store file `path` by `tmp` (from [`write_tmp`]), keeping the file as found
+/// as `records.<label>.bin` (a hard link where the file system allows it, else a copy);
+/// returns the new file, open for reading and appending, and the backup's path.
+fn replace(path: &Path, tmp: &Path, label: &str) -> Result<(File, PathBuf), StoreError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut backup = dir.join(format!("records.{label}.bin"));
     let mut n = 1;
@@ -450,18 +487,14 @@ fn rewrite(path: &Path, label: &str, bytes: &[u8]) -> Result<(File, PathBuf), St
         n += 1;
         backup = dir.join(format!("records.{label}-{n}.bin"));
     }
-    if fs::hard_link(path, &backup).is_err() {
-        fs::copy(path, &backup).map_err(io_err(&backup))?;
-    }
-    let tmp = path.with_extension("bin.tmp");
-    let written = (|| {
-        let mut f = File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
+    let kept = (|| {
+        if fs::hard_link(path, &backup).is_err() {
+            fs::copy(path, &backup)?;
+        }
+        fs::rename(tmp, path)
     })();
-    if let Err(e) = written {
-        let _ = fs::remove_file(&tmp);
+    if let Err(e) = kept {
+        let _ = fs::remove_file(tmp);
         return Err(StoreError::Io {
             path: path.to_path_buf(),
             source: e,
