@@ -16,6 +16,7 @@
 //! - [`suggest`]: "did you mean" for misspelt names.
 
 pub mod fmu;
+pub mod out_file;
 pub mod qoi;
 pub mod report;
 pub mod results;

@@ -209,7 +209,7 @@ fn run(a: RunArgs) -> Result<()> {
     a.safety.apply(&mut opts)?;
     let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
     match outcome {
-        Outcome::Study(r) => print_study(&r, &a.out),
+        Outcome::Study(r) => print_study(&r, &a.out, a.no_report),
         Outcome::Suite(r) => print_suite(&r, &a.out),
     }
     Ok(())

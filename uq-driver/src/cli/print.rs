@@ -6,8 +6,9 @@ use uq_driver::report::units::with_unit;
 use uq_driver::results::sig;
 use uq_driver::study::{StudyResult, SuiteResult};
 
-/// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings.
-pub(crate) fn print_study(r: &StudyResult, out: &Path) {
+/// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings;
+/// where the results are (`index.html`, or the folder when `--no-report` wrote no page).
+pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
     let s = &r.summary;
     for w in &s.warnings {
         eprintln!("uq-driver: warning: {w}");
@@ -15,14 +16,21 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path) {
     let t = &s.timing;
     println!(
         "{}: {} model runs ({} resumed); wall time: runs {:.2} s, analysis {:.2} s, report \
-         {:.2} s; report: {}",
+         {:.2} s; {}",
         s.study,
         s.model_runs,
         s.runs_resumed,
         t.runs_s,
         t.analysis_s,
         t.report_s,
-        out.join("index.html").display()
+        if no_report {
+            format!(
+                "results: {} (CSV files and summary.json only, --no-report)",
+                out.display()
+            )
+        } else {
+            format!("report: {}", out.join("index.html").display())
+        }
     );
     for q in &r.quantities {
         let u = q.unit.as_deref();

@@ -15,7 +15,8 @@ use uq_driver::uq::surrogate::Surrogate;
 /// Writes `text` to `out`, or to standard output.
 pub(crate) fn emit(text: &str, out: Option<&Path>) -> Result<()> {
     match out {
-        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display())),
+        Some(p) => uq_driver::out_file::write(p, text.as_bytes())
+            .with_context(|| format!("writing {}", p.display())),
         None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
     }
 }
@@ -92,7 +93,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     let mut text = String::from("time");
     for n in &sim.names {
         text.push(',');
-        text.push_str(n);
+        uq_driver::report::csv::push_field(&mut text, n);
     }
     text.push('\n');
     for (k, t) in sim.times.iter().enumerate() {
@@ -104,7 +105,8 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         text.push('\n');
     }
     match a.out.as_deref() {
-        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?,
+        Some(p) => uq_driver::out_file::write(p, text.as_bytes())
+            .with_context(|| format!("writing {}", p.display()))?,
         None => std::io::stdout().lock().write_all(text.as_bytes())?,
     }
     Ok(())

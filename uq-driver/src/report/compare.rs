@@ -4,6 +4,7 @@
 //! and quantity that several studies share, their bands, Std and PDFs in one plot each.
 //! Everything is read back from the folders' `summary.json` and CSV files.
 
+use crate::report::file_name::stem;
 use std::path::{Component, Path, PathBuf};
 
 use serde_json::Value;
@@ -282,7 +283,7 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
     let have: Vec<(&Folder, Csv)> = studies
         .iter()
         .filter(|f| !f.summary["outputs"][v].is_null())
-        .map(|f| Csv::read(&f.dir.join(format!("{v}.csv"))).map(|c| (f, c)))
+        .map(|f| Csv::read(&f.dir.join(format!("{}.csv", stem(v)))).map(|c| (f, c)))
         .collect::<Result<_, _>>()?;
     let unit = have.first().and_then(|(f, _)| f.unit(v));
     let unit = unit.as_deref();
@@ -319,9 +320,12 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         let line = Series::new(name, t.to_vec(), s.to_vec(), palette(i));
         std.series.push(if i > 0 { line.dashed() } else { line });
     }
-    bands.write(&out.join(format!("{v}_bands.svg")))?;
-    std.write(&out.join(format!("{v}_std.svg")))?;
-    let mut images = vec![format!("{v}_bands.svg"), format!("{v}_std.svg")];
+    bands.write(&out.join(format!("{}_bands.svg", stem(v))))?;
+    std.write(&out.join(format!("{}_std.svg", stem(v))))?;
+    let mut images = vec![
+        format!("{}_bands.svg", stem(v)),
+        format!("{}_std.svg", stem(v)),
+    ];
     let mut text = format!(
         "{v} in {} studies: their μ ± 3σ bands and Std over time.",
         have.len()
@@ -360,10 +364,10 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         if cols.len() > 3 {
             let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
             let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
-            write_columns(&out.join(format!("{v}_compare.csv")), &hdr, &refs)?;
-            diff.write(&out.join(format!("{v}_std_diff.svg")))?;
-            images.push(format!("{v}_std_diff.svg"));
-            images.push(format!("{v}_compare.csv"));
+            write_columns(&out.join(format!("{}_compare.csv", stem(v))), &hdr, &refs)?;
+            diff.write(&out.join(format!("{}_std_diff.svg", stem(v))))?;
+            images.push(format!("{}_std_diff.svg", stem(v)));
+            images.push(format!("{}_compare.csv", stem(v)));
             text.push_str(&format!(
                 " The difference of each Std from that of {} is on a log axis (it spans decades \
                  between methods).",
@@ -396,7 +400,7 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
         let s = &f.summary["quantities"][q];
         let deterministic = s["deterministic"].as_bool().unwrap_or(false);
         if !deterministic {
-            let c = Csv::read(&f.dir.join(format!("{q}_pdf.csv")))?;
+            let c = Csv::read(&f.dir.join(format!("{}_pdf.csv", stem(q))))?;
             if let (Some(x), Some(d)) = (c.column("x"), c.column("density")) {
                 plot.curves
                     .push(Series::new(f.name(), x.to_vec(), d.to_vec(), palette(i)));
@@ -429,8 +433,8 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
     }
     let mut images = Vec::new();
     if !plot.curves.is_empty() {
-        plot.write(&out.join(format!("{q}_pdf_compare.svg")))?;
-        images.push(format!("{q}_pdf_compare.svg"));
+        plot.write(&out.join(format!("{}_pdf_compare.svg", stem(q))))?;
+        images.push(format!("{}_pdf_compare.svg", stem(q)));
     }
     Ok(Section {
         heading: format!("Quantity {q}"),

@@ -109,20 +109,50 @@ pub fn write_grid(
     write_bytes(path, out.as_bytes())
 }
 
-fn push_header(out: &mut String, header: &[&str]) {
+/// Appends a CSV header line: the names separated by commas, each quoted (RFC 4180) only
+/// where it must be ([`push_field`]), and a newline.
+pub fn push_header(out: &mut String, header: &[&str]) {
     for (j, name) in header.iter().enumerate() {
         if j > 0 {
             out.push(',');
         }
-        if name.contains([',', '"', '\n', '\r']) {
-            out.push('"');
-            out.push_str(&name.replace('"', "\"\""));
-            out.push('"');
-        } else {
-            out.push_str(name);
-        }
+        push_field(out, name);
     }
     out.push('\n');
+}
+
+/// Appends one CSV field: as it is, or, when it contains a comma, a double quote, a CR or an
+/// LF, in double quotes with its quotes doubled (RFC 4180): `T[1,2]` → `"T[1,2]"`.
+pub fn push_field(out: &mut String, field: &str) {
+    if field.contains([',', '"', '\n', '\r']) {
+        out.push('"');
+        out.push_str(&field.replace('"', "\"\""));
+        out.push('"');
+    } else {
+        out.push_str(field);
+    }
+}
+
+/// The fields of one CSV line (RFC 4180: a field in double quotes may hold commas, and `""`
+/// is a quote), as [`push_field`] writes them.
+pub fn split_line(line: &str) -> Vec<String> {
+    let mut fields = vec![String::new()];
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        let field = fields.last_mut().expect("never empty");
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            '"' if quoted => quoted = false,
+            '"' if field.is_empty() => quoted = true,
+            ',' if !quoted => fields.push(String::new()),
+            c => field.push(c),
+        }
+    }
+    fields
 }
 
 fn push_number(out: &mut String, v: f64) {
@@ -250,6 +280,26 @@ mod tests {
         write_columns(&path, &["mean", "q, \"lateral\""], &[&[1.0], &[2.0]]).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(text, "mean,\"q, \"\"lateral\"\"\"\n1,2\n");
+    }
+
+    #[test]
+    fn header_names_with_commas_quotes_or_line_breaks_are_quoted_and_read_back() {
+        let names = ["index", "T[1,2]", "q\"uote", "cr\rlf\n", "plain.x[1]"];
+        let mut line = String::new();
+        push_header(&mut line, &names);
+        assert_eq!(
+            line,
+            "index,\"T[1,2]\",\"q\"\"uote\",\"cr\rlf\n\",plain.x[1]\n"
+        );
+        assert_eq!(split_line(line.strip_suffix('\n').unwrap()), names);
+        // Ordinary names: the same bytes as before quoting existed.
+        let mut plain = String::new();
+        push_header(
+            &mut plain,
+            &["index", "weight", "body.frame_a.r_0[1]", "status"],
+        );
+        assert_eq!(plain, "index,weight,body.frame_a.r_0[1],status\n");
+        assert_eq!(split_line("1,,\"failed: a, b\""), ["1", "", "failed: a, b"]);
     }
 
     #[test]

@@ -18,6 +18,7 @@
 
 pub mod compare;
 pub mod csv;
+pub mod file_name;
 pub mod heatmap;
 pub mod html;
 pub mod inputs;
@@ -72,9 +73,10 @@ pub enum ReportError {
     },
 }
 
-/// Writes `bytes` to `path`, attaching the path to any I/O error.
+/// Writes `bytes` to `path`, attaching the path to any I/O error; never through a symbolic
+/// link, never half-written ([`crate::out_file`]).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    std::fs::write(path, bytes).map_err(|source| ReportError::Io {
+    crate::out_file::write(path, bytes).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })

@@ -10,10 +10,11 @@
 //!   its split into the inner and outer parts;
 //! - for a suite of nested variants, `variance_split.csv`: one row per variant and quantity.
 
+use crate::report::file_name::stem;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::csv::push_shortest;
+use super::csv::{push_field, push_header, push_shortest};
 use super::{
     palette, write_bytes, write_columns, Band, LinePlot, ReportError, Section, Series, Table,
 };
@@ -36,11 +37,11 @@ pub fn write(
         }
         let mut images = Vec::new();
         if !n.conditional.limits.is_empty() {
-            let file = format!("{}_conditional_exceedance.svg", q.name);
+            let file = format!("{}_conditional_exceedance.svg", stem(&q.name));
             exceedance_plot(&q.name, &n.conditional).write(&dir.join(&file))?;
             images.push(file);
         }
-        let file = format!("{}_conditional_mean.svg", q.name);
+        let file = format!("{}_conditional_mean.svg", stem(&q.name));
         conditional_mean_plot(&q.name, &n.conditional).write(&dir.join(&file))?;
         images.push(file);
         images.push(n.conditional_csv.clone());
@@ -51,7 +52,7 @@ pub fn write(
         if !plots {
             continue;
         }
-        split_plot(s).write(&dir.join(format!("{}_split.svg", s.name)))?;
+        split_plot(s).write(&dir.join(format!("{}_split.svg", stem(&s.name))))?;
         sections.push(Section {
             heading: format!("Two-level split of {} over time", s.name),
             text: format!(
@@ -62,8 +63,8 @@ pub fn write(
                 s.name, s.outer_samples
             ),
             images: vec![
-                format!("{}_split.svg", s.name),
-                format!("{}_split.csv", s.name),
+                format!("{}_split.svg", stem(&s.name)),
+                format!("{}_split.csv", stem(&s.name)),
             ],
             table: None,
         });
@@ -166,8 +167,11 @@ fn conditional_csv(path: &Path, t: &ConditionalTable) -> Result<(), ReportError>
             format!("c_{}", k.join("_"))
         }));
     }
-    let mut text = header.join(",");
-    text.push('\n');
+    let mut text = String::new();
+    push_header(
+        &mut text,
+        &header.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
     for r in 0..t.mean.len() {
         let mut row: Vec<f64> = t.outer_values[r].clone();
         row.extend([t.runs[r] as f64, t.mean[r], t.std[r]]);
@@ -267,7 +271,7 @@ fn split_csv(dir: &Path, s: &OutputSplit) -> Result<(), ReportError> {
         })
         .unzip();
     write_columns(
-        &dir.join(format!("{}_split.csv", s.name)),
+        &dir.join(format!("{}_split.csv", stem(&s.name))),
         &[
             "time",
             "mean",
@@ -358,7 +362,9 @@ pub fn write_suite(dir: &Path, summary: &SuiteSummary) -> Result<Option<String>,
                     n.exceedance_ci.iter().map(Some).collect()
                 };
             for e in limits {
-                let _ = write!(text, "{},{}", v.name, q.name);
+                push_field(&mut text, &v.name);
+                text.push(',');
+                push_field(&mut text, &q.name);
                 let tail = e.map_or([f64::NAN; 6], |e| {
                     [
                         e.limit,

@@ -3,6 +3,7 @@
 //! number of model runs, a table with published values where given, `summary.json` and
 //! `index.html`. Each variant's own report is in its sub-folder.
 
+use crate::report::file_name::stem;
 use std::path::Path;
 
 use super::units::label;
@@ -219,7 +220,7 @@ fn compare_output(
     let mut all: Vec<&[f64]> = vec![&rs.times];
     all.extend(cols.iter().map(Vec::as_slice));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
-    write_columns(&dir.join(format!("{v}_compare.csv")), &hdr, &all)?;
+    write_columns(&dir.join(format!("{}_compare.csv", stem(v))), &hdr, &all)?;
     let log_mean = spans_decades(&mean_plot);
     let log_std = spans_decades(&std_plot);
     absolute_on_log(
@@ -232,9 +233,9 @@ fn compare_output(
         log_std,
         &format!("|Std − Std({ref_name})| of {v}"),
     );
-    mean_plot.write(&dir.join(format!("{v}_mean_diff.svg")))?;
-    std_plot.write(&dir.join(format!("{v}_std_diff.svg")))?;
-    bands.write(&dir.join(format!("{v}_bands.svg")))?;
+    mean_plot.write(&dir.join(format!("{}_mean_diff.svg", stem(v))))?;
+    std_plot.write(&dir.join(format!("{}_std_diff.svg", stem(v))))?;
+    bands.write(&dir.join(format!("{}_bands.svg", stem(v))))?;
     Ok(output_section(v, ref_name))
 }
 
@@ -281,10 +282,10 @@ fn output_section(v: &str, ref_name: &str) -> Section {
              The reference's band and PDF evolution are in {ref_name}/index.html."
         ),
         images: vec![
-            format!("{v}_mean_diff.svg"),
-            format!("{v}_std_diff.svg"),
-            format!("{v}_bands.svg"),
-            format!("{v}_compare.csv"),
+            format!("{}_mean_diff.svg", stem(v)),
+            format!("{}_std_diff.svg", stem(v)),
+            format!("{}_bands.svg", stem(v)),
+            format!("{}_compare.csv", stem(v)),
         ],
         table: None,
     }
@@ -331,7 +332,7 @@ fn compare_scalar(
             .map(|(l, _, _)| (*l, format!("limit {l}")))
             .collect(),
     }
-    .write(&dir.join(format!("{q}_pdf_compare.svg")))?;
+    .write(&dir.join(format!("{}_pdf_compare.svg", stem(q))))?;
     let kinds: Vec<&str> = having
         .iter()
         .map(|(i, _)| variants[*i].summary.method.kind.as_str())
@@ -350,17 +351,18 @@ fn compare_scalar(
     );
     mean_plot.log_x = true;
     convergence(mean_plot, &kinds, &runs, &means)
-        .write(&dir.join(format!("{q}_mean_vs_runs.svg")))?;
+        .write(&dir.join(format!("{}_mean_vs_runs.svg", stem(q))))?;
     let mut std_plot = LinePlot::new(
         format!("Std of {q} against model runs"),
         "model runs",
         label(&format!("Std {q}"), unit),
     );
     std_plot.log_x = true;
-    convergence(std_plot, &kinds, &runs, &stds).write(&dir.join(format!("{q}_std_vs_runs.svg")))?;
+    convergence(std_plot, &kinds, &runs, &stds)
+        .write(&dir.join(format!("{}_std_vs_runs.svg", stem(q))))?;
     let idx: Vec<f64> = having.iter().map(|(i, _)| *i as f64).collect();
     write_columns(
-        &dir.join(format!("{q}_compare.csv")),
+        &dir.join(format!("{}_compare.csv", stem(q))),
         &[
             "variant_index",
             "model_runs",
@@ -385,10 +387,10 @@ fn scalar_section(q: &str, labels: &[&str]) -> Section {
             labels.join(", ")
         ),
         images: vec![
-            format!("{q}_pdf_compare.svg"),
-            format!("{q}_mean_vs_runs.svg"),
-            format!("{q}_std_vs_runs.svg"),
-            format!("{q}_compare.csv"),
+            format!("{}_pdf_compare.svg", stem(q)),
+            format!("{}_mean_vs_runs.svg", stem(q)),
+            format!("{}_std_vs_runs.svg", stem(q)),
+            format!("{}_compare.csv", stem(q)),
         ],
         table: None,
     }

@@ -6,6 +6,7 @@
 
 mod nested;
 
+use crate::report::file_name::stem;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
@@ -388,8 +389,8 @@ impl OutputSummary {
             .max_by(|&a, &b| s.std[a].total_cmp(&s.std[b]))
             .unwrap_or(0);
         OutputSummary {
-            csv: format!("{}.csv", s.name),
-            pdf_csv: format!("{}_pdf.csv", s.name),
+            csv: format!("{}.csv", stem(&s.name)),
+            pdf_csv: format!("{}_pdf.csv", stem(&s.name)),
             mean_at_stop: s.mean[last],
             std_at_stop: s.std[last],
             max_std: s.std[imax],

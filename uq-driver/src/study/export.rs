@@ -20,6 +20,9 @@ use serde_json::Value;
 use super::lock::{FolderLock, LockError};
 use super::store::format::{self, Slot};
 use super::store::Manifest;
+use crate::out_file::OutFile;
+use crate::report::csv::{push_header, split_line};
+use crate::report::file_name::stem;
 use crate::report::ReportError;
 use crate::spec::Experiment;
 
@@ -214,16 +217,16 @@ impl StoredValues<'_> {
 fn read_points(path: &Path) -> Result<Vec<(String, Vec<f64>)>, ExportError> {
     let text = String::from_utf8_lossy(&read(path)?).into_owned();
     let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let header = split_line(lines.next().unwrap_or(""));
     let cols: Vec<usize> = (0..header.len())
-        .filter(|&j| !matches!(header[j], "index" | "weight" | "status"))
+        .filter(|&j| !matches!(header[j].as_str(), "index" | "weight" | "status"))
         .collect();
     let mut out: Vec<(String, Vec<f64>)> = cols
         .iter()
-        .map(|&j| (header[j].to_owned(), Vec::new()))
+        .map(|&j| (header[j].clone(), Vec::new()))
         .collect();
     for line in lines {
-        let cells: Vec<&str> = line.split(',').collect();
+        let cells = split_line(line);
         for (k, &j) in cols.iter().enumerate() {
             let v = cells
                 .get(j)
@@ -245,15 +248,11 @@ fn write_csv(
         path: path.to_path_buf(),
         source,
     };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    let mut w = OutFile::create(path, 1 << 20).map_err(io)?;
     let mut line = String::with_capacity(64);
-    line.push_str("run,time");
-    for o in outputs {
-        line.push(',');
-        line.push_str(o);
-    }
-    line.push('\n');
+    let mut header = vec!["run", "time"];
+    header.extend(outputs.iter().map(String::as_str));
+    push_header(&mut line, &header);
     w.write_all(line.as_bytes()).map_err(io)?;
     let nt = times.len();
     for (r, (i, _)) in runs.ok.iter().enumerate() {
@@ -267,7 +266,7 @@ fn write_csv(
             w.write_all(line.as_bytes()).map_err(io)?;
         }
     }
-    w.flush().map_err(io)?;
+    w.commit().map_err(io)?;
     Ok(())
 }
 
@@ -347,13 +346,13 @@ fn write_npz(
         path: path.to_path_buf(),
         source,
     };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut z = zip::ZipWriter::new(std::io::BufWriter::with_capacity(1 << 20, file));
+    let mut z = zip::ZipWriter::new(OutFile::create(path, 1 << 20).map_err(io)?);
     let opts = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Stored)
         .large_file(true);
     let mut add = |name: &str, bytes: Vec<u8>| -> Result<(), ExportError> {
-        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.start_file(format!("{}.npy", stem(name)), opts)
+            .map_err(zip_err)?;
         z.write_all(&bytes).map_err(io)?;
         Ok(())
     };
@@ -362,7 +361,8 @@ fn write_npz(
     add("run", npy(&[n], Npy::I64(&index)))?;
     // The series, a run at a time straight from the store (already little-endian f64).
     for (o, name) in outputs.iter().enumerate() {
-        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.start_file(format!("{}.npy", stem(name)), opts)
+            .map_err(zip_err)?;
         z.write_all(&npy_header(&[n, nt], "<f8")).map_err(io)?;
         for r in 0..n {
             z.write_all(runs.output_bytes(r, o)).map_err(io)?;
@@ -377,10 +377,11 @@ fn write_npz(
             .iter()
             .map(|(i, _)| values.get(*i).copied().unwrap_or(f64::NAN))
             .collect();
-        z.start_file(format!("{name}.npy"), opts).map_err(zip_err)?;
+        z.start_file(format!("{}.npy", stem(name)), opts)
+            .map_err(zip_err)?;
         z.write_all(&npy(&[n], Npy::F64(&per_run))).map_err(io)?;
     }
-    z.finish().map_err(zip_err)?.flush().map_err(io)?;
+    z.finish().map_err(zip_err)?.commit().map_err(io)?;
     Ok(())
 }
 

@@ -12,6 +12,7 @@
 //! - Outputs over time: the marginal mean and Std and the split at every time; quantiles and
 //!   the PDF evolution from at most [`SERIES_DRAWS`] pooled draws.
 
+use crate::report::file_name::stem;
 use nalgebra::DMatrix;
 use rand::RngCore;
 use rayon::prelude::*;
@@ -343,7 +344,7 @@ fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedSca
             split::RESAMPLES
         ),
         outer_samples: outer,
-        conditional_csv: format!("{name}_conditional.csv"),
+        conditional_csv: format!("{}_conditional.csv", stem(name)),
         conditional: table,
     }
 }

@@ -158,11 +158,15 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
             )));
         }
     }
-    std::fs::write(&path, serde_json::to_string_pretty(&p).expect("json")).map_err(io(&path))?;
+    crate::out_file::write(
+        &path,
+        serde_json::to_string_pretty(&p).expect("json").as_bytes(),
+    )
+    .map_err(io(&path))?;
     let mut csv = String::from("index,shard");
     for par in &study.parameters {
         csv.push(',');
-        csv.push_str(&par.name);
+        crate::report::csv::push_field(&mut csv, &par.name);
     }
     csv.push('\n');
     for (i, vals) in design.values.iter().enumerate() {
@@ -174,7 +178,7 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
         csv.push('\n');
     }
     let dpath = dir.join("design.csv");
-    std::fs::write(&dpath, csv).map_err(io(&dpath))?;
+    crate::out_file::write(&dpath, csv.as_bytes()).map_err(io(&dpath))?;
     Ok(p)
 }
 
@@ -393,8 +397,8 @@ pub fn write_sbatch(
         out = q(&dir.join("result")),
     );
     let (a, b) = (sdir.join("shard.sbatch"), sdir.join("merge.sbatch"));
-    std::fs::write(&a, shard).map_err(io(&a))?;
-    std::fs::write(&b, merge).map_err(io(&b))?;
+    crate::out_file::write(&a, shard.as_bytes()).map_err(io(&a))?;
+    crate::out_file::write(&b, merge.as_bytes()).map_err(io(&b))?;
     Ok((a, b))
 }
 

@@ -322,7 +322,7 @@ fn write_surrogate(
         quantities,
     );
     let text = serde_json::to_string(&file).expect("surrogates serialize");
-    std::fs::write(&path, text).map_err(|source| ReportError::Io { path, source })
+    crate::report::write_bytes(&path, text.as_bytes())
 }
 
 /// The design with the status of each point.

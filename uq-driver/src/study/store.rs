@@ -19,6 +19,7 @@ mod runs;
 use std::fmt;
 use std::fs::{self, File, OpenOptions};
 use std::io::{Seek, SeekFrom, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -237,6 +238,15 @@ impl Store {
         if fresh && sdir.exists() {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
         }
+        // A planted link (the folder may be shared, the run root's) is never written through.
+        if fs::symlink_metadata(&sdir).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(StoreError::Io {
+                path: sdir,
+                source: std::io::Error::other(
+                    "is a symbolic link; uq-driver does not write through it (remove it)",
+                ),
+            });
+        }
         fs::create_dir_all(&sdir).map_err(io_err(&sdir))?;
         check_manifest(dir, &sdir.join("manifest.json"), manifest)?;
         let path = sdir.join("records.bin");
@@ -244,6 +254,7 @@ impl Store {
             .create(true)
             .read(true)
             .append(true)
+            .custom_flags(libc::O_NOFOLLOW)
             .open(&path)
             .map_err(io_err(&path))?;
         let len = file.metadata().map_err(io_err(&path))?.len();
@@ -427,7 +438,7 @@ fn write_kept(
 fn check_manifest(dir: &Path, mpath: &Path, manifest: &Manifest) -> Result<(), StoreError> {
     if !mpath.exists() {
         let text = serde_json::to_string_pretty(manifest).expect("serializable");
-        return fs::write(mpath, text).map_err(io_err(mpath));
+        return crate::out_file::write(mpath, text.as_bytes()).map_err(io_err(mpath));
     }
     let text = fs::read_to_string(mpath).map_err(io_err(mpath))?;
     let old: Manifest = serde_json::from_str(&text).map_err(|e| StoreError::Corrupt {
@@ -462,7 +473,13 @@ fn write_tmp(
 ) -> Result<PathBuf, StoreError> {
     let tmp = path.with_extension("bin.tmp");
     let written = (|| {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
+        let file = OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(true)
+            .custom_flags(libc::O_NOFOLLOW)
+            .open(&tmp)?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         write(&mut w)?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()
     })();
@@ -505,6 +522,7 @@ fn replace(path: &Path, tmp: &Path, label: &str) -> Result<(File, PathBuf), Stor
     let file = OpenOptions::new()
         .read(true)
         .append(true)
+        .custom_flags(libc::O_NOFOLLOW)
         .open(path)
         .map_err(io_err(path))?;
     Ok((file, backup))

@@ -377,11 +377,13 @@ impl Surrogate {
         for (o, vals) in self.file.outputs.iter().zip(&v.outputs) {
             let times = o.times.as_deref().unwrap_or(&[]);
             for (t, y) in times.iter().zip(vals) {
-                text.push_str(&format!("{},{t},{y}\n", o.name));
+                crate::report::csv::push_field(&mut text, &o.name);
+                text.push_str(&format!(",{t},{y}\n"));
             }
         }
         for (q, y) in self.file.quantities.iter().zip(&v.quantities) {
-            text.push_str(&format!("{},,{y}\n", q.name));
+            crate::report::csv::push_field(&mut text, &q.name);
+            text.push_str(&format!(",,{y}\n"));
         }
         text
     }
@@ -413,8 +415,9 @@ impl Surrogate {
         let mut header: Vec<String> = self.inputs.iter().map(|p| p.name.clone()).collect();
         header.extend(self.file.quantities.iter().map(|q| q.name.clone()));
         header.extend(picks.iter().map(|p| p.2.clone()));
-        let mut text = header.join(",");
-        text.push('\n');
+        let mut text = String::new();
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        crate::report::csv::push_header(&mut text, &header);
         for (x, v) in self.sample(n, seed) {
             let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
             row.extend(v.quantities.iter().map(f64::to_string));

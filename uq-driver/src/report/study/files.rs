@@ -2,10 +2,11 @@
 //! `<q>_pdf.csv`, `<q>_samples.csv`, `<q>_convergence.csv`, `points.csv` and the units
 //! sidecar `units.csv`.
 
+use crate::report::file_name::stem;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::super::csv::push_shortest;
+use super::super::csv::{push_field, push_shortest};
 use super::super::{write_bytes, write_columns, write_grid, ReportError};
 use super::quantile_column;
 use crate::results::{Convergence, OutputStats, PointStatus, PointTable, ScalarStats};
@@ -14,7 +15,7 @@ use crate::uq::method::Sobol;
 /// `<V>_pdf.csv`: the PDF evolution in long format (empty for a deterministic output).
 pub(super) fn pdf_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
     write_grid(
-        &dir.join(format!("{}_pdf.csv", s.name)),
+        &dir.join(format!("{}_pdf.csv", stem(&s.name))),
         &s.pdf_times,
         &s.pdf_grid,
         &s.pdf,
@@ -25,7 +26,7 @@ pub(super) fn pdf_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
 pub(super) fn output_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
     let (header, cols) = output_columns(s);
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
-    write_columns(&dir.join(format!("{}.csv", s.name)), &hdr, &cols)
+    write_columns(&dir.join(format!("{}.csv", stem(&s.name))), &hdr, &cols)
 }
 
 fn output_columns(s: &OutputStats) -> (Vec<String>, Vec<&[f64]>) {
@@ -89,7 +90,11 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
     let mut cols: Vec<&[f64]> = vec![&s.times];
     cols.extend(data.iter().map(Vec::as_slice));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
-    write_columns(&dir.join(format!("{}_sobol.csv", s.name)), &hdr, &cols)
+    write_columns(
+        &dir.join(format!("{}_sobol.csv", stem(&s.name))),
+        &hdr,
+        &cols,
+    )
 }
 
 /// `<V>_sobol_overall.csv`: one row, `S_<p>...,ST_<p>...`, the Sobol' indices of the whole
@@ -111,7 +116,7 @@ pub(super) fn sobol_overall_csv(
     let cols: Vec<&[f64]> = values.iter().map(|v| &v[..]).collect();
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     write_columns(
-        &dir.join(format!("{}_sobol_overall.csv", s.name)),
+        &dir.join(format!("{}_sobol_overall.csv", stem(&s.name))),
         &hdr,
         &cols,
     )
@@ -129,7 +134,7 @@ pub(super) fn overall_sobol(s: &OutputStats) -> Option<(Vec<f64>, Vec<f64>)> {
 /// `<q>_pdf.csv`: `x,density` (header only for a deterministic quantity).
 pub(super) fn scalar_pdf_csv(dir: &Path, q: &ScalarStats) -> Result<(), ReportError> {
     write_columns(
-        &dir.join(format!("{}_pdf.csv", q.name)),
+        &dir.join(format!("{}_pdf.csv", stem(&q.name))),
         &["x", "density"],
         &[&q.pdf_x, &q.pdf],
     )
@@ -139,7 +144,7 @@ pub(super) fn scalar_pdf_csv(dir: &Path, q: &ScalarStats) -> Result<(), ReportEr
 pub(super) fn scalar_samples(dir: &Path, q: &ScalarStats) -> Result<(), ReportError> {
     let idx: Vec<f64> = (0..q.samples.len()).map(|i| i as f64).collect();
     write_columns(
-        &dir.join(format!("{}_samples.csv", q.name)),
+        &dir.join(format!("{}_samples.csv", stem(&q.name))),
         &["run", &q.name],
         &[&idx, &q.samples],
     )
@@ -149,7 +154,7 @@ pub(super) fn scalar_samples(dir: &Path, q: &ScalarStats) -> Result<(), ReportEr
 /// `order,mean,std,std_of_order` (the chaos truncated at each total order, and the Std of
 /// the terms of that order alone).
 pub(super) fn convergence_csv(dir: &Path, name: &str, c: &Convergence) -> Result<(), ReportError> {
-    let path = dir.join(format!("{name}_convergence.csv"));
+    let path = dir.join(format!("{}_convergence.csv", stem(name)));
     if c.axis == "runs" {
         write_columns(&path, &["runs", "mean", "std"], &[&c.x, &c.mean, &c.std])
     } else {
@@ -169,7 +174,7 @@ pub fn points_csv(path: &Path, t: &PointTable) -> Result<(), ReportError> {
     }
     for n in &t.names {
         text.push(',');
-        text.push_str(n);
+        push_field(&mut text, n);
     }
     text.push_str(",status\n");
     for (i, vals) in t.values.iter().enumerate() {
@@ -210,17 +215,17 @@ pub(super) fn units_csv(
         }
     };
     for s in outputs {
-        let file = format!("{}.csv", s.name);
+        let file = format!("{}.csv", stem(&s.name));
         let u = s.unit.as_deref();
         for col in output_columns(s).0 {
             push(&file, &col, if col == "time" { Some("s") } else { u });
         }
-        let file = format!("{}_pdf.csv", s.name);
+        let file = format!("{}_pdf.csv", stem(&s.name));
         push(&file, "time", Some("s"));
         push(&file, "x", u);
         push(&file, "density", super::super::units::per(u).as_deref());
         if s.sobol.is_some() {
-            let file = format!("{}_sobol.csv", s.name);
+            let file = format!("{}_sobol.csv", stem(&s.name));
             push(&file, "time", Some("s"));
             for n in names {
                 push(&file, &format!("S_{n}"), Some("1"));
@@ -228,7 +233,7 @@ pub(super) fn units_csv(
             }
         }
         if overall_sobol(s).is_some() {
-            let file = format!("{}_sobol_overall.csv", s.name);
+            let file = format!("{}_sobol_overall.csv", stem(&s.name));
             for n in names {
                 push(&file, &format!("S_{n}"), Some("1"));
                 push(&file, &format!("ST_{n}"), Some("1"));
@@ -237,11 +242,11 @@ pub(super) fn units_csv(
     }
     for q in quantities {
         let u = q.unit.as_deref();
-        let file = format!("{}_pdf.csv", q.name);
+        let file = format!("{}_pdf.csv", stem(&q.name));
         push(&file, "x", u);
         push(&file, "density", super::super::units::per(u).as_deref());
-        push(&format!("{}_samples.csv", q.name), &q.name, u);
-        let file = format!("{}_convergence.csv", q.name);
+        push(&format!("{}_samples.csv", stem(&q.name)), &q.name, u);
+        let file = format!("{}_convergence.csv", stem(&q.name));
         push(&file, "mean", u);
         push(&file, "std", u);
         push(&file, "std_of_order", u);
@@ -262,9 +267,7 @@ pub(super) fn units_csv(
 }
 
 fn csv_cell(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_owned()
-    }
+    let mut out = String::new();
+    push_field(&mut out, s);
+    out
 }

@@ -5,6 +5,7 @@
 mod files;
 mod plots;
 
+use crate::report::file_name::stem;
 use std::path::Path;
 use std::time::Instant;
 
@@ -201,7 +202,7 @@ fn output_section(
 ) -> Result<Section, ReportError> {
     let v = &s.name;
     plots::band(dir, s, summary)?;
-    let mut images = vec![format!("{v}_band.svg")];
+    let mut images = vec![format!("{}_band.svg", stem(v))];
     let mut text = if s.deterministic {
         format!(
             "{v} has the same value in every run at every time: it is deterministic in this \
@@ -215,7 +216,7 @@ fn output_section(
         )
     };
     if plots::pdf_heatmap(dir, s)? {
-        images.push(format!("{v}_pdf.svg"));
+        images.push(format!("{}_pdf.svg", stem(v)));
         text.push_str(&format!(
             "\n\nPDF evolution: the density of {v} at {} times (columns) on a grid of {} \
              values, colour from 0 upwards. Columns where every run has the same value (for \
@@ -226,7 +227,7 @@ fn output_section(
     }
     if s.sobol.is_some() && !s.deterministic {
         plots::sobol_over_time(dir, s, names)?;
-        images.push(format!("{v}_sobol.svg"));
+        images.push(format!("{}_sobol.svg", stem(v)));
         text.push_str(
             "\n\nSobol' indices over time: the first-order index of each parameter (the share \
              of the variance it causes alone) stacked, and on top the share from interactions \
@@ -237,7 +238,7 @@ fn output_section(
     let overall = files::overall_sobol(s);
     if let Some((first, total)) = &overall {
         plots::sobol_overall_bars(dir, v, names, first, total)?;
-        images.push(format!("{v}_sobol_overall.svg"));
+        images.push(format!("{}_sobol_overall.svg", stem(v)));
         text.push_str(&format!(
             "\n\nSobol' indices of the whole series: each time's indices weighted by its \
              variance, S = ∫ Var(t) S(t) dt / ∫ Var(t) dt, the share of the variance of {v} \
@@ -253,15 +254,15 @@ fn output_section(
             sig(s.convergence_time.unwrap_or(f64::NAN)),
             convergence_axis(c)
         ));
-        images.push(format!("{v}_convergence.csv"));
+        images.push(format!("{}_convergence.csv", stem(v)));
     }
-    images.push(format!("{v}.csv"));
-    images.push(format!("{v}_pdf.csv"));
+    images.push(format!("{}.csv", stem(v)));
+    images.push(format!("{}_pdf.csv", stem(v)));
     if s.sobol.is_some() {
-        images.push(format!("{v}_sobol.csv"));
+        images.push(format!("{}_sobol.csv", stem(v)));
     }
     if overall.is_some() {
-        images.push(format!("{v}_sobol_overall.csv"));
+        images.push(format!("{}_sobol_overall.csv", stem(v)));
     }
     Ok(Section {
         heading: format!("Output {v}"),
@@ -308,13 +309,13 @@ fn quantity_section(
         ));
     } else {
         plots::scalar_pdf(dir, q, study)?;
-        images.push(format!("{name}_pdf.svg"));
+        images.push(format!("{}_pdf.svg", stem(name)));
         text.push_str(&format!(
             "\n\nDistribution of {name} ({}).",
             q.draws.describe()
         ));
         if plots::sobol_bars(dir, q, names, None)? {
-            images.push(format!("{name}_sobol.svg"));
+            images.push(format!("{}_sobol.svg", stem(name)));
         }
         if let Some(c) = &q.convergence {
             images.extend(plots::convergence(dir, name, unit, c)?);
@@ -322,11 +323,11 @@ fn quantity_section(
                 "\n\nConvergence: mean and Std against {}.",
                 convergence_axis(c)
             ));
-            images.push(format!("{name}_convergence.csv"));
+            images.push(format!("{}_convergence.csv", stem(name)));
         }
     }
-    images.push(format!("{name}_pdf.csv"));
-    images.push(format!("{name}_samples.csv"));
+    images.push(format!("{}_pdf.csv", stem(name)));
+    images.push(format!("{}_samples.csv", stem(name)));
     let mut rows = vec![
         vec!["computed as".to_string(), q.definition.text.clone()],
         vec!["unit".into(), unit.unwrap_or("(not declared)").to_owned()],

@@ -3,6 +3,7 @@
 //! and the convergence of its mean and Std; the signal against the speed for a critical
 //! speed. Every axis carries the unit the FMU declares.
 
+use crate::report::file_name::stem;
 use std::path::Path;
 
 use super::super::svg::{BarChart, BarGroup};
@@ -50,7 +51,7 @@ pub(super) fn band(dir: &Path, s: &OutputStats, summary: &Summary) -> Result<(),
             }
         }
     }
-    plot.write(&dir.join(format!("{v}_band.svg")))
+    plot.write(&dir.join(format!("{}_band.svg", stem(v))))
 }
 
 /// Adds the mean ± 3σ band of `s` (unless its Std is zero throughout) and its mean, both
@@ -117,12 +118,12 @@ pub(super) fn pdf_heatmap(dir: &Path, s: &OutputStats) -> Result<bool, ReportErr
         log_scale: false,
     };
     let png = heat.to_png().map_err(|source| ReportError::Png {
-        path: dir.join(format!("{v}_pdf.png")),
+        path: dir.join(format!("{}_pdf.png", stem(v))),
         source,
     })?;
-    write_bytes(&dir.join(format!("{v}_pdf.png")), &png)?;
+    write_bytes(&dir.join(format!("{}_pdf.png", stem(v))), &png)?;
     write_bytes(
-        &dir.join(format!("{v}_pdf.svg")),
+        &dir.join(format!("{}_pdf.svg", stem(v))),
         heat.to_svg(&Heatmap::data_uri(&png)).as_bytes(),
     )?;
     Ok(true)
@@ -186,7 +187,7 @@ pub(super) fn sobol_over_time(
         )
         .opacity(0.75),
     );
-    plot.write(&dir.join(format!("{v}_sobol.svg")))
+    plot.write(&dir.join(format!("{}_sobol.svg", stem(v))))
 }
 
 /// `<q>_pdf.svg`: the density, a histogram of the runs (more than 10) and the limits. The
@@ -232,7 +233,7 @@ pub(super) fn scalar_pdf(dir: &Path, q: &ScalarStats, study: &str) -> Result<(),
             })
             .collect(),
     }
-    .write(&dir.join(format!("{name}_pdf.svg")))
+    .write(&dir.join(format!("{}_pdf.svg", stem(name))))
 }
 
 /// 95 % intervals of the first-order and the total indices, per parameter (where given).
@@ -254,7 +255,7 @@ pub(super) fn sobol_bars(
         None => (vec![None; first.len()], vec![None; total.len()]),
     };
     let title = format!("Sobol' indices of {}", q.name);
-    let file = dir.join(format!("{}_sobol.svg", q.name));
+    let file = dir.join(format!("{}_sobol.svg", stem(&q.name)));
     bars(&title, names, (first, fi), (total, ti), &file)?;
     Ok(true)
 }
@@ -270,7 +271,7 @@ pub(super) fn sobol_overall_bars(
 ) -> Result<(), ReportError> {
     let title = format!("Sobol' indices of {output} over the whole series");
     let none = vec![None; first.len()];
-    let file = dir.join(format!("{output}_sobol_overall.svg"));
+    let file = dir.join(format!("{}_sobol_overall.svg", stem(output)));
     bars(&title, names, (first, none.clone()), (total, none), &file)
 }
 
@@ -344,7 +345,7 @@ pub(super) fn convergence(
             )
             .dashed(),
         );
-        let file = format!("{name}_convergence.svg");
+        let file = format!("{}_convergence.svg", stem(name));
         p.write(&dir.join(&file))?;
         return Ok(vec![file]);
     }
@@ -378,8 +379,8 @@ pub(super) fn convergence(
     std.series
         .push(Series::new("Std", c.x.clone(), c.std.clone(), palette(1)));
     let files = vec![
-        format!("{name}_convergence.svg"),
-        format!("{name}_std_convergence.svg"),
+        format!("{}_convergence.svg", stem(name)),
+        format!("{}_std_convergence.svg", stem(name)),
     ];
     mean.write(&dir.join(&files[0]))?;
     std.write(&dir.join(&files[1]))?;
@@ -425,7 +426,7 @@ pub(super) fn speed_plot(
     );
     plot.series
         .push(Series::new("", ends, vec![-*threshold; 2], palette(3)).dashed());
-    let file = format!("{signal}_vs_{speed}.svg");
+    let file = format!("{}_vs_{}.svg", stem(signal), stem(speed));
     plot.write(&dir.join(&file))?;
     Ok(Some(file))
 }

@@ -1,0 +1,205 @@
+//! File-system safety of the output folder (QA findings 1 and 3): links planted in the
+//! folder are never written through, and names of outputs and quantities never become
+//! paths outside it nor overwrite the folder's own files.
+
+#[path = "support/wheel.rs"]
+mod wheel;
+
+use std::os::unix::fs::symlink;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use wheel::{fmu_dir, write_study};
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+fn run(args: &[&str]) -> Output {
+    Command::new(DRIVER)
+        .args(args)
+        .env("RAILUQ_FMU_DIR", fmu_dir())
+        .output()
+        .unwrap()
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
+const METHOD: &str = "kind = \"scm\"\nnodes = 2";
+
+fn is_link(p: &Path) -> bool {
+    std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink())
+}
+
+#[test]
+fn a_symlink_planted_as_the_lock_file_is_refused_and_its_target_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
+    let victim = dir.path().join("passwd");
+    std::fs::write(&victim, "root:x:0:0:VICTIM:/root:/bin/sh\n").unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    symlink(&victim, out.join("uq-driver.lock")).unwrap();
+    let o = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("symbolic link"), "{t}");
+    assert!(!t.contains("VICTIM"), "the target's content is echoed: {t}");
+    assert_eq!(
+        std::fs::read_to_string(&victim).unwrap(),
+        "root:x:0:0:VICTIM:/root:/bin/sh\n"
+    );
+    assert!(!out.join("store").exists(), "refused before any run");
+}
+
+#[test]
+fn symlinks_planted_as_summary_json_and_points_csv_are_replaced_not_written_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let mut victims = Vec::new();
+    for name in [
+        "summary.json",
+        "points.csv",
+        "q.csv",
+        "q_band.svg",
+        "index.html",
+    ] {
+        let victim = dir.path().join(format!("victim-{name}"));
+        std::fs::write(&victim, "precious\n").unwrap();
+        symlink(&victim, out.join(name)).unwrap();
+        victims.push((victim, out.join(name)));
+    }
+    let o = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    for (victim, planted) in victims {
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
+        assert!(!is_link(&planted), "{}", planted.display());
+        assert!(std::fs::metadata(&planted).unwrap().len() > 0);
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| n.to_string_lossy().starts_with(".uq-driver-tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn quantity_names_with_slashes_or_the_folders_own_names_stay_inside_and_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    let qoi = r#"
+[[qoi]]
+kind = "final"
+name = "../../escape_y"
+signal = "q"
+[[qoi]]
+kind = "final"
+name = "points"
+signal = "q"
+[[qoi]]
+kind = "final"
+name = "/tmp/uq-driver-abs-test"
+signal = "q"
+"#;
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let out = dir.path().join("a").join("b").join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let o = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    // Nothing beside or above the folder.
+    let above: Vec<_> = std::fs::read_dir(dir.path().join("a"))
+        .unwrap()
+        .chain(std::fs::read_dir(dir.path().join("a/b")).unwrap())
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(above, ["b", "out"]);
+    assert!(!Path::new("/tmp/uq-driver-abs-test_pdf.csv").exists());
+    // points.csv is still the design; the quantity has its own, escaped files.
+    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    assert!(points.starts_with("index,weight,K,C,status\n"), "{points}");
+    for f in [
+        "%2E.%2F..%2Fescape_y_samples.csv",
+        "%70oints_samples.csv",
+        "%70oints_pdf.csv",
+        "%2Ftmp%2Fuq-driver-abs-test_samples.csv",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let samples = std::fs::read_to_string(out.join("%70oints_samples.csv")).unwrap();
+    assert!(samples.starts_with("run,points\n"), "{samples}");
+    // index.html links the real files.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains("href=\"%2570oints_pdf.csv\""),
+        "link to the escaped file"
+    );
+}
+
+#[test]
+fn two_names_that_would_share_a_file_are_refused_before_any_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let qoi = r#"
+[[qoi]]
+kind = "final"
+name = "y"
+signal = "q"
+[[qoi]]
+kind = "final"
+name = "y_pdf"
+signal = "q"
+"#;
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let out = dir.path().join("out");
+    let o = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("'y'") && t.contains("'y_pdf'"), "{t}");
+    assert!(!out.join("store").exists(), "refused before any run");
+}
+
+#[test]
+fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
+    let out = dir.path().join("out");
+    let o = run(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-report",
+    ]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(!out.join("index.html").exists());
+    assert!(!t.contains("index.html: "), "{t}");
+    assert!(!t.contains("report: "), "{t}");
+    assert!(t.contains("--no-report"), "{t}");
+}
