@@ -390,6 +390,21 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_parameter_name_with_a_comma_is_read_back_from_points_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("points.csv");
+        std::fs::write(
+            &p,
+            "index,weight,\"k[2,1]\",x,status\n0,0.5,1.5,2,ok\n1,0.5,3,4,\"failed: a, b\"\n",
+        )
+        .unwrap();
+        let cols = read_points(&p).unwrap();
+        assert_eq!(cols.len(), 2);
+        assert_eq!(cols[0], ("k[2,1]".to_string(), vec![1.5, 3.0]));
+        assert_eq!(cols[1], ("x".to_string(), vec![2.0, 4.0]));
+    }
+
+    #[test]
     fn npy_header_is_aligned_and_parsable() {
         let b = npy(&[2, 3], Npy::F64(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
         assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
