@@ -166,6 +166,37 @@ fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
     );
 }
 
+/// The comparison of a suite (`<q>_compare.csv`): `nan` where a variant's method has no
+/// standard error of the mean, the number where it has one.
+#[test]
+fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = test_fmus::test_fmu("Functions").unwrap();
+    let text = format!(
+        "name = \"suite\"\nfmu = \"{}\"\nseed = 5\n[experiment]\nstart = 0.0\nstop = 0.1\n\
+         step = 0.1\n[method]\nkind = \"mc\"\nsamples = 100\n{}\n[[variants]]\nname = \"sg\"\n\
+         method = {{ kind = \"sparse_grid\", level = 2 }}\n\n[[variants]]\nname = \"mc\"\n\
+         method = {{ kind = \"mc\", samples = 100 }}\n",
+        fmu.display(),
+        function4(NORMAL_X1_X2, false)
+    );
+    let s = dir.path().join("suite.toml");
+    std::fs::write(&s, text).unwrap();
+    let out = run_ok(&s, &[]);
+    let (header, rows) = csv(&out.join("Y_compare.csv"));
+    let se = header.iter().position(|h| h == "std_error_mean").unwrap();
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    assert_eq!(rows[0][se], "nan", "sparse grid: {rows:?}");
+    let mc_se: f64 = rows[1][se].parse().unwrap();
+    let mc = summary(&out.join("mc"))["quantities"]["Y"]["std_error_mean"]
+        .as_f64()
+        .unwrap();
+    assert!(mc_se > 0.0 && mc_se == mc, "{mc_se} vs {mc}");
+}
+
 #[test]
 fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
     if test_fmus::built().is_none() {
