@@ -440,6 +440,13 @@ impl Surrogate {
                 picks.push((o, k, format!("{}@{}", chaos.name, shortest(ts[k]))));
             }
         }
+        if picks.is_empty() && !times.is_empty() {
+            return Err(SurrogateError::Input(
+                "times given, but the surrogate has no output over time (only scalar \
+                 quantities)"
+                    .into(),
+            ));
+        }
         Ok(picks)
     }
 
@@ -615,6 +622,18 @@ mod tests {
         };
         assert_eq!(header(&[0.0, 1.0]), "a,b,f@0,f@1");
         assert_eq!(header(&[]), "a,b,f@1");
+        // Only a scalar quantity: a time has nothing to choose.
+        let mut q = constant_over_time([1.0, 2.0, 3.0]);
+        q.times = None;
+        q.pce = chaos().pce;
+        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[], &[q]);
+        let s = Surrogate::new(file).unwrap();
+        assert!(s
+            .sample_csv(1, 1, &[0.5])
+            .unwrap_err()
+            .to_string()
+            .contains("no output over time"));
+        assert!(s.sample_csv(1, 1, &[]).unwrap().starts_with("a,b,f\n"));
     }
 
     /// F9: `surrogate eval` printed 5.19e-17 as a 35-character decimal; numbers are written
