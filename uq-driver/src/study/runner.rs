@@ -17,7 +17,8 @@ use super::progress::{Progress, ProgressMode};
 use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
-use crate::uq::method::{Design, MethodError};
+use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
+use crate::uq::pce::Family;
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -97,15 +98,19 @@ pub enum RunError {
     Design(#[from] MethodError),
     /// Points failed and failures are not allowed.
     #[error(
-        "{failed} of {total} points failed; first: {first}. After fixing the cause, run again \
+        "{}; first: {first}. After fixing the cause, run again \
          with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
-         and LHS, to analyse the others)"
+         and LHS, to analyse the others)",
+        failure_count(*.failed, *.total, *.not_run)
     )]
     PointsFailed {
-        /// Number of failed points.
+        /// Number of failed points (among those run before the study stopped).
         failed: usize,
-        /// Number of points.
+        /// Number of points (of this run: a shard's points for a shard).
         total: usize,
+        /// Points not run because the study stopped at the first failure: their outcome is
+        /// unknown, so `failed` is a lower bound when this is not 0.
+        not_run: usize,
         /// The first failed point.
         first: FailedPoint,
     },
@@ -191,7 +196,28 @@ pub fn study_hash(study: &Study) -> String {
     if let Some(c) = &study.correlation {
         key["correlation"] = serde_json::json!(c.pairs);
     }
+    // SCM follows each input's Askey family since `chaos` became one of its keys: where that
+    // changes the design (an input with a non-Hermite germ) the hash says so, so that a store
+    // of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
+    if scm_askey(&study.method)
+        && study
+            .parameters
+            .iter()
+            .any(|p| !matches!(Family::of(&p.distribution), None | Some(Family::Hermite)))
+    {
+        key["scm_germ"] = serde_json::json!("askey");
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
+}
+
+/// Whether `method` (or a nested study's inner method) is an SCM on the inputs' Askey
+/// families.
+fn scm_askey(method: &MethodSpec) -> bool {
+    match method {
+        MethodSpec::Scm(s) => s.chaos == ChaosBasis::Askey,
+        MethodSpec::Nested(n) => scm_askey(&n.inner),
+        _ => false,
+    }
 }
 
 /// What a run produced: every point's record, in design order, read in place from the
@@ -470,6 +496,23 @@ impl Batch<'_> {
     }
 }
 
+/// What is known of the failures: "3 of 200 points failed" when every point was run, else
+/// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
+fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
+    if not_run == 0 {
+        return format!("{failed} of {total} points failed");
+    }
+    let first = if failed == 1 {
+        "at the first failure".to_owned()
+    } else {
+        format!("after the first {failed} failures")
+    };
+    format!(
+        "stopped {first} of {total} points (runs not started: {not_run}; how many of those \
+         would fail is not known)"
+    )
+}
+
 /// "K = 1.2, C = 3" for messages.
 fn describe_values(study: &Study, values: &[f64]) -> String {
     study
@@ -482,12 +525,15 @@ fn describe_values(study: &Study, values: &[f64]) -> String {
 }
 
 /// The number of failed points; an error naming the first when failures are not allowed
-/// (or the design is weighted: dropping a weighted point would bias every moment silently).
+/// (or the design is weighted: dropping a weighted point would bias every moment silently),
+/// with how many of the `points` (None: every point) were not run (the study stops at the
+/// first failure).
 pub fn check_failures(
     study: &Study,
     design: &Design,
     records: &[Option<Entry>],
     allow: bool,
+    points: Option<&[usize]>,
 ) -> Result<usize, RunError> {
     let failed: Vec<(usize, &String)> = records
         .iter()
@@ -509,9 +555,14 @@ pub fn check_failures(
         .zip(&design.values[index])
         .map(|(p, v)| (p.name.clone(), *v))
         .collect();
+    let wanted: Vec<usize> = match points {
+        Some(p) => p.iter().copied().filter(|&i| i < records.len()).collect(),
+        None => (0..records.len()).collect(),
+    };
     Err(RunError::PointsFailed {
         failed: failed.len(),
-        total: records.len(),
+        total: wanted.len(),
+        not_run: wanted.iter().filter(|&&i| records[i].is_none()).count(),
         first: FailedPoint {
             index,
             parameters,
@@ -523,6 +574,44 @@ pub fn check_failures(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// QA F4: a study stopped at its first failures said "2 of 200 points failed" although
+    /// 103 of them fail; the points not started are not counted as successes.
+    #[test]
+    fn failure_message_says_the_study_stopped_and_how_many_points_were_not_started() {
+        let first = FailedPoint {
+            index: 4,
+            parameters: vec![("K".into(), 1.5)],
+            message: "NaN".into(),
+        };
+        let err = |failed, not_run| {
+            RunError::PointsFailed {
+                failed,
+                total: 200,
+                not_run,
+                first: first.clone(),
+            }
+            .to_string()
+        };
+        let one = err(1, 197);
+        assert!(
+            one.starts_with(
+                "stopped at the first failure of 200 points (runs not started: 197; how many \
+                 of those would fail is not known); first: point 4 with K = 1.5: NaN."
+            ),
+            "{one}"
+        );
+        let two = err(2, 150);
+        assert!(
+            two.starts_with(
+                "stopped after the first 2 failures of 200 points (runs not started: 150;"
+            ),
+            "{two}"
+        );
+        assert!(!two.contains("2 of 200 points failed"));
+        // Every point run: the count is the whole truth.
+        assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
+    }
 
     #[test]
     fn changed_quantity_settings_do_not_resume_stale_records() {
@@ -537,6 +626,42 @@ mod tests {
         let renamed = base.replace("name = \"bogie-lhs-500\"", "name = \"renamed\"");
         let c = study_hash(&study(&format!("{renamed}\n[analysis]\npdf_grid = 50\n")));
         assert_eq!(a, c);
+    }
+
+    #[test]
+    fn an_scm_whose_design_follows_the_askey_families_does_not_resume_a_hermite_store() {
+        // SCM with a uniform input now runs Gauss–Legendre nodes; a store of the Gauss–Hermite
+        // design the same file gave before must not be resumed, so its hash differs from the
+        // hash of the same file with `chaos = "hermite"` and from the hash without the key
+        // as computed before (the method serialised without `chaos`, no `scm_germ`).
+        let text = |dist: &str, chaos: &str| {
+            format!(
+                "name = \"u\"\nfmu = \"Wheel.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
+                 [[parameters]]\nname = \"K\"\n{dist}\n\
+                 [outputs]\nvariables = [\"q\"]\n[method]\nkind = \"scm\"\nnodes = 3\n{chaos}"
+            )
+        };
+        let study = |t: String| Study::parse(&t, "t.toml", None).unwrap();
+        let uniform = "distribution = \"uniform\"\nlow = 90.0\nhigh = 110.0";
+        let askey = study(text(uniform, ""));
+        let hermite = study(text(uniform, "chaos = \"hermite\""));
+        assert_ne!(study_hash(&askey), study_hash(&hermite));
+        let mut old_key = serde_json::json!({
+            "seed": askey.seed,
+            "experiment": askey.experiment,
+            "method": askey.method,
+            "parameters": askey.parameters,
+            "fixed": askey.fixed,
+            "outputs": { "variables": askey.outputs },
+        });
+        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
+        assert_ne!(study_hash(&askey), old);
+        // A normal input: the design is the Gauss–Hermite one either way, the hash as before.
+        let normal = study(text("mean = 100.0\nstd = 10.0", ""));
+        old_key["parameters"] = serde_json::json!(normal.parameters);
+        old_key["seed"] = serde_json::json!(normal.seed);
+        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
+        assert_eq!(study_hash(&normal), old);
     }
 
     #[test]

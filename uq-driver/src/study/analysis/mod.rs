@@ -29,7 +29,7 @@ use crate::results::{
 };
 use crate::spec::{Analysis, Study};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Sobol, Solution};
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
@@ -207,6 +207,24 @@ pub(crate) fn output_stats(
     summarise(name, times, estimate, cols, &run_column, settings)
 }
 
+/// The estimate's Sobol' indices, NaN where a column has no variance (there they are 0/0:
+/// [`Sobol::undefined_without_variance`]).
+fn defined_sobol(estimate: &Estimate) -> Option<Sobol> {
+    estimate
+        .sobol
+        .as_ref()
+        .map(|s| s.undefined_without_variance(&estimate.mean, &estimate.std))
+}
+
+/// `x`, with −0 written as 0 (a standard deviation is never negative).
+fn unsigned_zero(x: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x
+    }
+}
+
 /// An empty summary of `nt` columns under the settings.
 fn series_columns(nt: usize, settings: &Settings) -> SeriesColumns {
     let a = settings.analysis;
@@ -316,13 +334,13 @@ fn summarise(
         name: name.to_owned(),
         times: times.to_vec(),
         mean: estimate.mean.clone(),
-        std: estimate.std.clone(),
+        std: estimate.std.iter().map(|&s| unsigned_zero(s)).collect(),
         lower_3sigma,
         upper_3sigma,
         quantiles,
         std_pce: estimate.std_chaos.clone(),
         std_error_mean: estimate.std_error_mean.clone(),
-        sobol: estimate.sobol.clone(),
+        sobol: defined_sobol(estimate),
         pdf_times: picked.iter().map(|&k| times[k]).collect(),
         pdf_grid: grid,
         pdf,
@@ -384,11 +402,12 @@ pub(crate) fn scalar_stats(
         })
         .collect();
     let valid = runs.valid;
+    let sobol = defined_sobol(estimate);
     Ok(ScalarStats {
         name: name.to_owned(),
         mean: estimate.mean[0],
-        std: estimate.std[0],
-        std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
+        std: unsigned_zero(estimate.std[0]),
+        std_error_mean: estimate.std_error_mean.as_ref().map(|s| s[0]),
         n_valid: valid.len(),
         n_never_hunts: runs.never_hunts,
         n_never_stops: runs.never_stops,
@@ -405,9 +424,9 @@ pub(crate) fn scalar_stats(
         unit: None,
         samples: valid,
         density_samples,
-        sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
-        sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
-        sobol: estimate.sobol.as_ref().map(|s| {
+        sobol_first: sobol.as_ref().map(|s| s.first[0].clone()),
+        sobol_total: sobol.as_ref().map(|s| s.total[0].clone()),
+        sobol: sobol.as_ref().map(|s| {
             let names: Vec<&str> = settings
                 .parameters
                 .iter()
@@ -486,6 +505,77 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
         std,
         std_of_order: Vec::new(),
     })
+}
+
+/// A chaos whose variance differs from the method's own by more than this fraction of it
+/// (at some time) is reported ([`chaos_gap_warnings`]).
+const CHAOS_GAP: f64 = 0.01;
+
+/// Warnings where a method's chaos holds a variance that differs by more than
+/// [`CHAOS_GAP`] from the method's own estimate of it (SCM: the quadrature's, from the same
+/// runs): the chaos's Sobol' indices, quantiles and densities then miss (or invent) that part,
+/// and the quadrature itself may not have converged. `askey_hint`: the design maps inputs
+/// that have an Askey family of their own through the normal (`chaos = "hermite"`), so the
+/// warning suggests their own families.
+pub(crate) fn chaos_gap_warnings(a: &Analysed, askey_hint: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    for o in &a.outputs {
+        if let Some(sc) = &o.std_pce {
+            out.extend(chaos_gap(&o.name, &o.std, sc, Some(&o.times), askey_hint));
+        }
+    }
+    for c in &a.quantity_chaos {
+        if let Some(q) = a.quantities.iter().find(|q| q.name == c.name) {
+            out.extend(chaos_gap(&q.name, &[q.std], &c.pce.std(), None, askey_hint));
+        }
+    }
+    out
+}
+
+/// The warning of one output (`times`) or quantity (`None`) whose Std is `std` by the method
+/// and `std_chaos` by its chaos, at the column where they differ most (columns whose Std is
+/// below 1e-3 of the largest are left out: rounding dominates there).
+fn chaos_gap(
+    name: &str,
+    std: &[f64],
+    std_chaos: &[f64],
+    times: Option<&[f64]>,
+    askey_hint: bool,
+) -> Option<String> {
+    let largest = std
+        .iter()
+        .filter(|s| s.is_finite())
+        .fold(0.0_f64, |m, s| m.max(s.abs()));
+    let (k, gap) = std
+        .iter()
+        .zip(std_chaos)
+        .enumerate()
+        .filter(|(_, (s, c))| s.is_finite() && c.is_finite() && s.abs() > 1e-3 * largest)
+        .map(|(k, (s, c))| (k, (s * s - c * c).abs() / (s * s)))
+        .fold(None, |w: Option<(usize, f64)>, (k, g)| match w {
+            Some((_, best)) if best >= g => w,
+            _ => Some((k, g)),
+        })?;
+    if gap <= CHAOS_GAP {
+        return None;
+    }
+    let at = times.map_or(String::new(), |t| format!(" at t = {} s", t[k]));
+    let (s, c) = (std[k], std_chaos[k]);
+    Some(format!(
+        "{name}{at}: the chaos holds {:.1} % {} variance than the method's own estimate \
+         (Std {c:.6e} against {s:.6e}); its Sobol' indices, quantiles and densities {} that \
+         part, and the estimate may not have converged either: raise `order` (below `nodes`) \
+         or `nodes`{}",
+        100.0 * gap,
+        if c < s { "less" } else { "more" },
+        if c < s { "miss" } else { "add" },
+        if askey_hint {
+            ", or expand the bounded inputs in their own families (`chaos = \"askey\"`, \
+             the default)"
+        } else {
+            ""
+        },
+    ))
 }
 
 /// What [`analyse_runs`] finds.
