@@ -492,3 +492,95 @@ fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read
         .to_string();
     assert!(err.contains("more than the limit"), "{err}");
 }
+
+/// Runs uq-driver with `args` (and `TMPDIR` = `tmp`), killing it after `limit`: a regression
+/// must fail the test, never hang the suite. `None` when it had to be killed.
+fn run_limited(args: &[&str], tmp: &Path, limit: Duration) -> Option<Output> {
+    let mut child = Command::new(DRIVER)
+        .args(args)
+        .env("TMPDIR", tmp)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Some(child.wait_with_output().unwrap())
+}
+
+impl Case {
+    fn run_limited(&self, extra: &[&str], limit: Duration) -> Option<Output> {
+        let mut args = vec![
+            "run",
+            self.study.to_str().unwrap(),
+            "--out",
+            self.out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run_limited(&args, &self.tmp(), limit)
+    }
+}
+
+#[test]
+fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers() {
+    // QA finding 6: fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
+    // forever, --timeout-per-run or not. The pipes now sit at high descriptors.
+    let Some(c) = case(9) else { return };
+    let o = c
+        .run_limited(
+            &["--isolate", "-t", "1", "--timeout-per-run", "5"],
+            Duration::from_secs(60),
+        )
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        c.points().iter().all(|(_, s)| s == "ok"),
+        "{:?}",
+        c.points()
+    );
+    // The same numbers as in-process with a well-behaved FMU (mode 9 changes no value).
+    let isolated = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    let text = std::fs::read_to_string(&c.study).unwrap();
+    std::fs::write(&c.study, text.replace("misbehave = 9", "misbehave = 0")).unwrap();
+    let o = c.run(&["--fresh", "-t", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let in_process = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    assert_eq!(isolated, in_process);
+}
+
+#[test]
+fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_its_pipes() {
+    // QA finding 7: the driver noticed a crashed worker only when its pipes closed, i.e. when
+    // a helper process the FMU had started (here one that lives 20 s) ended.
+    let Some(c) = case(10) else { return };
+    let t0 = Instant::now();
+    let o = c
+        .run_limited(&["--isolate", "-t", "1"], Duration::from_secs(60))
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("killed by signal 11 (SIGSEGV");
+    c.check_failed_with("misbehave = 10: starting a helper");
+    // At least two crashed points: waiting for the helpers would take 40 s.
+    assert!(t0.elapsed() < Duration::from_secs(15), "{:?}", t0.elapsed());
+}
+
+#[test]
+fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finishes() {
+    // QA finding L11: a worker dead of SIGTERM was taken for a driver being stopped from
+    // outside, so the study stopped at that point on every re-run and could never finish.
+    let Some(c) = case(11) else { return };
+    let o = c
+        .run_limited(&["--isolate", "-t", "1"], Duration::from_secs(60))
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("SIGTERM");
+    c.check_failed_with("misbehave = 11: raising SIGTERM");
+}

@@ -21,6 +21,8 @@ pub const EXIT_INTERRUPTED: i32 = 130;
 static ACTIVE: AtomicUsize = AtomicUsize::new(0);
 /// Set when the process ends on purpose (a signal, a timeout): the `atexit` handler is quiet.
 static DELIBERATE: AtomicBool = AtomicBool::new(false);
+/// Set as SIGINT, SIGTERM or SIGHUP reaches the driver (before it ends).
+static STOPPING: AtomicBool = AtomicBool::new(false);
 static NEXT_TOKEN: AtomicU64 = AtomicU64::new(0);
 static STATE: Mutex<State> = Mutex::new(State {
     studies: BTreeMap::new(),
@@ -150,6 +152,7 @@ pub fn exit_now(code: i32, message: &str) -> ! {
 /// from the command line program.
 pub fn install_signal_handler() {
     let _ = ctrlc::set_handler(|| {
+        STOPPING.store(true, Ordering::Release);
         let message = match describe_running() {
             Some(what) => format!(
                 "uq-driver: interrupted during {what}; finished points are kept in the \
@@ -159,6 +162,24 @@ pub fn install_signal_handler() {
         };
         exit_now(EXIT_INTERRUPTED, &message)
     });
+}
+
+/// Whether the driver itself is being stopped by SIGINT, SIGTERM or SIGHUP, waiting up to
+/// `wait` for the news (a signal sent to the whole process group reaches a worker and the
+/// driver at about the same time; the driver's handler runs on its own thread). A worker that
+/// died of such a signal while the driver was not asked to stop killed itself: its point
+/// failed.
+pub fn stop_requested_within(wait: Duration) -> bool {
+    let start = Instant::now();
+    loop {
+        if STOPPING.load(Ordering::Acquire) {
+            return true;
+        }
+        if start.elapsed() >= wait {
+            return false;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }
 
 /// Keeps another thread that calls `exit()` meanwhile (a second FMU instance misbehaving at
