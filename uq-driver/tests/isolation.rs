@@ -584,3 +584,82 @@ fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finis
     c.check_failed_with("SIGTERM");
     c.check_failed_with("misbehave = 11: raising SIGTERM");
 }
+
+#[test]
+fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status() {
+    // QA finding 12: an FMU crashing in-process killed the driver printing only the plan line.
+    use std::os::unix::process::ExitStatusExt;
+    for (mode, sig, name) in [(2, 11, "SIGSEGV"), (3, 6, "SIGABRT")] {
+        let Some(c) = case(mode) else { return };
+        for threads in ["1", "2"] {
+            let o = c
+                .run_limited(&["-t", threads, "--fresh"], Duration::from_secs(60))
+                .expect("ends");
+            let err = stderr(&o);
+            assert_eq!(o.status.signal(), Some(sig), "{err}");
+            assert!(err.contains(&format!("killed by {name}")), "{err}");
+            assert!(err.contains("running point "), "{err}");
+            assert!(err.contains("misbehave_at = "), "{err}");
+            assert!(err.contains("--isolate"), "{err}");
+        }
+        // The finished points are kept: --isolate resumes and completes the study.
+        let o = c.run(&["--isolate"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        c.check_failed_with(name);
+    }
+}
+
+#[test]
+fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
+    // QA finding 5: `simulate` exited 0 with no CSV and no message.
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("f4.csv");
+    let o = run_limited(
+        &[
+            "simulate",
+            fmu.to_str().unwrap(),
+            "--set",
+            "misbehave=4",
+            "--out",
+            csv.to_str().unwrap(),
+        ],
+        dir.path(),
+        Duration::from_secs(60),
+    )
+    .expect("ends");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("called exit()"), "{err}");
+    assert!(err.contains("Features.fmu"), "{err}");
+}
+
+#[test]
+fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
+    // QA finding 9: the FMU's printf output was interleaved with the CSV rows on stdout.
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let o = run_limited(
+        &[
+            "simulate",
+            fmu.to_str().unwrap(),
+            "--set",
+            "misbehave=12",
+            "--output",
+            "u_integral",
+        ],
+        dir.path(),
+        Duration::from_secs(60),
+    )
+    .expect("ends");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(out.starts_with("time,u_integral\n"), "{out}");
+    assert_eq!(out.lines().count(), 12, "{out}");
+    assert!(!out.contains("prints to stdout"), "{out}");
+    assert!(stderr(&o).contains("misbehave = 12 prints to stdout"));
+}
