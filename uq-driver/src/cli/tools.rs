@@ -36,7 +36,7 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             out,
         } => {
             let s = Surrogate::load(&dir)?;
-            emit(&s.sample_csv(n, seed, &times), out.as_deref())
+            emit(&s.sample_csv(n, seed, &times)?, out.as_deref())
         }
     }
 }
