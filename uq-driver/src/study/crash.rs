@@ -132,14 +132,28 @@ fn near_stack_pointer(info: *mut libc::siginfo_t, ctx: *mut libc::c_void) -> boo
 }
 
 /// Passes `sig` on to the handler that was there before: restores it and returns (a fault
-/// happens again; glibc's abort() raises again).
+/// happens again; glibc's abort() raises again). A previous default action gets the signal
+/// again at once (it is blocked until this handler returns), so that a signal sent by
+/// `raise` or `kill` ends the process as it would have.
 #[cfg(unix)]
 fn pass_on(sig: i32) {
     PASSED_ON.store(true, Ordering::Release);
-    if let Some(prev) = PREVIOUS.get() {
-        if let Some((_, act)) = prev.iter().find(|(s, _)| *s == sig) {
-            // SAFETY: restores an action the kernel gave us for this signal.
-            unsafe { libc::sigaction(sig, act, std::ptr::null_mut()) };
+    let Some((_, act)) = PREVIOUS
+        .get()
+        .and_then(|p| p.iter().find(|(s, _)| *s == sig))
+    else {
+        // SAFETY: the default action for this signal, then the signal again (see above).
+        unsafe {
+            libc::signal(sig, libc::SIG_DFL);
+            libc::raise(sig);
+        }
+        return;
+    };
+    // SAFETY: restores an action the kernel gave us for this signal; raise as above.
+    unsafe {
+        libc::sigaction(sig, act, std::ptr::null_mut());
+        if act.sa_sigaction == libc::SIG_DFL {
+            libc::raise(sig);
         }
     }
 }
