@@ -34,7 +34,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
     );
     for q in &r.quantities {
         let u = q.unit.as_deref();
-        let v = |x: f64| with_unit(&format!("{x:.6}"), u);
+        let v = |x: f64| with_unit(&six_digits(x), u);
         if q.deterministic {
             println!(
                 "  {} = {} (every run; {})",
@@ -78,5 +78,35 @@ pub(crate) fn print_suite(r: &SuiteResult, out: &Path) {
             "  {:<12} {:<16} {:>7} model runs, wall time {:.2} s",
             v.name, v.method, v.model_runs, v.wall_time_s
         );
+    }
+}
+
+/// `x` with six significant digits: fixed-point from 1e-3 to 1e6 (trailing zeros kept, as
+/// `{:.6}` did for values near 1), exponent notation outside (a quantity of 1e-9 no longer
+/// prints as 0.000000).
+fn six_digits(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if (1e-3..1e6).contains(&a) {
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.5e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::six_digits;
+
+    #[test]
+    fn a_tiny_quantity_is_not_printed_as_zero() {
+        assert_eq!(six_digits(1.234567e-9), "1.23457e-9");
+        assert_eq!(six_digits(0.5), "0.500000");
+        assert_eq!(six_digits(-3.14159265), "-3.14159");
+        assert_eq!(six_digits(123.456789), "123.457");
+        assert_eq!(six_digits(2.5e7), "2.50000e7");
+        assert_eq!(six_digits(0.0), "0");
     }
 }
