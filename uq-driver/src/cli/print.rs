@@ -104,7 +104,7 @@ mod tests {
     fn a_tiny_quantity_is_not_printed_as_zero() {
         assert_eq!(six_digits(1.234567e-9), "1.23457e-9");
         assert_eq!(six_digits(0.5), "0.500000");
-        assert_eq!(six_digits(-2.71828182), "-2.71828");
+        assert_eq!(six_digits(-4.5678912), "-4.56789");
         assert_eq!(six_digits(123.456789), "123.457");
         assert_eq!(six_digits(2.5e7), "2.50000e7");
         assert_eq!(six_digits(0.0), "0");
