@@ -24,6 +24,7 @@ pub mod size;
 pub mod speed_runs;
 pub mod store;
 pub mod suite;
+mod worker_fmu;
 
 use std::path::Path;
 
