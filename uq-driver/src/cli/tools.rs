@@ -36,6 +36,11 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             out,
         } => {
             let s = Surrogate::load(&dir)?;
+            size::check_memory(
+                &format!("surrogate sample -n {n}"),
+                s.sample_memory(n, &times),
+            )
+            .map_err(|e| anyhow::anyhow!("{e}; use a smaller -n"))?;
             emit(&s.sample_csv(n, seed, &times), out.as_deref())
         }
     }
