@@ -17,6 +17,7 @@ pub mod nested;
 mod outcome;
 mod point;
 pub mod progress;
+pub mod ranges;
 pub mod runner;
 pub mod shard;
 mod single;

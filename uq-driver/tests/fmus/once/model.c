@@ -8,9 +8,14 @@
  * that runs two instances on one copy is caught instead of giving wrong numbers. Two copies of
  * the library (loaded from two files) have globals of their own and run side by side.
  * `step_delay` (s, default 0) makes each step sleep that long, so that runs overlap in time.
+ * `log_bytes` > 0 (default 0): every step logs a warning of that many bytes, starting with a
+ * terminal colour escape; with x > `fail_above` (default 1e300) that step then fails
+ * (fmi2Error) after logging such a message as an error.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "fmu_common.h"
@@ -20,6 +25,8 @@
 typedef struct {
     double x;
     double step_delay;
+    double log_bytes;
+    double fail_above;
     double y; /* output: a copy of the global integral */
 } Data;
 
@@ -32,12 +39,16 @@ static const Variable VARIABLES[] = {
     {"x", TYPE_REAL, 1, KIND_FIXED_PARAMETER, offsetof(Data, x), 0, 0, 0},
     {"y", TYPE_REAL, 2, KIND_OUTPUT, offsetof(Data, y), 0, 0, 0},
     {"step_delay", TYPE_REAL, 3, KIND_FIXED_PARAMETER, offsetof(Data, step_delay), 0, 0, 0},
+    {"log_bytes", TYPE_REAL, 4, KIND_FIXED_PARAMETER, offsetof(Data, log_bytes), 0, 0, 0},
+    {"fail_above", TYPE_REAL, 5, KIND_FIXED_PARAMETER, offsetof(Data, fail_above), 0, 0, 0},
 };
 
 static void set_defaults(void *data) {
     Data *d = (Data *)data;
     d->x = 1.0;
     d->step_delay = 0.0;
+    d->log_bytes = 0.0;
+    d->fail_above = 1e300;
     d->y = 0.0;
 }
 
@@ -63,6 +74,23 @@ static fmi2Status step(Instance *inst, double h) {
         t.tv_sec = (time_t)d->step_delay;
         t.tv_nsec = (long)((d->step_delay - (double)t.tv_sec) * 1e9);
         nanosleep(&t, NULL);
+    }
+    if (d->log_bytes > 0.0 && d->log_bytes < 1e9) {
+        size_t n = (size_t)d->log_bytes;
+        char *text = (char *)malloc(n + 1);
+        int fail = d->x > d->fail_above;
+        if (text != NULL) {
+            memset(text, 'w', n);
+            memcpy(text, "\x1b[31m", n < 5 ? n : 5);
+            text[n] = '\0';
+            /* The logger itself: fmu_log would cut the text at 4 KiB. */
+            inst->cb.logger(inst->cb.componentEnvironment, inst->name,
+                            fail ? fmi2Error : fmi2Warning, "logStatusWarning", "%s", text);
+            free(text);
+        }
+        if (fail) {
+            return fmi2Error;
+        }
     }
     g_integral += d->x * h;
     inst->time += h;
