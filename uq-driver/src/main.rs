@@ -129,18 +129,28 @@ fn dispatch(cmd: Command) -> Result<()> {
             dir,
             out,
             allow_failures,
+            no_report,
         } => {
             let out = out.unwrap_or_else(|| dir.join("result"));
             let opts = RunOptions {
                 allow_failures,
+                no_report,
                 ..RunOptions::default()
             };
             let r = shard::merge(&dir, &out, &opts)?;
-            println!(
-                "merged {} points; report: {}",
-                r.summary.model_runs,
-                out.join("index.html").display()
-            );
+            if no_report {
+                println!(
+                    "merged {} points; results (no report): {}",
+                    r.summary.model_runs,
+                    out.join("summary.json").display()
+                );
+            } else {
+                println!(
+                    "merged {} points; report: {}",
+                    r.summary.model_runs,
+                    out.join("index.html").display()
+                );
+            }
             Ok(())
         }
         Command::Slurm(args) => slurm(args),

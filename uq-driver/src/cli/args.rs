@@ -63,6 +63,9 @@ pub(crate) enum Command {
         /// MC/LHS: accept failed points and report how many.
         #[arg(long)]
         allow_failures: bool,
+        /// Write the CSV files and summary.json only: no plots, no index.html (as `run`).
+        #[arg(long)]
+        no_report: bool,
     },
     /// Plan a study and submit it to Slurm: a job array of shards and a dependent merge job.
     Slurm(SlurmArgs),
@@ -242,6 +245,9 @@ pub(crate) struct SlurmArgs {
     /// Plan a large study (more than 100 000 runs, or much memory or time) anyway.
     #[arg(long)]
     pub(crate) yes: bool,
+    /// The merge job writes the CSV files and summary.json only: no plots, no index.html.
+    #[arg(long)]
+    pub(crate) no_report: bool,
 }
 
 #[derive(Args)]

@@ -62,6 +62,7 @@ pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
         time: a.time,
         cpus_per_task: a.cpus_per_task,
         extra: a.sbatch,
+        no_report: a.no_report,
     };
     let (array_script, merge_script) = shard::write_sbatch(&a.out, &driver, a.shards, &o)?;
     if a.dry_run {

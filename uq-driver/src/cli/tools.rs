@@ -41,7 +41,7 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
                 s.sample_memory(n, &times),
             )
             .map_err(|e| anyhow::anyhow!("{e}; use a smaller -n"))?;
-            emit(&s.sample_csv(n, seed, &times), out.as_deref())
+            emit(&s.sample_csv(n, seed, &times)?, out.as_deref())
         }
     }
 }

@@ -44,11 +44,18 @@ pub enum CompareError {
 struct Folder {
     dir: PathBuf,
     summary: Value,
+    /// How the page, its plots and CSV columns call the study: unique among the folders
+    /// compared ([`labels`]).
+    label: String,
 }
 
 impl Folder {
+    fn study(&self) -> &str {
+        self.summary["study"].as_str().unwrap_or("?")
+    }
+
     fn name(&self) -> String {
-        self.summary["study"].as_str().unwrap_or("?").to_owned()
+        self.label.clone()
     }
 
     fn unit(&self, var: &str) -> Option<String> {
@@ -87,6 +94,7 @@ fn folders(dirs: &[PathBuf]) -> Result<Vec<Folder>, CompareError> {
             out.push(Folder {
                 dir: dir.clone(),
                 summary,
+                label: String::new(),
             });
         } else {
             return Err(CompareError::Invalid {
@@ -164,10 +172,59 @@ fn names(f: &Folder, key: &str) -> Vec<String> {
         .unwrap_or_default()
 }
 
+/// The label of each study (`(study name, folder)`, in the order given): its name where no
+/// other study compared has that name (today's labels); otherwise its folder's name (the last
+/// part of the path); a label that is still taken gets `-2`, `-3`, … (the first free one).
+fn labels(studies: &[(String, &Path)]) -> Vec<String> {
+    let folder = |d: &Path| {
+        std::fs::canonicalize(d)
+            .unwrap_or_else(|_| d.to_path_buf())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+    };
+    let unique = |name: &String| studies.iter().filter(|(n, _)| n == name).count() == 1;
+    let wanted: Vec<String> = studies
+        .iter()
+        .map(|(name, dir)| match unique(name) {
+            true => name.clone(),
+            false => folder(dir).unwrap_or_else(|| name.clone()),
+        })
+        .collect();
+    // The unique names are kept as they are; the others take what is left, in order.
+    let mut out: Vec<Option<String>> = studies
+        .iter()
+        .map(|(name, _)| unique(name).then(|| name.clone()))
+        .collect();
+    for i in 0..studies.len() {
+        if out[i].is_some() {
+            continue;
+        }
+        let free = |l: &String, out: &[Option<String>]| {
+            !out.iter().flatten().any(|o| o == l)
+                && (l == &wanted[i] || !wanted.iter().any(|w| w == l))
+        };
+        let mut label = wanted[i].clone();
+        let mut k = 2;
+        while !free(&label, &out) {
+            label = format!("{}-{k}", wanted[i]);
+            k += 1;
+        }
+        out[i] = Some(label);
+    }
+    out.into_iter().flatten().collect()
+}
+
 /// Writes `out/index.html` (and its plots and `compare.csv`) comparing the study folders
 /// `dirs`.
 pub fn write(dirs: &[PathBuf], out: &Path) -> Result<(), CompareError> {
-    let studies = folders(dirs)?;
+    let mut studies = folders(dirs)?;
+    let named: Vec<(String, &Path)> = studies
+        .iter()
+        .map(|f| (f.study().to_owned(), f.dir.as_path()))
+        .collect();
+    for (label, f) in labels(&named).into_iter().zip(&mut studies) {
+        f.label = label;
+    }
     std::fs::create_dir_all(out).map_err(|source| ReportError::Io {
         path: out.to_path_buf(),
         source,
@@ -466,6 +523,70 @@ mod tests {
             relative(&a.join("index.html"), &c),
             PathBuf::from("../../out/wheel-scm/index.html")
         );
+    }
+
+    /// A study folder with output `y` on the times 0, 1: `summary.json` and `y.csv`.
+    fn study_folder(dir: &Path, name: &str, mean: f64) {
+        std::fs::create_dir_all(dir).unwrap();
+        let summary = serde_json::json!({
+            "study": name,
+            "method": {"kind": "mc"},
+            "outputs": {"y": {"mean_at_stop": mean, "std_at_stop": 1.0}},
+            "quantities": {},
+        });
+        std::fs::write(dir.join("summary.json"), summary.to_string()).unwrap();
+        let csv = format!("time,mean,std\n0,{mean},1\n1,{mean},2\n");
+        std::fs::write(dir.join("y.csv"), csv).unwrap();
+    }
+
+    /// F7: `compare` of folders whose studies share a `name` wrote `mean_ishi,std_ishi`
+    /// once per folder; the columns are now told apart by the folders' names, and unique
+    /// study names stay the labels.
+    #[test]
+    fn compare_of_studies_with_the_same_name_writes_distinct_columns() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path();
+        study_folder(&p.join("ishi_qmc"), "ishi", 1.0);
+        study_folder(&p.join("ishi_sg5"), "ishi", 2.0);
+        study_folder(&p.join("other"), "borehole", 3.0);
+        study_folder(&p.join("a/ishi_pce"), "ishi", 4.0);
+        // The same folder name under another parent: numbered.
+        study_folder(&p.join("b/ishi_pce"), "ishi", 5.0);
+        let dirs: Vec<PathBuf> = ["ishi_qmc", "ishi_sg5", "other", "a/ishi_pce", "b/ishi_pce"]
+            .iter()
+            .map(|f| p.join(f))
+            .collect();
+        write(&dirs, &p.join("cmp")).unwrap();
+        let text = std::fs::read_to_string(p.join("cmp/y_compare.csv")).unwrap();
+        assert_eq!(
+            text.lines().next().unwrap(),
+            "time,mean_ishi_qmc,std_ishi_qmc,mean_ishi_sg5,std_ishi_sg5,mean_borehole,\
+             std_borehole,mean_ishi_pce,std_ishi_pce,mean_ishi_pce-2,std_ishi_pce-2"
+        );
+        assert_eq!(text.lines().nth(1).unwrap(), "0,1,1,2,1,3,1,4,1,5,1");
+        // Unique names: the labels are the study names, as before.
+        write(&dirs[1..3], &p.join("c2")).unwrap();
+        let text = std::fs::read_to_string(p.join("c2/y_compare.csv")).unwrap();
+        assert_eq!(
+            text.lines().next().unwrap(),
+            "time,mean_ishi,std_ishi,mean_borehole,std_borehole"
+        );
+    }
+
+    #[test]
+    fn labels_stay_unique_when_a_folder_is_named_like_another_study() {
+        let s = |n: &str| n.to_string();
+        let (a, b, c) = (
+            Path::new("x/borehole"),
+            Path::new("y/borehole"),
+            Path::new("z/q"),
+        );
+        // Two studies "ishi" in folders named like the third study: that one keeps its name.
+        let got = labels(&[(s("ishi"), a), (s("borehole"), c), (s("ishi"), b)]);
+        assert_eq!(got, ["borehole-2", "borehole", "borehole-3"]);
+        // The same folder twice.
+        let got = labels(&[(s("ishi"), a), (s("ishi"), a)]);
+        assert_eq!(got, ["borehole", "borehole-2"]);
     }
 
     #[test]

@@ -170,6 +170,39 @@ pub struct Analysis {
     pub allow_failures: bool,
 }
 
+/// Column name of a quantile level `p` (in [0, 1]): `q` and the percentage 100·p written
+/// exactly, from the shortest decimal of `p` with its point moved two places (no
+/// floating-point noise, nothing rounded): 0.01 → `q1`, 0.5 → `q50`, 0.025 → `q2.5`,
+/// 0.0015 → `q0.15`, 0.9951 → `q99.51`. Distinct levels give distinct names. Every CSV
+/// header and plot legend that names a quantile uses this.
+pub fn quantile_column(p: f64) -> String {
+    if !p.is_finite() {
+        return format!("q{p}");
+    }
+    // `{}` writes the shortest decimal that reads back as `p`, never in exponent notation;
+    // `+ 0.0` turns -0 into 0.
+    let text = format!("{}", p + 0.0);
+    let (sign, digits) = match text.strip_prefix('-') {
+        Some(rest) => ("-", rest),
+        None => ("", text.as_str()),
+    };
+    let (int, frac) = digits.split_once('.').unwrap_or((digits, ""));
+    // 100·p: the first two fraction digits join the integer part.
+    let frac = format!("{frac:0<2}");
+    let (moved, rest) = frac.split_at(2);
+    let int = format!("{int}{moved}");
+    let int = match int.trim_start_matches('0') {
+        "" => "0",
+        t => t,
+    };
+    let rest = rest.trim_end_matches('0');
+    if rest.is_empty() {
+        format!("q{sign}{int}")
+    } else {
+        format!("q{sign}{int}.{rest}")
+    }
+}
+
 impl Default for Analysis {
     fn default() -> Self {
         Analysis {

@@ -8,7 +8,7 @@ use toml::Spanned;
 
 use super::builtins::builtin;
 use super::error::{location, Location, StudyError};
-use super::file::{Analysis, StudyFile, Variant};
+use super::file::{quantile_column, Analysis, StudyFile, Variant};
 use super::parameter::{Level, ParameterSpec};
 use super::study::{Study, Suite};
 use crate::qoi::QoiSpec;
@@ -256,6 +256,21 @@ fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
             "analysis: pdf_grid >= 2, pdf_times >= 1, series_samples >= 2, \
              surrogate_samples >= 2, quantiles in [0, 1]",
         ));
+    }
+    // Each level names a column of `<V>.csv`: two levels with one name would be two
+    // columns that cannot be told apart.
+    let names: Vec<String> = a.quantiles.iter().map(|&p| quantile_column(p)).collect();
+    for (j, name) in names.iter().enumerate() {
+        if let Some(i) = names[..j].iter().position(|n| n == name) {
+            return Err(cx.invalid(
+                None,
+                format!(
+                    "analysis: quantiles {} and {} both give the column '{name}': give each \
+                     level once",
+                    a.quantiles[i], a.quantiles[j]
+                ),
+            ));
+        }
     }
     Ok(())
 }

@@ -43,8 +43,8 @@ mod value;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{
-    Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs, PaperValue,
-    StudyFile, Variant,
+    quantile_column, Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs,
+    PaperValue, StudyFile, Variant,
 };
 pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};

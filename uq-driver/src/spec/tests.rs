@@ -252,3 +252,58 @@ fn hunting_speed_yields_two_quantities_and_variants_can_leave_quantities_out() {
         assert!(err.contains(needle), "{err} should mention {needle}");
     }
 }
+
+/// F6: quantile columns were named by 100·p rounded to 0.1 (0.0015 → `q0.2`, 0.9951 →
+/// `q99.5`), so distinct levels shared a name. The expected names are the percentages
+/// written out by hand.
+#[test]
+fn quantile_column_names_are_exact_not_rounded_to_a_tenth_of_a_percent() {
+    let cases = [
+        // The names that were already exact stay as they were.
+        (0.01, "q1"),
+        (0.5, "q50"),
+        (0.99, "q99"),
+        (0.025, "q2.5"),
+        (0.001, "q0.1"),
+        (0.123, "q12.3"),
+        (0.0, "q0"),
+        (-0.0, "q0"),
+        (1.0, "q100"),
+        (0.1, "q10"),
+        (0.05, "q5"),
+        (0.975, "q97.5"),
+        // The ones that were rounded (0.0015 · 100 is 0.15000000000000002 in binary).
+        (0.0015, "q0.15"),
+        (0.002, "q0.2"),
+        (0.9951, "q99.51"),
+        (0.995, "q99.5"),
+        (0.123456, "q12.3456"),
+        (0.00001, "q0.001"),
+        (1e-7, "q0.00001"),
+        (0.3333, "q33.33"),
+    ];
+    for (p, name) in cases {
+        assert_eq!(quantile_column(p), name, "level {p}");
+    }
+}
+
+/// F6: two levels that give one column name are refused when the study file is read.
+#[test]
+fn quantile_levels_that_share_a_column_name_are_refused() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let with = |q: &str| format!("{base}\n[analysis]\nquantiles = {q}\n");
+    for q in [
+        "[0.5, 0.5]",
+        "[0.01, 0.0, 0.3, -0.0]",
+        "[0.995, 0.99, 0.995]",
+    ] {
+        let err = Study::parse(&with(q), "t.toml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("both give the column"), "{q}: {err}");
+    }
+    for q in ["[0.001, 0.0015]", "[0.0015, 0.002]", "[0.995, 0.9951]"] {
+        let s = Study::parse(&with(q), "t.toml", None).unwrap();
+        assert_eq!(s.analysis.quantiles.len(), 2, "{q}");
+    }
+}

@@ -18,7 +18,8 @@ use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
 use super::worker_fmu::WorkerFmus;
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
-use crate::uq::method::{Design, MethodError};
+use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
+use crate::uq::pce::Family;
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -192,7 +193,28 @@ pub fn study_hash(study: &Study) -> String {
     if let Some(c) = &study.correlation {
         key["correlation"] = serde_json::json!(c.pairs);
     }
+    // SCM follows each input's Askey family since `chaos` became one of its keys: where that
+    // changes the design (an input with a non-Hermite germ) the hash says so, so that a store
+    // of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
+    if scm_askey(&study.method)
+        && study
+            .parameters
+            .iter()
+            .any(|p| !matches!(Family::of(&p.distribution), None | Some(Family::Hermite)))
+    {
+        key["scm_germ"] = serde_json::json!("askey");
+    }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
+}
+
+/// Whether `method` (or a nested study's inner method) is an SCM on the inputs' Askey
+/// families.
+fn scm_askey(method: &MethodSpec) -> bool {
+    match method {
+        MethodSpec::Scm(s) => s.chaos == ChaosBasis::Askey,
+        MethodSpec::Nested(n) => scm_askey(&n.inner),
+        _ => false,
+    }
 }
 
 /// What a run produced: every point's record, in design order, read in place from the
@@ -540,6 +562,42 @@ mod tests {
         let renamed = base.replace("name = \"bogie-lhs-500\"", "name = \"renamed\"");
         let c = study_hash(&study(&format!("{renamed}\n[analysis]\npdf_grid = 50\n")));
         assert_eq!(a, c);
+    }
+
+    #[test]
+    fn an_scm_whose_design_follows_the_askey_families_does_not_resume_a_hermite_store() {
+        // SCM with a uniform input now runs Gauss–Legendre nodes; a store of the Gauss–Hermite
+        // design the same file gave before must not be resumed, so its hash differs from the
+        // hash of the same file with `chaos = "hermite"` and from the hash without the key
+        // as computed before (the method serialised without `chaos`, no `scm_germ`).
+        let text = |dist: &str, chaos: &str| {
+            format!(
+                "name = \"u\"\nfmu = \"Wheel.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
+                 [[parameters]]\nname = \"K\"\n{dist}\n\
+                 [outputs]\nvariables = [\"q\"]\n[method]\nkind = \"scm\"\nnodes = 3\n{chaos}"
+            )
+        };
+        let study = |t: String| Study::parse(&t, "t.toml", None).unwrap();
+        let uniform = "distribution = \"uniform\"\nlow = 90.0\nhigh = 110.0";
+        let askey = study(text(uniform, ""));
+        let hermite = study(text(uniform, "chaos = \"hermite\""));
+        assert_ne!(study_hash(&askey), study_hash(&hermite));
+        let mut old_key = serde_json::json!({
+            "seed": askey.seed,
+            "experiment": askey.experiment,
+            "method": askey.method,
+            "parameters": askey.parameters,
+            "fixed": askey.fixed,
+            "outputs": { "variables": askey.outputs },
+        });
+        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
+        assert_ne!(study_hash(&askey), old);
+        // A normal input: the design is the Gauss–Hermite one either way, the hash as before.
+        let normal = study(text("mean = 100.0\nstd = 10.0", ""));
+        old_key["parameters"] = serde_json::json!(normal.parameters);
+        old_key["seed"] = serde_json::json!(normal.seed);
+        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
+        assert_eq!(study_hash(&normal), old);
     }
 
     #[test]

@@ -344,6 +344,8 @@ pub struct SlurmOptions {
     pub cpus_per_task: Option<usize>,
     /// Extra `#SBATCH` lines.
     pub extra: Vec<String>,
+    /// The merge writes the CSV files and `summary.json` only (`merge --no-report`).
+    pub no_report: bool,
 }
 
 /// Writes `DIR/slurm/shard.sbatch` and `DIR/slurm/merge.sbatch`; returns their paths.
@@ -386,11 +388,12 @@ pub fn write_sbatch(
     );
     let merge = format!(
         "#!/bin/bash\n#SBATCH --job-name=uq-merge\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --kill-on-invalid-dep=yes\n#SBATCH --output={log}/merge.out\n{common}\
-         exec {driver} merge {dir} --out {out}\n",
+         exec {driver} merge {dir} --out {out}{no_report}\n",
         log = dir.join("slurm").display(),
         driver = q(driver),
         dir = q(&dir),
         out = q(&dir.join("result")),
+        no_report = if o.no_report { " --no-report" } else { "" },
     );
     let (a, b) = (sdir.join("shard.sbatch"), sdir.join("merge.sbatch"));
     std::fs::write(&a, shard).map_err(io(&a))?;

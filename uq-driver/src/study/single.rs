@@ -21,6 +21,7 @@ use crate::results::{
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
 use crate::uq::method::{Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling};
+use crate::uq::pce::Family;
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
@@ -222,11 +223,17 @@ fn analyse(
             let n = super::nested::analyse(study, nested, design, records)?;
             (n.analysed, n.splits, n.warnings)
         }
-        _ => (
-            analysis::analyse_runs(study, method, design, records)?,
-            Vec::new(),
-            Vec::new(),
-        ),
+        _ => {
+            let analysed = analysis::analyse_runs(study, method, design, records)?;
+            // Inputs with an Askey family of their own that the design maps through the normal.
+            let askey_hint = design.germ == Germ::Normal
+                && design
+                    .inputs
+                    .iter()
+                    .any(|p| !matches!(Family::of(&p.distribution), None | Some(Family::Hermite)));
+            let warnings = analysis::chaos_gap_warnings(&analysed, askey_hint);
+            (analysed, Vec::new(), warnings)
+        }
     })
 }
 

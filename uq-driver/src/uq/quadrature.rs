@@ -268,19 +268,37 @@ pub fn tensor_grid(nodes_per_dim: &[usize]) -> Result<TensorGrid, QuadratureErro
     if nodes_per_dim.is_empty() {
         return Err(QuadratureError::NoDimensions);
     }
-    let mut total: usize = 1;
     for &n in nodes_per_dim {
         check_nodes(n)?;
-        total = total
-            .checked_mul(n)
-            .filter(|&t| t <= MAX_TENSOR_POINTS)
-            .ok_or(QuadratureError::TooManyPoints)?;
     }
     let rules: Vec<(Vec<f64>, Vec<f64>)> = nodes_per_dim
         .iter()
         .map(|&n| gauss_hermite(n))
         .collect::<Result<_, _>>()?;
-    let d = nodes_per_dim.len();
+    tensor_product(&rules)
+}
+
+/// Tensor product of one-dimensional rules `(nodes, weights)`, one per dimension, in the
+/// order of [`TensorGrid`] (last dimension fastest); each point's weight is the product of
+/// its nodes' weights.
+///
+/// Errors: no dimension, an empty rule, or more than [`MAX_TENSOR_POINTS`] points.
+pub fn tensor_product(rules: &[(Vec<f64>, Vec<f64>)]) -> Result<TensorGrid, QuadratureError> {
+    if rules.is_empty() {
+        return Err(QuadratureError::NoDimensions);
+    }
+    let sizes: Vec<usize> = rules.iter().map(|r| r.0.len().min(r.1.len())).collect();
+    let mut total: usize = 1;
+    for &n in &sizes {
+        if n == 0 {
+            return Err(QuadratureError::ZeroNodes);
+        }
+        total = total
+            .checked_mul(n)
+            .filter(|&t| t <= MAX_TENSOR_POINTS)
+            .ok_or(QuadratureError::TooManyPoints)?;
+    }
+    let d = rules.len();
     let mut points = Vec::with_capacity(total);
     let mut weights = Vec::with_capacity(total);
     let mut idx = vec![0usize; d];
@@ -290,7 +308,7 @@ pub fn tensor_grid(nodes_per_dim: &[usize]) -> Result<TensorGrid, QuadratureErro
         // Odometer increment, last dimension fastest.
         for j in (0..d).rev() {
             idx[j] += 1;
-            if idx[j] < nodes_per_dim[j] {
+            if idx[j] < sizes[j] {
                 break;
             }
             idx[j] = 0;

@@ -13,6 +13,7 @@ use std::path::Path;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use crate::report::csv::{push_shortest, shortest};
 use crate::uq::distributions::{Distribution, Germ, RandomParameter};
 use crate::uq::method::ChaosError;
 use crate::uq::pce::{germ_draws, Basis, Family, MultiIndexSet, Pce};
@@ -464,59 +465,110 @@ impl Surrogate {
     }
 
     /// `eval` as CSV: `name,time,value`, one row per output and time, then one per quantity
-    /// (empty time).
+    /// (empty time). Numbers as every CSV of the driver writes them
+    /// ([`crate::report::csv::push_shortest`]).
     pub fn eval_csv(&self, x: &[f64]) -> String {
         let v = self.eval(x);
         let mut text = String::from("name,time,value\n");
         for (o, vals) in self.file.outputs.iter().zip(&v.outputs) {
             let times = o.times.as_deref().unwrap_or(&[]);
             for (t, y) in times.iter().zip(vals) {
-                text.push_str(&format!("{},{t},{y}\n", o.name));
+                text.push_str(&o.name);
+                text.push(',');
+                push_shortest(&mut text, *t);
+                text.push(',');
+                push_shortest(&mut text, *y);
+                text.push('\n');
             }
         }
         for (q, y) in self.file.quantities.iter().zip(&v.quantities) {
-            text.push_str(&format!("{},,{y}\n", q.name));
+            text.push_str(&q.name);
+            text.push_str(",,");
+            push_shortest(&mut text, *y);
+            text.push('\n');
         }
         text
     }
 
-    /// `sample` as CSV: the inputs, the quantities, then each output at the communication
-    /// points nearest to `times` (default: its last), as columns `NAME@TIME`.
-    pub fn sample_csv(&self, n: usize, seed: u64, times: &[f64]) -> String {
-        // (output index, time index, column name)
-        let mut picks: Vec<(usize, usize, String)> = Vec::new();
+    /// The columns of `sample` for the requested `times` (s): per output (that has times),
+    /// `(output index, time index, NAME@TIME)` with TIME the communication point nearest to
+    /// each requested time (default: the last one). A time outside an output's time grid,
+    /// or two times that fall on one communication point, are refused.
+    fn sample_columns(&self, times: &[f64]) -> Result<Vec<(usize, usize, String)>, SurrogateError> {
+        let mut picks = Vec::new();
         for (o, chaos) in self.file.outputs.iter().enumerate() {
             let ts = chaos.times.as_deref().unwrap_or(&[]);
-            if ts.is_empty() {
+            let (Some(&first), Some(&last)) = (ts.first(), ts.last()) else {
                 continue;
-            }
-            let nearest = |t: f64| {
-                (0..ts.len())
+            };
+            let mut wanted: Vec<(f64, usize)> = Vec::new();
+            for &t in times {
+                if !(first..=last).contains(&t) {
+                    return Err(SurrogateError::Input(format!(
+                        "time {} s is outside the time grid of output '{}' ({} to {} s)",
+                        shortest(t),
+                        chaos.name,
+                        shortest(first),
+                        shortest(last)
+                    )));
+                }
+                let k = (0..ts.len())
                     .min_by(|&a, &b| (ts[a] - t).abs().total_cmp(&(ts[b] - t).abs()))
-                    .unwrap_or(0)
-            };
-            let wanted: Vec<usize> = if times.is_empty() {
-                vec![ts.len() - 1]
-            } else {
-                times.iter().map(|&t| nearest(t)).collect()
-            };
-            for k in wanted {
-                picks.push((o, k, format!("{}@{}", chaos.name, ts[k])));
+                    .unwrap_or(0);
+                if let Some((u, _)) = wanted.iter().find(|&&(_, j)| j == k) {
+                    return Err(SurrogateError::Input(format!(
+                        "times {} s and {} s both fall on the communication point {} s of \
+                         output '{}': give each time once",
+                        shortest(*u),
+                        shortest(t),
+                        shortest(ts[k]),
+                        chaos.name
+                    )));
+                }
+                wanted.push((t, k));
+            }
+            if times.is_empty() {
+                wanted.push((last, ts.len() - 1));
+            }
+            for (_, k) in wanted {
+                picks.push((o, k, format!("{}@{}", chaos.name, shortest(ts[k]))));
             }
         }
+        if picks.is_empty() && !times.is_empty() {
+            return Err(SurrogateError::Input(
+                "times given, but the surrogate has no output over time (only scalar \
+                 quantities)"
+                    .into(),
+            ));
+        }
+        Ok(picks)
+    }
+
+    /// `sample` as CSV: the inputs, the quantities, then each output at the communication
+    /// points nearest to `times` (default: its last), as columns `NAME@TIME` (TIME the
+    /// communication point). Refuses a time outside an output's time grid, and two times
+    /// that fall on one communication point.
+    pub fn sample_csv(&self, n: usize, seed: u64, times: &[f64]) -> Result<String, SurrogateError> {
+        let picks = self.sample_columns(times)?;
         let mut header: Vec<String> = self.inputs.iter().map(|p| p.name.clone()).collect();
         header.extend(self.file.quantities.iter().map(|q| q.name.clone()));
         header.extend(picks.iter().map(|p| p.2.clone()));
         let mut text = header.join(",");
         text.push('\n');
         for (x, v) in self.sample(n, seed) {
-            let mut row: Vec<String> = x.iter().map(f64::to_string).collect();
-            row.extend(v.quantities.iter().map(f64::to_string));
-            row.extend(picks.iter().map(|&(o, k, _)| v.outputs[o][k].to_string()));
-            text.push_str(&row.join(","));
+            let values = x
+                .iter()
+                .chain(&v.quantities)
+                .chain(picks.iter().map(|&(o, k, _)| &v.outputs[o][k]));
+            for (j, y) in values.enumerate() {
+                if j > 0 {
+                    text.push(',');
+                }
+                push_shortest(&mut text, *y);
+            }
             text.push('\n');
         }
-        text
+        Ok(text)
     }
 
     /// The memory (bytes) [`Surrogate::sample_csv`] of `n` draws needs at its peak: every
@@ -620,8 +672,107 @@ mod tests {
                 assert!((s.eval(x).outputs[0][0] - v.outputs[0][0]).abs() < 1e-9);
                 assert!((0.0..=4.0).contains(&x[1]));
             }
-            assert_eq!(s.sample_csv(50, 1, &[]), s.sample_csv(50, 1, &[]));
+            assert_eq!(
+                s.sample_csv(50, 1, &[]).unwrap(),
+                s.sample_csv(50, 1, &[]).unwrap()
+            );
         }
+    }
+
+    /// A chaos of output `f` on the times 0, 0.5, 1 s: the constant `c[k]` at time k.
+    fn constant_over_time(c: [f64; 3]) -> NamedChaos {
+        let set = MultiIndexSet::from_indices(2, vec![vec![0, 0]]).unwrap();
+        let basis = Basis::new(vec![Family::Hermite, Family::Legendre], set).unwrap();
+        NamedChaos {
+            name: "f".into(),
+            times: Some(vec![0.0, 0.5, 1.0]),
+            pce: Pce::new(basis, DMatrix::from_row_slice(1, 3, &c)).unwrap(),
+            error: None,
+        }
+    }
+
+    /// F8: `surrogate sample --time` took any time (5 s on a 0–1 s grid) and wrote two
+    /// columns `f@1` for two times near 1 s.
+    #[test]
+    fn sample_times_outside_the_grid_or_on_one_point_are_refused() {
+        let file = SurrogateFile::new(
+            "s",
+            "sparse_grid",
+            Germ::Askey,
+            &inputs(false),
+            &[constant_over_time([1.0, 2.0, 3.0])],
+            &[],
+        );
+        let s = Surrogate::new(file).unwrap();
+        for t in [5.0, -0.1, 1.0000001, f64::NAN] {
+            let e = s.sample_csv(2, 1, &[t]).unwrap_err().to_string();
+            assert!(
+                e.contains("outside the time grid of output 'f' (0 to 1 s)"),
+                "{e}"
+            );
+        }
+        let e = s.sample_csv(2, 1, &[0.96, 1.0]).unwrap_err().to_string();
+        assert!(
+            e.contains("0.96 s and 1 s both fall on the communication point 1 s"),
+            "{e}"
+        );
+        // Columns by the communication point used: 0.2 s → 0, 0.3 s → 0.5, 1 s → 1.
+        let text = s.sample_csv(2, 1, &[0.3, 1.0, 0.2]).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next().unwrap(), "a,b,f@0.5,f@1,f@0");
+        for line in lines {
+            assert!(line.ends_with(",2,3,1"), "{line}");
+        }
+        // The ends of the grid are inside it; no time: the last.
+        let header = |t: &[f64]| {
+            s.sample_csv(1, 1, t)
+                .unwrap()
+                .lines()
+                .next()
+                .unwrap()
+                .to_owned()
+        };
+        assert_eq!(header(&[0.0, 1.0]), "a,b,f@0,f@1");
+        assert_eq!(header(&[]), "a,b,f@1");
+        // Only a scalar quantity: a time has nothing to choose.
+        let mut q = constant_over_time([1.0, 2.0, 3.0]);
+        q.times = None;
+        q.pce = chaos().pce;
+        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[], &[q]);
+        let s = Surrogate::new(file).unwrap();
+        assert!(s
+            .sample_csv(1, 1, &[0.5])
+            .unwrap_err()
+            .to_string()
+            .contains("no output over time"));
+        assert!(s.sample_csv(1, 1, &[]).unwrap().starts_with("a,b,f\n"));
+    }
+
+    /// F9: `surrogate eval` printed 5.19e-17 as a 35-character decimal; numbers are written
+    /// as in every CSV of the driver (exponent notation below 1e-4 and from 1e16).
+    #[test]
+    fn eval_and_sample_write_numbers_like_the_other_csv_files() {
+        let file = SurrogateFile::new(
+            "s",
+            "scm",
+            Germ::Askey,
+            &inputs(false),
+            &[constant_over_time([5.1906094329251493e-17, 0.25, 1.5e16])],
+            &[],
+        );
+        let s = Surrogate::new(file).unwrap();
+        assert_eq!(
+            s.eval_csv(&[2.0, 2.0]),
+            "name,time,value\nf,0,5.1906094329251493e-17\nf,0.5,0.25\nf,1,1.5e16\n"
+        );
+        let text = s.sample_csv(1, 1, &[0.0, 1.0]).unwrap();
+        assert!(
+            text.lines()
+                .nth(1)
+                .unwrap()
+                .ends_with(",5.1906094329251493e-17,1.5e16"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -37,10 +37,8 @@ pub struct StudyReport<'a> {
     pub extra: &'a [Section],
 }
 
-/// Column name of a quantile level: 0.01 → `q1`, 0.5 → `q50`, 0.025 → `q2.5`.
-pub fn quantile_column(p: f64) -> String {
-    format!("q{}", (p * 1000.0).round() / 10.0)
-}
+/// Column name of a quantile level (the study file's one function: exact, e.g. `q0.15`).
+pub use crate::spec::quantile_column;
 
 /// Writes every file of a finished study into `dir`; returns the wall time of the writing
 /// (s), which `summary.json` reports as `timing.report_s` (written last, with that number).

@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 use super::error::InvalidSettings;
 use super::estimate::{ChaosError, ChaosErrorKind};
 use super::traits::Problem;
-use crate::uq::distributions::Germ;
-use crate::uq::pce::Pce;
+use crate::uq::distributions::{Germ, RandomParameter};
+use crate::uq::pce::{Family, Pce};
 
 /// `chaos = "askey" | "hermite"` of a chaos method's `[method]` table.
 ///
@@ -16,7 +16,8 @@ use crate::uq::pce::Pce;
 ///   Jacobi for a Beta input, Laguerre for a Gamma input; the others (log-normal, truncated
 ///   normal, Weibull) through the isoprobabilistic map to a standard normal (Hermite);
 /// - `hermite`: every input through the isoprobabilistic map to a standard normal, one
-///   Hermite chaos (as stochastic collocation does).
+///   Hermite chaos (the paper's stochastic collocation; `kind = "scm"` follows `askey` by
+///   default too).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ChaosBasis {
@@ -28,6 +29,23 @@ pub enum ChaosBasis {
 }
 
 impl ChaosBasis {
+    /// Whether this is the default, [`ChaosBasis::Askey`].
+    pub fn is_askey(&self) -> bool {
+        *self == ChaosBasis::Askey
+    }
+
+    /// The germ family of each input: its own Askey family (Hermite where it has none, the
+    /// input then mapped through the normal), or Hermite for all.
+    pub fn families(self, parameters: &[RandomParameter]) -> Vec<Family> {
+        parameters
+            .iter()
+            .map(|p| match self {
+                ChaosBasis::Hermite => Family::Hermite,
+                ChaosBasis::Askey => Family::of(&p.distribution).unwrap_or(Family::Hermite),
+            })
+            .collect()
+    }
+
     /// The standard space designs are built in.
     pub fn germ(self) -> Germ {
         match self {

@@ -80,13 +80,7 @@ pub struct SparseGrid {
 impl SparseGrid {
     /// The family of each input's germ.
     fn families(&self, parameters: &[RandomParameter]) -> Vec<Family> {
-        parameters
-            .iter()
-            .map(|p| match self.chaos {
-                ChaosBasis::Hermite => Family::Hermite,
-                ChaosBasis::Askey => Family::of(&p.distribution).unwrap_or(Family::Hermite),
-            })
-            .collect()
+        self.chaos.families(parameters)
     }
 
     /// The rule of each dimension, from its germ's family.
