@@ -45,7 +45,8 @@ pub fn check_supports(study: &Study, fmu: &Fmu) -> Result<(), InterfaceError> {
 }
 
 /// One warning per random parameter with design points outside its variable's declared range:
-/// how many, on which side, and their probability weight.
+/// how many and their probability weight (points only below a minimum <= 0 of a positive-mean
+/// input are left to the design's sign warning).
 pub fn range_warnings(study: &Study, fmu: &Fmu, design: &Design) -> Vec<String> {
     let mut warnings = Vec::new();
     for (j, p) in study.parameters.iter().enumerate() {
@@ -59,6 +60,12 @@ pub fn range_warnings(study: &Study, fmu: &Fmu, design: &Design) -> Vec<String> 
             })
             .collect();
         if outside.is_empty() {
+            continue;
+        }
+        // Below a minimum <= 0 only: the design's sign warning (a positive-mean input at
+        // values <= 0) already reports these points.
+        let above = outside.iter().any(|&i| design.values[i][j] > max);
+        if !above && min <= 0.0 && p.distribution.mean() > 0.0 {
             continue;
         }
         let weight: f64 = match &design.weights {
