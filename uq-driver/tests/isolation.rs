@@ -492,3 +492,174 @@ fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read
         .to_string();
     assert!(err.contains("more than the limit"), "{err}");
 }
+
+/// Runs uq-driver with `args` (and `TMPDIR` = `tmp`), killing it after `limit`: a regression
+/// must fail the test, never hang the suite. `None` when it had to be killed.
+fn run_limited(args: &[&str], tmp: &Path, limit: Duration) -> Option<Output> {
+    let mut child = Command::new(DRIVER)
+        .args(args)
+        .env("TMPDIR", tmp)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Some(child.wait_with_output().unwrap())
+}
+
+impl Case {
+    fn run_limited(&self, extra: &[&str], limit: Duration) -> Option<Output> {
+        let mut args = vec![
+            "run",
+            self.study.to_str().unwrap(),
+            "--out",
+            self.out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run_limited(&args, &self.tmp(), limit)
+    }
+}
+
+#[test]
+fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers() {
+    // QA finding 6: fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
+    // forever, --timeout-per-run or not. The pipes now sit at high descriptors.
+    let Some(c) = case(9) else { return };
+    let o = c
+        .run_limited(
+            &["--isolate", "-t", "1", "--timeout-per-run", "5"],
+            Duration::from_secs(60),
+        )
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        c.points().iter().all(|(_, s)| s == "ok"),
+        "{:?}",
+        c.points()
+    );
+    // The same numbers as in-process with a well-behaved FMU (mode 9 changes no value).
+    let isolated = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    let text = std::fs::read_to_string(&c.study).unwrap();
+    std::fs::write(&c.study, text.replace("misbehave = 9", "misbehave = 0")).unwrap();
+    let o = c.run(&["--fresh", "-t", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let in_process = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    assert_eq!(isolated, in_process);
+}
+
+#[test]
+fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_its_pipes() {
+    // QA finding 7: the driver noticed a crashed worker only when its pipes closed, i.e. when
+    // a helper process the FMU had started (here one that lives 20 s) ended.
+    let Some(c) = case(10) else { return };
+    let t0 = Instant::now();
+    let o = c
+        .run_limited(&["--isolate", "-t", "1"], Duration::from_secs(60))
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("killed by signal 11 (SIGSEGV");
+    c.check_failed_with("misbehave = 10: starting a helper");
+    // At least two crashed points: waiting for the helpers would take 40 s.
+    assert!(t0.elapsed() < Duration::from_secs(15), "{:?}", t0.elapsed());
+}
+
+#[test]
+fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finishes() {
+    // QA finding L11: a worker dead of SIGTERM was taken for a driver being stopped from
+    // outside, so the study stopped at that point on every re-run and could never finish.
+    let Some(c) = case(11) else { return };
+    let o = c
+        .run_limited(&["--isolate", "-t", "1"], Duration::from_secs(60))
+        .expect("the study must not hang");
+    assert!(o.status.success(), "{}", stderr(&o));
+    c.check_failed_with("SIGTERM");
+    c.check_failed_with("misbehave = 11: raising SIGTERM");
+}
+
+#[test]
+fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status() {
+    // QA finding 12: an FMU crashing in-process killed the driver printing only the plan line.
+    use std::os::unix::process::ExitStatusExt;
+    for (mode, sig, name) in [(2, 11, "SIGSEGV"), (3, 6, "SIGABRT")] {
+        let Some(c) = case(mode) else { return };
+        for threads in ["1", "2"] {
+            let o = c
+                .run_limited(&["-t", threads, "--fresh"], Duration::from_secs(60))
+                .expect("ends");
+            let err = stderr(&o);
+            assert_eq!(o.status.signal(), Some(sig), "{err}");
+            assert!(err.contains(&format!("killed by {name}")), "{err}");
+            assert!(err.contains("running point "), "{err}");
+            assert!(err.contains("misbehave_at = "), "{err}");
+            assert!(err.contains("--isolate"), "{err}");
+        }
+        // The finished points are kept: --isolate resumes and completes the study.
+        let o = c.run(&["--isolate"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        c.check_failed_with(name);
+    }
+}
+
+#[test]
+fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
+    // QA finding 5: `simulate` exited 0 with no CSV and no message.
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("f4.csv");
+    let o = run_limited(
+        &[
+            "simulate",
+            fmu.to_str().unwrap(),
+            "--set",
+            "misbehave=4",
+            "--out",
+            csv.to_str().unwrap(),
+        ],
+        dir.path(),
+        Duration::from_secs(60),
+    )
+    .expect("ends");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("called exit()"), "{err}");
+    assert!(err.contains("Features.fmu"), "{err}");
+}
+
+#[test]
+fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
+    // QA finding 9: the FMU's printf output was interleaved with the CSV rows on stdout.
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let o = run_limited(
+        &[
+            "simulate",
+            fmu.to_str().unwrap(),
+            "--set",
+            "misbehave=12",
+            "--output",
+            "u_integral",
+        ],
+        dir.path(),
+        Duration::from_secs(60),
+    )
+    .expect("ends");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(out.starts_with("time,u_integral\n"), "{out}");
+    assert_eq!(out.lines().count(), 12, "{out}");
+    assert!(!out.contains("prints to stdout"), "{out}");
+    assert!(stderr(&o).contains("misbehave = 12 prints to stdout"));
+}

@@ -265,8 +265,15 @@ fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
         covered >= 18,
         "{covered} of 20 intervals cover the reference"
     );
-    // At t = 0 every run starts at q0: no variance, indices 0.
-    assert_eq!(csv.at(0.0, "S_K"), 0.0);
+    // At t = 0 every run starts at q0: no variance, so the indices (0/0) and their
+    // intervals are undefined: NaN, not 0 with a [0, 0] interval (QA F5).
+    for col in ["S_K", "ST_C", "S_K_lo", "S_K_hi", "ST_C_lo", "ST_C_hi"] {
+        assert!(
+            csv.at(0.0, col).is_nan(),
+            "t = 0 {col}: {}",
+            csv.at(0.0, col)
+        );
+    }
     let s = summary(&out);
     assert_eq!(s["model_runs"], 2048 * 4);
     let q = &s["quantities"]["q_max_late"]["sobol"];

@@ -9,7 +9,7 @@ use super::args::*;
 use uq_driver::fmu::{Fmu, VariableKind};
 use uq_driver::report::csv::push_shortest;
 use uq_driver::spec::{Experiment, FixedValue, InvalidExperiment};
-use uq_driver::study::{runner, size};
+use uq_driver::study::{guard, runner, size};
 use uq_driver::uq::surrogate::Surrogate;
 
 /// Writes `text` to `out`, or to standard output.
@@ -83,7 +83,12 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
             eprintln!("uq-driver: warning: {w}");
         }
     }
-    let sim = runner::simulate(&fmu, &params, &a.outputs, a.input.as_deref(), &times)?;
+    let sim = {
+        // An FMU that calls exit() is reported; what it prints stays out of a CSV on stdout.
+        let _exit = guard::SimulationGuard::begin(&a.fmu);
+        let _stdout = a.out.is_none().then(guard::StdoutToStderr::begin);
+        runner::simulate(&fmu, &params, &a.outputs, a.input.as_deref(), &times)?
+    };
     for (name, why) in &sim.skipped {
         eprintln!("uq-driver: note: output '{name}' not recorded: {why}");
     }

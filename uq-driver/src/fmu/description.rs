@@ -399,6 +399,10 @@ pub enum VariableKind {
         start: Option<i32>,
         /// `declaredType` (required by FMI 2.0).
         declared_type: String,
+        /// `min` (on the variable; the type's item range is not read).
+        min: Option<i32>,
+        /// `max` (on the variable).
+        max: Option<i32>,
     },
 }
 

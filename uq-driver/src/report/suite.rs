@@ -338,7 +338,11 @@ fn compare_scalar(
         .collect();
     let means: Vec<f64> = stats.iter().map(|s| s.mean).collect();
     let stds: Vec<f64> = stats.iter().map(|s| s.std).collect();
-    let ses: Vec<f64> = stats.iter().map(|s| s.std_error_mean).collect();
+    // No standard error (chaos, quadrature): `nan`, not 0.
+    let ses: Vec<f64> = stats
+        .iter()
+        .map(|s| s.std_error_mean.unwrap_or(f64::NAN))
+        .collect();
     let unit = variants
         .iter()
         .find_map(|d| d.summary.units.get(q))

@@ -83,8 +83,9 @@ pub struct ScalarStats {
     pub mean: f64,
     /// Standard deviation.
     pub std: f64,
-    /// Standard error of the mean (sampling: std/√n; quadrature: 0).
-    pub std_error_mean: f64,
+    /// Standard error of the mean, where the method estimates it (sampling: e.g. std/√n);
+    /// `None` (`null` in summary.json) for quadrature and chaos methods, which have none.
+    pub std_error_mean: Option<f64>,
     /// Runs with a valid value.
     pub n_valid: usize,
     /// Critical speed: runs that never hunt.

@@ -6,6 +6,7 @@
 //! are appended as they finish), so a re-run resumes.
 
 use std::collections::BTreeMap;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, Once};
@@ -21,12 +22,16 @@ pub const EXIT_INTERRUPTED: i32 = 130;
 static ACTIVE: AtomicUsize = AtomicUsize::new(0);
 /// Set when the process ends on purpose (a signal, a timeout): the `atexit` handler is quiet.
 static DELIBERATE: AtomicBool = AtomicBool::new(false);
+/// Set as SIGINT, SIGTERM or SIGHUP reaches the driver (before it ends).
+static STOPPING: AtomicBool = AtomicBool::new(false);
 static NEXT_TOKEN: AtomicU64 = AtomicU64::new(0);
 static STATE: Mutex<State> = Mutex::new(State {
     studies: BTreeMap::new(),
     running: BTreeMap::new(),
 });
 static ATEXIT: Once = Once::new();
+/// The FMU of a `simulate` in progress (for the `exit()` message).
+static SIMULATION: Mutex<Option<String>> = Mutex::new(None);
 
 struct State {
     /// Study token → (name, output folder, in-process).
@@ -51,12 +56,14 @@ impl StudyGuard {
     pub fn begin(name: &str, out_dir: &Path, in_process: bool) -> StudyGuard {
         if in_process {
             ATEXIT.call_once(register_atexit);
+            super::crash::install();
         }
         let token = NEXT_TOKEN.fetch_add(1, Ordering::Relaxed);
-        state()
-            .studies
+        let mut s = state();
+        s.studies
             .insert(token, (name.to_owned(), out_dir.to_path_buf(), in_process));
         ACTIVE.fetch_add(1, Ordering::AcqRel);
+        changed(&s);
         StudyGuard { token }
     }
 
@@ -64,9 +71,10 @@ impl StudyGuard {
     /// guard is dropped.
     pub fn running(&self, point: usize, values: String) -> RunningPoint {
         let token = NEXT_TOKEN.fetch_add(1, Ordering::Relaxed);
-        state()
-            .running
+        let mut s = state();
+        s.running
             .insert(token, (self.token, point, values, Instant::now()));
+        changed(&s);
         RunningPoint { token }
     }
 
@@ -88,6 +96,7 @@ impl Drop for StudyGuard {
         s.studies.remove(&self.token);
         s.running.retain(|_, (st, ..)| *st != self.token);
         ACTIVE.fetch_sub(1, Ordering::AcqRel);
+        changed(&s);
     }
 }
 
@@ -99,7 +108,9 @@ pub struct RunningPoint {
 
 impl Drop for RunningPoint {
     fn drop(&mut self) {
-        state().running.remove(&self.token);
+        let mut s = state();
+        s.running.remove(&self.token);
+        changed(&s);
     }
 }
 
@@ -113,6 +124,18 @@ fn describe_running() -> Option<String> {
     let Ok(s) = STATE.try_lock() else {
         return Some("a study (its running points are unknown)".to_owned());
     };
+    Some(describe(&s))
+}
+
+/// Prepares the message of a crash in-process for what runs now (called with the registry
+/// held, as it changes).
+fn changed(s: &State) {
+    let in_process = s.studies.values().any(|(_, _, p)| *p);
+    super::crash::prepare(in_process.then(|| describe(s)).as_deref());
+}
+
+/// "study S (output folder D): running point 3 (K = 1, C = 2), …" for every study.
+fn describe(s: &State) -> String {
     let mut parts = Vec::new();
     for (token, (name, dir, _)) in &s.studies {
         let points: Vec<String> = s
@@ -131,7 +154,7 @@ fn describe_running() -> Option<String> {
             dir.display()
         ));
     }
-    Some(parts.join("; "))
+    parts.join("; ")
 }
 
 /// Ends the process on purpose: prints `message`, removes the temporary folders of opened
@@ -150,6 +173,7 @@ pub fn exit_now(code: i32, message: &str) -> ! {
 /// from the command line program.
 pub fn install_signal_handler() {
     let _ = ctrlc::set_handler(|| {
+        STOPPING.store(true, Ordering::Release);
         let message = match describe_running() {
             Some(what) => format!(
                 "uq-driver: interrupted during {what}; finished points are kept in the \
@@ -159,6 +183,24 @@ pub fn install_signal_handler() {
         };
         exit_now(EXIT_INTERRUPTED, &message)
     });
+}
+
+/// Whether the driver itself is being stopped by SIGINT, SIGTERM or SIGHUP, waiting up to
+/// `wait` for the news (a signal sent to the whole process group reaches a worker and the
+/// driver at about the same time; the driver's handler runs on its own thread). A worker that
+/// died of such a signal while the driver was not asked to stop killed itself: its point
+/// failed.
+pub fn stop_requested_within(wait: Duration) -> bool {
+    let start = Instant::now();
+    loop {
+        if STOPPING.load(Ordering::Acquire) {
+            return true;
+        }
+        if start.elapsed() >= wait {
+            return false;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }
 
 /// Keeps another thread that calls `exit()` meanwhile (a second FMU instance misbehaving at
@@ -180,6 +222,68 @@ fn hold_other_exits() {
     }
 }
 
+/// A `simulate` run of an FMU in progress: an FMU that calls `exit()` meanwhile is reported
+/// (exit status 1) instead of ending the process quietly with its own status.
+#[derive(Debug)]
+pub struct SimulationGuard(());
+
+impl SimulationGuard {
+    /// Starts watching a simulation of `fmu` (as the user named it).
+    pub fn begin(fmu: &Path) -> SimulationGuard {
+        ATEXIT.call_once(register_atexit);
+        *SIMULATION.lock().unwrap_or_else(|e| e.into_inner()) = Some(fmu.display().to_string());
+        SimulationGuard(())
+    }
+}
+
+impl Drop for SimulationGuard {
+    fn drop(&mut self) {
+        *SIMULATION.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+}
+
+/// While alive, file descriptor 1 points at stderr, so that what FMU code prints cannot mix
+/// with output the program writes to stdout (a CSV); dropping it flushes the C streams and
+/// puts stdout back.
+#[derive(Debug)]
+pub struct StdoutToStderr {
+    saved: Option<std::os::fd::OwnedFd>,
+}
+
+impl StdoutToStderr {
+    /// Points fd 1 at stderr (when that fails, stdout stays as it is).
+    pub fn begin() -> StdoutToStderr {
+        use std::os::fd::FromRawFd;
+        let _ = std::io::stdout().flush();
+        // SAFETY: fcntl(F_DUPFD_CLOEXEC) of the process's own stdout; the result is checked.
+        let fd = unsafe { libc::fcntl(1, libc::F_DUPFD_CLOEXEC, 3) };
+        if fd < 0 {
+            return StdoutToStderr { saved: None };
+        }
+        // SAFETY: `fd` is a fresh descriptor owned by nothing else.
+        let saved = unsafe { std::os::fd::OwnedFd::from_raw_fd(fd) };
+        // SAFETY: 2 and 1 are the process's own stderr and stdout; Rust's stdout was flushed.
+        if unsafe { libc::dup2(2, 1) } < 0 {
+            return StdoutToStderr { saved: None };
+        }
+        StdoutToStderr { saved: Some(saved) }
+    }
+}
+
+impl Drop for StdoutToStderr {
+    fn drop(&mut self) {
+        use std::os::fd::AsRawFd;
+        if let Some(saved) = self.saved.take() {
+            // SAFETY: fflush(NULL) flushes every C stream (what the FMU printed goes where fd 1
+            // points now, stderr); dup2 puts the saved stdout back on fd 1.
+            unsafe {
+                libc::fflush(std::ptr::null_mut());
+                libc::dup2(saved.as_raw_fd(), 1);
+            }
+        }
+    }
+}
+
 /// Registers [`on_exit`] with the C library.
 fn register_atexit() {
     // SAFETY: `on_exit` is an `extern "C" fn()` that lives as long as the program; `atexit`
@@ -195,16 +299,23 @@ extern "C" fn on_exit() {
     if DELIBERATE.load(Ordering::Acquire) {
         return;
     }
-    let Some(what) = describe_running() else {
+    let simulation = SIMULATION.try_lock().ok().and_then(|s| s.clone());
+    let what = describe_running();
+    if what.is_none() && simulation.is_none() {
         return;
-    };
+    }
     hold_other_exits();
-    let _ = std::panic::catch_unwind(|| {
-        eprintln!(
+    let _ = std::panic::catch_unwind(|| match (what, simulation) {
+        (Some(what), _) => eprintln!(
             "uq-driver: error: the process was ended by a call to exit() during {what}: an FMU \
              running in-process called exit(). Finished points are kept in the results store. \
              Run with --isolate to have such a run marked failed and the study go on."
-        );
+        ),
+        (None, Some(fmu)) => eprintln!(
+            "uq-driver: error: the process was ended by a call to exit() while simulating \
+             {fmu}: the FMU called exit() before the run was done; no result was written"
+        ),
+        (None, None) => {}
     });
     crate::fmu::cleanup::remove_all();
     // SAFETY: `_exit` ends the process at once with this status, which is what is wanted here

@@ -85,6 +85,24 @@ pub enum VariableProblem {
         /// The value.
         value: f64,
     },
+    /// A fixed whole number outside the `min`/`max` the modelDescription declares.
+    #[error(
+        "'{name}' is an {found} declared with {} in the modelDescription; the fixed value \
+         {value} is outside that range",
+        declared_range(*.min, *.max)
+    )]
+    OutOfRange {
+        /// The variable.
+        name: String,
+        /// Its type (Integer or Enumeration).
+        found: &'static str,
+        /// The value.
+        value: i32,
+        /// Declared `min`.
+        min: Option<i32>,
+        /// Declared `max`.
+        max: Option<i32>,
+    },
     /// A design value that is not a whole number for an Integer or Enumeration random
     /// parameter.
     #[error(
@@ -126,6 +144,16 @@ pub enum VariableProblem {
         /// What does not fit.
         problem: String,
     },
+}
+
+/// "min = 1, max = 4" (or only the bound that is declared).
+fn declared_range(min: Option<i32>, max: Option<i32>) -> String {
+    match (min, max) {
+        (Some(lo), Some(hi)) => format!("min = {lo}, max = {hi}"),
+        (Some(lo), None) => format!("min = {lo}"),
+        (None, Some(hi)) => format!("max = {hi}"),
+        (None, None) => "no range".to_owned(),
+    }
 }
 
 /// Values set before initialization, by FMI type: (value reference, value).
@@ -525,6 +553,20 @@ impl<'a> Variables<'a> {
                             value: x,
                         })
                     })?;
+                    let (min, max) = match var.kind {
+                        VariableKind::Integer { min, max, .. }
+                        | VariableKind::Enumeration { min, max, .. } => (min, max),
+                        _ => (None, None),
+                    };
+                    if min.is_some_and(|lo| i < lo) || max.is_some_and(|hi| i > hi) {
+                        return Err(self.error(VariableProblem::OutOfRange {
+                            name: name.to_owned(),
+                            found,
+                            value: i,
+                            min,
+                            max,
+                        }));
+                    }
                     s.integer.push((vr, i));
                 }
                 (VariableKind::Boolean { .. }, _) => {

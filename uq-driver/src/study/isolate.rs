@@ -21,20 +21,23 @@
 //!
 //! What the worker writes to stderr (the FMU's log messages, which the worker echoes, and
 //! anything the FMU prints) is kept by the parent, the last lines of it going into the message
-//! of a point whose worker died. A worker that dies (signal or exit) or outlives
-//! `--timeout-per-run` (then it is killed) fails its point; the next point starts a new worker.
-//! A worker killed by SIGINT, SIGTERM or SIGHUP from outside (Ctrl-C, `kill`, `scancel`)
-//! fails nothing: the study stops and a re-run computes the point. Workers ignore SIGINT (the
+//! of a point whose worker died. A worker that dies (signal or exit; noticed by its exit
+//! status, not by the end of its pipes, which a program the FMU started may keep open) or
+//! outlives `--timeout-per-run` (then it is killed) fails its point; the next point starts a
+//! new worker. A worker killed by SIGINT, SIGTERM or SIGHUP while the driver itself is being
+//! stopped (Ctrl-C, `kill`, `scancel`) fails nothing: the study stops and a re-run computes
+//! the point; a worker that dies of such a signal otherwise (an FMU that raises SIGTERM on
+//! itself) fails its point like any crash. Workers ignore SIGINT (the
 //! terminal sends it to the whole process group; the parent handles it) and, on Linux, are
 //! killed when the parent dies.
 
 use std::collections::VecDeque;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +49,14 @@ use crate::fmu::{Fmu, Instance};
 const TAIL_LINES: usize = 12;
 /// Largest frame accepted (bytes): far above any record, small enough to refuse garbage.
 const MAX_FRAME: u64 = 1 << 34;
+/// The worker's protocol descriptors are moved to this number or above, out of the way of an
+/// FMU that writes to (or closes) low descriptors.
+pub const PROTOCOL_FD_MIN: i32 = 100;
+/// How often a waiting parent checks whether its worker is still alive.
+const POLL: Duration = Duration::from_millis(20);
+/// How long the parent waits for the last frames and output of a worker that has ended, and
+/// for a worker that closed its answer pipe to end.
+const GRACE: Duration = Duration::from_millis(500);
 
 /// What a worker needs to run points.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -83,12 +94,45 @@ pub enum WorkerFailure {
 /// A frame read by the reader thread.
 type Frame = (u8, Vec<u8>);
 
+/// What the reader thread passes on: a frame, or why the bytes were not one.
+type Answer = Result<Frame, String>;
+
+/// The last lines a worker wrote to stderr.
+#[derive(Debug)]
+struct Tail {
+    lines: VecDeque<String>,
+    /// The start of a line not yet ended.
+    partial: Vec<u8>,
+    /// When the last bytes came.
+    last: Instant,
+}
+
+impl Tail {
+    fn push(&mut self, bytes: &[u8]) {
+        self.last = Instant::now();
+        for chunk in bytes.split_inclusive(|b| *b == b'\n') {
+            self.partial.extend_from_slice(chunk);
+            if chunk.ends_with(b"\n") {
+                let line =
+                    String::from_utf8_lossy(&self.partial[..self.partial.len() - 1]).into_owned();
+                self.partial.clear();
+                if self.lines.len() == TAIL_LINES {
+                    self.lines.pop_front();
+                }
+                self.lines.push_back(line);
+            } else if self.partial.len() > 4096 {
+                self.partial.drain(..self.partial.len() - 4096);
+            }
+        }
+    }
+}
+
 /// A running worker process.
 pub struct Worker {
     child: Child,
     stdin: Option<ChildStdin>,
-    frames: Receiver<Frame>,
-    tail: Arc<Mutex<VecDeque<String>>>,
+    frames: Receiver<Answer>,
+    tail: Arc<Mutex<Tail>>,
     stderr_done: Receiver<()>,
 }
 
@@ -138,8 +182,12 @@ pub fn read_frame(r: &mut impl Read) -> std::io::Result<Option<Frame>> {
             format!("frame of {len} bytes"),
         ));
     }
-    let mut payload = vec![0u8; len as usize];
-    r.read_exact(&mut payload)?;
+    // Grown as the bytes come: a garbage length allocates nothing up front.
+    let mut payload = Vec::new();
+    r.take(len).read_to_end(&mut payload)?;
+    if payload.len() as u64 != len {
+        return Err(std::io::ErrorKind::UnexpectedEof.into());
+    }
     Ok(Some((head[0], payload)))
 }
 
@@ -166,13 +214,15 @@ fn signal_name(sig: i32) -> String {
     }
 }
 
-/// How the worker ended: a description and whether it was stopped from outside.
+/// How the worker ended: a description and whether it was stopped from outside (by a signal
+/// that stops the driver too, while the driver is being stopped).
 fn describe_exit(status: ExitStatus) -> (String, bool) {
     #[cfg(unix)]
     {
         use std::os::unix::process::ExitStatusExt;
         if let Some(sig) = status.signal() {
-            let outside = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP].contains(&sig);
+            let outside = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP].contains(&sig)
+                && super::guard::stop_requested_within(GRACE);
             return (
                 format!(
                     "the worker process running the FMU was killed by {}",
@@ -214,23 +264,34 @@ impl Worker {
         let mut stdout = child.stdout.take().expect("piped");
         let stderr = child.stderr.take().expect("piped");
         let (tx, frames) = mpsc::channel();
-        std::thread::spawn(move || {
-            while let Ok(Some(frame)) = read_frame(&mut stdout) {
-                if tx.send(frame).is_err() {
-                    break;
-                }
+        std::thread::spawn(move || loop {
+            let answer = match read_frame(&mut stdout) {
+                Ok(Some(frame)) => Ok(frame),
+                Ok(None) => break,
+                Err(e) => Err(e.to_string()),
+            };
+            let end = answer.is_err();
+            if tx.send(answer).is_err() || end {
+                break;
             }
         });
-        let tail = Arc::new(Mutex::new(VecDeque::with_capacity(TAIL_LINES)));
+        let tail = Arc::new(Mutex::new(Tail {
+            lines: VecDeque::with_capacity(TAIL_LINES),
+            partial: Vec::new(),
+            last: Instant::now(),
+        }));
         let (done_tx, stderr_done) = mpsc::channel();
         let t = Arc::clone(&tail);
         std::thread::spawn(move || {
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                let mut t = t.lock().unwrap_or_else(|e| e.into_inner());
-                if t.len() == TAIL_LINES {
-                    t.pop_front();
+            let mut stderr = stderr;
+            let mut buf = [0u8; 8192];
+            loop {
+                match stderr.read(&mut buf) {
+                    Ok(0) => break,
+                    Ok(n) => t.lock().unwrap_or_else(|e| e.into_inner()).push(&buf[..n]),
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(_) => break,
                 }
-                t.push_back(line);
             }
             let _ = done_tx.send(());
         });
@@ -257,7 +318,11 @@ impl Worker {
         timeout: Option<Duration>,
     ) -> Result<Vec<f64>, WorkerFailure> {
         match self.request(b'P', &f64s_to_bytes(values), timeout, "running the point")? {
-            (b'O', v) => Ok(bytes_to_f64s(&v)),
+            (b'O', v) if v.len() % 8 == 0 => Ok(bytes_to_f64s(&v)),
+            (b'O', v) => Err(self.malformed(
+                &format!("a record of {} bytes", v.len()),
+                "running the point",
+            )),
             (b'F', msg) => Err(WorkerFailure::Point(
                 String::from_utf8_lossy(&msg).into_owned(),
             )),
@@ -270,15 +335,16 @@ impl Worker {
     }
 
     fn protocol_error(&mut self, tag: u8) -> WorkerFailure {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        self.stop();
         WorkerFailure::Died(format!(
             "the worker process answered with an unknown frame '{}'",
             char::from(tag).escape_default()
         ))
     }
 
-    /// Sends a frame and waits (at most `timeout`) for the answer.
+    /// Sends a frame and waits (at most `timeout`) for the answer. The worker's own end is
+    /// watched (its exit status, polled), not the end of its pipes, which a program the FMU
+    /// started may hold open; the watchdog stays armed until a well-formed answer arrives.
     fn request(
         &mut self,
         tag: u8,
@@ -287,57 +353,125 @@ impl Worker {
         doing: &str,
     ) -> Result<Frame, WorkerFailure> {
         // The lines of earlier points are not this point's last words.
-        self.tail.lock().unwrap_or_else(|e| e.into_inner()).clear();
-        // A write error means the worker is gone: the receive below reports how it ended.
+        {
+            let mut t = self.tail.lock().unwrap_or_else(|e| e.into_inner());
+            t.lines.clear();
+            t.partial.clear();
+        }
+        // A write error means the worker is gone: the wait below reports how it ended.
         if let Some(stdin) = self.stdin.as_mut() {
             let _ = write_frame(stdin, tag, payload);
         }
-        let answer = match timeout {
-            Some(t) => self.frames.recv_timeout(t),
-            None => self
-                .frames
-                .recv()
-                .map_err(|_| RecvTimeoutError::Disconnected),
-        };
-        match answer {
-            Ok(frame) => Ok(frame),
-            Err(RecvTimeoutError::Timeout) => {
-                let _ = self.child.kill();
-                let _ = self.child.wait();
+        let deadline = timeout.map(|t| Instant::now() + t);
+        // When the answer pipe reached its end while the worker still ran.
+        let mut pipe_closed: Option<Instant> = None;
+        loop {
+            let now = Instant::now();
+            if deadline.is_some_and(|d| now >= d) {
+                self.stop();
                 let t = timeout.expect("only with a timeout").as_secs_f64();
-                Err(WorkerFailure::Died(format!(
+                return Err(WorkerFailure::Died(format!(
                     "the run took longer than --timeout-per-run {t} s and its worker process \
                      was killed while {doing}{}",
                     self.tail_text()
-                )))
+                )));
             }
-            Err(RecvTimeoutError::Disconnected) => {
-                let status = self.child.wait();
-                let (what, outside) = match status {
-                    Ok(s) => describe_exit(s),
-                    Err(e) => (format!("the worker process was lost: {e}"), false),
-                };
-                let message = format!("{what} while {doing}{}", self.tail_text());
-                Err(if outside {
-                    WorkerFailure::Interrupted(message)
-                } else {
-                    WorkerFailure::Died(message)
-                })
+            let slice = deadline.map_or(POLL, |d| POLL.min(d - now));
+            let answer = if pipe_closed.is_some() {
+                std::thread::sleep(slice);
+                Err(RecvTimeoutError::Disconnected)
+            } else {
+                self.frames.recv_timeout(slice)
+            };
+            match answer {
+                Ok(Ok(frame)) => return Ok(frame),
+                Ok(Err(why)) => return Err(self.malformed(&why, doing)),
+                Err(RecvTimeoutError::Disconnected) if pipe_closed.is_none() => {
+                    pipe_closed = Some(Instant::now());
+                }
+                Err(_) => {}
+            }
+            match self.child.try_wait() {
+                Ok(Some(status)) => {
+                    // Its last frame (fmi2Fatal's 'X' comes just before the end) may still be
+                    // in the pipe.
+                    if pipe_closed.is_none() {
+                        if let Ok(answer) = self.frames.recv_timeout(GRACE) {
+                            return answer.map_err(|why| self.malformed(&why, doing));
+                        }
+                    }
+                    return Err(self.ended(Ok(status), doing));
+                }
+                Ok(None) => {}
+                Err(e) => return Err(self.ended(Err(e), doing)),
+            }
+            if pipe_closed.is_some_and(|t| t.elapsed() > GRACE) {
+                self.stop();
+                return Err(WorkerFailure::Died(format!(
+                    "the worker process closed its answer pipe while {doing} (the FMU closed \
+                     file descriptors it does not own?) and was stopped{}",
+                    self.tail_text()
+                )));
             }
         }
     }
 
-    /// "; its last output: ..." from the worker's stderr, once it has been read to its end.
+    /// Kills the worker and waits for it.
+    fn stop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
+    /// The failure of a worker whose answer was not a well-formed frame (it is stopped).
+    fn malformed(&mut self, why: &str, doing: &str) -> WorkerFailure {
+        self.stop();
+        WorkerFailure::Died(format!(
+            "the worker process sent a malformed answer ({why}) while {doing} (the FMU wrote \
+             into its answer pipe?) and was stopped{}",
+            self.tail_text()
+        ))
+    }
+
+    /// The failure of a worker that ended by itself.
+    fn ended(&mut self, status: std::io::Result<ExitStatus>, doing: &str) -> WorkerFailure {
+        let (what, outside) = match status {
+            Ok(s) => describe_exit(s),
+            Err(e) => (format!("the worker process was lost: {e}"), false),
+        };
+        let message = format!("{what} while {doing}{}", self.tail_text());
+        if outside {
+            WorkerFailure::Interrupted(message)
+        } else {
+            WorkerFailure::Died(message)
+        }
+    }
+
+    /// "; its last output: ..." from the worker's stderr, once it has been read to its end
+    /// (or has been quiet for a moment: a program the FMU started may keep it open).
     fn tail_text(&self) -> String {
-        let _ = self.stderr_done.recv_timeout(Duration::from_secs(2));
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(2) {
+            if self.stderr_done.recv_timeout(POLL).is_ok() {
+                break;
+            }
+            let last = self.tail.lock().unwrap_or_else(|e| e.into_inner()).last;
+            // Quiet since the wait began too: the last bytes may not have been read yet.
+            if last.elapsed().min(start.elapsed()) > Duration::from_millis(200) {
+                break;
+            }
+        }
         let t = self.tail.lock().unwrap_or_else(|e| e.into_inner());
-        if t.is_empty() {
+        let mut lines: Vec<String> = t.lines.iter().cloned().collect();
+        if !t.partial.is_empty() {
+            lines.push(String::from_utf8_lossy(&t.partial).into_owned());
+        }
+        if lines.len() > TAIL_LINES {
+            lines.remove(0);
+        }
+        if lines.is_empty() {
             String::new()
         } else {
-            format!(
-                "; its last output: {}",
-                t.iter().cloned().collect::<Vec<_>>().join(" | ")
-            )
+            format!("; its last output: {}", lines.join(" | "))
         }
     }
 }
@@ -398,23 +532,41 @@ impl WorkerPool {
 // ------------------------------------------------------------------------------------------
 // The worker side.
 
-/// Makes the protocol channel safe from the FMU: returns a handle on the original stdout and
-/// points file descriptor 1 at stderr, so that whatever the FMU prints goes to stderr.
+/// Makes the protocol channel safe from the FMU: moves the worker's stdin and stdout (the
+/// pipes to the parent) to descriptors at or above [`PROTOCOL_FD_MIN`], close-on-exec, and
+/// points descriptor 0 at /dev/null and descriptor 1 at stderr, so that whatever the FMU
+/// prints goes to stderr, a write to a low descriptor misses the pipes and a program the FMU
+/// starts does not inherit them. Returns (input, output).
 #[cfg(unix)]
-fn protocol_out() -> std::io::Result<std::fs::File> {
+fn protocol_fds() -> std::io::Result<(std::fs::File, std::fs::File)> {
     use std::os::fd::FromRawFd;
-    // SAFETY: dup of the process's stdout; a negative result is checked.
-    let fd = unsafe { libc::dup(1) };
-    if fd < 0 {
-        return Err(std::io::Error::last_os_error());
+    let last = std::io::Error::last_os_error;
+    // SAFETY: fcntl(F_DUPFD_CLOEXEC) on the process's own stdout/stdin; results are checked.
+    let out = unsafe { libc::fcntl(1, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
+    if out < 0 {
+        return Err(last());
     }
+    // SAFETY: `out` is a fresh descriptor owned by nothing else.
+    let out = unsafe { std::fs::File::from_raw_fd(out) };
+    // SAFETY: as above, for stdin.
+    let input = unsafe { libc::fcntl(0, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
+    if input < 0 {
+        return Err(last());
+    }
+    // SAFETY: `input` is a fresh descriptor owned by nothing else.
+    let input = unsafe { std::fs::File::from_raw_fd(input) };
     // SAFETY: 2 and 1 are the process's own stderr and stdout; nothing in this process holds a
-    // Rust handle that relies on fd 1 staying the pipe (only `fd` is used for the protocol).
+    // Rust handle that relies on fd 1 staying the pipe (only `out` is used for the protocol).
     if unsafe { libc::dup2(2, 1) } < 0 {
-        return Err(std::io::Error::last_os_error());
+        return Err(last());
     }
-    // SAFETY: `fd` is a fresh descriptor owned by nothing else.
-    Ok(unsafe { std::fs::File::from_raw_fd(fd) })
+    let null = std::fs::File::open("/dev/null")?;
+    // SAFETY: `null` is an open descriptor; fd 0 is the process's stdin, which nothing reads
+    // any more (the protocol reads `input`).
+    if unsafe { libc::dup2(std::os::fd::AsRawFd::as_raw_fd(&null), 0) } < 0 {
+        return Err(last());
+    }
+    Ok((input, out))
 }
 
 /// Ignores SIGINT and, on Linux, asks to be killed when the parent dies.
@@ -448,14 +600,13 @@ fn detach_from_terminal_signals() {
 #[cfg(unix)]
 pub fn serve() -> i32 {
     detach_from_terminal_signals();
-    let mut out = match protocol_out() {
-        Ok(f) => std::io::BufWriter::new(f),
+    let (mut input, mut out) = match protocol_fds() {
+        Ok((i, o)) => (BufReader::new(i), std::io::BufWriter::new(o)),
         Err(e) => {
             eprintln!("uq-driver worker: {e}");
             return 1;
         }
     };
-    let mut input = std::io::stdin().lock();
     let setup: Setup = match read_frame(&mut input) {
         Ok(Some((b'S', payload))) => match serde_json::from_slice(&payload) {
             Ok(s) => s,
@@ -557,5 +708,66 @@ mod tests {
         let mut huge = vec![b'O'];
         huge.extend_from_slice(&u64::MAX.to_le_bytes());
         assert!(read_frame(&mut &huge[..]).is_err());
+    }
+
+    /// A fake worker: a shell script that reads the setup, answers "ready", then `then`.
+    #[cfg(unix)]
+    fn fake_worker(dir: &std::path::Path, then: &str) -> IsolateOptions {
+        use std::os::unix::fs::PermissionsExt;
+        let exe = dir.join("fake-worker");
+        std::fs::write(
+            &exe,
+            format!(
+                "#!/bin/sh\nhead -c 9 >/dev/null\nprintf 'R\\0\\0\\0\\0\\0\\0\\0\\0'\n{then}\n"
+            ),
+        )
+        .unwrap();
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        IsolateOptions {
+            exe,
+            timeout: Some(Duration::from_secs(2)),
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_malformed_answer_fails_the_point_and_a_torn_one_is_stopped_by_the_watchdog() {
+        // QA finding 6: stray bytes on the answer pipe hung the driver forever.
+        let dir = tempfile::tempdir().unwrap();
+        // A length far beyond any frame: refused at once.
+        let opts = fake_worker(dir.path(), "printf 'garbage12345'; sleep 30");
+        let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
+        let t0 = Instant::now();
+        match w.run(&[1.0], opts.timeout) {
+            Err(WorkerFailure::Died(m)) => assert!(m.contains("malformed answer"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        assert!(t0.elapsed() < Duration::from_secs(2));
+        // A plausible length whose bytes never come: the watchdog still fires.
+        let opts = fake_worker(
+            dir.path(),
+            "printf 'O\\20\\0\\0\\0\\0\\0\\0\\0abc'; sleep 30",
+        );
+        let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
+        match w.run(&[1.0], opts.timeout) {
+            Err(WorkerFailure::Died(m)) => assert!(m.contains("--timeout-per-run"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_dead_worker_is_noticed_though_a_process_it_started_keeps_its_pipes_open() {
+        // QA finding 7: only the end of the pipes was noticed.
+        let dir = tempfile::tempdir().unwrap();
+        let mut opts = fake_worker(dir.path(), "sleep 20 & kill -SEGV $$");
+        opts.timeout = None;
+        let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
+        let t0 = Instant::now();
+        match w.run(&[1.0], None) {
+            Err(WorkerFailure::Died(m)) => assert!(m.contains("SIGSEGV"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        assert!(t0.elapsed() < Duration::from_secs(5), "{:?}", t0.elapsed());
     }
 }

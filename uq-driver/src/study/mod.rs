@@ -7,6 +7,7 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+mod crash;
 pub mod export;
 pub mod guard;
 pub mod inputs;

@@ -99,15 +99,19 @@ pub enum RunError {
     Design(#[from] MethodError),
     /// Points failed and failures are not allowed.
     #[error(
-        "{failed} of {total} points failed; first: {first}. After fixing the cause, run again \
+        "{}; first: {first}. After fixing the cause, run again \
          with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
-         and LHS, to analyse the others)"
+         and LHS, to analyse the others)",
+        failure_count(*.failed, *.total, *.not_run)
     )]
     PointsFailed {
-        /// Number of failed points.
+        /// Number of failed points (among those run before the study stopped).
         failed: usize,
-        /// Number of points.
+        /// Number of points (of this run: a shard's points for a shard).
         total: usize,
+        /// Points not run because the study stopped at the first failure: their outcome is
+        /// unknown, so `failed` is a lower bound when this is not 0.
+        not_run: usize,
         /// The first failed point.
         first: FailedPoint,
     },
@@ -495,6 +499,23 @@ impl Batch<'_> {
     }
 }
 
+/// What is known of the failures: "3 of 200 points failed" when every point was run, else
+/// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
+fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
+    if not_run == 0 {
+        return format!("{failed} of {total} points failed");
+    }
+    let first = if failed == 1 {
+        "at the first failure".to_owned()
+    } else {
+        format!("after the first {failed} failures")
+    };
+    format!(
+        "stopped {first} of {total} points (runs not started: {not_run}; how many of those \
+         would fail is not known)"
+    )
+}
+
 /// "K = 1.2, C = 3" for messages.
 fn describe_values(study: &Study, values: &[f64]) -> String {
     study
@@ -507,12 +528,15 @@ fn describe_values(study: &Study, values: &[f64]) -> String {
 }
 
 /// The number of failed points; an error naming the first when failures are not allowed
-/// (or the design is weighted: dropping a weighted point would bias every moment silently).
+/// (or the design is weighted: dropping a weighted point would bias every moment silently),
+/// with how many of the `points` (None: every point) were not run (the study stops at the
+/// first failure).
 pub fn check_failures(
     study: &Study,
     design: &Design,
     records: &[Option<Entry>],
     allow: bool,
+    points: Option<&[usize]>,
 ) -> Result<usize, RunError> {
     let failed: Vec<(usize, &String)> = records
         .iter()
@@ -534,9 +558,14 @@ pub fn check_failures(
         .zip(&design.values[index])
         .map(|(p, v)| (p.name.clone(), *v))
         .collect();
+    let wanted: Vec<usize> = match points {
+        Some(p) => p.iter().copied().filter(|&i| i < records.len()).collect(),
+        None => (0..records.len()).collect(),
+    };
     Err(RunError::PointsFailed {
         failed: failed.len(),
-        total: records.len(),
+        total: wanted.len(),
+        not_run: wanted.iter().filter(|&&i| records[i].is_none()).count(),
         first: FailedPoint {
             index,
             parameters,
@@ -548,6 +577,44 @@ pub fn check_failures(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// QA F4: a study stopped at its first failures said "2 of 200 points failed" although
+    /// 103 of them fail; the points not started are not counted as successes.
+    #[test]
+    fn failure_message_says_the_study_stopped_and_how_many_points_were_not_started() {
+        let first = FailedPoint {
+            index: 4,
+            parameters: vec![("K".into(), 1.5)],
+            message: "NaN".into(),
+        };
+        let err = |failed, not_run| {
+            RunError::PointsFailed {
+                failed,
+                total: 200,
+                not_run,
+                first: first.clone(),
+            }
+            .to_string()
+        };
+        let one = err(1, 197);
+        assert!(
+            one.starts_with(
+                "stopped at the first failure of 200 points (runs not started: 197; how many \
+                 of those would fail is not known); first: point 4 with K = 1.5: NaN."
+            ),
+            "{one}"
+        );
+        let two = err(2, 150);
+        assert!(
+            two.starts_with(
+                "stopped after the first 2 failures of 200 points (runs not started: 150;"
+            ),
+            "{two}"
+        );
+        assert!(!two.contains("2 of 200 points failed"));
+        // Every point run: the count is the whole truth.
+        assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
+    }
 
     #[test]
     fn changed_quantity_settings_do_not_resume_stale_records() {

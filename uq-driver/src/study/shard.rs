@@ -241,6 +241,7 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
         &design,
         outcome.runs.entries(),
         opts.allow_failures(&study),
+        opts.points.as_deref(),
     )?;
     Ok(outcome)
 }

@@ -138,7 +138,13 @@ pub(crate) fn finish(
 ) -> Result<StudyResult, StudyRunError> {
     let entries = outcome.runs.entries();
     let done = entries.iter().filter(|r| r.is_some()).count();
-    let failed = runner::check_failures(study, design, entries, opts.allow_failures(study))?;
+    let failed = runner::check_failures(
+        study,
+        design,
+        entries,
+        opts.allow_failures(study),
+        opts.points.as_deref(),
+    )?;
     if done < design.len() {
         return Err(StudyRunError::Incomplete {
             done,

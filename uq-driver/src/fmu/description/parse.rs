@@ -567,6 +567,8 @@ fn variable_kind(a: &Attrs) -> Result<VariableKind, DescriptionError> {
         _ => VariableKind::Enumeration {
             start: a.number("start", INT)?,
             declared_type: a.required("declaredType")?,
+            min: a.number("min", INT)?,
+            max: a.number("max", INT)?,
         },
     })
 }

@@ -135,7 +135,9 @@ generationTool="railuq" variableNamingConvention="structured" numberOfEventIndic
         md.variable("mode").unwrap().kind,
         VariableKind::Enumeration {
             start: Some(1),
-            declared_type: "Mode".into()
+            declared_type: "Mode".into(),
+            min: None,
+            max: None,
         }
     );
     let y = md.variable("y").unwrap();
@@ -399,4 +401,26 @@ fn byte_order_mark_is_accepted() {
     let mut bytes = b"\xEF\xBB\xBF".to_vec();
     bytes.extend_from_slice(MINIMAL.as_bytes());
     assert!(ModelDescription::parse(&bytes).is_ok());
+}
+
+/// QA F4: the `min`/`max` of an Enumeration variable are read, so that a fixed value outside
+/// them is refused before any run (as for an Integer).
+#[test]
+fn enumeration_min_and_max_are_read() {
+    let xml = MINIMAL.replace(
+        "<ScalarVariable name=\"x\" valueReference=\"0\"><Real/></ScalarVariable>",
+        "<ScalarVariable name=\"e\" valueReference=\"0\" causality=\"parameter\" \
+         variability=\"fixed\"><Enumeration declaredType=\"T\" start=\"2\" min=\"1\" max=\"3\"/>\
+         </ScalarVariable>",
+    );
+    let md = parse(&xml).unwrap();
+    assert_eq!(
+        md.variable("e").unwrap().kind,
+        VariableKind::Enumeration {
+            start: Some(2),
+            declared_type: "T".into(),
+            min: Some(1),
+            max: Some(3),
+        }
+    );
 }

@@ -331,10 +331,10 @@ fn quantity_section(
         vec!["mean".into(), num(q.mean)],
         vec!["Std".into(), num(q.std)],
     ];
-    if q.std_error_mean > 0.0 {
+    if let Some(se) = q.std_error_mean.filter(|&se| se > 0.0) {
         rows.push(vec![
             "standard error of the mean".into(),
-            with_unit(&sig(q.std_error_mean), unit),
+            with_unit(&sig(se), unit),
         ]);
     }
     rows.push(vec!["valid runs".into(), q.n_valid.to_string()]);
@@ -358,7 +358,15 @@ fn quantity_section(
         ]);
     }
     if let (Some(f), Some(t)) = (&q.sobol_first, &q.sobol_total) {
-        for (i, n) in names.iter().enumerate() {
+        let undefined = f.iter().chain(t).all(|x| x.is_nan());
+        if undefined {
+            // No variance: the indices are 0/0 (NaN in the files).
+            rows.push(vec![
+                "Sobol' indices".into(),
+                "undefined: the quantity has no variance".into(),
+            ]);
+        }
+        for (i, n) in names.iter().enumerate().filter(|_| !undefined) {
             rows.push(vec![
                 format!("Sobol' index of {n}: first order / total"),
                 format!(

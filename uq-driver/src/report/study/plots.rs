@@ -249,6 +249,10 @@ pub(super) fn sobol_bars(
     let (Some(first), Some(total)) = (&q.sobol_first, &q.sobol_total) else {
         return Ok(false);
     };
+    if first.iter().chain(total).all(|x| x.is_nan()) {
+        // No variance: the indices are undefined, there is nothing to draw.
+        return Ok(false);
+    }
     let (fi, ti) = match intervals {
         Some((f, t)) => (f.to_vec(), t.to_vec()),
         None => (vec![None; first.len()], vec![None; total.len()]),

@@ -29,7 +29,7 @@ use crate::results::{
 };
 use crate::spec::{Analysis, Study};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Solution};
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Sobol, Solution};
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
@@ -207,6 +207,24 @@ pub(crate) fn output_stats(
     summarise(name, times, estimate, cols, &run_column, settings)
 }
 
+/// The estimate's Sobol' indices, NaN where a column has no variance (there they are 0/0:
+/// [`Sobol::undefined_without_variance`]).
+fn defined_sobol(estimate: &Estimate) -> Option<Sobol> {
+    estimate
+        .sobol
+        .as_ref()
+        .map(|s| s.undefined_without_variance(&estimate.mean, &estimate.std))
+}
+
+/// `x`, with −0 written as 0 (a standard deviation is never negative).
+fn unsigned_zero(x: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x
+    }
+}
+
 /// An empty summary of `nt` columns under the settings.
 fn series_columns(nt: usize, settings: &Settings) -> SeriesColumns {
     let a = settings.analysis;
@@ -316,13 +334,13 @@ fn summarise(
         name: name.to_owned(),
         times: times.to_vec(),
         mean: estimate.mean.clone(),
-        std: estimate.std.clone(),
+        std: estimate.std.iter().map(|&s| unsigned_zero(s)).collect(),
         lower_3sigma,
         upper_3sigma,
         quantiles,
         std_pce: estimate.std_chaos.clone(),
         std_error_mean: estimate.std_error_mean.clone(),
-        sobol: estimate.sobol.clone(),
+        sobol: defined_sobol(estimate),
         pdf_times: picked.iter().map(|&k| times[k]).collect(),
         pdf_grid: grid,
         pdf,
@@ -384,11 +402,12 @@ pub(crate) fn scalar_stats(
         })
         .collect();
     let valid = runs.valid;
+    let sobol = defined_sobol(estimate);
     Ok(ScalarStats {
         name: name.to_owned(),
         mean: estimate.mean[0],
-        std: estimate.std[0],
-        std_error_mean: estimate.std_error_mean.as_ref().map_or(0.0, |s| s[0]),
+        std: unsigned_zero(estimate.std[0]),
+        std_error_mean: estimate.std_error_mean.as_ref().map(|s| s[0]),
         n_valid: valid.len(),
         n_never_hunts: runs.never_hunts,
         n_never_stops: runs.never_stops,
@@ -405,9 +424,9 @@ pub(crate) fn scalar_stats(
         unit: None,
         samples: valid,
         density_samples,
-        sobol_first: estimate.sobol.as_ref().map(|s| s.first[0].clone()),
-        sobol_total: estimate.sobol.as_ref().map(|s| s.total[0].clone()),
-        sobol: estimate.sobol.as_ref().map(|s| {
+        sobol_first: sobol.as_ref().map(|s| s.first[0].clone()),
+        sobol_total: sobol.as_ref().map(|s| s.total[0].clone()),
+        sobol: sobol.as_ref().map(|s| {
             let names: Vec<&str> = settings
                 .parameters
                 .iter()

@@ -7,6 +7,7 @@ use super::error::MethodError;
 use crate::uq::distributions::Germ;
 use crate::uq::pce::Family;
 use crate::uq::random_inputs::RandomInputs;
+use crate::uq::Distribution;
 
 /// Where a [`Sampling`](super::Sampling) method runs the model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -93,12 +94,17 @@ impl Design {
         }
     }
 
-    /// One warning per positive-mean parameter that some points set to a value <= 0, with the
-    /// probability weight of those points.
+    /// One warning per positive-mean normal parameter that some points set to a value <= 0,
+    /// with the probability weight of those points. Only a normal input warns: its support
+    /// (the whole real line) was not chosen by the user, whereas every other family's support
+    /// is declared (bounds, or positive by construction), so values <= 0 there are intended.
     fn sign_warnings(&self) -> Vec<String> {
         let mut warnings = Vec::new();
         for (j, p) in self.inputs.iter().enumerate() {
-            if p.distribution.mean() <= 0.0 {
+            let Distribution::Normal { mean, .. } = p.distribution else {
+                continue;
+            };
+            if mean <= 0.0 {
                 continue;
             }
             let neg: Vec<usize> = (0..self.len())
@@ -113,7 +119,8 @@ impl Design {
             };
             warnings.push(format!(
                 "{} of {} points have {} <= 0 (a positive-mean Gaussian reaches negative values in its tail; \
-                 probability weight {:.3e}); they are run, not dropped — consider a lognormal or truncated_normal input",
+                 probability weight {:.3e}); they are run as drawn (any that fail count as failed points) \
+                 — consider a lognormal or truncated_normal input",
                 neg.len(),
                 self.len(),
                 p.name,
@@ -127,7 +134,7 @@ impl Design {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::{Distribution, RandomParameter};
+    use crate::uq::RandomParameter;
 
     #[test]
     fn negative_values_of_a_positive_parameter_are_reported_with_their_weight() {
@@ -149,5 +156,38 @@ mod tests {
         let u = Design::mapped(Germ::Uniform, vec![vec![0.5]], None, &params);
         assert_eq!(u.values, vec![vec![1.0]]);
         assert!(u.warnings.is_empty());
+    }
+
+    /// QA F3: the "positive-mean Gaussian" warning fired for uniform [−1, 2], a normal truncated
+    /// at −0.5 and integers −2..5, whose declared support includes x <= 0 by the user's choice.
+    #[test]
+    fn sign_warning_only_for_normal_inputs_not_for_families_whose_support_includes_zero() {
+        let families = [
+            Distribution::uniform(-1.0, 2.0).unwrap(),
+            Distribution::truncated_normal(1.0, 1.0, -0.5, f64::INFINITY).unwrap(),
+            Distribution::integer_uniform(-2, 5).unwrap(),
+        ];
+        // Unit-cube points 0.05, 0.5, 0.95: the first maps to x < 0 in every family
+        // (uniform: −1 + 3·0.05 = −0.85; truncated normal: just above −0.5; integers: −2).
+        let cube = vec![vec![0.05], vec![0.5], vec![0.95]];
+        for d in families {
+            assert!(d.mean() > 0.0, "{d:?}");
+            let inputs = RandomInputs::independent(vec![RandomParameter {
+                name: "a".into(),
+                distribution: d.clone(),
+            }]);
+            let design = Design::mapped(Germ::Uniform, cube.clone(), None, &inputs);
+            assert!(design.values[0][0] <= 0.0, "{d:?}: {:?}", design.values);
+            assert!(design.warnings.is_empty(), "{d:?}: {:?}", design.warnings);
+        }
+        // A normal input still warns, and its text no longer claims that failed points are run.
+        let normal = RandomInputs::independent(vec![RandomParameter {
+            name: "k".into(),
+            distribution: Distribution::normal(1.0, 1.0).unwrap(),
+        }]);
+        let d = Design::mapped(Germ::Uniform, cube, None, &normal);
+        assert_eq!(d.warnings.len(), 1);
+        assert!(d.warnings[0].starts_with("1 of 3 points have k <= 0"));
+        assert!(!d.warnings[0].contains("not dropped"), "{}", d.warnings[0]);
     }
 }

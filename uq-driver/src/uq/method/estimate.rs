@@ -141,6 +141,36 @@ impl Sobol {
         Some((first, total))
     }
 
+    /// These indices with those of the columns without variance set to NaN (indices and
+    /// intervals): where `std` is zero at the rounding level of `mean` ([`no_variance`]) the
+    /// indices are 0/0, undefined, whatever the estimator computed there.
+    pub fn undefined_without_variance(&self, mean: &[f64], std: &[f64]) -> Sobol {
+        let mut out = self.clone();
+        let constant = |k: usize| match (mean.get(k), std.get(k)) {
+            (Some(&m), Some(&s)) => no_variance(m, s),
+            _ => false,
+        };
+        let nan = |rows: &mut [Vec<f64>]| {
+            for (k, row) in rows.iter_mut().enumerate() {
+                if constant(k) {
+                    row.fill(f64::NAN);
+                }
+            }
+        };
+        nan(&mut out.first);
+        nan(&mut out.total);
+        if let Some(iv) = &mut out.intervals {
+            for rows in [&mut iv.first, &mut iv.total] {
+                for (k, row) in rows.iter_mut().enumerate() {
+                    if constant(k) {
+                        row.fill((f64::NAN, f64::NAN));
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The indices of every column of a chaos (variance shares of its terms).
     pub fn from_chaos(pce: &Pce) -> Sobol {
         let cols = 0..pce.outputs();
@@ -149,6 +179,16 @@ impl Sobol {
             cols.map(|k| pce.sobol_total(k)).collect(),
         )
     }
+}
+
+/// A standard deviation at or below this fraction of |mean| is rounding noise, not variance
+/// (a chaos of a constant output has coefficients of about 1e-16 |mean|).
+pub const ROUNDING_STD: f64 = 1e-12;
+
+/// Whether a column with this mean and standard deviation has no variance: `std` (NaN
+/// aside) is at most [`ROUNDING_STD`] · |mean| (exactly 0 for a zero mean).
+pub fn no_variance(mean: f64, std: f64) -> bool {
+    std.abs() <= ROUNDING_STD * mean.abs()
 }
 
 /// Statistics of a results matrix, one value per column (time step or quantity).
@@ -347,5 +387,71 @@ mod replicate_tests {
         let data = DMatrix::from_column_slice(2, 1, &[1.0, 2.0]);
         let e = Estimate::from_replicates(&data, &[4, 5], 2);
         assert!(e.std_error_mean.unwrap()[0].is_nan());
+    }
+
+    /// QA F5: where a column has no variance (a fixed initial state at t = 0, a constant
+    /// output) its indices are 0/0; they were written as exact 0 with a [0, 0] interval.
+    #[test]
+    fn sobol_indices_without_variance_are_nan_and_the_whole_series_skips_them() {
+        let mut s = Sobol::new(
+            vec![
+                vec![0.0, 0.0],
+                vec![0.25, 0.5],
+                vec![0.0, 0.0],
+                vec![0.6, 0.3],
+            ],
+            vec![
+                vec![0.0, 0.0],
+                vec![0.5, 0.75],
+                vec![0.0, 0.0],
+                vec![0.7, 0.4],
+            ],
+        );
+        s.intervals = Some(SobolIntervals {
+            level: 0.95,
+            first: vec![
+                vec![(0.0, 0.0); 2],
+                vec![(0.2, 0.3); 2],
+                vec![(0.0, 0.0); 2],
+                vec![(0.5, 0.7); 2],
+            ],
+            total: vec![
+                vec![(0.0, 0.0); 2],
+                vec![(0.4, 0.6); 2],
+                vec![(0.0, 0.0); 2],
+                vec![(0.6, 0.8); 2],
+            ],
+        });
+        // Column 0: mean 0, std 0; column 2: std at the rounding level of the mean 1.79
+        // (1.1e-15 relative, a chaos of a constant); -0 counts as 0. Columns 1 and 3 vary.
+        let mean = [0.0, 1.0, 1.79, -3.0];
+        let std = [-0.0, 2.0, 2.0e-15, 1e-6];
+        let d = s.undefined_without_variance(&mean, &std);
+        for k in [0, 2] {
+            assert!(
+                d.first[k].iter().chain(&d.total[k]).all(|x| x.is_nan()),
+                "{k}"
+            );
+            let iv = d.intervals.as_ref().unwrap();
+            assert!(iv.first[k]
+                .iter()
+                .chain(&iv.total[k])
+                .all(|(a, b)| a.is_nan() && b.is_nan()));
+        }
+        for k in [1, 3] {
+            assert_eq!(d.first[k], s.first[k]);
+            assert_eq!(d.total[k], s.total[k]);
+            assert_eq!(
+                d.intervals.as_ref().unwrap().first[k],
+                s.intervals.as_ref().unwrap().first[k]
+            );
+        }
+        // The whole-series indices skip the NaN columns: over times 0, 1, 2, 3 (trapezoid
+        // weights 0.5, 1, 1, 0.5) only columns 1 (weight 1 · 2²) and 3 (0.5 · 1e-12) count.
+        let (f, t) = d.integrated(&[0.0, 1.0, 2.0, 3.0], &std).unwrap();
+        let (w1, w3) = (4.0, 0.5e-12);
+        assert!((f[0] - (w1 * 0.25 + w3 * 0.6) / (w1 + w3)).abs() < 1e-15);
+        assert!((t[1] - (w1 * 0.75 + w3 * 0.4) / (w1 + w3)).abs() < 1e-15);
+        assert!(no_variance(0.0, 0.0) && !no_variance(0.0, 1e-300) && !no_variance(1.0, f64::NAN));
     }
 }

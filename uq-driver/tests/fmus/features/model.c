@@ -17,6 +17,9 @@
  *     1 returns fmi2Error (logged)   2 segfaults        3 calls abort()   4 calls exit(0)
  *     5 blocks forever (sleeps)      6 makes every Real output NaN from then on (fmi2OK)
  *     7 returns fmi2Fatal (logged)   8 returns fmi2Warning (logged) and goes on
+ *     9 writes 12 bytes of garbage to file descriptor 3 and goes on
+ *     10 starts a helper process that lives 20 s (holding every descriptor), then segfaults
+ *     11 raises SIGTERM on itself   12 prints a line to stdout (fd 1) and goes on
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -26,6 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <signal.h>
+#include <unistd.h>
 
 #include "fmu_common.h"
 
@@ -35,7 +40,8 @@
 #define FILE_LIMIT 65536
 
 enum { MISBEHAVE_NONE, MISBEHAVE_ERROR, MISBEHAVE_SEGFAULT, MISBEHAVE_ABORT, MISBEHAVE_EXIT,
-       MISBEHAVE_BLOCK, MISBEHAVE_NAN, MISBEHAVE_FATAL, MISBEHAVE_WARNING, MISBEHAVE_LAST };
+       MISBEHAVE_BLOCK, MISBEHAVE_NAN, MISBEHAVE_FATAL, MISBEHAVE_WARNING, MISBEHAVE_FD3,
+       MISBEHAVE_CHILD_SEGFAULT, MISBEHAVE_SIGTERM, MISBEHAVE_STDOUT, MISBEHAVE_LAST };
 
 typedef struct {
     /* parameters */
@@ -229,6 +235,29 @@ static fmi2Status misbehave(Instance *inst, double end) {
     case MISBEHAVE_WARNING:
         LOG_WARNING(inst, "misbehave = 8: a warning on purpose at t = %g", end);
         return fmi2Warning;
+    case MISBEHAVE_FD3: {
+        static const char garbage[12] = "garbage\xff\x01\x02\x03!";
+        ssize_t written = write(3, garbage, sizeof garbage);
+        (void)written;
+        return fmi2OK;
+    }
+    case MISBEHAVE_CHILD_SEGFAULT:
+        LOG_WARNING(inst, "misbehave = 10: starting a helper, then segfaulting at t = %g", end);
+        if (fork() == 0) {
+            const struct timespec life = {20, 0};
+            nanosleep(&life, NULL);
+            _exit(0);
+        }
+        *null_pointer = 1;
+        return fmi2Error;
+    case MISBEHAVE_SIGTERM:
+        LOG_WARNING(inst, "misbehave = 11: raising SIGTERM on purpose at t = %g", end);
+        raise(SIGTERM);
+        return fmi2Error;
+    case MISBEHAVE_STDOUT:
+        printf("Features: misbehave = 12 prints to stdout at t = %g\n", end);
+        fflush(stdout);
+        return fmi2OK;
     default: return fmi2OK; /* MISBEHAVE_NAN: applied in step() */
     }
 }
