@@ -156,6 +156,31 @@ def test_binary_exports_the_34_co_simulation_functions(built, name):
         shutil.rmtree(unzipdir, ignore_errors=True)
 
 
+def test_once_builds_cleanly_validates_and_refuses_an_interleaved_second_instance(built, capsys):
+    # Once keeps its state in globals (canBeInstantiatedOnlyOncePerProcess): a step of an
+    # instance other than the one last initialized fails instead of giving wrong numbers.
+    path, warnings = built["Once"]
+    assert warnings == ""
+    assert validate_fmu(str(path)) == []
+    unzipdir = extract(str(path))
+    a = b = None
+    try:
+        a = Slave(str(path), unzipdir)
+        a.start(x=2.0)
+        a.fmu.doStep(0.0, 0.5)
+        assert a.get("y") == pytest.approx(1.0, abs=1e-15)
+        b = Slave(str(path), unzipdir)  # the same file: the same loaded library
+        b.start(x=3.0)
+        with pytest.raises(FMICallException):
+            a.fmu.doStep(0.5, 0.5)
+        assert "another instance of this library" in capsys.readouterr().out
+    finally:
+        for s in (b, a):
+            if s is not None:
+                s.fmu.freeInstance()
+        shutil.rmtree(unzipdir, ignore_errors=True)
+
+
 def _parse_start(variable):
     if variable.type == "Real":
         return float(variable.start)

@@ -37,6 +37,11 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             out,
         } => {
             let s = Surrogate::load(&dir)?;
+            size::check_memory(
+                &format!("surrogate sample -n {n}"),
+                s.sample_memory(n, &times),
+            )
+            .map_err(|e| anyhow::anyhow!("{e}; use a smaller -n"))?;
             emit(&s.sample_csv(n, seed, &times)?, out.as_deref())
         }
     }
@@ -74,6 +79,11 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         .into_iter()
         .map(|(n, v)| (n, FixedValue::Text(v)))
         .collect();
+    for (name, value) in &params {
+        if let Some(w) = uq_driver::study::ranges::value_warning(&fmu, name, value) {
+            eprintln!("uq-driver: warning: {w}");
+        }
+    }
     let sim = {
         // An FMU that calls exit() is reported; what it prints stays out of a CSV on stdout.
         let _exit = guard::SimulationGuard::begin(&a.fmu);
@@ -188,9 +198,27 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
             v.variability.as_str(),
             start.unwrap_or_default(),
             unit.unwrap_or_default(),
-            v.description.as_deref().unwrap_or("")
+            described_range(&v.kind, v.description.as_deref().unwrap_or(""))
         )?;
     }
     o.flush()?;
     Ok(())
+}
+
+/// A variable's description, after its declared `min`/`max` (`range [0.5, 1]`, an open end
+/// as `-inf` or `inf`) when it declares either.
+fn described_range(kind: &VariableKind, description: &str) -> String {
+    let (min, max) = match kind {
+        VariableKind::Real { min, max, .. } => (*min, *max),
+        VariableKind::Integer { min, max, .. } => (min.map(f64::from), max.map(f64::from)),
+        _ => (None, None),
+    };
+    if min.is_none() && max.is_none() {
+        return description.to_owned();
+    }
+    let lo = min.unwrap_or(f64::NEG_INFINITY);
+    let hi = max.unwrap_or(f64::INFINITY);
+    format!("range [{lo}, {hi}] {description}")
+        .trim_end()
+        .to_owned()
 }

@@ -207,6 +207,31 @@ pub struct ModelDescription {
     pub variables: Vec<ScalarVariable>,
     /// 1-based indices into `variables` from `ModelStructure/Outputs`.
     pub outputs: Vec<usize>,
+    /// Variable positions by name, built on the first [`ModelDescription::variable`] call.
+    pub(crate) by_name: NameIndex,
+}
+
+/// A cache of variable positions by name: looking up every variable of a large FMU by name
+/// is linear, not quadratic. Equal, cloned and shown as nothing (it is derived data).
+#[derive(Default)]
+pub(crate) struct NameIndex(std::sync::OnceLock<std::collections::HashMap<String, usize>>);
+
+impl Clone for NameIndex {
+    fn clone(&self) -> Self {
+        NameIndex::default()
+    }
+}
+
+impl PartialEq for NameIndex {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for NameIndex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("NameIndex")
+    }
 }
 
 /// `variableNamingConvention`.
@@ -514,7 +539,18 @@ impl ModelDescription {
 
     /// The variable with this name, if any.
     pub fn variable(&self, name: &str) -> Option<&ScalarVariable> {
-        self.variables.iter().find(|v| v.name == name)
+        let index = self.by_name.0.get_or_init(|| {
+            let mut index = std::collections::HashMap::with_capacity(self.variables.len());
+            for (i, v) in self.variables.iter().enumerate() {
+                index.entry(v.name.clone()).or_insert(i);
+            }
+            index
+        });
+        match index.get(name).and_then(|&i| self.variables.get(i)) {
+            Some(v) if v.name == name => Some(v),
+            // The variables were changed after the index was built.
+            _ => self.variables.iter().find(|v| v.name == name),
+        }
     }
 
     /// The variables listed in `ModelStructure/Outputs`, in that order.

@@ -12,10 +12,17 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 use super::error::{LogMessage, Status};
-use super::ffi::c_string;
 
 /// How many messages an instance keeps.
 const CAPACITY: usize = 256;
+/// The longest message kept (bytes of UTF-8): the rest is cut, and said so.
+pub(crate) const MAX_MESSAGE_BYTES: usize = 4096;
+/// The longest instance name or category kept (bytes).
+const MAX_NAME_BYTES: usize = 256;
+/// The most bytes of message text an instance keeps: older messages are forgotten first (the
+/// newest is always kept), so an FMU that logs a lot costs little memory, and an error,
+/// which carries the messages of the failing call, stays small in `points.csv` and the store.
+const MAX_KEPT_BYTES: usize = 64 * 1024;
 /// How many of the last messages an error carries when the failing call itself logged none.
 const FALLBACK: usize = 8;
 
@@ -70,7 +77,29 @@ pub(crate) struct LogSink {
     echo: AtomicBool,
     /// Sequence number of the next message.
     next: AtomicU64,
-    messages: Mutex<VecDeque<(u64, LogMessage)>>,
+    messages: Mutex<Kept>,
+}
+
+/// The kept messages with their sequence numbers, and the bytes of their text.
+#[derive(Default)]
+struct Kept {
+    messages: VecDeque<(u64, LogMessage)>,
+    bytes: usize,
+}
+
+impl Kept {
+    fn iter(&self) -> impl Iterator<Item = &(u64, LogMessage)> {
+        self.messages.iter()
+    }
+
+    fn len(&self) -> usize {
+        self.messages.len()
+    }
+}
+
+/// Bytes a message counts against [`MAX_KEPT_BYTES`].
+fn kept_bytes(m: &LogMessage) -> usize {
+    m.message.len() + m.category.len()
 }
 
 impl LogSink {
@@ -80,11 +109,11 @@ impl LogSink {
             sink: uq_driver_log,
             echo: AtomicBool::new(echo),
             next: AtomicU64::new(0),
-            messages: Mutex::new(VecDeque::with_capacity(16)),
+            messages: Mutex::new(Kept::default()),
         })
     }
 
-    fn lock(&self) -> MutexGuard<'_, VecDeque<(u64, LogMessage)>> {
+    fn lock(&self) -> MutexGuard<'_, Kept> {
         self.messages.lock().unwrap_or_else(|e| e.into_inner())
     }
 
@@ -120,21 +149,69 @@ impl LogSink {
 
     /// Forgets all messages.
     pub(crate) fn clear(&self) {
-        self.lock().clear();
+        let mut kept = self.lock();
+        kept.messages.clear();
+        kept.bytes = 0;
     }
 
     fn push(&self, instance: &str, message: LogMessage) {
         if self.echo.load(Ordering::Relaxed) {
             eprintln!("[fmu {instance}] {message}");
         }
-        let mut messages = self.lock();
-        if messages.len() == CAPACITY {
-            messages.pop_front();
-        }
+        let mut kept = self.lock();
+        kept.bytes += kept_bytes(&message);
         let seq = self.next.load(Ordering::Relaxed);
-        messages.push_back((seq, message));
+        kept.messages.push_back((seq, message));
+        while kept.messages.len() > CAPACITY
+            || (kept.bytes > MAX_KEPT_BYTES && kept.messages.len() > 1)
+        {
+            if let Some((_, old)) = kept.messages.pop_front() {
+                kept.bytes -= kept_bytes(&old);
+            }
+        }
         self.next.store(seq + 1, Ordering::Release);
     }
+}
+
+/// The text of an FMU's C string made safe to keep and show: at most `max` bytes (cut on a
+/// character boundary, with `… (N bytes cut)`), invalid UTF-8 replaced, and control characters
+/// other than tab and newline (terminal escapes, carriage returns, NUL-like bytes) written as
+/// `\u{1b}`, so they reach neither the terminal nor a CSV file raw.
+pub(crate) fn clean_text(bytes: &[u8], max: usize) -> String {
+    let mut end = bytes.len().min(max);
+    if end < bytes.len() {
+        // Back to the start of a UTF-8 sequence (at most 3 continuation bytes).
+        let floor = end.saturating_sub(3);
+        while end > floor && (bytes[end] & 0b1100_0000) == 0b1000_0000 {
+            end -= 1;
+        }
+    }
+    let text = String::from_utf8_lossy(&bytes[..end]);
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() && c != '\t' && c != '\n' {
+            out.push_str(&format!("\\u{{{:x}}}", u32::from(c)));
+        } else {
+            out.push(c);
+        }
+    }
+    if end < bytes.len() {
+        out.push_str(&format!("… ({} bytes cut)", bytes.len() - end));
+    }
+    out
+}
+
+/// [`clean_text`] of a C string, `None` if null.
+///
+/// # Safety
+/// `ptr` must be null or point to a NUL-terminated string valid for the duration of the call.
+unsafe fn clean_c_string(ptr: *const c_char, max: usize) -> Option<String> {
+    if ptr.is_null() {
+        return None;
+    }
+    // SAFETY: non-null, and NUL-terminated and valid per this function's contract.
+    let s = unsafe { std::ffi::CStr::from_ptr(ptr) };
+    Some(clean_text(s.to_bytes(), max))
 }
 
 /// Receives a formatted message from the C shim and stores it in the [`LogSink`] at `env`.
@@ -155,8 +232,13 @@ extern "C" fn uq_driver_log(
         let sink = unsafe { &*(env as *const LogSink) };
         // SAFETY: the shim passes NUL-terminated strings from the FMU (or its own buffer), valid
         // during this call, or null.
-        let (instance, category, text) =
-            unsafe { (c_string(instance), c_string(category), c_string(message)) };
+        let (instance, category, text) = unsafe {
+            (
+                clean_c_string(instance, MAX_NAME_BYTES),
+                clean_c_string(category, MAX_NAME_BYTES),
+                clean_c_string(message, MAX_MESSAGE_BYTES),
+            )
+        };
         sink.push(
             instance.as_deref().unwrap_or(""),
             LogMessage {
@@ -219,13 +301,71 @@ mod tests {
         assert_eq!(got[0].message, "value 42 is bad");
         assert_eq!(got[0].status, Status::Error);
         assert_eq!(got[0].category, "logStatusError");
-        assert_eq!(got[1].message, format!("{long}!"));
+        // 5001 bytes: cut to the first 4096, and said so.
+        assert_eq!(
+            got[1].message,
+            format!("{}… (905 bytes cut)", &long[..MAX_MESSAGE_BYTES])
+        );
         assert_eq!(got[1].category, "");
         assert_eq!(
             sink.since(sink.mark()).len(),
             2,
             "falls back to the last messages"
         );
+        sink.clear();
+        assert!(sink.all().is_empty());
+    }
+
+    #[test]
+    fn huge_messages_are_cut_on_a_character_boundary_and_say_how_much() {
+        // "é" is 2 bytes: 4095 'a' then 'é' straddles the 4096-byte limit.
+        let text = format!(
+            "{}é{}",
+            "a".repeat(MAX_MESSAGE_BYTES - 1),
+            "b".repeat(5_000_000)
+        );
+        let cut = clean_text(text.as_bytes(), MAX_MESSAGE_BYTES);
+        assert_eq!(
+            cut,
+            format!(
+                "{}… ({} bytes cut)",
+                "a".repeat(MAX_MESSAGE_BYTES - 1),
+                text.len() - (MAX_MESSAGE_BYTES - 1)
+            )
+        );
+        assert_eq!(clean_text(b"short", MAX_MESSAGE_BYTES), "short");
+    }
+
+    #[test]
+    fn terminal_escapes_and_control_characters_are_escaped_tabs_and_newlines_kept() {
+        let raw = b"\x1b[31mred\x1b[0m\tcol\nline\rback\x07\x7f\xff";
+        assert_eq!(
+            clean_text(raw, MAX_MESSAGE_BYTES),
+            "\\u{1b}[31mred\\u{1b}[0m\tcol\nline\\u{d}back\\u{7}\\u{7f}\u{fffd}"
+        );
+    }
+
+    #[test]
+    fn a_flood_of_large_messages_keeps_a_bounded_number_of_bytes() {
+        let sink = LogSink::new(false);
+        let big = "m".repeat(MAX_MESSAGE_BYTES);
+        let mark = sink.mark();
+        for _ in 0..1000 {
+            sink.push(
+                "x",
+                LogMessage {
+                    status: Status::Warning,
+                    category: "c".into(),
+                    message: big.clone(),
+                },
+            );
+        }
+        let bytes: usize = sink.all().iter().map(kept_bytes).sum();
+        assert!(bytes <= MAX_KEPT_BYTES, "{bytes}");
+        assert_eq!(sink.all().len(), MAX_KEPT_BYTES / (MAX_MESSAGE_BYTES + 1));
+        // An error carries what is kept of the failing call's messages: as bounded.
+        let since: usize = sink.since(mark).iter().map(kept_bytes).sum();
+        assert!(since <= MAX_KEPT_BYTES, "{since}");
         sink.clear();
         assert!(sink.all().is_empty());
     }

@@ -19,9 +19,10 @@
 //! # Ok(()) }
 //! ```
 //!
-//! Every `Fmu::open` extracts and loads its own copy of the binary, so an FMU that keeps global
-//! state (`canBeInstantiatedOnlyOncePerProcess`) can still run in parallel by opening it once
-//! per worker.
+//! Every `Fmu::open` extracts and loads its own copy of the binary, and
+//! [`Fmu::private_copy`] loads another copy of an opened FMU's binary, so an FMU that keeps
+//! global state (`canBeInstantiatedOnlyOncePerProcess`) can still run in parallel with one
+//! copy per worker.
 
 pub mod archive;
 mod binary;
@@ -72,6 +73,8 @@ pub(crate) struct FmuInner {
     /// Set when a call returned fmi2Fatal: no function of this FMU may be called again.
     pub(crate) fatal: AtomicBool,
     _extracted: Option<Extracted>,
+    /// For a [`Fmu::private_copy`]: the FMU it copies (its extraction holds the resources).
+    _parent: Option<Arc<FmuInner>>,
 }
 
 /// A temporary extraction folder, known to [`cleanup`] until it is removed.
@@ -183,22 +186,7 @@ impl Fmu {
             });
         }
         // Name the binary by its place in the FMU, not in the temporary folder.
-        let shown = path.join(&relative);
-        let library = FmuLibrary::load(&binary).map_err(|e| match e {
-            FmuError::Load { reason, .. } => FmuError::Load {
-                path: shown.clone(),
-                reason,
-            },
-            FmuError::MissingSymbol { symbol, .. } => FmuError::MissingSymbol {
-                path: shown.clone(),
-                symbol,
-            },
-            FmuError::IncompatibleBinary { reason, .. } => FmuError::IncompatibleBinary {
-                path: shown.clone(),
-                reason,
-            },
-            other => other,
-        })?;
+        let library = load_library(&binary, &path.join(&relative))?;
 
         let resource_uri = format!("{}/", file_uri(&root.join("resources")));
         Ok(Fmu {
@@ -212,6 +200,54 @@ impl Fmu {
                 live_instances: AtomicUsize::new(0),
                 fatal: AtomicBool::new(false),
                 _extracted: extracted,
+                _parent: None,
+            }),
+        })
+    }
+
+    /// Loads another copy of this FMU's binary, with globals of its own: the files of the
+    /// binary's platform folder are copied into a new temporary folder (deleted on drop) and
+    /// the copy is loaded from there. The copy shares the description and the resources, and
+    /// counts its instances apart, so an FMU that declares
+    /// `canBeInstantiatedOnlyOncePerProcess="true"` can have one live instance per copy.
+    pub fn private_copy(&self) -> Result<Fmu, FmuError> {
+        let inner = &self.inner;
+        let dir = cleanup::temp_dir("uq-fmu-").map_err(|source| FmuError::Io {
+            path: std::env::temp_dir(),
+            source,
+        })?;
+        let dir = Extracted(Some(dir));
+        let folder = inner.binary.parent().unwrap_or(&inner.root);
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| FmuError::Io { path, source }
+        };
+        {
+            let _filling = cleanup::filling();
+            for entry in fs::read_dir(folder).map_err(io(folder))? {
+                let from = entry.map_err(io(folder))?.path();
+                if fs::metadata(&from).map_err(io(&from))?.is_file() {
+                    let name = from.file_name().expect("a folder entry has a name");
+                    fs::copy(&from, dir.path().join(name)).map_err(io(&from))?;
+                }
+            }
+        }
+        let name = inner.binary.file_name().expect("the binary has a name");
+        let binary = dir.path().join(name);
+        let relative = binary_path_in_fmu(&inner.description.co_simulation.model_identifier)?;
+        let library = load_library(&binary, &inner.path.join(relative))?;
+        Ok(Fmu {
+            inner: Arc::new(FmuInner {
+                path: inner.path.clone(),
+                description: inner.description.clone(),
+                library,
+                resource_uri: inner.resource_uri.clone(),
+                root: inner.root.clone(),
+                binary,
+                live_instances: AtomicUsize::new(0),
+                fatal: AtomicBool::new(false),
+                _extracted: Some(dir),
+                _parent: Some(Arc::clone(inner)),
             }),
         })
     }
@@ -259,6 +295,25 @@ impl Fmu {
     pub fn instantiate(&self, instance_name: &str, logging_on: bool) -> Result<Instance, FmuError> {
         Instance::new(Arc::clone(&self.inner), instance_name, logging_on)
     }
+}
+
+/// Loads the library at `binary`, naming it `shown` (its place in the FMU) in errors.
+fn load_library(binary: &Path, shown: &Path) -> Result<FmuLibrary, FmuError> {
+    FmuLibrary::load(binary).map_err(|e| match e {
+        FmuError::Load { reason, .. } => FmuError::Load {
+            path: shown.to_path_buf(),
+            reason,
+        },
+        FmuError::MissingSymbol { symbol, .. } => FmuError::MissingSymbol {
+            path: shown.to_path_buf(),
+            symbol,
+        },
+        FmuError::IncompatibleBinary { reason, .. } => FmuError::IncompatibleBinary {
+            path: shown.to_path_buf(),
+            reason,
+        },
+        other => other,
+    })
 }
 
 /// The folders under `root/binaries`, for error messages.

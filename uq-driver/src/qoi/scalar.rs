@@ -370,6 +370,44 @@ impl QoiSpec {
         }
     }
 
+    /// Refuses settings that no run on the communication grid from `start` to `stop` (s) by
+    /// `step` (s) can satisfy, so that the study is refused when it is read instead of every
+    /// point failing: a Sperling `f_max` above the Nyquist frequency `0.5 / step`, a window
+    /// (`from`, `to`) that holds no communication point.
+    pub fn check_grid(&self, start: f64, stop: f64, step: f64) -> Result<(), InvalidQuantity> {
+        let fail = |problem: String| {
+            Err(InvalidQuantity {
+                name: self.name().to_owned(),
+                problem,
+            })
+        };
+        match self {
+            QoiSpec::Sperling { f_max, .. } if *f_max > 0.5 / step * (1.0 + 1e-12) => {
+                fail(format!(
+                    "f_max = {f_max} Hz is above the Nyquist frequency {} Hz of the communication \
+                 step {step} s: lower f_max or use a smaller step",
+                    0.5 / step
+                ))
+            }
+            QoiSpec::MaxAbs { from, to, .. } | QoiSpec::Range { from, to, .. } => {
+                let tol = 1e-9 * step;
+                let to_t = to.unwrap_or(stop).min(stop);
+                // The first communication point at or after `from`.
+                let k = ((from - start) / step - 1e-9).ceil().max(0.0);
+                let first = (start + k * step).min(stop);
+                if first < *from - tol || first > to_t + tol {
+                    return fail(format!(
+                        "the window from {from} s to {} s holds no communication point of the run \
+                         ({start} s to {stop} s by {step} s)",
+                        to.map_or_else(|| format!("the stop time {stop}"), |t| t.to_string())
+                    ));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
     fn check_limits(&self) -> Result<(), InvalidQuantity> {
         match self.limits().iter().any(|l| !l.is_finite()) {
             true => Err(InvalidQuantity {

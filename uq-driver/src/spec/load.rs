@@ -222,10 +222,8 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
             "nothing to analyse: give [outputs] variables and/or [[qoi]]",
         ));
     }
-    let duration = {
-        let e = file.experiment.get_ref();
-        e.stop - e.start
-    };
+    let e = file.experiment.get_ref();
+    let duration = e.stop - e.start;
     let mut names: Vec<String> = file.outputs.variables.clone();
     for q in &file.qoi {
         let (span, q): (_, &QoiSpec) = (q.span(), q.get_ref());
@@ -239,6 +237,7 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
             names.push(name);
         }
         q.validate(duration)
+            .and_then(|()| q.check_grid(e.start, e.stop, e.step))
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
     // Their files: two names must not write the same one (checked before any run).

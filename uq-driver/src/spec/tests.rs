@@ -307,3 +307,40 @@ fn quantile_levels_that_share_a_column_name_are_refused() {
         assert_eq!(s.analysis.quantiles.len(), 2, "{q}");
     }
 }
+
+#[test]
+fn quantity_settings_the_communication_grid_cannot_meet_are_refused_when_the_study_is_read() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    // wheel-scm: 0 to 5 s by 0.01 s (Nyquist 50 Hz).
+    let with = |qoi: &str| format!("{base}\n{qoi}\n");
+    let cases = [
+        (
+            with("[[qoi]]\nkind = \"sperling\"\nname = \"W\"\nsignal = \"z\"\ndirection = \"vertical\"\nsegment = 1.0\nf_min = 0.5\nf_max = 1000.0"),
+            "f_max = 1000 Hz is above the Nyquist frequency 50 Hz of the communication step 0.01 s",
+        ),
+        (
+            with("[[qoi]]\nkind = \"max_abs\"\nname = \"m\"\nsignal = \"z\"\nfrom = 6.0\nto = 7.0"),
+            "the window from 6 s to 7 s holds no communication point",
+        ),
+        (
+            with("[[qoi]]\nkind = \"range\"\nname = \"m\"\nsignal = \"z\"\nfrom = 0.001\nto = 0.002"),
+            "the window from 0.001 s to 0.002 s holds no communication point",
+        ),
+        (
+            with("[[qoi]]\nkind = \"max_abs\"\nname = \"m\"\nsignal = \"z\"\nfrom = 5.5"),
+            "the window from 5.5 s to the stop time 5 s holds no communication point",
+        ),
+    ];
+    for (text, needle) in cases {
+        let err = Study::parse(&text, "t.toml", None).unwrap_err().to_string();
+        assert!(err.contains(needle), "{err} should mention {needle}");
+    }
+    // Windows that hold a point, and f_max at Nyquist, are fine.
+    for qoi in [
+        "[[qoi]]\nkind = \"max_abs\"\nname = \"m\"\nsignal = \"z\"\nfrom = 4.995\nto = 5.0",
+        "[[qoi]]\nkind = \"max_abs\"\nname = \"m\"\nsignal = \"z\"\nfrom = 5.0",
+        "[[qoi]]\nkind = \"sperling\"\nname = \"W\"\nsignal = \"z\"\ndirection = \"vertical\"\nsegment = 1.0\nf_min = 0.5\nf_max = 50.0",
+    ] {
+        Study::parse(&with(qoi), "t.toml", None).unwrap();
+    }
+}

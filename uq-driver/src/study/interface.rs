@@ -133,6 +133,9 @@ pub enum VariableProblem {
     /// The input signals do not fit.
     #[error("{0}")]
     Inputs(String),
+    /// A random parameter's distribution lies wholly outside its variable's declared range.
+    #[error("{0}")]
+    SupportOutsideRange(String),
     /// A quantity's settings do not fit the FMU or the study.
     #[error("quantity '{name}': {problem}")]
     Quantity {

@@ -18,6 +18,7 @@ pub mod nested;
 mod outcome;
 mod point;
 pub mod progress;
+pub mod ranges;
 pub mod runner;
 pub mod shard;
 mod single;
@@ -25,6 +26,7 @@ pub mod size;
 pub mod speed_runs;
 pub mod store;
 pub mod suite;
+mod worker_fmu;
 
 use std::path::Path;
 

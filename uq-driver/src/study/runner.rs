@@ -15,6 +15,7 @@ use super::lock::{FolderLock, LockError};
 pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
 use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
+use super::worker_fmu::WorkerFmus;
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
 use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
@@ -335,7 +336,7 @@ pub fn run_points(
     });
     let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
     let batch = Batch {
-        fmu,
+        fmus: WorkerFmus::new(fmu, threads),
         iface,
         study,
         design,
@@ -421,7 +422,8 @@ fn watchdog(guard: &StudyGuard, limit: Duration, done: &AtomicBool) {
 
 /// Points to run in parallel, each appended to the store as it finishes.
 struct Batch<'a> {
-    fmu: &'a Fmu,
+    /// The FMU of each worker thread.
+    fmus: WorkerFmus<'a>,
     iface: Interface,
     study: &'a Study,
     design: &'a Design,
@@ -481,8 +483,9 @@ impl Batch<'_> {
         let values = &self.design.values[i];
         let _running = self.guard.running(i, describe_values(self.study, values));
         let Some(workers) = &self.workers else {
+            let fmu = self.fmus.current()?;
             return Ok(
-                match run_point(self.fmu, slot, &self.iface, values, &self.times) {
+                match run_point(&fmu, slot, &self.iface, values, &self.times) {
                     Ok(v) => Record::Ok(v),
                     Err(e) => Record::Failed(e.to_string()),
                 },

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::lock::FolderLock;
 use super::outcome::{StudyResult, StudyRunError};
+use super::ranges;
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::single::{finish, open_fmu};
 use super::store::{Manifest, Store, StoreError, StoredRuns};
@@ -133,6 +134,10 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     let mut study = study.clone();
     study.fmu_path = Some(fmu_path.clone());
     let fmu = open_fmu(&study)?;
+    ranges::check_supports(&study, &fmu).map_err(RunError::from)?;
+    for w in ranges::range_warnings(&study, &fmu, &design) {
+        eprintln!("uq-driver: warning: {w}");
+    }
     let manifest = runner::manifest(&study, &fmu, &design)?;
     let p = Plan {
         version: PLAN_VERSION,

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::analysis::{self, Analysed, AnalysisError};
 use super::outcome::{StudyResult, StudyRunError};
+use super::ranges;
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
 use super::store::{Entry, StoredRuns};
@@ -38,6 +39,7 @@ pub(crate) fn run_single(
         Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
             let fmu = open_fmu(study)?;
+            ranges::check_supports(study, &fmu).map_err(RunError::from)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
             if method.planned_runs(study.parameters.len()).is_none() {
                 // Only the design knew its size: check it before it runs.
@@ -49,6 +51,9 @@ pub(crate) fn run_single(
                 study.method().label(study.parameters.len()),
                 design.len()
             );
+            for w in ranges::range_warnings(study, &fmu, &design) {
+                eprintln!("uq-driver: warning: {w}");
+            }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
             finish(study, method, &fmu, &design, outcome, out_dir, opts)
         }
@@ -172,6 +177,7 @@ pub(crate) fn finish(
     };
     let method_summary = study.method().summary(study.parameters.len());
     warnings.splice(0..0, design.warnings.iter().cloned());
+    warnings.splice(0..0, ranges::range_warnings(study, fmu, design));
     let mut summary = summary(
         study,
         facts,

@@ -118,6 +118,18 @@ pub enum SizeError {
         /// A hint for many random parameters.
         suggest: Suggestion,
     },
+    /// A command's result needs more memory than there is (e.g. `surrogate sample -n`).
+    #[error(
+        "{what} needs about {need} of memory, more than the {limit} available to this process"
+    )]
+    NoMemory {
+        /// What needs it.
+        what: String,
+        /// The memory it needs (formatted).
+        need: String,
+        /// The memory available (formatted).
+        limit: String,
+    },
     /// The study is large: it starts only with `--yes`.
     #[error(
         "the study is large ({reasons}): {footprint}. Run again with --yes to start it \
@@ -491,6 +503,20 @@ pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, Si
     };
     judge(&footprint, true)?;
     Ok(footprint)
+}
+
+/// Refuses `what` when its `need` (bytes) exceeds the memory available to this process
+/// ([`available_memory`], or an assumed amount where the system does not say).
+pub fn check_memory(what: &str, need: f64) -> Result<(), SizeError> {
+    let available = available_memory().unwrap_or(ASSUMED_MEMORY);
+    if need.is_nan() || need > available {
+        return Err(SizeError::NoMemory {
+            what: what.to_owned(),
+            need: bytes(need),
+            limit: bytes(available),
+        });
+    }
+    Ok(())
 }
 
 /// The footprint of `shape` with `runs` runs (none known: the grid and one run's buffers).

@@ -167,21 +167,7 @@ impl SurrogateFile {
             .iter()
             .map(|p| {
                 let d = &p.distribution;
-                let (family, map) = match (germ, Family::of(d), d.askey_affine()) {
-                    (Germ::Askey, Some(f), Some((offset, scale))) => {
-                        (f, InputMap::Affine { offset, scale })
-                    }
-                    (_, _, _) => match *d {
-                        Distribution::Normal { mean, std } => (
-                            Family::Hermite,
-                            InputMap::Affine {
-                                offset: mean,
-                                scale: std,
-                            },
-                        ),
-                        _ => (Family::Hermite, InputMap::Normal),
-                    },
-                };
+                let (family, map) = chaos_input(germ, d);
                 SurrogateInput {
                     name: p.name.clone(),
                     distribution: d.clone(),
@@ -218,6 +204,108 @@ impl SurrogateFile {
             quantities: quantities.iter().map(chaos).collect(),
         }
     }
+}
+
+/// The family of an input's chaos and how its germ maps to it, with the standard space
+/// `germ` (what the evaluation uses: [`RandomInputs::to_germ`]).
+fn chaos_input(germ: Germ, d: &Distribution) -> (Family, InputMap) {
+    match (germ, Family::of(d), d.askey_affine()) {
+        (Germ::Askey, Some(f), Some((offset, scale))) => (f, InputMap::Affine { offset, scale }),
+        (_, _, _) => match *d {
+            Distribution::Normal { mean, std } => (
+                Family::Hermite,
+                InputMap::Affine {
+                    offset: mean,
+                    scale: std,
+                },
+            ),
+            _ => (Family::Hermite, InputMap::Normal),
+        },
+    }
+}
+
+/// The highest polynomial degree a surrogate may have in one input: far above any chaos a
+/// study fits, low enough that evaluating it stays cheap (a damaged index is refused instead
+/// of allocating for it).
+pub const MAX_DEGREE: usize = 1000;
+
+/// Checks what [`Surrogate::new`] relies on beyond the format: a chaos germ, each input's
+/// family and map those of its distribution, sane multi-indices, and finite coefficients of
+/// the right count (one vector per time of an output, one for a quantity).
+fn validate(f: &SurrogateFile) -> Result<(), String> {
+    if f.germ == Germ::Uniform {
+        return Err("germ \"uniform\" is not a chaos germ (\"normal\" or \"askey\")".into());
+    }
+    for (i, input) in f.inputs.iter().enumerate() {
+        if f.inputs[..i].iter().any(|o| o.name == input.name) {
+            return Err(format!("input '{}' is listed twice", input.name));
+        }
+        let (family, map) = chaos_input(f.germ, &input.distribution);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1.0);
+        let same_map = match (&map, &input.map) {
+            (InputMap::Normal, InputMap::Normal) => true,
+            (
+                InputMap::Affine { offset, scale },
+                InputMap::Affine {
+                    offset: o,
+                    scale: s,
+                },
+            ) => close(*offset, *o) && close(*scale, *s),
+            _ => false,
+        };
+        if family != input.family || !same_map {
+            return Err(format!(
+                "input '{}': family {:?} with map {:?} does not match its distribution with germ \
+                 {:?} (expected family {family:?} with map {map:?})",
+                input.name, input.family, input.map, f.germ
+            ));
+        }
+    }
+    for (c, is_output) in f
+        .outputs
+        .iter()
+        .map(|c| (c, true))
+        .chain(f.quantities.iter().map(|c| (c, false)))
+    {
+        let name = &c.name;
+        if c.multi_indices.is_empty() {
+            return Err(format!("'{name}': no multi-index"));
+        }
+        if let Some(k) = c
+            .multi_indices
+            .iter()
+            .find(|k| k.iter().any(|&d| d > MAX_DEGREE))
+        {
+            return Err(format!(
+                "'{name}': multi-index {k:?} has a degree above {MAX_DEGREE}"
+            ));
+        }
+        let wanted = match (is_output, &c.times) {
+            (true, Some(t)) if !t.is_empty() => {
+                if t.iter().any(|x| !x.is_finite()) || t.windows(2).any(|w| w[1] < w[0]) {
+                    return Err(format!("'{name}': the times must be finite and increasing"));
+                }
+                t.len()
+            }
+            (true, _) => return Err(format!("'{name}': an output needs its times")),
+            (false, _) => 1,
+        };
+        if c.coefficients.len() != wanted {
+            return Err(format!(
+                "'{name}': {} coefficient vectors for {wanted} {}",
+                c.coefficients.len(),
+                if is_output {
+                    "times"
+                } else {
+                    "value (a quantity has one)"
+                }
+            ));
+        }
+        if c.coefficients.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(format!("'{name}': a coefficient is not a finite number"));
+        }
+    }
+    Ok(())
 }
 
 /// A surrogate ready to evaluate: the inputs with their copula, and the chaoses.
@@ -267,6 +355,7 @@ impl Surrogate {
                 f.format, f.version
             )));
         }
+        validate(&f).map_err(invalid)?;
         let parameters: Vec<RandomParameter> = f
             .inputs
             .iter()
@@ -327,7 +416,12 @@ impl Surrogate {
             .iter()
             .map(|p| p.distribution.nominal())
             .collect();
-        for (name, v) in at {
+        for (k, (name, v)) in at.iter().enumerate() {
+            if at[..k].iter().any(|(n, _)| n == name) {
+                return Err(SurrogateError::Input(format!(
+                    "'{name}' is given more than once"
+                )));
+            }
             let i = self
                 .inputs
                 .iter()
@@ -476,6 +570,24 @@ impl Surrogate {
             text.push('\n');
         }
         Ok(text)
+    }
+
+    /// The memory (bytes) [`Surrogate::sample_csv`] of `n` draws needs at its peak: every
+    /// draw's inputs and values (all times of every output) with their allocations, and its
+    /// CSV row (about 25 bytes a number), with the text doubled as it grows.
+    pub fn sample_memory(&self, n: usize, times: &[f64]) -> f64 {
+        const VEC: f64 = 24.0 + 16.0; // a Vec and its allocation's overhead
+        let d = self.inputs.len() as f64;
+        let nq = self.file.quantities.len() as f64;
+        let values: f64 = self
+            .file
+            .outputs
+            .iter()
+            .map(|o| VEC + 8.0 * o.times.as_ref().map_or(0, Vec::len) as f64)
+            .sum();
+        let columns = d + nq + self.file.outputs.len() as f64 * times.len().max(1) as f64;
+        let draw = 3.0 * VEC + 16.0 * d + values + 8.0 * nq;
+        n as f64 * (draw + 2.0 * 25.0 * columns)
     }
 
     /// `n` random points of the inputs' joint law with the surrogate's values there: point
@@ -677,5 +789,82 @@ mod tests {
         file.version = VERSION;
         file.outputs[0].coefficients[0].pop();
         assert!(Surrogate::new(file).is_err());
+    }
+
+    fn refusal(file: SurrogateFile) -> String {
+        match Surrogate::new(file) {
+            Err(SurrogateError::Invalid(m)) => m,
+            other => panic!("not refused: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn damaged_surrogate_files_are_refused_on_loading_not_when_sampled() {
+        let good = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[chaos()], &[]);
+        // Fewer coefficient vectors than times (sample used to index past them).
+        let mut f = good.clone();
+        f.outputs[0].times = Some(vec![0.0, 1.0, 2.0]);
+        assert!(refusal(f).contains("1 coefficient vectors for 3 times"));
+        let mut f = good.clone();
+        f.outputs[0].times = None;
+        assert!(refusal(f).contains("needs its times"));
+        let mut f = good.clone();
+        f.outputs[0].times = Some(vec![f64::NAN]);
+        assert!(refusal(f).contains("finite and increasing"));
+        // A huge degree (used to allocate for it).
+        let mut f = good.clone();
+        f.outputs[0].multi_indices[2] = vec![4_000_000_000, 0];
+        assert!(refusal(f).contains("degree above 1000"));
+        let mut f = good.clone();
+        f.outputs[0].coefficients[0][1] = f64::INFINITY;
+        assert!(refusal(f).contains("not a finite number"));
+        // A quantity has one coefficient vector.
+        let mut f = good.clone();
+        let mut q = f.outputs[0].clone();
+        q.times = None;
+        q.coefficients.push(q.coefficients[0].clone());
+        f.quantities.push(q);
+        assert!(refusal(f).contains("2 coefficient vectors for 1 value"));
+        // The uniform germ (Monte Carlo designs) has no chaos: draws were NaN.
+        let mut f = good.clone();
+        f.germ = Germ::Uniform;
+        assert!(refusal(f).contains("not a chaos germ"));
+        // Families and maps that are not those the evaluation uses.
+        let mut f = good.clone();
+        f.inputs[1].family = Family::Hermite;
+        assert!(refusal(f).contains("input 'b'"));
+        let mut f = good.clone();
+        f.inputs[0].map = InputMap::Affine {
+            offset: 2.0,
+            scale: -1.0,
+        };
+        assert!(refusal(f).contains("input 'a'"));
+        let mut f = good.clone();
+        f.inputs[1].name = "a".into();
+        assert!(refusal(f).contains("listed twice"));
+        assert!(Surrogate::new(good).is_ok());
+    }
+
+    #[test]
+    fn a_repeated_at_is_refused_not_the_last_value_kept() {
+        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[chaos()], &[]);
+        let s = Surrogate::new(file).unwrap();
+        let err = s
+            .point(&[("a".into(), 1.0), ("b".into(), 1.0), ("a".into(), 2.0)])
+            .unwrap_err();
+        assert!(
+            err.to_string().contains("'a' is given more than once"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn sample_memory_grows_with_the_draws_and_bounds_the_csv_text() {
+        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[chaos()], &[]);
+        let s = Surrogate::new(file).unwrap();
+        let one = s.sample_memory(1000, &[]);
+        assert_eq!(s.sample_memory(2000, &[]), 2.0 * one);
+        assert!(one > s.sample_csv(1000, 1, &[]).unwrap().len() as f64);
+        assert!(s.sample_memory(100_000_000_000, &[]) > 1e12);
     }
 }

@@ -452,6 +452,7 @@ impl Builder {
             log_categories: self.log_categories,
             variables: self.variables,
             outputs: self.outputs,
+            by_name: Default::default(),
         })
     }
 }
