@@ -63,9 +63,13 @@ fn test_fmus_are_packed_with_description_binary_and_resources() {
     };
     assert_eq!(
         built.keys().map(String::as_str).collect::<Vec<_>>(),
-        ["Features", "Functions"]
+        ["Features", "Functions", "Once"]
     );
-    for (name, identifier) in [("Functions", "functions"), ("Features", "features")] {
+    for (name, identifier) in [
+        ("Functions", "functions"),
+        ("Features", "features"),
+        ("Once", "once"),
+    ] {
         let path = test_fmus::test_fmu(name).unwrap();
         let mut archive = zip::ZipArchive::new(fs::File::open(&path).unwrap()).unwrap();
         let mut names: Vec<&str> = archive.file_names().collect();
