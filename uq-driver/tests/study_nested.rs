@@ -330,3 +330,63 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
     }
     assert_eq!(summary(&whole)["model_runs"], 40);
 }
+
+#[test]
+fn conditional_sobol_indices_of_an_outer_sample_without_inner_variance_are_nan_not_zero() {
+    // Before: the S_<p> columns of <q>_conditional.csv wrote 0 where the inner variance is
+    // zero (the indices are 0/0 there). Here y = x1 + x2² + h(seed) with x1, x2 fixed and the
+    // inner input x3, which function 4 ignores: every outer sample has no inner variance.
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        r#"name = "flat-inner"
+fmu = "{fmu}"
+seed = 3
+[experiment]
+stop = 0.2
+step = 0.1
+[method]
+kind = "nested"
+outer = {{ kind = "mc", samples = 3 }}
+inner = {{ kind = "scm", nodes = 2, order = 1 }}
+[[parameters]]
+name = "seed"
+distribution = "integer_uniform"
+low = 1
+high = {SEEDS}
+level = "outer"
+[[parameters]]
+name = "x3"
+mean = 0.0
+std = 1.0
+[fixed]
+function = 4
+x1 = 0.5
+x2 = 0.0
+[outputs]
+variables = ["y"]
+[[qoi]]
+kind = "final"
+name = "y_end"
+signal = "y"
+limits = [3.0]
+"#,
+        fmu = fmu.display()
+    );
+    let s = dir.path().join("flat.toml");
+    std::fs::write(&s, text).unwrap();
+    let out = dir.path().join("flat");
+    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let (header, rows) = conditional(&out);
+    let (std, s3) = (
+        header.iter().position(|h| h == "std").unwrap(),
+        header.iter().position(|h| h == "S_x3").unwrap(),
+    );
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r[std], 0.0, "{header:?} {r:?}");
+        assert!(r[s3].is_nan(), "{header:?} {r:?}");
+    }
+}

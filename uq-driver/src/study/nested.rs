@@ -396,7 +396,12 @@ fn conditional_table(
         exceedance: exceedance.to_vec(),
         sobol_first: est
             .iter()
-            .map(|e| e.sobol.as_ref().map(|s| s.first[0].clone()))
+            .map(|e| {
+                // An outer sample whose inner variance is zero has undefined indices (NaN).
+                e.sobol
+                    .as_ref()
+                    .map(|s| s.undefined_without_variance(&e.mean, &e.std).first[0].clone())
+            })
             .collect(),
         chaos,
     }
