@@ -9,11 +9,16 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 pub mod blocks;
+mod chaos_gap;
 mod columns;
+mod error;
 mod exceedance;
 mod runs;
 mod surrogate;
 
+pub(crate) use chaos_gap::chaos_gap_warnings;
+pub(crate) use error::quantity_error;
+pub use error::AnalysisError;
 pub use exceedance::{clopper_pearson, exceedance_count};
 
 use blocks::SeriesColumns;
@@ -29,86 +34,11 @@ use crate::results::{
 };
 use crate::spec::{Analysis, Study};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling, Sobol, Solution};
+use crate::uq::method::{Design, Draws, Estimate, Sampling, Sobol, Solution};
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
 pub(crate) const SURROGATE_SEED: u64 = 0x5eed_5a4d_0000_0000;
-
-/// Failures of the analysis.
-#[derive(Debug, thiserror::Error)]
-pub enum AnalysisError {
-    /// Too few runs succeeded.
-    #[error("only {ok} successful runs: nothing to analyse")]
-    TooFewRuns {
-        /// Successful runs.
-        ok: usize,
-    },
-    /// The estimator refused an output.
-    #[error("output '{name}'")]
-    Output {
-        /// The output.
-        name: String,
-        /// Why.
-        #[source]
-        source: MethodError,
-    },
-    /// No run gave a value of a quantity.
-    #[error(
-        "quantity '{name}': no run gave a value ({never_hunts} never hunt, {never_stops} never stop)"
-    )]
-    NoValue {
-        /// The quantity.
-        name: String,
-        /// Runs that never hunt.
-        never_hunts: usize,
-        /// Runs whose oscillation never stops.
-        never_stops: usize,
-    },
-    /// The estimator refused a quantity (e.g. a weighted point without a value).
-    #[error(
-        "quantity '{name}' ({never_hunts} runs never hunt, {never_stops} never stop; use a method \
-         that can leave points out, such as LHS or MC, or change the detection settings or the run length)"
-    )]
-    Quantity {
-        /// The quantity.
-        name: String,
-        /// Runs that never hunt.
-        never_hunts: usize,
-        /// Runs whose oscillation never stops.
-        never_stops: usize,
-        /// Why.
-        #[source]
-        source: MethodError,
-    },
-    /// A `hunting_speed` quantity whose bracket does not contain the transition at every
-    /// point that needs a value (all points, or any point of a weighted design).
-    #[error(
-        "quantity '{name}': at {decays_at_high} points the disturbance dies out even at the top of \
-         the bracket (high = {high}) and at {hunts_at_low} it keeps hunting even at the bottom \
-         (low = {low}); widen the bracket{more}"
-    )]
-    OutsideBracket {
-        /// The quantity.
-        name: String,
-        /// The bracket.
-        low: f64,
-        /// The bracket.
-        high: f64,
-        /// Points that die out at `high`.
-        decays_at_high: usize,
-        /// Points that keep hunting at `low`.
-        hunts_at_low: usize,
-        /// Further advice.
-        more: &'static str,
-    },
-    /// The results store could not be read.
-    #[error(transparent)]
-    Store(#[from] super::store::StoreError),
-    /// An estimate asks for draws it cannot give.
-    #[error("output '{0}': the estimate has neither runs nor a chaos to draw from")]
-    NoDraws(String),
-}
 
 /// The analysis settings of a study, and the surrogate draws it shares.
 #[derive(Clone, Copy)]
@@ -507,77 +437,6 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
     })
 }
 
-/// A chaos whose variance differs from the method's own by more than this fraction of it
-/// (at some time) is reported ([`chaos_gap_warnings`]).
-const CHAOS_GAP: f64 = 0.01;
-
-/// Warnings where a method's chaos holds a variance that differs by more than
-/// [`CHAOS_GAP`] from the method's own estimate of it (SCM: the quadrature's, from the same
-/// runs): the chaos's Sobol' indices, quantiles and densities then miss (or invent) that part,
-/// and the quadrature itself may not have converged. `askey_hint`: the design maps inputs
-/// that have an Askey family of their own through the normal (`chaos = "hermite"`), so the
-/// warning suggests their own families.
-pub(crate) fn chaos_gap_warnings(a: &Analysed, askey_hint: bool) -> Vec<String> {
-    let mut out = Vec::new();
-    for o in &a.outputs {
-        if let Some(sc) = &o.std_pce {
-            out.extend(chaos_gap(&o.name, &o.std, sc, Some(&o.times), askey_hint));
-        }
-    }
-    for c in &a.quantity_chaos {
-        if let Some(q) = a.quantities.iter().find(|q| q.name == c.name) {
-            out.extend(chaos_gap(&q.name, &[q.std], &c.pce.std(), None, askey_hint));
-        }
-    }
-    out
-}
-
-/// The warning of one output (`times`) or quantity (`None`) whose Std is `std` by the method
-/// and `std_chaos` by its chaos, at the column where they differ most (columns whose Std is
-/// below 1e-3 of the largest are left out: rounding dominates there).
-fn chaos_gap(
-    name: &str,
-    std: &[f64],
-    std_chaos: &[f64],
-    times: Option<&[f64]>,
-    askey_hint: bool,
-) -> Option<String> {
-    let largest = std
-        .iter()
-        .filter(|s| s.is_finite())
-        .fold(0.0_f64, |m, s| m.max(s.abs()));
-    let (k, gap) = std
-        .iter()
-        .zip(std_chaos)
-        .enumerate()
-        .filter(|(_, (s, c))| s.is_finite() && c.is_finite() && s.abs() > 1e-3 * largest)
-        .map(|(k, (s, c))| (k, (s * s - c * c).abs() / (s * s)))
-        .fold(None, |w: Option<(usize, f64)>, (k, g)| match w {
-            Some((_, best)) if best >= g => w,
-            _ => Some((k, g)),
-        })?;
-    if gap <= CHAOS_GAP {
-        return None;
-    }
-    let at = times.map_or(String::new(), |t| format!(" at t = {} s", t[k]));
-    let (s, c) = (std[k], std_chaos[k]);
-    Some(format!(
-        "{name}{at}: the chaos holds {:.1} % {} variance than the method's own estimate \
-         (Std {c:.6e} against {s:.6e}); its Sobol' indices, quantiles and densities {} that \
-         part, and the estimate may not have converged either: raise `order` (below `nodes`) \
-         or `nodes`{}",
-        100.0 * gap,
-        if c < s { "less" } else { "more" },
-        if c < s { "miss" } else { "add" },
-        if askey_hint {
-            ", or expand the bounded inputs in their own families (`chaos = \"askey\"`, \
-             the default)"
-        } else {
-            ""
-        },
-    ))
-}
-
 /// What [`analyse_runs`] finds.
 #[derive(Clone, Debug)]
 pub struct Analysed {
@@ -658,46 +517,6 @@ pub fn analyse_runs(
         output_chaos,
         quantity_chaos,
     })
-}
-
-/// The error of scalar quantity `name` (its runs `qr`) that has no value at any run
-/// (`source` `None`) or whose estimator refused its values (`source`, e.g. a weighted design
-/// with points left without a value). A `hunting_speed` whose runs missed the transition names
-/// its bracket and how many points fell outside it on each side.
-pub(crate) fn quantity_error(
-    name: &str,
-    q: &QoiSpec,
-    qr: &QuantityRuns,
-    source: Option<MethodError>,
-) -> AnalysisError {
-    let missed = qr.never_hunts + qr.never_stops > 0;
-    match (q, source) {
-        (QoiSpec::HuntingSpeed(h), source) if source.is_none() || missed => {
-            AnalysisError::OutsideBracket {
-                name: name.to_owned(),
-                low: h.low,
-                high: h.high,
-                decays_at_high: qr.never_hunts,
-                hunts_at_low: qr.never_stops,
-                more: if source.is_some() {
-                    " (or use a method that can leave points out, such as LHS or MC)"
-                } else {
-                    ""
-                },
-            }
-        }
-        (_, None) => AnalysisError::NoValue {
-            name: name.to_owned(),
-            never_hunts: qr.never_hunts,
-            never_stops: qr.never_stops,
-        },
-        (_, Some(source)) => AnalysisError::Quantity {
-            name: name.to_owned(),
-            never_hunts: qr.never_hunts,
-            never_stops: qr.never_stops,
-            source,
-        },
-    }
 }
 
 /// The estimate and the statistics of output `o`, estimated a block of time columns at a
