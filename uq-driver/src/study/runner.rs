@@ -19,7 +19,6 @@ use super::worker_fmu::WorkerFmus;
 use crate::fmu::{Fmu, FmuError, Instance};
 use crate::spec::Study;
 use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
-use crate::uq::pce::Family;
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -200,12 +199,7 @@ pub fn study_hash(study: &Study) -> String {
     // SCM follows each input's Askey family since `chaos` became one of its keys: where that
     // changes the design (an input with a non-Hermite germ) the hash says so, so that a store
     // of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
-    if scm_askey(&study.method)
-        && study
-            .parameters
-            .iter()
-            .any(|p| !matches!(Family::of(&p.distribution), None | Some(Family::Hermite)))
-    {
+    if scm_askey(&study.method) && ChaosBasis::some_own_family(&study.parameters) {
         key["scm_germ"] = serde_json::json!("askey");
     }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))

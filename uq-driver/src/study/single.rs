@@ -20,8 +20,9 @@ use crate::results::{
 };
 use crate::spec::Study;
 use crate::uq::distributions::Germ;
-use crate::uq::method::{Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling};
-use crate::uq::pce::Family;
+use crate::uq::method::{
+    ChaosBasis, Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling,
+};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
@@ -232,11 +233,8 @@ fn analyse(
         _ => {
             let analysed = analysis::analyse_runs(study, method, design, records)?;
             // Inputs with an Askey family of their own that the design maps through the normal.
-            let askey_hint = design.germ == Germ::Normal
-                && design
-                    .inputs
-                    .iter()
-                    .any(|p| !matches!(Family::of(&p.distribution), None | Some(Family::Hermite)));
+            let askey_hint =
+                design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);
             let warnings = analysis::chaos_gap_warnings(&analysed, askey_hint);
             (analysed, Vec::new(), warnings)
         }

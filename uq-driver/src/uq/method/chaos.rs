@@ -34,6 +34,15 @@ impl ChaosBasis {
         *self == ChaosBasis::Askey
     }
 
+    /// Whether some input has an Askey family of its own other than Hermite (uniform,
+    /// Beta, Gamma): there the `askey` and `hermite` designs differ.
+    pub fn some_own_family(parameters: &[RandomParameter]) -> bool {
+        ChaosBasis::Askey
+            .families(parameters)
+            .iter()
+            .any(|f| *f != Family::Hermite)
+    }
+
     /// The germ family of each input: its own Askey family (Hermite where it has none, the
     /// input then mapped through the normal), or Hermite for all.
     pub fn families(self, parameters: &[RandomParameter]) -> Vec<Family> {
