@@ -178,6 +178,8 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
         outside as f64 / 200.0
     );
     assert!(stderr.contains(&want), "{stderr}\nwant: {want}");
+    // Printed before the runs, and not a second time with the final warnings.
+    assert_eq!(stderr.matches(&want).count(), 1, "{stderr}");
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
     assert!(summary.contains(&want), "{summary}");
 }

@@ -10,7 +10,7 @@ use uq_driver::study::{StudyResult, SuiteResult};
 /// where the results are (`index.html`, or the folder when `--no-report` wrote no page).
 pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
     let s = &r.summary;
-    for w in &s.warnings {
+    for w in s.warnings.iter().skip(r.warnings_shown) {
         eprintln!("uq-driver: warning: {w}");
     }
     let t = &s.timing;
@@ -57,14 +57,15 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
         }
     }
     if s.failed_runs > 0 {
-        println!("{} points failed (see points.csv)", s.failed_runs);
+        let points = if s.failed_runs == 1 { "point" } else { "points" };
+        println!("{} {points} failed (see points.csv)", s.failed_runs);
     }
 }
 
 /// The result of `run` for a suite: one line per variant.
 pub(crate) fn print_suite(r: &SuiteResult, out: &Path) {
     for v in &r.variants {
-        for w in &v.summary.warnings {
+        for w in v.summary.warnings.iter().skip(v.warnings_shown) {
             eprintln!("uq-driver: warning: {}: {w}", v.summary.study);
         }
     }

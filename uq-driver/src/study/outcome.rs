@@ -44,6 +44,9 @@ pub struct StudyResult {
     pub outputs: Vec<OutputStats>,
     /// Statistics per scalar quantity of interest.
     pub quantities: Vec<ScalarStats>,
+    /// How many of `summary.warnings`, from the first, were already printed before the runs
+    /// (the declared-range warnings), so that `run` does not print them again at the end.
+    pub warnings_shown: usize,
 }
 
 /// What a finished suite returns.

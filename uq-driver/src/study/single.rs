@@ -52,11 +52,15 @@ pub(crate) fn run_single(
                 study.method().label(study.parameters.len()),
                 design.len()
             );
-            for w in ranges::range_warnings(study, &fmu, &design) {
+            let early = ranges::range_warnings(study, &fmu, &design);
+            for w in &early {
                 eprintln!("uq-driver: warning: {w}");
             }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
-            finish(study, method, &fmu, &design, outcome, out_dir, opts)
+            let mut result = finish(study, method, &fmu, &design, outcome, out_dir, opts)?;
+            // finish puts the same range warnings first in the summary's list.
+            result.warnings_shown = early.len();
+            Ok(result)
         }
     }
 }
@@ -214,6 +218,7 @@ pub(crate) fn finish(
         summary,
         outputs,
         quantities,
+        warnings_shown: 0,
     })
 }
 
@@ -313,6 +318,7 @@ fn solve(
         summary,
         outputs,
         quantities: Vec::new(),
+        warnings_shown: 0,
     })
 }
 
