@@ -41,6 +41,32 @@ fn temp_beside(path: &Path) -> io::Result<NamedTempFile> {
         .tempfile_in(folder_of(path))
 }
 
+/// Removes the temporary files a killed run left in `dir` (not in its sub-folders): regular
+/// files and links named `.uq-driver-tmp-*.part`, never followed. Called by the holder of the
+/// folder's lock, while no other run writes there. Returns how many were removed; a file that
+/// cannot be removed is left (it is only clutter).
+pub fn remove_leftovers(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if !(name.starts_with(TEMP_PREFIX) && name.ends_with(".part")) {
+            continue;
+        }
+        // file_type() does not follow a link: a directory of that name is left alone.
+        let Ok(kind) = entry.file_type() else {
+            continue;
+        };
+        if (kind.is_file() || kind.is_symlink()) && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
 /// Writes `bytes` to `path` through a temporary file renamed over it (see the module docs).
 pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut tmp = temp_beside(path)?;
@@ -110,6 +136,35 @@ mod tests {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .filter(|n| n.starts_with(TEMP_PREFIX))
             .collect()
+    }
+
+    #[test]
+    fn temporary_files_left_by_a_killed_run_are_removed_and_nothing_else() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let victim = d.join("victim.txt");
+        std::fs::write(&victim, "precious\n").unwrap();
+        std::fs::write(d.join(format!("{TEMP_PREFIX}abc.part")), "half").unwrap();
+        symlink(&victim, d.join(format!("{TEMP_PREFIX}link.part"))).unwrap();
+        std::fs::create_dir(d.join(format!("{TEMP_PREFIX}dir.part"))).unwrap();
+        std::fs::write(d.join(format!("{TEMP_PREFIX}abc.csv")), "other").unwrap();
+        std::fs::write(d.join("summary.json"), "{}").unwrap();
+        assert_eq!(remove_leftovers(d), 2);
+        let mut left: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            [
+                format!("{TEMP_PREFIX}abc.csv"),
+                format!("{TEMP_PREFIX}dir.part"),
+                "summary.json".to_owned(),
+                "victim.txt".to_owned()
+            ]
+        );
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
     }
 
     #[test]

@@ -218,6 +218,9 @@ impl FolderLock {
         file.write_all(format!("{}\n", holder_text()).as_bytes())
             .map_err(io)?;
         file.sync_data().map_err(io)?;
+        // Only this process writes in the folder now: temporary files there are a killed
+        // run's leftovers.
+        crate::out_file::remove_leftovers(dir);
         Ok(FolderLock {
             path,
             file,
