@@ -67,6 +67,18 @@ pub fn remove_leftovers(dir: &Path) -> usize {
     removed
 }
 
+/// Creates the sub-folder `path` of an output folder (with its parents) unless it exists,
+/// and refuses it when it is a symbolic link: a link planted in a shared folder (e.g.
+/// `slurm/` → `/etc/cron.d`) would otherwise put uq-driver's files wherever it points.
+pub fn sub_folder(path: &Path) -> io::Result<()> {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(io::Error::other(
+            "is a symbolic link; uq-driver does not write through it (remove it)",
+        ));
+    }
+    std::fs::create_dir_all(path)
+}
+
 /// Writes `bytes` to `path` through a temporary file renamed over it (see the module docs).
 pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut tmp = temp_beside(path)?;
@@ -136,6 +148,21 @@ mod tests {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .filter(|n| n.starts_with(TEMP_PREFIX))
             .collect()
+    }
+
+    #[test]
+    fn a_symlink_planted_as_a_sub_folder_is_refused_not_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let elsewhere = dir.path().join("elsewhere");
+        std::fs::create_dir(&elsewhere).unwrap();
+        let planted = dir.path().join("slurm");
+        symlink(&elsewhere, &planted).unwrap();
+        let err = sub_folder(&planted).unwrap_err();
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        let made = dir.path().join("a").join("b");
+        sub_folder(&made).unwrap();
+        assert!(made.is_dir());
+        sub_folder(&made).unwrap();
     }
 
     #[test]

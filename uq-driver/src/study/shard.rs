@@ -366,7 +366,7 @@ pub fn write_sbatch(
     o: &SlurmOptions,
 ) -> Result<(PathBuf, PathBuf), ShardError> {
     let sdir = dir.join("slurm");
-    std::fs::create_dir_all(&sdir).map_err(io(&sdir))?;
+    crate::out_file::sub_folder(&sdir).map_err(io(&sdir))?;
     let dir = std::fs::canonicalize(dir).map_err(io(dir))?;
     if dir.to_string_lossy().contains(char::is_whitespace) {
         // #SBATCH lines are not parsed by a shell: a path with blanks cannot be written there.

@@ -34,7 +34,12 @@ pub fn run(
             v.name,
             v.method().label(v.parameters.len())
         );
-        results.push(run_single(v, &out_dir.join(&v.name), opts)?);
+        let folder = out_dir.join(&v.name);
+        crate::out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
+            path: folder.clone(),
+            source,
+        })?;
+        results.push(run_single(v, &folder, opts)?);
     }
     let summary = summarize(study, suite, &results);
     std::fs::create_dir_all(out_dir).map_err(|source| report::ReportError::Io {
