@@ -57,7 +57,11 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
         }
     }
     if s.failed_runs > 0 {
-        let points = if s.failed_runs == 1 { "point" } else { "points" };
+        let points = if s.failed_runs == 1 {
+            "point"
+        } else {
+            "points"
+        };
         println!("{} {points} failed (see points.csv)", s.failed_runs);
     }
 }

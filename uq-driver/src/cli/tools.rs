@@ -37,12 +37,21 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             out,
         } => {
             let s = Surrogate::load(&dir)?;
-            size::check_memory(
-                &format!("surrogate sample -n {n}"),
-                s.sample_memory(n, &times),
-            )
-            .map_err(|e| anyhow::anyhow!("{e}; use a smaller -n"))?;
-            emit(&s.sample_csv(n, seed, &times)?, out.as_deref())
+            // Written as drawn: the memory does not grow with -n.
+            match out.as_deref() {
+                Some(p) => {
+                    let mut f = uq_driver::out_file::OutFile::create(p, 1 << 16)
+                        .with_context(|| format!("writing {}", p.display()))?;
+                    s.write_sample_csv(n, seed, &times, &mut f, &p.display().to_string())?;
+                    f.commit()
+                        .with_context(|| format!("writing {}", p.display()))?;
+                }
+                None => {
+                    let mut stdout = std::io::stdout().lock();
+                    s.write_sample_csv(n, seed, &times, &mut stdout, "standard output")?;
+                }
+            }
+            Ok(())
         }
     }
 }

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::report::csv::{push_shortest, shortest};
 use crate::uq::distributions::{Distribution, Germ, RandomParameter};
 use crate::uq::method::ChaosError;
-use crate::uq::pce::{germ_draws, Basis, Family, MultiIndexSet, Pce};
+use crate::uq::pce::{germ_draw, germ_draws, Basis, Family, MultiIndexSet, Pce};
 use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
 
 /// `format` of the file.
@@ -549,6 +549,22 @@ impl Surrogate {
     /// communication point). Refuses a time outside an output's time grid, and two times
     /// that fall on one communication point.
     pub fn sample_csv(&self, n: usize, seed: u64, times: &[f64]) -> Result<String, SurrogateError> {
+        let mut bytes = Vec::new();
+        self.write_sample_csv(n, seed, times, &mut bytes, "memory")?;
+        Ok(String::from_utf8(bytes).expect("CSV text is UTF-8"))
+    }
+
+    /// [`Surrogate::sample_csv`] written to `w` row by row as the points are drawn: the memory
+    /// does not grow with `n` (the draws are those of [`Surrogate::sample`], point `i` from
+    /// the stream `(seed, i)`). `target` names `w` in an error.
+    pub fn write_sample_csv(
+        &self,
+        n: usize,
+        seed: u64,
+        times: &[f64],
+        w: &mut dyn std::io::Write,
+        target: &str,
+    ) -> Result<(), SurrogateError> {
         let picks = self.sample_columns(times)?;
         let mut header: Vec<String> = self.inputs.iter().map(|p| p.name.clone()).collect();
         header.extend(self.file.quantities.iter().map(|q| q.name.clone()));
@@ -556,38 +572,41 @@ impl Surrogate {
         let mut text = String::new();
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
         crate::report::csv::push_header(&mut text, &header);
-        for (x, v) in self.sample(n, seed) {
+        let families: Vec<Family> = self.file.inputs.iter().map(|i| i.family).collect();
+        let laws: Vec<_> = families.iter().map(Family::law).collect();
+        let mut t = vec![0.0; families.len()];
+        let io = |source| SurrogateError::Io {
+            path: target.to_owned(),
+            source,
+        };
+        for i in 0..n {
+            germ_draw(&families, &laws, seed, i, &mut t);
+            let x = self.inputs.to_physical(self.file.germ, &t);
+            let n_out = self.file.outputs.len();
+            // Only the picked times of each output are evaluated (the same sums as eval_germ).
             let values = x
                 .iter()
-                .chain(&v.quantities)
-                .chain(picks.iter().map(|&(o, k, _)| &v.outputs[o][k]));
+                .copied()
+                .chain(self.chaos[n_out..].iter().map(|p| p.eval_column(0, &t)))
+                .chain(
+                    picks
+                        .iter()
+                        .map(|&(o, k, _)| self.chaos[o].eval_column(k, &t)),
+                );
             for (j, y) in values.enumerate() {
                 if j > 0 {
                     text.push(',');
                 }
-                push_shortest(&mut text, *y);
+                push_shortest(&mut text, y);
             }
             text.push('\n');
+            if text.len() >= 1 << 16 {
+                w.write_all(text.as_bytes()).map_err(io)?;
+                text.clear();
+            }
         }
-        Ok(text)
-    }
-
-    /// The memory (bytes) [`Surrogate::sample_csv`] of `n` draws needs at its peak: every
-    /// draw's inputs and values (all times of every output) with their allocations, and its
-    /// CSV row (about 25 bytes a number), with the text doubled as it grows.
-    pub fn sample_memory(&self, n: usize, times: &[f64]) -> f64 {
-        const VEC: f64 = 24.0 + 16.0; // a Vec and its allocation's overhead
-        let d = self.inputs.len() as f64;
-        let nq = self.file.quantities.len() as f64;
-        let values: f64 = self
-            .file
-            .outputs
-            .iter()
-            .map(|o| VEC + 8.0 * o.times.as_ref().map_or(0, Vec::len) as f64)
-            .sum();
-        let columns = d + nq + self.file.outputs.len() as f64 * times.len().max(1) as f64;
-        let draw = 3.0 * VEC + 16.0 * d + values + 8.0 * nq;
-        n as f64 * (draw + 2.0 * 25.0 * columns)
+        w.write_all(text.as_bytes()).map_err(io)?;
+        w.flush().map_err(io)
     }
 
     /// `n` random points of the inputs' joint law with the surrogate's values there: point
@@ -859,12 +878,35 @@ mod tests {
     }
 
     #[test]
-    fn sample_memory_grows_with_the_draws_and_bounds_the_csv_text() {
-        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(false), &[chaos()], &[]);
+    fn sample_written_row_by_row_is_the_sample_drawn_at_once() {
+        let file = SurrogateFile::new("s", "scm", Germ::Askey, &inputs(true), &[chaos()], &[]);
         let s = Surrogate::new(file).unwrap();
-        let one = s.sample_memory(1000, &[]);
-        assert_eq!(s.sample_memory(2000, &[]), 2.0 * one);
-        assert!(one > s.sample_csv(1000, 1, &[]).unwrap().len() as f64);
-        assert!(s.sample_memory(100_000_000_000, &[]) > 1e12);
+        // More than one 64 KiB chunk of text.
+        let n = 5000;
+        let text = s.sample_csv(n, 3, &[]).unwrap();
+        assert!(text.len() > 1 << 17, "{}", text.len());
+        let draws = s.sample(n, 3);
+        let rows: Vec<&str> = text.lines().skip(1).collect();
+        assert_eq!(rows.len(), n);
+        for (row, (x, v)) in rows.iter().zip(&draws) {
+            let got: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
+            let want: Vec<f64> = x.iter().chain(&v.quantities).copied().collect();
+            assert_eq!(&got[..want.len()], &want[..]);
+            assert_eq!(got[want.len()], v.outputs[0][0]);
+        }
+        // A writer that fails names its target.
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::other("no space left"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let err = s
+            .write_sample_csv(10, 3, &[], &mut Full, "draws.csv")
+            .unwrap_err();
+        assert_eq!(err.to_string(), "draws.csv: no space left");
     }
 }
