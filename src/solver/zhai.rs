@@ -8,8 +8,21 @@
 //! a_{n+1} = M⁻¹ F(x_{n+1}, v_{n+1})
 //! ```
 //!
-//! with ψ = φ = 1/2 (second order), and ψ = φ = 0 on a start step (no `a_{n−1}` yet), or
-//! after the step length changed (the two-step formula assumes a constant step).
+//! with ψ = φ = 1/2 (second order), and ψ = φ = 0 on a start step (no `a_{n−1}` yet).
+//!
+//! A step `h` after a step of another length `h'` uses the variable-step form: the
+//! difference `a_n − a_{n−1}` stands for `ȧ h'`, so it is scaled by `r = h / h'`:
+//!
+//! ```text
+//! x_{n+1} = x_n + v_n h + a_n h²/2 + ψ r (a_n − a_{n−1}) h²
+//! v_{n+1} = v_n + a_n h + φ r (a_n − a_{n−1}) h        (the variable-step Adams–Bashforth 2)
+//! ```
+//!
+//! which is the formula above when `r = 1`. Only when the step more than doubles
+//! (`r > 2`, e.g. after a short last substep) is it a start step again. Restarting at every
+//! change of length instead (as this module did before) is the one-step formula, which
+//! gains energy: an importer that varies its communication step by 1 % from step to step made
+//! the vehicle–track model blow up within 0.03 s (found by QA).
 //! The caller supplies the accelerations `M⁻¹F` as a closure writing into a slice, so the
 //! integrator is generic over the state dimension and never allocates while stepping.
 #![forbid(unsafe_code)]
@@ -83,12 +96,27 @@ impl Zhai {
     #[inline(always)]
     pub fn predict(&mut self, h: f64) {
         let same_h = self.started && (h - self.last_h).abs() <= 1e-12 * h.abs();
-        let (psi, phi) = if same_h { (PSI, PSI) } else { (0.0, 0.0) };
         let h2 = h * h;
         let state = self.x.iter_mut().zip(self.v.iter_mut());
-        for ((x, v), (&a, &ap)) in state.zip(self.a.iter().zip(&self.a_prev)) {
-            *x += *v * h + (0.5 + psi) * a * h2 - psi * ap * h2;
-            *v += (1.0 + phi) * a * h - phi * ap * h;
+        let accel = self.a.iter().zip(&self.a_prev);
+        let r = h / self.last_h;
+        if same_h {
+            for ((x, v), (&a, &ap)) in state.zip(accel) {
+                *x += *v * h + (0.5 + PSI) * a * h2 - PSI * ap * h2;
+                *v += (1.0 + PSI) * a * h - PSI * ap * h;
+            }
+        } else if self.started && r <= 2.0 {
+            let (psi_r, phi_r) = (PSI * r, PSI * r);
+            for ((x, v), (&a, &ap)) in state.zip(accel) {
+                let da = a - ap;
+                *x += *v * h + 0.5 * a * h2 + psi_r * da * h2;
+                *v += a * h + phi_r * da * h;
+            }
+        } else {
+            for ((x, v), (&a, _)) in state.zip(accel) {
+                *x += *v * h + 0.5 * a * h2;
+                *v += a * h;
+            }
         }
         std::mem::swap(&mut self.a, &mut self.a_prev);
     }
@@ -164,7 +192,25 @@ mod tests {
     }
 
     #[test]
-    fn a_change_of_step_restarts_with_the_one_step_formula() {
+    fn a_step_more_than_twice_the_last_restarts_with_the_one_step_formula() {
+        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
+            a[0] = -x[0];
+            Ok(())
+        };
+        let mut z = Zhai::new(1);
+        z.x[0] = 1.0;
+        z.init_accel(f).unwrap();
+        z.step(0.01, f).unwrap();
+        let (x1, v1) = (z.x[0], z.v[0]);
+        z.step(0.05, f).unwrap();
+        // r = 5: restarted, x = x1 + v1·0.05 + 0.5·(−x1)·0.05², not the two-step formula.
+        let expected = x1 + v1 * 0.05 - 0.5 * x1 * 0.0025;
+        assert!((z.x[0] - expected).abs() < 1e-15, "{}", z.x[0]);
+        assert_eq!(z.last_h, 0.05);
+    }
+
+    #[test]
+    fn a_shorter_step_uses_the_variable_step_formula() {
         let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
             a[0] = -x[0];
             Ok(())
@@ -173,13 +219,72 @@ mod tests {
         z.x[0] = 1.0;
         z.init_accel(f).unwrap();
         z.step(0.1, f).unwrap();
-        // First step: x = 1 + 0.5·(−1)·0.01.
-        assert!((z.x[0] - 0.995).abs() < 1e-15);
-        assert!((z.v[0] + 0.1).abs() < 1e-15);
+        let (x1, v1, a0, a1) = (z.x[0], z.v[0], -1.0, -z.x[0]);
         z.step(0.05, f).unwrap();
-        // Restarted: x = 0.995 − 0.1·0.05 + 0.5·(−0.995)·0.05², not the two-step formula.
-        let expected = 0.995 - 0.1 * 0.05 - 0.5 * 0.995 * 0.0025;
-        assert!((z.x[0] - expected).abs() < 1e-15, "{}", z.x[0]);
-        assert_eq!(z.last_h, 0.05);
+        // r = 1/2: the difference a1 − a0 over 0.1 s scaled to 0.05 s.
+        let (h, r) = (0.05, 0.5);
+        let x = x1 + v1 * h + 0.5 * a1 * h * h + 0.5 * r * (a1 - a0) * h * h;
+        let v = v1 + a1 * h + 0.5 * r * (a1 - a0) * h;
+        assert!((z.x[0] - x).abs() < 1e-15 && (z.v[0] - v).abs() < 1e-15);
+    }
+
+    /// Undamped x'' = −x with 20 000 steps alternating between `ωh` and `ωh·q`: the largest
+    /// |x| (1 when the energy is kept).
+    fn alternating_peak(omega_h: f64, q: f64) -> f64 {
+        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
+            a[0] = -x[0];
+            Ok(())
+        };
+        let mut z = Zhai::new(1);
+        z.x[0] = 1.0;
+        z.init_accel(f).unwrap();
+        let mut peak: f64 = 0.0;
+        for k in 0..20_000 {
+            let h = if k % 2 == 0 { omega_h } else { omega_h * q };
+            z.step(h, f).unwrap();
+            peak = peak.max(z.x[0].abs());
+        }
+        peak
+    }
+
+    #[test]
+    fn steps_that_change_length_every_step_stay_stable() {
+        // QA: the vehicle–track model (stiffest mode at ωh ≈ 0.5) blew up when an importer
+        // alternated communication steps of 1e-4 and 0.99e-4 s: each change restarted the
+        // method with the one-step formula, which gains energy.
+        for q in [0.99, 0.9, 0.5] {
+            for oh in [0.25, 0.5, 1.0] {
+                let peak = alternating_peak(oh, q);
+                assert!(peak < 1.0 + 1e-3, "ωh = {oh}, q = {q}: peak {peak}");
+            }
+        }
+    }
+
+    #[test]
+    fn alternating_steps_converge_at_second_order() {
+        // Damped oscillator to t = 1 with steps h, 0.7h, h, 0.7h ...: halving h quarters the
+        // error, as with constant steps.
+        let (w, zeta) = (2.0 * std::f64::consts::PI * 1.5, 0.05);
+        let err = |h: f64| {
+            let f = |x: &[f64], v: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
+                a[0] = -w * w * x[0] - 2.0 * zeta * w * v[0];
+                Ok(())
+            };
+            let mut z = Zhai::new(1);
+            z.x[0] = 1.0;
+            z.init_accel(f).unwrap();
+            let (mut t, mut k) = (0.0, 0);
+            while t < 1.0 - 1e-12 {
+                let step = (if k % 2 == 0 { h } else { 0.7 * h }).min(1.0 - t);
+                z.step(step, f).unwrap();
+                t += step;
+                k += 1;
+            }
+            let wd = w * (1.0 - zeta * zeta).sqrt();
+            let exact = (-zeta * w).exp() * (wd.cos() + zeta * w / wd * wd.sin());
+            (z.x[0] - exact).abs()
+        };
+        let ratio = err(1.0 / 1700.0) / err(1.0 / 3400.0);
+        assert!((ratio - 4.0).abs() < 0.5, "ratio {ratio}");
     }
 }
