@@ -14,8 +14,10 @@ pub const MAX_SUBSTEPS: usize = 10_000_000;
 /// A step that needs more than [`MAX_SUBSTEPS`] substeps (or a step that is not a number).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
-    "a step of {span} s needs {needed:.3e} internal substeps of at most {h_max} s, more than the \
-     {MAX_SUBSTEPS} allowed per step: use shorter communication steps"
+    "a step of {} s needs {needed:.3e} internal substeps of at most {} s, more than the \
+     {MAX_SUBSTEPS} allowed per step: use shorter communication steps",
+    readable(*span),
+    readable(*h_max)
 )]
 pub struct TooManySubsteps {
     /// The step (s).
@@ -24,6 +26,17 @@ pub struct TooManySubsteps {
     pub h_max: f64,
     /// Substeps it would need.
     pub needed: f64,
+}
+
+/// `x` as Rust prints it when that is short (0.001, 250), else in exponent form (1e-300, not
+/// 300 zeros).
+fn readable(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() <= 12 {
+        plain
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// Number of equal substeps of length <= `h_max` that cover `span` (at least 1), or an error
@@ -74,6 +87,19 @@ fn add_scaled<const N: usize>(y: &[f64; N], k: &[f64; N], s: f64) -> [f64; N] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tiny_substep_is_written_in_exponent_form_not_with_300_zeros() {
+        // QA: h = 1e-300 gave a 452-character message.
+        let e = substeps(0.01, 1e-300).unwrap_err().to_string();
+        assert!(e.len() < 200, "{e}");
+        assert!(e.contains("of at most 1e-300 s"), "{e}");
+        let e = substeps(1e300, 1e-3).unwrap_err().to_string();
+        assert!(
+            e.starts_with("a step of 1e300 s needs") && e.contains("at most 0.001 s"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn substeps_tolerates_importer_rounding() {

@@ -38,7 +38,7 @@ variables! {
     real_parameter("k0", VR_K0 = 13, Some("N/m"), b.p.k0, 14.60e6, Fixed, non_negative, "Flange stiffness [lit] True & Kaas-Petersen", min = 0.0),
     real_parameter("delta", VR_DELTA = 14, Some("m"), b.p.delta, 9.1e-3, Fixed, non_negative, "Flange clearance (dead band of the flange spring) [lit] True & Kaas-Petersen", min = 0.0),
     real_parameter("V0", VR_V0 = 15, Some("m/s"), b.v0, 100.0, Fixed, above_min_speed, "Speed at the start time; must exceed 1 m/s [assumed]", min = MIN_SPEED),
-    real_parameter("ramp", VR_RAMP = 16, None, b.ramp, 10.0, Fixed, finite, "Speed ramp Df in s2/m: V = V0 - (t - t_start)/Df, i.e. the speed falls by 1/Df m/s per second; 0 = constant speed V0, < 0 = rising speed [paper eq. 29]"),
+    real_parameter("ramp", VR_RAMP = 16, Some("s2/m"), b.ramp, 10.0, Fixed, finite, "Speed ramp Df in s2/m: V = V0 - (t - t_start)/Df, i.e. the speed falls by 1/Df m/s per second; 0 = constant speed V0, < 0 = rising speed [paper eq. 29]"),
     real_parameter("Y0", VR_Y0 = 17, Some("m"), b.y0, 0.012, Fixed, finite, "Initial lateral displacement Y(t_start) [assumed]"),
     real_parameter("phi0", VR_PHI0 = 18, Some("rad"), b.phi0, 0.0, Fixed, finite, "Initial yaw angle phi(t_start) [assumed]"),
     real_parameter("dt", VR_DT = 19, Some("s"), b.dt, 1e-3, Fixed, positive, "Largest internal RK4 step; each communication step is split into equal substeps no longer than dt [numerical]", min = 0.0),

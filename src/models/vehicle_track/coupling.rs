@@ -194,10 +194,17 @@ impl VehicleTrack {
                 };
                 let sample = match &self.sample_cache {
                     Some(s) if s.key == key => s.clone(),
-                    _ => Arc::new(
-                        RandomProfile::generate(key)
-                            .map_err(|e| Self::invalid(VR_LAMBDA_MIN, p.r(VR_LAMBDA_MIN), e))?,
-                    ),
+                    _ => Arc::new(RandomProfile::generate(key).map_err(|e| {
+                        // About the three together: name them all, not one the user may not
+                        // have changed.
+                        ModelError::Other(format!(
+                            "irregularity sample (irregularity_length = {} m, lambda_min = {} m, \
+                             lambda_max = {} m): {e}",
+                            p.r(VR_IRR_LENGTH),
+                            p.r(VR_LAMBDA_MIN),
+                            p.r(VR_LAMBDA_MAX)
+                        ))
+                    })?),
                 };
                 self.sample_cache = Some(sample.clone());
                 Irregularity::Random(sample)

@@ -82,6 +82,34 @@ impl VehicleTrack {
         }
     }
 
+    /// Refuses a `dt` at which the explicit integration surely diverges: the highest rail
+    /// mode, `ω = (NM π / l)² √(EI / mr)` (bending alone; the supports only raise it), beyond
+    /// the undamped stability limit `ω dt = 2` of Zhai's method (damping lowers the limit
+    /// further). Such a run used to return fmi2OK with forces of 1e63 N until the state
+    /// overflowed (found by QA: dt = 0.01 s).
+    fn check_stability_limit(&self) -> Result<(), ModelError> {
+        let p = &self.p;
+        let length = (f64::from(p.n_sleepers) + 1.0) * p.r(VR_LS);
+        let k = f64::from(p.n_modes) * std::f64::consts::PI / length;
+        let omega = k * k * (p.r(VR_EI) / p.r(VR_MR)).sqrt();
+        let dt = p.r(VR_DT);
+        if omega * dt > 2.0 {
+            return Err(Self::invalid(
+                VR_DT,
+                dt,
+                format!(
+                    "the explicit integration diverges: the highest rail mode (n_modes = {}, \
+                     {omega:.4e} rad/s) needs dt < 2/omega = {:.3e} s (a margin of 1.5-2 below \
+                     that, as the default 1e-4 s has, keeps it stable with damping); reduce dt \
+                     or n_modes",
+                    p.n_modes,
+                    2.0 / omega
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     fn sim(&self) -> Option<&Sim> {
         self.sim.as_ref()
     }
@@ -140,6 +168,7 @@ impl Model for VehicleTrack {
                 format!("must be below lambda_max = {lmax} m"),
             ));
         }
+        self.check_stability_limit()?;
         let mut sim = self.build(ctx.start_time)?;
         self.check_reach(&sim, sim.run.xc)?;
         self.equilibrate(&mut sim)?;

@@ -250,6 +250,17 @@ fn refuses_bad_parameters_with_clear_messages() {
     assert!(m.set_real(VR_CPZ, 0.0).is_ok());
     assert!(m.set_integer(VR_N_SLEEPERS, 100).is_err());
     assert!(m.set_integer(VR_N_SLEEPERS, 511).is_ok());
+    // QA: 2^24 - 1 sleepers were accepted and aborted the importer at initialization when
+    // the allocation failed; the window is bounded instead.
+    assert!(m.set_integer(VR_N_SLEEPERS, 65_535).is_ok());
+    let e = m
+        .set_integer(VR_N_SLEEPERS, 131_071)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("at most 65535"), "{e}");
+    assert!(m.set_integer(VR_N_SLEEPERS, 16_777_215).is_err());
+    assert!(m.set_integer(VR_N_SLEEPERS, i32::MAX).is_err());
+    m.set_integer(VR_N_SLEEPERS, 255).unwrap();
     assert!(m.set_integer(VR_N_MODES, 0).is_err());
     assert!(m.set_integer(VR_CONTACT_LAW, 2).is_err());
     assert!(m.set_integer(VR_IRREGULARITY, 11).is_err());
@@ -565,5 +576,43 @@ fn communication_steps_that_change_length_every_step_stay_stable() {
             (swing - constant).abs() < 0.05 * constant,
             "steps {steps:?}: max |P1 − P_static| {swing} N, constant steps {constant} N"
         );
+    }
+}
+
+#[test]
+fn a_dt_beyond_the_stability_limit_is_refused_at_initialization() {
+    // QA: dt = 0.01 s returned fmi2OK with P1 up to 4.7e63 N until the state overflowed.
+    // Highest rail mode of the defaults: (255 π / 153.6 m)² √(6.6e6 / 60.64) ≈ 8980 rad/s,
+    // so 2/ω ≈ 2.23e-4 s.
+    let omega = (255.0 * std::f64::consts::PI / 153.6f64).powi(2) * (6.6e6f64 / 60.64).sqrt();
+    for dt in [0.01, 1.05 * 2.0 / omega] {
+        let mut m = small(255, 255);
+        m.set_real(VR_DT, dt).unwrap();
+        let e = m
+            .initialize(&InitContext::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'dt'") && e.contains("diverges"), "{e}");
+    }
+    // Just above the limit the run does diverge (the check refuses nothing that would run):
+    // started anyway, by-passing the check, it fails within 0.05 s.
+    let dt = 1.05 * 2.0 / omega;
+    let mut m = small(255, 255);
+    m.set_real(VR_DT, dt).unwrap();
+    let mut sim = m.build(0.0).unwrap();
+    m.equilibrate(&mut sim).unwrap();
+    m.sim = Some(sim);
+    let failed = (0..500).any(|i| m.do_step(i as f64 * dt, dt).is_err());
+    assert!(failed, "dt = {dt} s did not diverge");
+    // The resolutions the README recommends pass.
+    for (n, nm, dt) in [
+        (255, 255, 1e-4),
+        (255, 511, 2e-5),
+        (511, 511, 1e-4),
+        (255, 510, 5e-5),
+    ] {
+        let mut m = small(n, nm);
+        m.set_real(VR_DT, dt).unwrap();
+        m.initialize(&InitContext::default()).unwrap();
     }
 }

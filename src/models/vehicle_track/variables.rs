@@ -24,9 +24,25 @@ fn invalid(name: &'static str, value: i32, reason: &str) -> SetResult {
     })
 }
 
+/// Largest computing window (sleepers): 2^16 − 1 sleepers are about 39 km of track at 0.6 m,
+/// a few tens of MB. A larger value is refused here rather than failing to allocate at
+/// initialization, which would abort the importing process (found by QA: 2^24 − 1 sleepers
+/// under a 3 GB limit).
+pub const MAX_SLEEPERS: i32 = 65_535;
+
 fn sleeper_count(name: &'static str, value: i32) -> SetResult {
     if value < 3 || !((value as u32) + 1).is_power_of_two() {
         return invalid(name, value, "n_sleepers + 1 must be a power of two >= 4 (63, 127, 255, 511, 1023, ...): the fast sine transform is radix 2");
+    }
+    if value > MAX_SLEEPERS {
+        return invalid(
+            name,
+            value,
+            &format!(
+                "must be at most {MAX_SLEEPERS} (2^16 - 1: about 39 km of track at 0.6 m sleeper \
+                 spacing)"
+            ),
+        );
     }
     Ok(None)
 }
@@ -104,7 +120,7 @@ variables! {
     real_parameter("irregularity_length", VR_IRR_LENGTH = 34, Some("m"), m.p.reals[34], 4096.0, Fixed, positive, "Length of the random irregularity sample; it repeats beyond [assumed]"),
     real_parameter("ramp_length", VR_RAMP_LENGTH = 35, Some("m"), m.p.reals[35], 20.0, Fixed, non_negative, "Irregularity fades in over this length ahead of the leading wheel's start position; 0 = none [assumed]"),
     real_parameter("irregularity_scale", VR_IRREGULARITY_SCALE = 36, None, m.p.reals[36], 1.0, Fixed, non_negative, "Factor on the amplitude of the irregularity (random or measured; not the dip): 0 = perfect track, 2 = twice as rough [assumed]"),
-    integer_parameter("n_sleepers", VR_N_SLEEPERS = 40, m.p.n_sleepers, 255, sleeper_count, "Sleepers in the computing window N (N + 1 a power of two: 63, 127, 255, 511, ...) [assumed]"),
+    integer_parameter("n_sleepers", VR_N_SLEEPERS = 40, m.p.n_sleepers, 255, sleeper_count, "Sleepers in the computing window N (N + 1 a power of two: 63, 127, 255, 511, ..., at most 65535) [assumed]"),
     integer_parameter("n_modes", VR_N_MODES = 41, m.p.n_modes, 255, mode_count, "Rail modes NM, 1..2N+1; default N: shortest modal wavelength 2 l/NM = 2 ls [assumed]"),
     integer_parameter("contact_law", VR_CONTACT_LAW = 42, m.p.contact_law, 0, contact_law, "0 = nonlinear Hertz, 1 = Hertz linearised at the static load"),
     integer_parameter("irregularity", VR_IRREGULARITY = 43, m.p.irregularity, 1, irregularity_code, "0 none, 1 Chinese ballastless TB/T 3352-2014 (default), 2 German low, 3 German high, 4..9 FRA class 1..6, 10 measured profile_file"),
