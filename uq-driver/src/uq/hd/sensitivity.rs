@@ -289,6 +289,77 @@ fn selected_percentile(values: &mut [f64], q: f64) -> f64 {
     low + (pos - lo as f64) * (high - low)
 }
 
+/// [`pick_freeze`] on all `n` rows with intervals from independent replicates of the design:
+/// the rows are grouped replicate after replicate, `sizes[r]` rows in replicate `r` (the rows
+/// of an independently scrambled Sobol' net, say, whose rows are not independent of each
+/// other, so that a bootstrap over them does not see the error). Each replicate with at least
+/// 2 rows gives its own estimates; the interval of an index is the estimate on all rows
+/// `± t_{R-1, (1 + level)/2} sd_R / sqrt(R)`, with `sd_R` the standard deviation of the `R`
+/// replicate estimates (Student's t). Fewer than 2 such replicates, or a replicate estimate
+/// that is not finite (a replicate without variance), give NaN intervals.
+pub fn pick_freeze_replicates(
+    values: &[f64],
+    n: usize,
+    d: usize,
+    sizes: &[usize],
+    level: f64,
+) -> Result<SobolWithCi, SensitivityError> {
+    let estimate = pick_freeze(values, n, d)?;
+    if sizes.iter().sum::<usize>() != n {
+        return Err(SensitivityError::Mismatch);
+    }
+    let mut start = 0;
+    let mut replicates = Vec::with_capacity(sizes.len());
+    for &size in sizes {
+        let rows: Vec<usize> = (start..start + size).collect();
+        start += size;
+        if size >= 2 {
+            replicates.push(estimate_rows(values, n, d, &rows));
+        }
+    }
+    let half = |spread: Vec<f64>| {
+        let r = spread.len();
+        if r < 2 || spread.iter().any(|v| !v.is_finite()) {
+            return f64::NAN;
+        }
+        student_t_quantile(0.5 * (1.0 + level), (r - 1) as f64)
+            * replicate_summary(&spread).std_error
+    };
+    let interval = |at: f64, h: f64| {
+        if h.is_nan() {
+            (f64::NAN, f64::NAN)
+        } else {
+            (at - h, at + h)
+        }
+    };
+    let first_ci = (0..d)
+        .map(|i| {
+            let h = half(replicates.iter().map(|e| e.first[i]).collect());
+            interval(estimate.first[i], h)
+        })
+        .collect();
+    let total_ci = (0..d)
+        .map(|i| {
+            let h = half(replicates.iter().map(|e| e.total[i]).collect());
+            interval(estimate.total[i], h)
+        })
+        .collect();
+    Ok(SobolWithCi {
+        estimate,
+        first_ci,
+        total_ci,
+    })
+}
+
+/// The `p` quantile of Student's t distribution with `freedom` degrees of freedom.
+pub fn student_t_quantile(p: f64, freedom: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    match StudentsT::new(0.0, 1.0, freedom) {
+        Ok(t) if (0.0..=1.0).contains(&p) => t.inverse_cdf(p),
+        _ => f64::NAN,
+    }
+}
+
 /// Summary of `R` independent replicate estimates of one statistic (replicated LHS,
 /// independently scrambled QMC): their mean and its standard error
 /// `sd(estimates) / sqrt(R)` (an honest error, unlike the plain MC formula for LHS).

@@ -3,19 +3,31 @@
 //! `B`): `samples × (d + 2)` model runs, laid out `A`, `B`, `AB_1`, …, `AB_d` (point `k` of
 //! block `b` is design point `b × samples + k`).
 //!
-//! `A` and `B` are the two halves of one `2d`-dimensional design of `samples` points: a
-//! scrambled Sobol' sequence (`base = "qmc"`, the default; scrambling key `(seed, 0)`), Monte
-//! Carlo (`"mc"`) or a Latin hypercube (`"lhs"`), mapped through each input's quantile function.
+//! `A` and `B` are the two halves of a `2d`-dimensional design of `samples` points, mapped
+//! through each input's quantile function:
+//! - `base = "qmc"` (the default): `replicates` (R, default 8) independently scrambled Sobol'
+//!   sequences of `samples / R` points each (the scramblings of the `qmc` method: replicate `r`
+//!   keyed by `(seed, r)`); base row `k` is point `k % (samples / R)` of replicate
+//!   `k / (samples / R)`;
+//! - `"mc"`: Monte Carlo; `"lhs"`: a Latin hypercube (one design of `samples` points).
 //!
 //! Estimators ([`crate::uq::hd::sensitivity`]): first order by Saltelli (2010), total by
 //! Jansen (1999), normalised by the variance of the `2 × samples` values of `A` and `B`, on
 //! the values less their mean over `A` and `B` (same expectation; centring cuts the variance
-//! of the first-order estimator when the mean is large against the spread);
-//! percentile bootstrap intervals at `confidence` from `bootstrap` resamples of the rows
-//! (the same resampled rows for every column; resample `k` from the ChaCha20 stream
-//! `(0x5eed_b007, k)`, so the intervals are reproducible). A row whose runs did not all
-//! succeed is left out of every block. A column without variance (e.g. a fixed initial value)
-//! gets indices 0 with intervals `[0, 0]`, as a chaos gives.
+//! of the first-order estimator when the mean is large against the spread), always on all
+//! the rows. Intervals at `confidence`:
+//! - base `qmc`: from the spread of the R replicate estimates (each replicate's rows alone),
+//!   `estimate ± t_{R-1, (1 + confidence)/2} sd_R / sqrt(R)`. The rows of one scrambled net
+//!   are not independent: a bootstrap over them missed the indices of the Morris function in
+//!   every seed (QA2 F1), since the error of one net depends on its scrambling;
+//! - bases `mc` and `lhs`: percentile bootstrap from `bootstrap` resamples of the rows (the
+//!   same resampled rows for every column; resample `k` from the ChaCha20 stream
+//!   `(0x5eed_b007, k)`, so the intervals are reproducible).
+//!
+//! A row whose runs did not all succeed is left out of every block (and of its replicate: a
+//! replicate left with fewer than 2 rows does not count, and fewer than 2 counting replicates
+//! give NaN intervals). A column without variance (e.g. a fixed initial value) gets indices 0
+//! with intervals `[0, 0]`, as a chaos gives.
 //!
 //! Mean, Std and the standard error of the mean come from the runs of `A` and `B`
 //! (Monte Carlo formula); quantiles and densities from every run (each block follows the
@@ -23,16 +35,17 @@
 
 use nalgebra::DMatrix;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::ser::SerializeStruct;
+use serde::{Deserialize, Serialize, Serializer};
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
-use super::qmc::check_sobol_points;
 use super::estimate::{Estimate, Sobol, SobolIntervals};
+use super::qmc::{check_sobol_points, Qmc, DEFAULT_REPLICATES};
+use super::sample::UnitCubeSample;
 use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
-use crate::uq::hd::sobol_seq::{self, Sobol as SobolSequence};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::sampling;
 
@@ -56,7 +69,11 @@ pub enum Base {
 }
 
 /// `kind = "sobol_sampling"`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Serialized (the study hash) as `samples`, `base` and, for the `qmc` base only, the number
+/// of replicates: a `qmc` study of the single-net design of before does not resume, an `mc`
+/// or `lhs` study keeps its hash.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SobolSampling {
     /// Base sample size N (at least 2): N (d + 2) model runs.
@@ -64,19 +81,36 @@ pub struct SobolSampling {
     /// Where `A` and `B` come from (default `qmc`).
     #[serde(default)]
     pub base: Base,
-    /// Bootstrap resamples for the confidence intervals (default 200, at most 10 000; 0: no
-    /// intervals). Analysis only: not part of the study hash, so a changed value re-analyses
-    /// the stored runs instead of refusing the folder.
-    #[serde(default = "default_bootstrap", skip_serializing)]
-    pub bootstrap: usize,
+    /// Independently scrambled Sobol' designs the `qmc` base is made of (default 8, at least
+    /// 2; `samples / replicates` a power of two); refused for the `mc` and `lhs` bases.
+    #[serde(default)]
+    pub replicates: Option<usize>,
+    /// Bootstrap resamples for the intervals of the `mc` and `lhs` bases (default 200, at
+    /// most 10 000; 0: no intervals); the `qmc` base takes its intervals from the replicates
+    /// and ignores it (with a warning). Analysis only: not part of the study hash, so a
+    /// changed value re-analyses the stored runs instead of refusing the folder.
+    #[serde(default)]
+    pub bootstrap: Option<usize>,
     /// Confidence level of the intervals (default 0.95; analysis only, like `bootstrap`).
-    #[serde(default = "default_confidence", skip_serializing)]
+    #[serde(default = "default_confidence")]
     pub confidence: f64,
 }
 
-fn default_bootstrap() -> usize {
-    200
+impl Serialize for SobolSampling {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let qmc = self.base == Base::Qmc;
+        let mut s = serializer.serialize_struct("SobolSampling", 2 + usize::from(qmc))?;
+        s.serialize_field("samples", &self.samples)?;
+        s.serialize_field("base", &self.base)?;
+        if qmc {
+            s.serialize_field("replicates", &self.replicate_count())?;
+        }
+        s.end()
+    }
 }
+
+/// Default bootstrap resamples (bases `mc` and `lhs`).
+const DEFAULT_BOOTSTRAP: usize = 200;
 
 fn default_confidence() -> f64 {
     0.95
@@ -88,13 +122,11 @@ impl Method for SobolSampling {
     }
 
     fn label(&self, dim: usize) -> String {
-        format!(
-            "sobol_sampling {}x{} ({:?})",
-            self.samples,
-            dim + 2,
-            self.base
-        )
-        .to_lowercase()
+        let base = match self.base {
+            Base::Qmc => format!("qmc, {} replicates", self.replicate_count()),
+            other => format!("{other:?}"),
+        };
+        format!("sobol_sampling {}x{} ({base})", self.samples, dim + 2).to_lowercase()
     }
 
     fn validate(&self, problem: &Problem) -> Result<(), InvalidSettings> {
@@ -102,10 +134,10 @@ impl Method for SobolSampling {
         if self.samples < 2 {
             return Err(InvalidSettings("`samples` must be at least 2".into()));
         }
-        if self.bootstrap > MAX_BOOTSTRAP {
+        let bootstrap = self.bootstrap_resamples();
+        if bootstrap > MAX_BOOTSTRAP {
             return Err(InvalidSettings(format!(
-                "`bootstrap` = {} resamples: at most {MAX_BOOTSTRAP}",
-                self.bootstrap
+                "`bootstrap` = {bootstrap} resamples: at most {MAX_BOOTSTRAP}"
             )));
         }
         if !(self.confidence > 0.0 && self.confidence < 1.0) {
@@ -115,8 +147,16 @@ impl Method for SobolSampling {
             )));
         }
         if self.base == Base::Qmc {
+            let per = self.points_per_replicate()?;
             let hint = " (twice the random parameters); use base = \"lhs\"";
-            check_sobol_points(2 * d, self.samples, hint)?;
+            check_sobol_points(2 * d, per, hint)?;
+        } else if let Some(r) = self.replicates {
+            return Err(InvalidSettings(format!(
+                "`replicates` = {r} applies to base = \"qmc\" only (independently scrambled \
+                 Sobol' designs); base = \"{}\" takes its intervals from the bootstrap over \
+                 the rows (`bootstrap`)",
+                format!("{:?}", self.base).to_lowercase()
+            )));
         }
         Ok(())
     }
@@ -130,17 +170,42 @@ impl Method for SobolSampling {
         let mut s = MethodSummary::new(self.kind(), &size);
         let d = &mut s.details;
         d.insert("base".into(), serde_json::json!(self.base));
-        d.insert("bootstrap".into(), self.bootstrap.into());
+        if self.base == Base::Qmc {
+            d.insert("replicates".into(), self.replicate_count().into());
+            d.insert("bootstrap".into(), serde_json::Value::Null);
+        } else {
+            d.insert("bootstrap".into(), self.bootstrap_resamples().into());
+        }
         d.insert("confidence".into(), self.confidence.into());
         d.insert(
             "runs".into(),
             (self.samples.saturating_mul(dim + 2)).into(),
         );
-        d.insert(
-            "estimators".into(),
-            "first order: Saltelli (2010); total: Jansen (1999); percentile bootstrap intervals"
-                .into(),
-        );
+        let estimators = match self.base {
+            Base::Qmc => {
+                "first order: Saltelli (2010); total: Jansen (1999); on all rows; intervals \
+                 from the independently scrambled replicates"
+            }
+            Base::Mc | Base::Lhs => {
+                "first order: Saltelli (2010); total: Jansen (1999); percentile bootstrap \
+                 intervals"
+            }
+        };
+        d.insert("estimators".into(), estimators.into());
+        let intervals = match self.base {
+            Base::Qmc => format!(
+                "replicates: estimate on all rows ± t(R - 1, (1 + confidence)/2) sd(replicate \
+                 estimates) / sqrt(R), R = {} independently scrambled Sobol' designs of {} \
+                 base points each (Student's t)",
+                self.replicate_count(),
+                self.samples / self.replicate_count().max(1)
+            ),
+            Base::Mc | Base::Lhs => format!(
+                "percentile bootstrap over the base rows ({} resamples)",
+                self.bootstrap_resamples()
+            ),
+        };
+        d.insert("intervals".into(), intervals.into());
         d.insert(
             "standard_error".into(),
             "Monte Carlo formula std / sqrt(2 samples) over the runs of A and B (exact for \
@@ -156,17 +221,69 @@ impl Method for SobolSampling {
 }
 
 impl SobolSampling {
-    /// The `samples` points of the `2d`-dimensional base design in the unit cube.
+    /// Replicates of the `qmc` base (the given number or 8).
+    pub fn replicate_count(&self) -> usize {
+        self.replicates.unwrap_or(DEFAULT_REPLICATES)
+    }
+
+    /// Bootstrap resamples of the `mc` and `lhs` bases (the given number or 200).
+    pub fn bootstrap_resamples(&self) -> usize {
+        self.bootstrap.unwrap_or(DEFAULT_BOOTSTRAP)
+    }
+
+    /// Base points of each replicate of the `qmc` base: `samples / replicates`, a power of two
+    /// (at least 2).
+    fn points_per_replicate(&self) -> Result<usize, InvalidSettings> {
+        let (n, r) = (self.samples, self.replicate_count());
+        if r < 2 {
+            return Err(InvalidSettings(format!(
+                "`replicates` = {r}: at least 2 independently scrambled replicates are needed \
+                 for intervals from their spread"
+            )));
+        }
+        let suggest = |per: usize| per.max(2).next_power_of_two() * r;
+        if n % r != 0 {
+            return Err(InvalidSettings(format!(
+                "`samples` = {n} is not a multiple of `replicates` = {r}: each replicate takes \
+                 samples / replicates base points, a power of two (e.g. samples = {})",
+                suggest(n / r)
+            )));
+        }
+        let per = n / r;
+        if per < 2 || !per.is_power_of_two() {
+            let down = suggest(per) / 2;
+            let others = if down >= 2 * r && down != suggest(per) {
+                format!("{down} or {}", suggest(per))
+            } else {
+                suggest(per).to_string()
+            };
+            return Err(InvalidSettings(format!(
+                "`samples` / `replicates` = {n} / {r} = {per} base points per replicate: must \
+                 be a power of two, at least 2 (the scrambled Sobol' points are a net only in \
+                 blocks of 2^m); use samples = {others}, or other `replicates`"
+            )));
+        }
+        Ok(per)
+    }
+
+    /// The `samples` points of the `2d`-dimensional base design in the unit cube (for `qmc`,
+    /// replicate after replicate).
     fn base_points(&self, d: usize, seed: u64) -> Result<Vec<Vec<f64>>, MethodError> {
         let n = self.samples;
         Ok(match self.base {
             Base::Qmc => {
-                let invalid =
-                    |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
-                SobolSequence::scrambled(2 * d, seed, 0)
-                    .map_err(invalid)?
-                    .points(0, n)
-                    .map_err(invalid)?
+                let per = self.points_per_replicate()?;
+                let r = self.replicate_count();
+                // The scramblings of the `qmc` method: replicate `k` keyed by `(seed, k)`.
+                let qmc = Qmc {
+                    samples: per,
+                    replicates: r,
+                };
+                let blocks = (0..r)
+                    .into_par_iter()
+                    .map(|k| qmc.block(per, 2 * d, seed, Some(k)))
+                    .collect::<Result<Vec<_>, _>>()?;
+                blocks.into_iter().flatten().collect()
             }
             Base::Mc => sampling::monte_carlo(n, 2 * d, seed),
             Base::Lhs => sampling::latin_hypercube(n, 2 * d, seed),
@@ -186,12 +303,11 @@ impl Sampling for SobolSampling {
             .unzip();
         let points = sensitivity::pick_freeze_design(&a, &b)?;
         let mut design = Design::mapped(Germ::Uniform, points, None, inputs);
-        if self.base == Base::Qmc && !self.samples.is_power_of_two() {
+        if let (Base::Qmc, Some(b)) = (self.base, self.bootstrap) {
             design.warnings.push(format!(
-                "sobol_sampling: samples = {} is not a power of two: the Sobol' base points are \
-                 balanced only in blocks of 2^m points (use samples = {})",
-                self.samples,
-                self.samples.next_power_of_two()
+                "sobol_sampling: `bootstrap` = {b} does not apply to base = \"qmc\": its \
+                 intervals come from the spread of its {} independently scrambled replicates",
+                self.replicate_count()
             ));
         }
         Ok(design)
@@ -210,7 +326,7 @@ impl Sampling for SobolSampling {
             return Err(SensitivityError::TooFew(blocks.complete.len()).into());
         }
         let (moments, columns) = self.columns(&blocks, data)?;
-        let intervals = (self.bootstrap > 0).then(|| SobolIntervals {
+        let intervals = (self.intervals() != Intervals::None).then(|| SobolIntervals {
             level: self.confidence,
             first: columns.iter().map(|c| c.first_ci.clone()).collect(),
             total: columns.iter().map(|c| c.total_ci.clone()).collect(),
@@ -231,6 +347,27 @@ impl Sampling for SobolSampling {
 
     fn draws_from_chaos(&self) -> bool {
         false
+    }
+}
+
+/// Where the intervals of the indices come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Intervals {
+    /// No intervals (`bootstrap = 0` on an `mc` or `lhs` base).
+    None,
+    /// Percentile bootstrap over the rows, with this many resamples.
+    Bootstrap(usize),
+    /// Student's t from the spread of the estimates of replicates of this many base rows.
+    Replicates(usize),
+}
+
+impl SobolSampling {
+    fn intervals(&self) -> Intervals {
+        match (self.base, self.bootstrap_resamples()) {
+            (Base::Qmc, _) => Intervals::Replicates(self.samples / self.replicate_count().max(1)),
+            (_, 0) => Intervals::None,
+            (_, b) => Intervals::Bootstrap(b),
+        }
     }
 }
 
@@ -280,8 +417,14 @@ impl SobolSampling {
             }
         }
         let varying: Vec<&Vec<f64>> = values.iter().flatten().collect();
-        let mut indices = if self.bootstrap == 0 {
-            varying
+        let with_ci = |e: sensitivity::SobolWithCi| ColumnIndices {
+            first: e.estimate.first,
+            total: e.estimate.total,
+            first_ci: e.first_ci,
+            total_ci: e.total_ci,
+        };
+        let mut indices = match self.intervals() {
+            Intervals::None => varying
                 .par_iter()
                 .map(|v| {
                     let e = sensitivity::pick_freeze(v, m, d)?;
@@ -292,24 +435,28 @@ impl SobolSampling {
                         total_ci: Vec::new(),
                     })
                 })
-                .collect::<Result<Vec<_>, SensitivityError>>()?
-        } else {
-            sensitivity::pick_freeze_bootstrap_columns(
+                .collect::<Result<Vec<_>, SensitivityError>>()?,
+            Intervals::Bootstrap(resamples) => sensitivity::pick_freeze_bootstrap_columns(
                 &varying,
                 m,
                 d,
-                self.bootstrap,
+                resamples,
                 self.confidence,
                 BOOTSTRAP_SEED,
             )?
             .into_iter()
-            .map(|e| ColumnIndices {
-                first: e.estimate.first,
-                total: e.estimate.total,
-                first_ci: e.first_ci,
-                total_ci: e.total_ci,
-            })
-            .collect()
+            .map(with_ci)
+            .collect(),
+            Intervals::Replicates(per) => {
+                let sizes = blocks.replicate_sizes(per, self.replicate_count());
+                varying
+                    .par_iter()
+                    .map(|v| {
+                        sensitivity::pick_freeze_replicates(v, m, d, &sizes, self.confidence)
+                            .map(with_ci)
+                    })
+                    .collect::<Result<Vec<_>, SensitivityError>>()?
+            }
         }
         .into_iter();
         let indices = values
@@ -387,6 +534,16 @@ impl PickFreezeRows {
         }
     }
 
+    /// The number of complete rows of each of the `replicates` replicates of `per` base rows
+    /// (base row `k` in replicate `k / per`).
+    fn replicate_sizes(&self, per: usize, replicates: usize) -> Vec<usize> {
+        let mut sizes = vec![0; replicates.max(1)];
+        for &k in &self.complete {
+            sizes[(k / per.max(1)).min(replicates.saturating_sub(1))] += 1;
+        }
+        sizes
+    }
+
     /// The result rows of block `b` (0: A, 1: B, 2 + i: AB_i) at the complete base rows.
     fn block_rows(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
         self.complete
@@ -430,7 +587,8 @@ mod tests {
             let m = SobolSampling {
                 samples: 4096,
                 base,
-                bootstrap: 100,
+                replicates: None,
+                bootstrap: Some(100),
                 confidence: 0.95,
             };
             let e = run(&m, &params, |x| x[0] + 2.0 * x[1]);
@@ -453,23 +611,52 @@ mod tests {
         let m = SobolSampling {
             samples: 512,
             base: Base::Qmc,
-            bootstrap: 0,
+            replicates: None,
+            bootstrap: None,
             confidence: 0.95,
         };
         let design = m.design(&params, 3).unwrap();
         let f = |x: &[f64]| x[0].sin() + 7.0 * x[1].sin().powi(2);
+        let estimate = |keep: &dyn Fn(usize) -> bool, m: &SobolSampling| {
+            let rows: Vec<usize> = (0..design.len()).filter(|&i| keep(i)).collect();
+            let values: Vec<f64> = rows.iter().map(|&i| f(&design.values[i])).collect();
+            let data = DMatrix::from_column_slice(values.len(), 1, &values);
+            m.estimate(&design, &rows, &data)
+        };
         // Every 7th point fails.
-        let rows: Vec<usize> = (0..design.len()).filter(|i| i % 7 != 3).collect();
-        let values: Vec<f64> = rows.iter().map(|&i| f(&design.values[i])).collect();
-        let data = DMatrix::from_column_slice(values.len(), 1, &values);
-        let e = m.estimate(&design, &rows, &data).unwrap();
+        let e = estimate(&|i| i % 7 != 3, &m).unwrap();
         // x3 does not matter: its indices are 0 up to sampling error.
         let s = e.sobol.unwrap();
         assert!(s.first[0][2].abs() < 0.05 && s.total[0][2].abs() < 1e-12);
-        assert!(s.intervals.is_none());
+        let ci = s.intervals.unwrap();
+        assert!(ci.first[0][0].0 < s.first[0][0] && s.first[0][0] < ci.first[0][0].1);
+        // Base rows k of replicate k / 64. Replicate 0 keeps one row (too few for its own
+        // estimate) and replicate 5 none: the intervals come from the other six.
+        let base_row = |i: usize| i % 512;
+        let some = |i: usize| !(base_row(i) < 63 || (320..384).contains(&base_row(i)));
+        let s = estimate(&some, &m).unwrap().sobol.unwrap();
+        let ci = s.intervals.unwrap();
+        assert!(ci.total[0].iter().all(|&(lo, hi)| lo.is_finite() && hi.is_finite()));
+        // Only replicate 2 left: indices, but no spread, so NaN intervals (not a panic).
+        let one = |i: usize| (128..192).contains(&base_row(i));
+        let s = estimate(&one, &m).unwrap().sobol.unwrap();
+        assert!(s.first[0][0].is_finite());
+        let ci = s.intervals.unwrap();
+        assert!(ci.first[0].iter().all(|&(lo, hi)| lo.is_nan() && hi.is_nan()));
         // Too few complete rows is an error, not a panic.
-        let e = m.estimate(&design, &rows[..3], &data.rows(0, 3).into_owned());
-        assert!(e.is_err());
+        assert!(estimate(&|i| base_row(i) < 1, &m).is_err());
+        // `bootstrap = 0`: no intervals for the other bases.
+        let lhs = SobolSampling {
+            base: Base::Lhs,
+            bootstrap: Some(0),
+            ..m.clone()
+        };
+        let design = lhs.design(&params, 3).unwrap();
+        let values: Vec<f64> = design.values.iter().map(|x| f(x)).collect();
+        let data = DMatrix::from_column_slice(values.len(), 1, &values);
+        let rows: Vec<usize> = (0..design.len()).collect();
+        let s = lhs.estimate(&design, &rows, &data).unwrap().sobol.unwrap();
+        assert!(s.intervals.is_none());
     }
 
     #[test]
@@ -482,7 +669,8 @@ mod tests {
         let m = SobolSampling {
             samples: 128,
             base: Base::Qmc,
-            bootstrap: 10,
+            replicates: None,
+            bootstrap: Some(10),
             confidence: 0.9,
         };
         let design = m.design(&params, 5).unwrap();
@@ -520,7 +708,8 @@ mod tests {
         let m = SobolSampling {
             samples: 64,
             base: Base::Lhs,
-            bootstrap: 20,
+            replicates: None,
+            bootstrap: Some(20),
             confidence: 0.9,
         };
         let e = run(&m, &params, |_| 0.1);
@@ -552,13 +741,60 @@ mod tests {
         assert!(m.validate(&problem).is_err());
         let m: SobolSampling = toml::from_str("samples = 64\nbootstrap = 100000").unwrap();
         assert!(m.validate(&problem).is_err());
-        // The analysis settings are not in the serialized settings (the study hash).
+        // The analysis settings are not in the serialized settings (the study hash); the qmc
+        // base's replicates are (the design of before, one net, gave no `replicates`: such a
+        // folder is not resumed), and the mc and lhs bases serialize as before.
         let m: SobolSampling =
             toml::from_str("samples = 64\nbootstrap = 50\nconfidence = 0.9").unwrap();
         assert_eq!(
             serde_json::to_string(&m).unwrap(),
-            r#"{"samples":64,"base":"qmc"}"#
+            r#"{"samples":64,"base":"qmc","replicates":8}"#
         );
+        let m: SobolSampling = toml::from_str("samples = 64\nreplicates = 4").unwrap();
+        assert_eq!(
+            serde_json::to_string(&m).unwrap(),
+            r#"{"samples":64,"base":"qmc","replicates":4}"#
+        );
+        for base in ["mc", "lhs"] {
+            let text = format!("samples = 64\nbase = \"{base}\"\nbootstrap = 7");
+            let m: SobolSampling = toml::from_str(&text).unwrap();
+            assert_eq!(
+                serde_json::to_string(&m).unwrap(),
+                format!(r#"{{"samples":64,"base":"{base}"}}"#)
+            );
+        }
         assert!(toml::from_str::<SobolSampling>("samples = 64\nbase = \"grid\"").is_err());
+        // Replicates of the qmc base: at least 2, dividing `samples` into powers of two.
+        let params = uniform_params(3, 0.0, 1.0);
+        let problem = Problem {
+            parameters: &params,
+            ..problem
+        };
+        let err = |text: &str| {
+            let m: SobolSampling = toml::from_str(text).unwrap();
+            m.validate(&problem).map(|_| ()).map_err(|e| e.0)
+        };
+        assert_eq!(err("samples = 64"), Ok(()));
+        assert_eq!(err("samples = 12\nreplicates = 3"), Ok(()));
+        let e = err("samples = 64\nreplicates = 1").unwrap_err();
+        assert!(e.contains("`replicates` = 1") && e.contains("at least 2"), "{e}");
+        let e = err("samples = 100").unwrap_err();
+        assert!(e.contains("not a multiple of `replicates` = 8"), "{e}");
+        assert!(e.contains("samples = 128"), "{e}");
+        let e = err("samples = 96").unwrap_err();
+        assert!(e.contains("96 / 8 = 12") && e.contains("power of two"), "{e}");
+        assert!(e.contains("samples = 64 or 128"), "{e}");
+        let e = err("samples = 8").unwrap_err();
+        assert!(e.contains("8 / 8 = 1") && e.contains("samples = 16"), "{e}");
+        assert_eq!(err("samples = 96\nreplicates = 3"), Ok(()));
+        let e = err("samples = 64\nbase = \"mc\"\nreplicates = 4").unwrap_err();
+        assert!(e.contains("`replicates` = 4 applies to base = \"qmc\" only"), "{e}");
+        assert!(e.contains("base = \"mc\""), "{e}");
+        // `bootstrap` on a qmc base is not used: said so in the design's warnings.
+        let m: SobolSampling = toml::from_str("samples = 16\nbootstrap = 50").unwrap();
+        let w = m.design(&params, 1).unwrap().warnings;
+        assert!(w[0].contains("`bootstrap` = 50 does not apply"), "{w:?}");
+        let m: SobolSampling = toml::from_str("samples = 16").unwrap();
+        assert!(m.design(&params, 1).unwrap().warnings.is_empty());
     }
 }
