@@ -321,3 +321,51 @@ fn mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
         assert_eq!(summary.details["bootstrap"], resamples);
     }
 }
+
+/// The study hash (which stored runs a folder may resume) covers the qmc base's replicates:
+/// a folder of the single-net design of before is not resumed, while an `mc` or `lhs` study
+/// keeps the hash it always had.
+#[test]
+fn a_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
+    use sha2::{Digest, Sha256};
+    use uq_driver::spec::{builtin, Study};
+    use uq_driver::study::runner::study_hash;
+    let text = builtin("wheel-sobol-sampling").unwrap();
+    let study = |base: &str, extra: &str| {
+        let t = text.replace("base = \"qmc\"", &format!("base = \"{base}\"{extra}"));
+        Study::parse(&t, "t.toml", None).unwrap()
+    };
+    // The hash as computed before: the method serialised as `kind`, `samples`, `base`.
+    let old_hash = |s: &Study, base: &str| {
+        let key = serde_json::json!({
+            "seed": s.seed,
+            "experiment": s.experiment,
+            "method": { "kind": "sobol_sampling", "samples": 2048, "base": base },
+            "parameters": s.parameters,
+            "fixed": s.fixed,
+            "outputs": { "variables": s.outputs },
+            "qoi": s.qoi,
+        });
+        format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
+    };
+    for base in ["mc", "lhs"] {
+        let s = study(base, "\nbootstrap = 20");
+        assert_eq!(study_hash(&s), old_hash(&s, base), "{base}");
+    }
+    let qmc = study("qmc", "");
+    assert_ne!(study_hash(&qmc), old_hash(&qmc, "qmc"));
+    // Other replicates, another design; the default written out, the same.
+    assert_ne!(
+        study_hash(&qmc),
+        study_hash(&study("qmc", "\nreplicates = 4"))
+    );
+    assert_eq!(
+        study_hash(&qmc),
+        study_hash(&study("qmc", "\nreplicates = 8"))
+    );
+    // Analysis settings do not change it.
+    assert_eq!(
+        study_hash(&qmc),
+        study_hash(&study("qmc", "\nconfidence = 0.9"))
+    );
+}

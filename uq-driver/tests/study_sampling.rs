@@ -255,8 +255,17 @@ fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
                     csv.at(t, &format!("{col}_lo")),
                     csv.at(t, &format!("{col}_hi")),
                 );
-                assert!((v - exact).abs() < 0.03, "t = {t} {col}: {v} vs {exact}");
+                // The intervals are those of the replicates (base qmc, 8 x 256 base points).
+                // Measured on seeds 1-10: 189 of 200 cover, half-widths 0.001-0.079, errors
+                // up to 2.2 half-widths (seed 42: 19 of 20, the largest error 0.034 = 1.1
+                // half-widths, S_C at 5 s).
                 assert!(lo <= v && v <= hi, "t = {t} {col}: [{lo}, {hi}]");
+                let half = 0.5 * (hi - lo);
+                assert!(half > 0.0 && half < 0.1, "t = {t} {col}: [{lo}, {hi}]");
+                assert!(
+                    (v - exact).abs() < 2.5 * half,
+                    "t = {t} {col}: {v} [{lo}, {hi}] vs {exact}"
+                );
                 covered += usize::from(lo <= exact && exact <= hi);
             }
         }
@@ -276,6 +285,11 @@ fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
     }
     let s = summary(&out);
     assert_eq!(s["model_runs"], 2048 * 4);
+    assert_eq!(s["method"]["replicates"], 8);
+    assert!(s["method"]["intervals"]
+        .as_str()
+        .unwrap()
+        .starts_with("replicates"));
     let q = &s["quantities"]["q_max_late"]["sobol"];
     for key in ["first", "total", "first_ci", "total_ci"] {
         assert!(
@@ -406,6 +420,12 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
         covered >= 5,
         "{covered} of 6 intervals cover the exact indices"
     );
+    // The default base: 8 independently scrambled replicates of 1024 base points, the
+    // intervals from their spread.
+    let method = &summary(&out)["method"];
+    assert_eq!(method["replicates"], 8);
+    let kind = method["intervals"].as_str().unwrap();
+    assert!(kind.contains("R = 8 independently scrambled"), "{kind}");
     // Over time, y is constant after initialization: the same indices at every time.
     let csv = read_csv(&out.join("y_sobol.csv"));
     assert_eq!(csv.at(0.1, "S_x1"), q["first"]["x1"].as_f64().unwrap());
