@@ -449,13 +449,23 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices(
     // g = prod (|4 x_i − 2| + a_i) / (1 + a_i): closed-form indices.
     let (first, total) = benchmarks::g_function_indices();
     let q = &summary(&out)["quantities"]["y_end"]["sobol"];
+    let mut covered = 0;
     for i in 0..8 {
         let p = format!("x{}", i + 1);
-        let f = q["first"][&p].as_f64().unwrap();
-        let t = q["total"][&p].as_f64().unwrap();
-        // Measured: within 0.0013 of the closed form.
-        assert!((f - first[i]).abs() < 0.005, "S_{p}: {f} vs {}", first[i]);
-        assert!((t - total[i]).abs() < 0.005, "ST_{p}: {t} vs {}", total[i]);
+        for (kind, exact) in [("first", first[i]), ("total", total[i])] {
+            let v = q[kind][&p].as_f64().unwrap();
+            let ci = &q[format!("{kind}_ci")][&p];
+            let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+            // Measured (8 replicates of 512 base points): within 0.0082 of the closed form
+            // (S_x1, S_x2; one net of 4096 points: 0.0013), half-widths up to 0.026.
+            assert!((v - exact).abs() < 0.015, "{kind} {p}: {v} vs {exact}");
+            assert!(hi - lo < 0.12, "{kind} {p}: [{lo}, {hi}]");
+            covered += usize::from(lo <= exact && exact <= hi);
+        }
     }
+    assert!(
+        covered >= 14,
+        "{covered} of 16 intervals cover the exact indices"
+    );
     assert_eq!(summary(&out)["model_runs"], 4096 * 10);
 }
