@@ -143,7 +143,7 @@ fn morris_exact() -> (Vec<f64>, Vec<f64>) {
 }
 
 #[test]
-fn morris_exact_indices_are_those_of_an_independent_monte_carlo() {
+fn morris_exact_sobol_indices_are_those_of_an_independent_monte_carlo() {
     // QA2's plain Monte Carlo pick-freeze in numpy (400 000 rows, Jansen): ST_x2 0.2477,
     // ST_x4 0.2481 (± 0.0019), S_x6 -0.0009 ± 0.0019.
     let (s, st) = morris_exact();
@@ -158,7 +158,7 @@ fn morris_exact_indices_are_those_of_an_independent_monte_carlo() {
 /// cluster by scrambling), and 716 of the 800 intervals in all (89.5 %); the replicate
 /// intervals (R = 8) cover ST_x4 and S_x6 in 20 of 20 and 767 of 800 (95.9 %).
 #[test]
-fn qmc_base_intervals_cover_the_morris_indices_that_one_nets_bootstrap_missed() {
+fn sobol_sampling_qmc_base_intervals_cover_the_morris_indices_that_one_nets_bootstrap_missed() {
     let (s, st) = morris_exact();
     let terms = morris_terms();
     let inputs = unit_inputs(20, 0.0, 1.0);
@@ -231,7 +231,7 @@ fn centred(values: &[f64], n: usize) -> Vec<f64> {
 }
 
 #[test]
-fn qmc_base_intervals_are_student_t_on_the_replicate_spread() {
+fn sobol_sampling_qmc_base_intervals_are_student_t_on_the_replicate_spread() {
     // Student's t quantiles from a table (97.5 % for 7 and 3 degrees of freedom, 95 % for 3).
     for (text, r, t) in [
         ("samples = 1024", 8, 2.364_624_251_6),
@@ -289,7 +289,7 @@ fn qmc_base_intervals_are_student_t_on_the_replicate_spread() {
 }
 
 #[test]
-fn mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
+fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
     let inputs = unit_inputs(3, -std::f64::consts::PI, std::f64::consts::PI);
     for (text, resamples) in [
         ("samples = 500\nbase = \"mc\"", 200),
@@ -326,13 +326,15 @@ fn mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
 /// a folder of the single-net design of before is not resumed, while an `mc` or `lhs` study
 /// keeps the hash it always had.
 #[test]
-fn a_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
+fn sobol_sampling_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
     use sha2::{Digest, Sha256};
     use uq_driver::spec::{builtin, Study};
     use uq_driver::study::runner::study_hash;
     let text = builtin("wheel-sobol-sampling").unwrap();
     let study = |base: &str, extra: &str| {
-        let t = text.replace("base = \"qmc\"", &format!("base = \"{base}\"{extra}"));
+        let t = text
+            .replace("replicates = 8\n", "")
+            .replace("base = \"qmc\"", &format!("base = \"{base}\"{extra}"));
         Study::parse(&t, "t.toml", None).unwrap()
     };
     // The hash as computed before: the method serialised as `kind`, `samples`, `base`.
@@ -353,6 +355,12 @@ fn a_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
         assert_eq!(study_hash(&s), old_hash(&s, base), "{base}");
     }
     let qmc = study("qmc", "");
+    let builtin = Study::parse(text, "t.toml", None).unwrap();
+    assert_eq!(
+        study_hash(&qmc),
+        study_hash(&builtin),
+        "replicates = 8 is the default"
+    );
     assert_ne!(study_hash(&qmc), old_hash(&qmc, "qmc"));
     // Other replicates, another design; the default written out, the same.
     assert_ne!(

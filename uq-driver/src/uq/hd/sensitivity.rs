@@ -19,6 +19,12 @@
 //! outputs are evaluated a few at a time in lock step (one SIMD lane each), every sum in the
 //! same order as for a single output, so the numbers are those of [`pick_freeze_bootstrap`]
 //! bit for bit.
+//!
+//! Replicates: [`pick_freeze_replicates`] takes the rows as consecutive groups, each an
+//! independent replicate of the design (e.g. independently scrambled Sobol' nets, whose rows
+//! are not independent within a net, so that the bootstrap over rows does not apply), and
+//! gives Student's t intervals from the spread of the replicate estimates around the
+//! estimate on all rows.
 
 use rayon::prelude::*;
 
