@@ -121,8 +121,15 @@ fn tiny_analysis_blocks_give_the_same_files_sparse_regression_chaos() {
 #[test]
 fn tiny_analysis_blocks_give_the_same_files_sobol_sampling() {
     // With bootstrap intervals (their streams do not depend on the column).
-    let m = "kind = \"sobol_sampling\"\nsamples = 256\nbase = \"qmc\"\nbootstrap = 50";
+    let m = "kind = \"sobol_sampling\"\nsamples = 256\nbase = \"mc\"\nbootstrap = 50";
     same_files_with_tiny_blocks("sobol", m, "");
+}
+
+#[test]
+fn tiny_analysis_blocks_give_the_same_files_sobol_sampling_qmc_replicates() {
+    // Intervals from the spread of 4 independently scrambled replicates.
+    let m = "kind = \"sobol_sampling\"\nsamples = 256\nreplicates = 4";
+    same_files_with_tiny_blocks("sobolq", m, "");
 }
 
 #[test]
