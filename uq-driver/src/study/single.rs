@@ -240,7 +240,12 @@ fn analyse(
             // Inputs with an Askey family of their own that the design maps through the normal.
             let askey_hint =
                 design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);
-            let warnings = analysis::chaos_gap_warnings(&analysed, askey_hint);
+            let mut warnings = analysis::chaos_gap_warnings(&analysed, askey_hint);
+            let no_estimate = matches!(study.method, MethodSpec::SparseGrid(_)).then_some(
+                "a sparse grid has one only at a level above 0 with nested rules; Beta and \
+                 Gamma inputs, and the gauss_* rules, are not nested",
+            );
+            warnings.extend(analysis::chaos_error_warnings(&analysed, no_estimate));
             (analysed, Vec::new(), warnings)
         }
     })

@@ -16,7 +16,7 @@ mod exceedance;
 mod runs;
 mod surrogate;
 
-pub(crate) use chaos_gap::chaos_gap_warnings;
+pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings};
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
 pub use exceedance::{clopper_pearson, exceedance_count};
