@@ -50,6 +50,7 @@
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
 
+mod chaos;
 mod disk;
 
 use std::fmt;
@@ -84,6 +85,7 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+pub use chaos::{hyperbolic_terms, ChaosFit, ChaosShape};
 pub use disk::Disk;
 
 /// Why a study does not start.
@@ -145,17 +147,41 @@ pub enum SizeError {
     },
 }
 
-/// The hint that cheaper methods exist.
+/// The hint that ends a refusal.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Suggestion;
+pub enum Suggestion {
+    /// Cheaper methods exist.
+    FewerRuns,
+    /// The study is a chaos whose terms make it large.
+    SmallerChaos,
+}
+
+impl Suggestion {
+    /// The hint for the study estimated by `f`.
+    fn for_footprint(f: &Footprint) -> Suggestion {
+        if f.memory.chaos > 0.0 {
+            Suggestion::SmallerChaos
+        } else {
+            Suggestion::FewerRuns
+        }
+    }
+}
 
 impl fmt::Display for Suggestion {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            ", or use a method that needs far fewer runs for a smooth response in many random \
-             parameters: `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`"
-        )
+        match self {
+            Suggestion::FewerRuns => write!(
+                f,
+                ", or use a method that needs far fewer runs for a smooth response in many \
+                 random parameters: `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`"
+            ),
+            Suggestion::SmallerChaos => write!(
+                f,
+                ", or a chaos of fewer terms: a lower `level` or `order` (or `q_norm`), fewer \
+                 random parameters, or fewer `[analysis] series_samples` and \
+                 `surrogate_samples`"
+            ),
+        }
     }
 }
 
@@ -189,12 +215,15 @@ pub struct Memory {
     pub design: f64,
     /// The time grid.
     pub grid: f64,
+    /// What grows with the terms of a chaos ([`ChaosShape::memory`]: the fit, the
+    /// surrogate's basis at its draws, the coefficients).
+    pub chaos: f64,
 }
 
 impl Memory {
     /// The peak (bytes).
     pub fn total(&self) -> f64 {
-        self.design + self.grid + self.records + self.store.max(self.analysis)
+        self.design + self.grid + self.records + self.store.max(self.analysis) + self.chaos
     }
 }
 
@@ -218,12 +247,17 @@ impl fmt::Display for Footprint {
         write!(
             f,
             " of {} communication points, about {} of memory (records {}, analysis {}, \
-             design {}; {} {})",
+             design {}{}; {} {})",
             count(self.time_points),
             bytes(self.memory.total()),
             bytes(self.memory.records),
             bytes(self.memory.analysis),
             bytes(self.memory.design),
+            if self.memory.chaos > 0.0 {
+                format!(", chaos {}", bytes(self.memory.chaos))
+            } else {
+                String::new()
+            },
             bytes(self.available.0),
             if self.available.1 {
                 "available"
@@ -323,6 +357,9 @@ pub struct Shape {
     pub block_bytes: f64,
     /// Whether the whole series of an output is analysed at once (nested studies).
     pub whole_series: bool,
+    /// The chaos of a method whose arrays grow with its terms (`sparse_grid`,
+    /// `pce_regression`).
+    pub chaos: Option<ChaosShape>,
 }
 
 impl Shape {
@@ -330,7 +367,7 @@ impl Shape {
     pub fn of(study: &Study, threads: usize) -> Shape {
         let (runs, chaos) = match study.method().evaluation() {
             Evaluation::Sampling(m) => {
-                (m.planned_runs(study.parameters.len()), m.draws_from_chaos())
+                (m.planned_runs_for(&study.parameters), m.draws_from_chaos())
             }
             Evaluation::Intrusive(_) => (Some(0.0), true),
         };
@@ -375,6 +412,7 @@ impl Shape {
             quantile_levels: study.analysis.quantiles.len(),
             block_bytes: blocks::block_bytes() as f64,
             whole_series: matches!(study.method, MethodSpec::Nested(_)),
+            chaos: ChaosShape::of(study),
         }
     }
 
@@ -402,6 +440,9 @@ impl Shape {
             analysis: series.max(scalars) + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
             design: 4.0 * n * (8.0 * d + 24.0),
             grid: 4.0 * 8.0 * nt,
+            chaos: self.chaos.map_or(0.0, |c| {
+                c.memory(n, nt, block_columns(nt, n, self.block_bytes))
+            }),
         }
     }
 }
@@ -542,7 +583,7 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
         return Err(SizeError::Refused {
             footprint: Box::new(f.clone()),
             limit: bytes(available),
-            suggest: Suggestion,
+            suggest: Suggestion::for_footprint(f),
         });
     }
     if let Some(d) = f.disk.filter(|d| d.store.is_nan() || d.store > d.free) {
@@ -583,7 +624,7 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
     Err(SizeError::NeedsConfirmation {
         footprint: Box::new(f.clone()),
         reasons: reasons.join("; "),
-        suggest: Suggestion,
+        suggest: Suggestion::for_footprint(f),
     })
 }
 
@@ -714,6 +755,7 @@ mod tests {
             quantile_levels: 3,
             block_bytes: 256.0 * 1024.0 * 1024.0,
             whole_series: false,
+            chaos: None,
         }
     }
 
