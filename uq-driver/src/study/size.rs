@@ -916,6 +916,103 @@ mod tests {
         assert!(matches!(judge(&f, true), Err(SizeError::Refused { .. })));
     }
 
+    /// `builtin:wheel-sparse` with `dim` uniform inputs and the method `method` (TOML).
+    fn chaos_study(dim: usize, method: &str) -> Study {
+        let mut s = Study::load("builtin:wheel-sparse").unwrap();
+        s.parameters = (0..dim)
+            .map(|i| crate::uq::RandomParameter {
+                name: format!("x{i}"),
+                distribution: crate::uq::Distribution::uniform(0.0, 1.0).unwrap(),
+            })
+            .collect();
+        s.method = toml::from_str(method).unwrap();
+        s
+    }
+
+    fn binomial(n: usize, k: usize) -> f64 {
+        (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+    }
+
+    #[test]
+    fn the_qa_chaos_studies_are_estimated_above_their_largest_allocations() {
+        // QA F2: 300 LHS runs, 30 inputs, order 5: the candidates of degree 5 at the runs,
+        // 300 × C(35, 5) × 8 B = 779 MB, was the allocation that failed (estimate: 5.1 MiB).
+        let s = chaos_study(
+            30,
+            "kind = \"pce_regression\"\nsamples = 300\norder = 5\nsparse = true",
+        );
+        let shape = Shape::of(&s, 2);
+        assert_eq!(shape.runs, Some(300.0));
+        let m = shape.memory(300.0);
+        let failed = 300.0 * binomial(35, 5) * 8.0;
+        assert_eq!(failed, 779_116_800.0);
+        // Every degree's candidates (sum_p C(29 + p, p) = C(35, 5) - 1), their copies.
+        assert!(
+            m.chaos >= 4.0 * 300.0 * (binomial(35, 5) - 1.0) * 8.0,
+            "{}",
+            m.chaos
+        );
+        // Least squares on the same basis (were there runs enough): the design four times.
+        let s = chaos_study(30, "kind = \"pce_regression\"\nsamples = 400000\norder = 5");
+        let ls = Shape::of(&s, 2).memory(400_000.0);
+        assert!(ls.chaos >= 4.0 * 8.0 * 400_000.0 * binomial(35, 5));
+        // A level-3 sparse grid in 30 uniform inputs (Gauss–Patterson): 41 601 runs (QA's
+        // count), and the basis of the 4 000 draws of the series twice (once while built):
+        // the chaos terms from the degrees 0, 2, 5, 11 projected at levels 0..=3 (new degrees
+        // 1, 2, 3, 6 per level), summed over the levels with |l| <= 3.
+        fn terms(d: usize, budget: usize) -> f64 {
+            const NEW: [f64; 4] = [1.0, 2.0, 3.0, 6.0];
+            if d == 0 {
+                return 1.0;
+            }
+            (0..=budget)
+                .map(|j| NEW[j] * terms(d - 1, budget - j))
+                .sum()
+        }
+        let s = chaos_study(30, "kind = \"sparse_grid\"\nlevel = 3");
+        let shape = Shape::of(&s, 2);
+        assert_eq!(shape.runs, Some(41_601.0));
+        let m = shape.memory(41_601.0);
+        let basis = 4000.0 * terms(30, 3) * 8.0;
+        assert!(m.chaos >= 2.0 * basis, "{} {}", m.chaos, basis);
+        // The QA's study (3 time points) peaked at 2.59 GB and was estimated at 97 MiB.
+        assert!(m.total() > 2.5e9, "{}", bytes(m.total()));
+        let f = Footprint {
+            available: (1.5e9, true),
+            ..estimate(&shape, shape.runs)
+        };
+        let e = judge(&f, true).unwrap_err().to_string();
+        assert!(
+            e.contains(", chaos ") && e.contains("a lower `level`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn other_methods_keep_their_estimates_and_no_built_in_needs_yes() {
+        for (name, _) in crate::spec::BUILTINS {
+            let study = Study::load(&format!("builtin:{name}")).unwrap();
+            let variants = match &study.suite {
+                Some(s) => s.variants.clone(),
+                None => vec![study],
+            };
+            for s in variants {
+                let shape = Shape::of(&s, 2);
+                let chaos = matches!(
+                    s.method,
+                    MethodSpec::SparseGrid(_) | MethodSpec::PceRegression(_)
+                );
+                assert_eq!(shape.chaos.is_some(), chaos, "{name}");
+                if !chaos {
+                    assert_eq!(shape.memory(1000.0).chaos, 0.0, "{name}");
+                }
+                // Memory and runs, on a machine of 4 GiB (the time is not estimated here).
+                let f = footprint(&shape, ASSUMED_MEMORY);
+                assert!(judge(&f, false).is_ok(), "{name}: {f}");
+            }
+        }
+    }
+
     #[test]
     fn units() {
         assert_eq!(bytes(512.0), "512.0 B");

@@ -321,6 +321,43 @@ mod tests {
     }
 
     #[test]
+    fn the_counted_runs_are_those_of_the_design() {
+        // Nested (Genz–Keister, Gauss–Patterson, Clenshaw–Curtis) and non-nested rules
+        // (Gauss–Hermite, Gauss–Legendre, and the Gauss rules of gamma and beta germs), alone
+        // and mixed, against the design as built.
+        let mixed = vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::uniform(0.0, 1.0).unwrap(),
+            Distribution::gamma(2.0, 1.0).unwrap(),
+            Distribution::beta(2.0, 3.0, 0.0, 1.0).unwrap(),
+            Distribution::lognormal(0.0, 0.3).unwrap(),
+            Distribution::beta(1.5, 1.5, -1.0, 1.0).unwrap(),
+        ];
+        let gammas = vec![Distribution::gamma(3.0, 0.5).unwrap(); 4];
+        let betas = vec![Distribution::beta(2.0, 5.0, 0.0, 1.0).unwrap(); 3];
+        for (ds, rules) in [
+            (mixed.clone(), vec!["", "rule = \"gauss_hermite\"", "rule = \"clenshaw_curtis\""]),
+            (mixed[..3].to_vec(), vec!["rule = \"gauss_legendre\""]),
+            (gammas, vec![""]),
+            (betas, vec![""]),
+        ] {
+            let ins = inputs(ds);
+            for rule in rules {
+                for level in 0..=3 {
+                    let m = method(&format!("level = {level}\n{rule}"));
+                    let n = m.design(&ins, 0).unwrap().len();
+                    assert_eq!(
+                        m.planned_runs_for(&ins.parameters),
+                        Some(n as f64),
+                        "{rule} level {level}, {} inputs",
+                        ins.parameters.len()
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn settings_that_do_not_fit_the_inputs_are_refused() {
         let ins = inputs(vec![
             Distribution::normal(1.0, 0.1).unwrap(),
