@@ -1,7 +1,8 @@
 //! Guards against designs too large to run, checked before anything is allocated or run.
 //!
 //! A study is estimated first ([`Footprint`]): its model runs (from the method, without
-//! building the design), the memory the driver will hold, and the wall time. Then:
+//! building the design: [`Sampling::planned_runs_for`](crate::uq::method::Sampling), e.g. a
+//! sparse grid's points counted from its rules), the memory the driver will hold, and the wall time. Then:
 //! - it is **refused** (whatever `--yes` says) when the memory estimate exceeds the memory
 //!   available to the process ([`available_memory`]): it could not be allocated;
 //! - it **needs `--yes`** when it has more than [`MAX_RUNS`] model runs, when the memory
@@ -27,12 +28,14 @@
 //!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; and the
 //!   statistics of every column of every output, `8 s nt (12 + k + 6 d)`. A nested study
 //!   analyses the whole series of an output at once: `1.5 × 8 n nt` instead of the blocks.
-//!   (The coefficients of a chaos, terms × nt per output, are not counted.)
+//! - for `sparse_grid` and `pce_regression`, what grows with the chaos terms: the fit, the
+//!   surrogate's basis at its draws and the coefficients (`size/chaos.rs`, [`Memory::chaos`]);
 //! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
 //! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
 //! - the time grid (a few copies): `4 × 8 nt`.
 //!
-//! The peak is the design, grid and records plus the analysis (with the worker buffers).
+//! The peak is the design, grid and records plus the analysis (with the worker buffers) and
+//! the chaos.
 //!
 //! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
 //! (runs × steps; a smaller study reaches an hour only if one step costs more than 0.36 ms on
@@ -50,6 +53,7 @@
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
 
+mod available;
 mod chaos;
 mod disk;
 
@@ -85,6 +89,7 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+pub use available::available_memory;
 pub use chaos::{hyperbolic_terms, ChaosFit, ChaosShape};
 pub use disk::Disk;
 
@@ -679,60 +684,6 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
         }
         k = (k * 4).min(steps as usize);
     }
-}
-
-/// Memory available to this process (bytes): the least of the system's available memory
-/// (`MemAvailable` of `/proc/meminfo`), the room left under a cgroup limit
-/// (`memory.max` − `memory.current`, v2; `memory.limit_in_bytes` − `memory.usage_in_bytes`,
-/// v1) and the room left in the address-space limit (`ulimit -v`: `Max address space` of
-/// `/proc/self/limits` − `VmSize` of `/proc/self/status`), and `RAILUQ_MEMORY_LIMIT`
-/// (bytes) where set (to keep studies within a budget of one's own, or to test the guard).
-/// `None` where none is known.
-pub fn available_memory() -> Option<f64> {
-    let read = |p: &str| std::fs::read_to_string(p).ok();
-    let number = |s: Option<String>| -> Option<f64> { s?.trim().parse::<f64>().ok() };
-    let kib_field = |text: &str, key: &str| -> Option<f64> {
-        let line = text.lines().find(|l| l.starts_with(key))?;
-        let kib: f64 = line[key.len()..].split_whitespace().next()?.parse().ok()?;
-        Some(kib * 1024.0)
-    };
-    let mut limits = Vec::new();
-    if let Some(m) = read("/proc/meminfo").and_then(|t| kib_field(&t, "MemAvailable:")) {
-        limits.push(m);
-    }
-    for (max, used) in [
-        ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
-        (
-            "/sys/fs/cgroup/memory/memory.limit_in_bytes",
-            "/sys/fs/cgroup/memory/memory.usage_in_bytes",
-        ),
-    ] {
-        if let (Some(m), Some(u)) = (number(read(max)), number(read(used))) {
-            // "max" (no limit) does not parse; v1 reports no limit as a huge number.
-            if m < 1e18 {
-                limits.push((m - u).max(0.0));
-            }
-        }
-    }
-    if let Some(text) = read("/proc/self/limits") {
-        let soft = text
-            .lines()
-            .find(|l| l.starts_with("Max address space"))
-            .and_then(|l| l.split_whitespace().nth(3))
-            .and_then(|v| v.parse::<f64>().ok());
-        let size = read("/proc/self/status").and_then(|t| kib_field(&t, "VmSize:"));
-        if let (Some(limit), Some(size)) = (soft, size) {
-            limits.push((limit - size).max(0.0));
-        }
-    }
-    if let Some(m) = std::env::var("RAILUQ_MEMORY_LIMIT")
-        .ok()
-        .and_then(|v| v.trim().parse::<f64>().ok())
-        .filter(|m| *m >= 0.0)
-    {
-        limits.push(m);
-    }
-    limits.into_iter().reduce(f64::min)
 }
 
 #[cfg(test)]
