@@ -604,3 +604,124 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("different study"));
 }
+
+#[test]
+fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    // QA: a 30-input G function at level 2 gave a mean of 0.013 (true 1) with a level
+    // difference of 1.45 written only to a CSV column, and no warning. Here: the g-function
+    // (|4x - 2| kinks) of 8 uniform inputs at level 1, and by LARS on 20 runs.
+    let dir = tempfile::tempdir().unwrap();
+    let names = ["x1", "x2", "x3", "x4", "x5", "x6", "x7", "x8"];
+    let params = uniform(&names, 0.0, 1.0);
+    for (name, method, kind) in [
+        (
+            "g_sg",
+            "kind = \"sparse_grid\"\nlevel = 1",
+            "level_difference",
+        ),
+        (
+            "g_lars",
+            "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 32\norder = 3\nsparse = true",
+            "loo",
+        ),
+    ] {
+        let out = run_study(&study(dir.path(), name, 3, &params, method));
+        let s = summary(&out);
+        let warnings = s["warnings"].to_string();
+        let estimate = s["quantities"]["Y"]["chaos_error"]["value"]
+            .as_f64()
+            .unwrap();
+        assert!(estimate > 0.05, "{name}: {estimate}");
+        assert!(
+            warnings.contains(&format!(
+                "Y: the chaos's own truncation-error estimate ({kind}) is"
+            )),
+            "{name}: {warnings}"
+        );
+    }
+    // y = x1 + x2² (function 4, sigma_h = 0) is a polynomial the chaos holds exactly: no
+    // warning; with a Beta input the sparse grid's rules are not nested: no estimate, said so.
+    let poly = uniform(&["x1", "x2"], 0.0, 1.0);
+    let out = run_study(&study(
+        dir.path(),
+        "poly",
+        4,
+        &poly,
+        "kind = \"sparse_grid\"\nlevel = 3",
+    ));
+    let warnings = summary(&out)["warnings"].to_string();
+    assert!(!warnings.contains("truncation-error"), "{warnings}");
+    let beta = "[[parameters]]\nname = \"x1\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 1\n\
+                [[parameters]]\nname = \"x2\"\ndistribution = \"beta\"\nalpha = 2\nbeta = 3\nlow = 0\nhigh = 1\n";
+    let out = run_study(&study(
+        dir.path(),
+        "beta",
+        4,
+        beta,
+        "kind = \"sparse_grid\"\nlevel = 2",
+    ));
+    let warnings = summary(&out)["warnings"].to_string();
+    assert!(
+        warnings.contains("no truncation-error estimate"),
+        "{warnings}"
+    );
+}
+
+#[test]
+fn correlated_inputs_say_their_sobol_indices_depend_on_the_parameter_order() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    // QA: with [[correlation]] the indices are those of the Cholesky-ordered germs; S of one
+    // input was 0.0006 in file order and 0.116 listed first, while the report called it "the
+    // share of the variance it causes alone". y = x1 + x2² (function 4), rho = 0.8.
+    let p = |n: &str, m: f64| format!("[[parameters]]\nname = \"{n}\"\nmean = {m}\nstd = 1.0\n");
+    let corr = "[[correlation]]\nbetween = [\"x1\", \"x2\"]\nrho = 0.8\n";
+    let dir = tempfile::tempdir().unwrap();
+    let mut s_x1 = Vec::new();
+    for (name, order) in [("x1_first", ["x1", "x2"]), ("x2_first", ["x2", "x1"])] {
+        let params = format!("{}{}{corr}", p(order[0], 0.0), p(order[1], 0.0));
+        let out = run_study(&study(
+            dir.path(),
+            name,
+            4,
+            &params,
+            "kind = \"sparse_grid\"\nlevel = 3",
+        ));
+        let s = summary(&out);
+        let warnings = s["warnings"].to_string();
+        assert!(
+            warnings.contains(&format!(
+                "the inputs are correlated: the Sobol' indices are those of the independent \
+                 germs in the order of [[parameters]] ({}, {})",
+                order[0], order[1]
+            )),
+            "{warnings}"
+        );
+        s_x1.push(
+            s["quantities"]["Y"]["sobol"]["first"]["x1"]
+                .as_f64()
+                .unwrap(),
+        );
+    }
+    // Listed first, x1's germ is x1: S = Var E[y | x1] / Var y = (1 + 2 rho⁴) / 3 = 0.606;
+    // listed second, only its part independent of x2 counts: (1 - rho²) / 3 = 0.12.
+    assert!(
+        (s_x1[0] - (1.0 + 2.0 * 0.8f64.powi(4)) / 3.0).abs() < 1e-6,
+        "{s_x1:?}"
+    );
+    assert!((s_x1[1] - (1.0 - 0.64) / 3.0).abs() < 1e-6, "{s_x1:?}");
+    // Independent inputs: no such warning.
+    let params = format!("{}{}", p("x1", 0.0), p("x2", 0.0));
+    let out = run_study(&study(
+        dir.path(),
+        "indep",
+        4,
+        &params,
+        "kind = \"sparse_grid\"\nlevel = 3",
+    ));
+    assert!(!summary(&out)["warnings"].to_string().contains("correlated"));
+}

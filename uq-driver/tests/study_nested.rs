@@ -211,6 +211,14 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     let (p, p_ci) = (e["p"].as_f64().unwrap(), pair(&e["ci"]));
     assert!((p - p_exact).abs() < 0.02, "P {p} vs {p_exact}");
     assert!(p_ci[0] <= p_exact && p_exact <= p_ci[1], "{p_ci:?}");
+    // The count's interval (printed by `run`) is that same bootstrap over the outer samples,
+    // not a Clopper–Pearson interval of the pooled draws as if they were independent (QA: that
+    // held the true P in 3 of 30 seeds), and the pooled values are named as chaos draws.
+    let c = &q["exceedance_counts"][0];
+    assert_eq!(pair(&c["ci_95"]), p_ci);
+    assert_eq!(c["ci_kind"], "outer_bootstrap");
+    assert_eq!(c["outer_samples"], 2000);
+    assert_eq!(c["of_what"], "draws of the inner chaos surrogates");
 
     // Per outer sample: the seed, the exact conditional moments, the conditional P.
     let (header, rows) = conditional(&out);

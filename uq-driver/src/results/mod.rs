@@ -220,24 +220,47 @@ pub struct ExceedanceCount {
     pub upper_95: f64,
     /// What was counted: `runs` or `draws of the chaos surrogate`.
     pub of_what: String,
+    /// How `ci_95` and `upper_95` were found: `clopper_pearson` (the draws counted as
+    /// independent) or, in a nested study, `outer_bootstrap` (percentile bootstrap over the
+    /// outer samples, the independent units; `upper_95` then is the interval's upper end, or
+    /// `1 − 0.05^(1/outer_samples)` when none exceeded).
+    pub ci_kind: &'static str,
+    /// Nested studies: the number of outer samples the interval rests on.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outer_samples: Option<usize>,
 }
 
 impl ExceedanceCount {
     /// E.g. `0 of 10 000 runs exceeded 2.5 (95 % upper bound 3.0e-4)` or
-    /// `12 of 1 000 runs exceeded 2.5: P = 0.012 (95 % interval 0.0062–0.021)`.
+    /// `12 of 1 000 runs exceeded 2.5: P = 0.012 (95 % interval 0.0062–0.021)`; nested:
+    /// `617 of 2 000 runs over 50 outer samples exceeded 1.5: P = 0.308 (95 % interval, bootstrap
+    /// over the outer samples: 0.2–0.42)`.
+    ///
+    /// Nested studies used to print the Clopper–Pearson interval of the pooled runs, as if
+    /// they were independent: it held the true P in 3 of 30 seeds (found by QA).
     pub fn describe(&self) -> String {
+        let outer = self.outer_samples.map_or(String::new(), |k| {
+            format!(" over {} outer samples", group_digits(k))
+        });
         let head = format!(
-            "{} of {} {} exceeded {}",
+            "{} of {} {}{outer} exceeded {}",
             group_digits(self.exceeded),
             group_digits(self.of),
             self.of_what,
             self.limit
         );
+        let kind = match self.outer_samples {
+            Some(_) => ", bootstrap over the outer samples",
+            None => "",
+        };
         if self.exceeded == 0 {
-            format!("{head} (95 % upper bound of P: {})", sig(self.upper_95))
+            format!(
+                "{head} (95 % upper bound of P{kind}: {})",
+                sig(self.upper_95)
+            )
         } else {
             format!(
-                "{head}: P = {} (95 % interval {}–{})",
+                "{head}: P = {} (95 % interval{kind}: {}–{})",
                 sig(self.p),
                 sig(self.ci_95[0]),
                 sig(self.ci_95[1])

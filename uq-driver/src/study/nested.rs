@@ -18,8 +18,8 @@ use rand::RngCore;
 use rayon::prelude::*;
 
 use super::analysis::{
-    output_stats, quantity_error, scalar_stats, surrogates_of, Analysed, AnalysisError,
-    QuantityRuns, Runs, Settings,
+    nest_exceedance_count, output_stats, quantity_error, scalar_stats, surrogates_of, Analysed,
+    AnalysisError, QuantityRuns, Runs, Settings,
 };
 use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
@@ -275,7 +275,15 @@ fn quantity(
         limits: &limits,
         exceedance: &exceedance,
     };
-    stats.nested = Some(nested_scalar(name, parts, table));
+    let nested = nested_scalar(name, parts, table);
+    for (count, e) in stats
+        .exceedance_counts
+        .iter_mut()
+        .zip(&nested.exceedance_ci)
+    {
+        nest_exceedance_count(count, e.ci, present.len(), stats.draws);
+    }
+    stats.nested = Some(nested);
     let warning = (s.var_outer < 0.0).then(|| {
         format!(
             "{}: the estimated variance between outer samples, {:.3e}, is below the inner \

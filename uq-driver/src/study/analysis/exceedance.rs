@@ -32,7 +32,33 @@ pub fn exceedance_count(draws: &[f64], limit: f64, source: Draws) -> ExceedanceC
             Draws::Runs => "runs".into(),
             Draws::Chaos => "draws of the chaos surrogate".into(),
         },
+        ci_kind: "clopper_pearson",
+        outer_samples: None,
     }
+}
+
+/// A nested study's count: the interval and upper bound from the outer samples
+/// (`ci`: the percentile bootstrap over them; `outer` of them), not from the pooled draws;
+/// `source` says what the pooled values are.
+pub fn nest_exceedance_count(
+    count: &mut ExceedanceCount,
+    ci: [f64; 2],
+    outer: usize,
+    source: Draws,
+) {
+    count.ci_95 = ci;
+    count.upper_95 = if count.exceeded == 0 && outer > 0 {
+        // Each outer sample's first inner value exceeds with probability P, independently.
+        1.0 - 0.05f64.powf(1.0 / outer as f64)
+    } else {
+        ci[1]
+    };
+    count.ci_kind = "outer_bootstrap";
+    count.outer_samples = Some(outer);
+    count.of_what = match source {
+        Draws::Runs => "runs".into(),
+        Draws::Chaos => "draws of the inner chaos surrogates".into(),
+    };
 }
 
 /// The Clopper–Pearson (exact binomial) interval of level `1 − alpha` for `k` successes in
@@ -59,6 +85,27 @@ pub fn clopper_pearson(k: usize, n: usize, alpha: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_nested_count_takes_the_outer_interval_and_an_outer_upper_bound() {
+        // 0 of 4 000 pooled runs from 40 outer samples: the bound rests on the 40 independent
+        // outer samples (1 - 0.05^(1/40) = 0.0722), not on 4 000 runs (7.5e-4).
+        let mut c = exceedance_count(&vec![0.0; 4000], 1.0, Draws::Runs);
+        assert!((c.upper_95 - 7.486e-4).abs() < 1e-6, "{}", c.upper_95);
+        nest_exceedance_count(&mut c, [0.0, 0.0], 40, Draws::Chaos);
+        assert!((c.upper_95 - (1.0 - 0.05f64.powf(1.0 / 40.0))).abs() < 1e-15);
+        assert!((c.upper_95 - 0.0722).abs() < 1e-4);
+        assert_eq!(c.ci_kind, "outer_bootstrap");
+        assert!(
+            c.describe().contains("over 40 outer samples"),
+            "{}",
+            c.describe()
+        );
+        assert!(c.describe().contains("bootstrap over the outer samples"));
+        let mut c = exceedance_count(&[0.0, 2.0, 3.0, 0.5], 1.0, Draws::Runs);
+        nest_exceedance_count(&mut c, [0.1, 0.9], 2, Draws::Runs);
+        assert_eq!((c.ci_95, c.upper_95), ([0.1, 0.9], 0.9));
+    }
 
     #[test]
     fn clopper_pearson_matches_published_values() {

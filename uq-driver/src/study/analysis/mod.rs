@@ -16,10 +16,10 @@ mod exceedance;
 mod runs;
 mod surrogate;
 
-pub(crate) use chaos_gap::chaos_gap_warnings;
+pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings};
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
-pub use exceedance::{clopper_pearson, exceedance_count};
+pub use exceedance::{clopper_pearson, exceedance_count, nest_exceedance_count};
 
 use blocks::SeriesColumns;
 use columns::{column, Column};
