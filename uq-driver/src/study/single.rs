@@ -42,7 +42,7 @@ pub(crate) fn run_single(
             let fmu = open_fmu(study)?;
             ranges::check_supports(study, &fmu).map_err(RunError::from)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
-            if method.planned_runs(study.parameters.len()).is_none() {
+            if method.planned_runs_for(&study.parameters).is_none() {
                 // Only the design knew its size: check it before it runs.
                 size::check_runs(study, design.len(), opts)?;
             }

@@ -1,7 +1,8 @@
 //! Guards against designs too large to run, checked before anything is allocated or run.
 //!
 //! A study is estimated first ([`Footprint`]): its model runs (from the method, without
-//! building the design), the memory the driver will hold, and the wall time. Then:
+//! building the design: [`Sampling::planned_runs_for`](crate::uq::method::Sampling), e.g. a
+//! sparse grid's points counted from its rules), the memory the driver will hold, and the wall time. Then:
 //! - it is **refused** (whatever `--yes` says) when the memory estimate exceeds the memory
 //!   available to the process ([`available_memory`]): it could not be allocated;
 //! - it **needs `--yes`** when it has more than [`MAX_RUNS`] model runs, when the memory
@@ -27,12 +28,14 @@
 //!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; and the
 //!   statistics of every column of every output, `8 s nt (12 + k + 6 d)`. A nested study
 //!   analyses the whole series of an output at once: `1.5 × 8 n nt` instead of the blocks.
-//!   (The coefficients of a chaos, terms × nt per output, are not counted.)
+//! - for `sparse_grid` and `pce_regression`, what grows with the chaos terms: the fit, the
+//!   surrogate's basis at its draws and the coefficients (`size/chaos.rs`, [`Memory::chaos`]);
 //! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
 //! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
 //! - the time grid (a few copies): `4 × 8 nt`.
 //!
-//! The peak is the design, grid and records plus the analysis (with the worker buffers).
+//! The peak is the design, grid and records plus the analysis (with the worker buffers) and
+//! the chaos.
 //!
 //! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
 //! (runs × steps; a smaller study reaches an hour only if one step costs more than 0.36 ms on
@@ -50,6 +53,8 @@
 //! `--timeout-per-run` the study is not timed (the timing run would run the FMU in-process,
 //! without a limit).
 
+mod available;
+mod chaos;
 mod disk;
 
 use std::fmt;
@@ -84,6 +89,8 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+pub use available::available_memory;
+pub use chaos::{hyperbolic_terms, ChaosFit, ChaosShape};
 pub use disk::Disk;
 
 /// Why a study does not start.
@@ -145,17 +152,41 @@ pub enum SizeError {
     },
 }
 
-/// The hint that cheaper methods exist.
+/// The hint that ends a refusal.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Suggestion;
+pub enum Suggestion {
+    /// Cheaper methods exist.
+    FewerRuns,
+    /// The study is a chaos whose terms make it large.
+    SmallerChaos,
+}
+
+impl Suggestion {
+    /// The hint for the study estimated by `f`.
+    fn for_footprint(f: &Footprint) -> Suggestion {
+        if f.memory.chaos > 0.0 {
+            Suggestion::SmallerChaos
+        } else {
+            Suggestion::FewerRuns
+        }
+    }
+}
 
 impl fmt::Display for Suggestion {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            ", or use a method that needs far fewer runs for a smooth response in many random \
-             parameters: `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`"
-        )
+        match self {
+            Suggestion::FewerRuns => write!(
+                f,
+                ", or use a method that needs far fewer runs for a smooth response in many \
+                 random parameters: `kind = \"sparse_grid\"` or `kind = \"pce_regression\"`"
+            ),
+            Suggestion::SmallerChaos => write!(
+                f,
+                ", or a chaos of fewer terms: a lower `level` or `order` (or `q_norm`), fewer \
+                 random parameters, or fewer `[analysis] series_samples` and \
+                 `surrogate_samples`"
+            ),
+        }
     }
 }
 
@@ -189,12 +220,15 @@ pub struct Memory {
     pub design: f64,
     /// The time grid.
     pub grid: f64,
+    /// What grows with the terms of a chaos ([`ChaosShape::memory`]: the fit, the
+    /// surrogate's basis at its draws, the coefficients).
+    pub chaos: f64,
 }
 
 impl Memory {
     /// The peak (bytes).
     pub fn total(&self) -> f64 {
-        self.design + self.grid + self.records + self.store.max(self.analysis)
+        self.design + self.grid + self.records + self.store.max(self.analysis) + self.chaos
     }
 }
 
@@ -218,12 +252,17 @@ impl fmt::Display for Footprint {
         write!(
             f,
             " of {} communication points, about {} of memory (records {}, analysis {}, \
-             design {}; {} {})",
+             design {}{}; {} {})",
             count(self.time_points),
             bytes(self.memory.total()),
             bytes(self.memory.records),
             bytes(self.memory.analysis),
             bytes(self.memory.design),
+            if self.memory.chaos > 0.0 {
+                format!(", chaos {}", bytes(self.memory.chaos))
+            } else {
+                String::new()
+            },
             bytes(self.available.0),
             if self.available.1 {
                 "available"
@@ -323,6 +362,9 @@ pub struct Shape {
     pub block_bytes: f64,
     /// Whether the whole series of an output is analysed at once (nested studies).
     pub whole_series: bool,
+    /// The chaos of a method whose arrays grow with its terms (`sparse_grid`,
+    /// `pce_regression`).
+    pub chaos: Option<ChaosShape>,
 }
 
 impl Shape {
@@ -330,7 +372,7 @@ impl Shape {
     pub fn of(study: &Study, threads: usize) -> Shape {
         let (runs, chaos) = match study.method().evaluation() {
             Evaluation::Sampling(m) => {
-                (m.planned_runs(study.parameters.len()), m.draws_from_chaos())
+                (m.planned_runs_for(&study.parameters), m.draws_from_chaos())
             }
             Evaluation::Intrusive(_) => (Some(0.0), true),
         };
@@ -375,6 +417,7 @@ impl Shape {
             quantile_levels: study.analysis.quantiles.len(),
             block_bytes: blocks::block_bytes() as f64,
             whole_series: matches!(study.method, MethodSpec::Nested(_)),
+            chaos: ChaosShape::of(study),
         }
     }
 
@@ -402,6 +445,9 @@ impl Shape {
             analysis: series.max(scalars) + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
             design: 4.0 * n * (8.0 * d + 24.0),
             grid: 4.0 * 8.0 * nt,
+            chaos: self.chaos.map_or(0.0, |c| {
+                c.memory(n, nt, block_columns(nt, n, self.block_bytes))
+            }),
         }
     }
 }
@@ -542,7 +588,7 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
         return Err(SizeError::Refused {
             footprint: Box::new(f.clone()),
             limit: bytes(available),
-            suggest: Suggestion,
+            suggest: Suggestion::for_footprint(f),
         });
     }
     if let Some(d) = f.disk.filter(|d| d.store.is_nan() || d.store > d.free) {
@@ -583,7 +629,7 @@ pub fn judge(f: &Footprint, yes: bool) -> Result<(), SizeError> {
     Err(SizeError::NeedsConfirmation {
         footprint: Box::new(f.clone()),
         reasons: reasons.join("; "),
-        suggest: Suggestion,
+        suggest: Suggestion::for_footprint(f),
     })
 }
 
@@ -640,60 +686,6 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
     }
 }
 
-/// Memory available to this process (bytes): the least of the system's available memory
-/// (`MemAvailable` of `/proc/meminfo`), the room left under a cgroup limit
-/// (`memory.max` − `memory.current`, v2; `memory.limit_in_bytes` − `memory.usage_in_bytes`,
-/// v1) and the room left in the address-space limit (`ulimit -v`: `Max address space` of
-/// `/proc/self/limits` − `VmSize` of `/proc/self/status`), and `RAILUQ_MEMORY_LIMIT`
-/// (bytes) where set (to keep studies within a budget of one's own, or to test the guard).
-/// `None` where none is known.
-pub fn available_memory() -> Option<f64> {
-    let read = |p: &str| std::fs::read_to_string(p).ok();
-    let number = |s: Option<String>| -> Option<f64> { s?.trim().parse::<f64>().ok() };
-    let kib_field = |text: &str, key: &str| -> Option<f64> {
-        let line = text.lines().find(|l| l.starts_with(key))?;
-        let kib: f64 = line[key.len()..].split_whitespace().next()?.parse().ok()?;
-        Some(kib * 1024.0)
-    };
-    let mut limits = Vec::new();
-    if let Some(m) = read("/proc/meminfo").and_then(|t| kib_field(&t, "MemAvailable:")) {
-        limits.push(m);
-    }
-    for (max, used) in [
-        ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
-        (
-            "/sys/fs/cgroup/memory/memory.limit_in_bytes",
-            "/sys/fs/cgroup/memory/memory.usage_in_bytes",
-        ),
-    ] {
-        if let (Some(m), Some(u)) = (number(read(max)), number(read(used))) {
-            // "max" (no limit) does not parse; v1 reports no limit as a huge number.
-            if m < 1e18 {
-                limits.push((m - u).max(0.0));
-            }
-        }
-    }
-    if let Some(text) = read("/proc/self/limits") {
-        let soft = text
-            .lines()
-            .find(|l| l.starts_with("Max address space"))
-            .and_then(|l| l.split_whitespace().nth(3))
-            .and_then(|v| v.parse::<f64>().ok());
-        let size = read("/proc/self/status").and_then(|t| kib_field(&t, "VmSize:"));
-        if let (Some(limit), Some(size)) = (soft, size) {
-            limits.push((limit - size).max(0.0));
-        }
-    }
-    if let Some(m) = std::env::var("RAILUQ_MEMORY_LIMIT")
-        .ok()
-        .and_then(|v| v.trim().parse::<f64>().ok())
-        .filter(|m| *m >= 0.0)
-    {
-        limits.push(m);
-    }
-    limits.into_iter().reduce(f64::min)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -714,6 +706,7 @@ mod tests {
             quantile_levels: 3,
             block_bytes: 256.0 * 1024.0 * 1024.0,
             whole_series: false,
+            chaos: None,
         }
     }
 
@@ -872,6 +865,103 @@ mod tests {
         let mut f = footprint(&wheel_shape(1.0), 1e12);
         f.memory.records = f64::NAN;
         assert!(matches!(judge(&f, true), Err(SizeError::Refused { .. })));
+    }
+
+    /// `builtin:wheel-sparse` with `dim` uniform inputs and the method `method` (TOML).
+    fn chaos_study(dim: usize, method: &str) -> Study {
+        let mut s = Study::load("builtin:wheel-sparse").unwrap();
+        s.parameters = (0..dim)
+            .map(|i| crate::uq::RandomParameter {
+                name: format!("x{i}"),
+                distribution: crate::uq::Distribution::uniform(0.0, 1.0).unwrap(),
+            })
+            .collect();
+        s.method = toml::from_str(method).unwrap();
+        s
+    }
+
+    fn binomial(n: usize, k: usize) -> f64 {
+        (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+    }
+
+    #[test]
+    fn the_qa_chaos_studies_are_estimated_above_their_largest_allocations() {
+        // QA F2: 300 LHS runs, 30 inputs, order 5: the candidates of degree 5 at the runs,
+        // 300 × C(35, 5) × 8 B = 779 MB, was the allocation that failed (estimate: 5.1 MiB).
+        let s = chaos_study(
+            30,
+            "kind = \"pce_regression\"\nsamples = 300\norder = 5\nsparse = true",
+        );
+        let shape = Shape::of(&s, 2);
+        assert_eq!(shape.runs, Some(300.0));
+        let m = shape.memory(300.0);
+        let failed = 300.0 * binomial(35, 5) * 8.0;
+        assert_eq!(failed, 779_116_800.0);
+        // Every degree's candidates (sum_p C(29 + p, p) = C(35, 5) - 1), their copies.
+        assert!(
+            m.chaos >= 4.0 * 300.0 * (binomial(35, 5) - 1.0) * 8.0,
+            "{}",
+            m.chaos
+        );
+        // Least squares on the same basis (were there runs enough): the design four times.
+        let s = chaos_study(30, "kind = \"pce_regression\"\nsamples = 400000\norder = 5");
+        let ls = Shape::of(&s, 2).memory(400_000.0);
+        assert!(ls.chaos >= 4.0 * 8.0 * 400_000.0 * binomial(35, 5));
+        // A level-3 sparse grid in 30 uniform inputs (Gauss–Patterson): 41 601 runs (QA's
+        // count), and the basis of the 4 000 draws of the series twice (once while built):
+        // the chaos terms from the degrees 0, 2, 5, 11 projected at levels 0..=3 (new degrees
+        // 1, 2, 3, 6 per level), summed over the levels with |l| <= 3.
+        fn terms(d: usize, budget: usize) -> f64 {
+            const NEW: [f64; 4] = [1.0, 2.0, 3.0, 6.0];
+            if d == 0 {
+                return 1.0;
+            }
+            (0..=budget)
+                .map(|j| NEW[j] * terms(d - 1, budget - j))
+                .sum()
+        }
+        let s = chaos_study(30, "kind = \"sparse_grid\"\nlevel = 3");
+        let shape = Shape::of(&s, 2);
+        assert_eq!(shape.runs, Some(41_601.0));
+        let m = shape.memory(41_601.0);
+        let basis = 4000.0 * terms(30, 3) * 8.0;
+        assert!(m.chaos >= 2.0 * basis, "{} {}", m.chaos, basis);
+        // The QA's study (3 time points) peaked at 2.59 GB and was estimated at 97 MiB.
+        assert!(m.total() > 2.5e9, "{}", bytes(m.total()));
+        let f = Footprint {
+            available: (1.5e9, true),
+            ..estimate(&shape, shape.runs)
+        };
+        let e = judge(&f, true).unwrap_err().to_string();
+        assert!(
+            e.contains(", chaos ") && e.contains("a lower `level`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn other_methods_keep_their_estimates_and_no_built_in_needs_yes() {
+        for (name, _) in crate::spec::BUILTINS {
+            let study = Study::load(&format!("builtin:{name}")).unwrap();
+            let variants = match &study.suite {
+                Some(s) => s.variants.clone(),
+                None => vec![study],
+            };
+            for s in variants {
+                let shape = Shape::of(&s, 2);
+                let chaos = matches!(
+                    s.method,
+                    MethodSpec::SparseGrid(_) | MethodSpec::PceRegression(_)
+                );
+                assert_eq!(shape.chaos.is_some(), chaos, "{name}");
+                if !chaos {
+                    assert_eq!(shape.memory(1000.0).chaos, 0.0, "{name}");
+                }
+                // Memory and runs, on a machine of 4 GiB (the time is not estimated here).
+                let f = footprint(&shape, ASSUMED_MEMORY);
+                assert!(judge(&f, false).is_ok(), "{name}: {f}");
+            }
+        }
     }
 
     #[test]

@@ -16,6 +16,10 @@ use std::collections::HashMap;
 
 use super::rules::{Rule1d, RuleError, RuleKind};
 
+mod count;
+
+pub use count::{total_level_size, GridSize};
+
 /// Largest number of merged points of a sparse grid.
 pub const MAX_SPARSE_POINTS: usize = 5_000_000;
 

@@ -27,7 +27,7 @@ use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
-use crate::uq::hd::smolyak::{LevelSet, SparseGrid as Grid};
+use crate::uq::hd::smolyak::{total_level_size as count, GridSize, LevelSet, SparseGrid as Grid};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::Family;
 
@@ -99,10 +99,37 @@ impl SparseGrid {
             .collect()
     }
 
-    /// The grid of `families`' germs.
+    /// The grid of `families`' germs (refused before a node is made when it has more than
+    /// [`MAX_POINTS`] points).
     fn grid(&self, families: &[Family]) -> Result<Grid, MethodError> {
+        let rules = self.rules(families);
+        self.refuse_too_large(&count(&rules, self.level).map_err(grid_error)?)
+            .map_err(MethodError::Invalid)?;
         let set = LevelSet::total(families.len(), self.level).map_err(grid_error)?;
-        Grid::new(&self.rules(families), &set).map_err(grid_error)
+        Grid::new(&rules, &set).map_err(grid_error)
+    }
+
+    /// The sizes of the grid of `parameters` (points, tensor nodes, chaos terms), counted
+    /// without building it: instant whatever the level and dimension.
+    pub fn size(&self, parameters: &[RandomParameter]) -> Result<GridSize, InvalidSettings> {
+        let rules = self.rules(&self.families(parameters));
+        count(&rules, self.level).map_err(|e| InvalidSettings(format!("sparse grid: {e}")))
+    }
+
+    fn refuse_too_large(&self, size: &GridSize) -> Result<(), InvalidSettings> {
+        if size.points > MAX_POINTS as f64 {
+            return Err(InvalidSettings(format!(
+                "the level-{} sparse grid has {} points (more than {MAX_POINTS}); lower the \
+                 level or use pce_regression",
+                self.level,
+                if size.points < 1e15 {
+                    format!("{:.0}", size.points)
+                } else {
+                    format!("{:.3e}", size.points)
+                }
+            )));
+        }
+        Ok(())
     }
 }
 
@@ -144,18 +171,8 @@ impl Method for SparseGrid {
                 )));
             }
         }
-        let n = self
-            .grid(&families)
-            .map_err(|e| InvalidSettings(e.to_string()))?
-            .len();
-        if n > MAX_POINTS {
-            return Err(InvalidSettings(format!(
-                "the level-{} sparse grid has {n} points (more than {MAX_POINTS}); lower the \
-                 level or use pce_regression",
-                self.level
-            )));
-        }
-        Ok(())
+        // Counted, not built: a grid too large is refused at once.
+        self.refuse_too_large(&self.size(problem.parameters)?)
     }
 
     fn summary(&self, _dim: usize) -> MethodSummary {
@@ -218,6 +235,11 @@ impl Sampling for SparseGrid {
 
     fn min_runs(&self) -> usize {
         1
+    }
+
+    /// The grid's points, counted without building it.
+    fn planned_runs_for(&self, parameters: &[RandomParameter]) -> Option<f64> {
+        self.size(parameters).ok().map(|s| s.points)
     }
 }
 
@@ -296,6 +318,43 @@ mod tests {
         assert_eq!(err.kind, ChaosErrorKind::LevelDifference);
         assert!(err.values[0] < 1e-24, "{:?}", err.values);
         assert!(m.estimate(&d, &rows[1..], &data.rows(1, d.len() - 1).into_owned()).is_err());
+    }
+
+    #[test]
+    fn the_counted_runs_are_those_of_the_design() {
+        // Nested (Genz–Keister, Gauss–Patterson, Clenshaw–Curtis) and non-nested rules
+        // (Gauss–Hermite, Gauss–Legendre, and the Gauss rules of gamma and beta germs), alone
+        // and mixed, against the design as built.
+        let mixed = vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::uniform(0.0, 1.0).unwrap(),
+            Distribution::gamma(2.0, 1.0).unwrap(),
+            Distribution::beta(2.0, 3.0, 0.0, 1.0).unwrap(),
+            Distribution::lognormal(0.0, 0.3).unwrap(),
+            Distribution::beta(1.5, 1.5, -1.0, 1.0).unwrap(),
+        ];
+        let gammas = vec![Distribution::gamma(3.0, 0.5).unwrap(); 4];
+        let betas = vec![Distribution::beta(2.0, 5.0, 0.0, 1.0).unwrap(); 3];
+        for (ds, rules) in [
+            (mixed.clone(), vec!["", "rule = \"gauss_hermite\"", "rule = \"clenshaw_curtis\""]),
+            (mixed[..3].to_vec(), vec!["rule = \"gauss_legendre\""]),
+            (gammas, vec![""]),
+            (betas, vec![""]),
+        ] {
+            let ins = inputs(ds);
+            for rule in rules {
+                for level in 0..=3 {
+                    let m = method(&format!("level = {level}\n{rule}"));
+                    let n = m.design(&ins, 0).unwrap().len();
+                    assert_eq!(
+                        m.planned_runs_for(&ins.parameters),
+                        Some(n as f64),
+                        "{rule} level {level}, {} inputs",
+                        ins.parameters.len()
+                    );
+                }
+            }
+        }
     }
 
     #[test]

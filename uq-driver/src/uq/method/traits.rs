@@ -123,6 +123,12 @@ pub trait Sampling {
         None
     }
 
+    /// [`Sampling::planned_runs`] for these `parameters`, for a method whose design size
+    /// depends on their distributions too (a sparse grid: the rule of each input's germ).
+    fn planned_runs_for(&self, parameters: &[RandomParameter]) -> Option<f64> {
+        self.planned_runs(parameters.len())
+    }
+
     /// Whether the estimates may draw their quantiles and densities from a chaos surrogate
     /// (`[analysis] surrogate_samples` draws of every output time): counted in the memory
     /// estimate of `study::size`. `true` unless the method never builds a chaos.
