@@ -147,31 +147,8 @@ impl ChaosShape {
 /// the non-increasing lists of non-zero degrees within the bound, the ways of placing them
 /// among the dimensions. `q = 1` gives `C(dim + order, order)`.
 pub fn hyperbolic_terms(dim: usize, order: usize, q: f64) -> f64 {
-    let bound = (order as f64).powf(q) * (1.0 + 1e-12) + 1e-12;
-    // `ways(r, mults)`: dim (dim - 1) ... (dim - r + 1) / prod mult!.
-    fn count(dim: usize, max: usize, budget: f64, q: f64, placed: usize, ways: f64) -> f64 {
-        // The list as it is, then longer lists with a next degree <= max.
-        let mut total = ways;
-        if placed == dim {
-            return total;
-        }
-        for v in 1..=max {
-            let cost = (v as f64).powf(q);
-            // `k` copies of degree `v` (their order among themselves does not count).
-            let mut w = ways;
-            let mut left = budget;
-            for k in 1..=(dim - placed) {
-                left -= cost;
-                if left < 0.0 {
-                    break;
-                }
-                w *= (dim - placed - k + 1) as f64 / k as f64;
-                total += count(dim, v - 1, left, q, placed + k, w);
-            }
-        }
-        total
-    }
-    count(dim, order, bound, q, 0, 1.0)
+    // Beyond 1e10 terms any estimate is refused: counting further would only take time.
+    crate::uq::pce::MultiIndexSet::hyperbolic_count_upto(dim, order, q, 1e10)
 }
 
 #[cfg(test)]
