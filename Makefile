@@ -95,9 +95,11 @@ venv: $(VPY)
 
 # The default study: the paper's wheel by stochastic collocation (6 x 6 nodes) and by Latin
 # hypercube (10 000 samples), both embedded in the binary, and one page comparing them.
+# --fresh: the results are always those of this build (about a second), never refused
+# because an older build's FMU wrote out/ (a resumed folder must hold the same FMU).
 run: build fmu
-	$(DRIVER) run builtin:wheel-scm --out out/wheel-scm
-	$(DRIVER) run builtin:wheel-lhs-10000 --out out/wheel-lhs-10000
+	$(DRIVER) run builtin:wheel-scm --out out/wheel-scm --fresh
+	$(DRIVER) run builtin:wheel-lhs-10000 --out out/wheel-lhs-10000 --fresh
 	$(DRIVER) compare out/wheel-scm out/wheel-lhs-10000 --out out
 	@echo "reports: out/index.html (both compared), out/wheel-scm/index.html, out/wheel-lhs-10000/index.html"
 
