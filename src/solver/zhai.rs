@@ -106,11 +106,12 @@ impl Zhai {
                 *v += (1.0 + PSI) * a * h - PSI * ap * h;
             }
         } else if self.started && r <= 2.0 {
-            let (psi_r, phi_r) = (PSI * r, PSI * r);
+            // ψ = φ: one scaled coefficient for both.
+            let c = PSI * r;
             for ((x, v), (&a, &ap)) in state.zip(accel) {
                 let da = a - ap;
-                *x += *v * h + 0.5 * a * h2 + psi_r * da * h2;
-                *v += a * h + phi_r * da * h;
+                *x += *v * h + 0.5 * a * h2 + c * da * h2;
+                *v += a * h + c * da * h;
             }
         } else {
             for ((x, v), (&a, _)) in state.zip(accel) {
@@ -133,6 +134,23 @@ impl Zhai {
 mod tests {
     use super::*;
     use std::convert::Infallible;
+
+    /// Accelerations of a model as a function pointer.
+    type Accel = fn(&[f64], &[f64], &mut [f64]) -> Result<(), Infallible>;
+
+    /// x'' = −x.
+    fn unit(x: &[f64], _: &[f64], a: &mut [f64]) -> Result<(), Infallible> {
+        a[0] = -x[0];
+        Ok(())
+    }
+
+    /// The state x(0) = 1, x'(0) = 0 of [`unit`], with its acceleration, and the model.
+    fn unit_oscillator() -> (Zhai, Accel) {
+        let mut z = Zhai::new(1);
+        z.x[0] = 1.0;
+        z.init_accel(unit).unwrap();
+        (z, unit)
+    }
 
     /// Damped oscillator x'' = −ω² x − 2ζω x', x(0) = 1, x'(0) = 0, integrated to t = 1.
     fn error(n: usize, zeta: f64) -> f64 {
@@ -166,13 +184,7 @@ mod tests {
 
     /// Growth of an undamped oscillator over many steps at Ω = ωh.
     fn growth(omega_h: f64) -> f64 {
-        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
-            a[0] = -x[0];
-            Ok(())
-        };
-        let mut z = Zhai::new(1);
-        z.x[0] = 1.0;
-        z.init_accel(f).unwrap();
+        let (mut z, f) = unit_oscillator();
         let mut peak: f64 = 0.0;
         for _ in 0..20_000 {
             z.step(omega_h, f).unwrap();
@@ -193,13 +205,7 @@ mod tests {
 
     #[test]
     fn a_step_more_than_twice_the_last_restarts_with_the_one_step_formula() {
-        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
-            a[0] = -x[0];
-            Ok(())
-        };
-        let mut z = Zhai::new(1);
-        z.x[0] = 1.0;
-        z.init_accel(f).unwrap();
+        let (mut z, f) = unit_oscillator();
         z.step(0.01, f).unwrap();
         let (x1, v1) = (z.x[0], z.v[0]);
         z.step(0.05, f).unwrap();
@@ -211,13 +217,7 @@ mod tests {
 
     #[test]
     fn a_shorter_step_uses_the_variable_step_formula() {
-        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
-            a[0] = -x[0];
-            Ok(())
-        };
-        let mut z = Zhai::new(1);
-        z.x[0] = 1.0;
-        z.init_accel(f).unwrap();
+        let (mut z, f) = unit_oscillator();
         z.step(0.1, f).unwrap();
         let (x1, v1, a0, a1) = (z.x[0], z.v[0], -1.0, -z.x[0]);
         z.step(0.05, f).unwrap();
@@ -231,13 +231,7 @@ mod tests {
     /// Undamped x'' = −x with 20 000 steps alternating between `ωh` and `ωh·q`: the largest
     /// |x| (1 when the energy is kept).
     fn alternating_peak(omega_h: f64, q: f64) -> f64 {
-        let f = |x: &[f64], _: &[f64], a: &mut [f64]| -> Result<(), Infallible> {
-            a[0] = -x[0];
-            Ok(())
-        };
-        let mut z = Zhai::new(1);
-        z.x[0] = 1.0;
-        z.init_accel(f).unwrap();
+        let (mut z, f) = unit_oscillator();
         let mut peak: f64 = 0.0;
         for k in 0..20_000 {
             let h = if k % 2 == 0 { omega_h } else { omega_h * q };

@@ -11,11 +11,15 @@
 //! Studies on the Functions test FMU (the g-function, `function = 3`), whose parameters
 //! `x1..x8`, `a1..a8`, `a`, `b`, `sigma_h`, `rw` are made random here; nothing is run.
 
+#[path = "support/refusal.rs"]
+mod refusal;
 #[path = "support/test_fmus.rs"]
 mod test_fmus;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use refusal::assert_refused;
 
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 
@@ -71,15 +75,25 @@ fn driver(args: &[&str], memory_limit: Option<&str>) -> Output {
     c.output().expect("uq-driver runs")
 }
 
-/// A refusal: exit status 1 (an error, not an abort), each of `needles`, no panic.
-fn assert_refused(o: &Output, needles: &[&str]) -> String {
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "missing '{n}' in: {err}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
-    err
+/// `uq-driver plan STUDY --shards N --out PLAN` with `extra` arguments.
+fn plan_study(
+    study: &Path,
+    shards: usize,
+    plan: &Path,
+    extra: &[&str],
+    memory_limit: Option<&str>,
+) -> Output {
+    let shards = shards.to_string();
+    let mut args = vec![
+        "plan",
+        study.to_str().unwrap(),
+        "--shards",
+        &shards,
+        "--out",
+        plan.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    driver(&args, memory_limit)
 }
 
 /// The memory estimate (bytes) in a refusal's text: "about X UNIT of memory".
@@ -139,17 +153,7 @@ fn a_lars_study_whose_design_matrix_does_not_fit_is_refused_before_any_run() {
     }
     // `plan` refuses it the same way.
     let plan = dir.path().join("plan");
-    let o = driver(
-        &[
-            "plan",
-            p.to_str().unwrap(),
-            "--shards",
-            "2",
-            "--out",
-            plan.to_str().unwrap(),
-        ],
-        Some("200000000"),
-    );
+    let o = plan_study(&p, 2, &plan, &[], Some("200000000"));
     assert_refused(&o, &["refused even with --yes"]);
     assert!(!plan.exists());
 }
@@ -252,17 +256,7 @@ fn plan_of_a_large_sparse_grid_needs_yes() {
     );
     let needles = ["105601 model runs, more than 100000", "--yes"];
     let plan = dir.path().join("plan");
-    let o = driver(
-        &[
-            "plan",
-            p.to_str().unwrap(),
-            "--shards",
-            "4",
-            "--out",
-            plan.to_str().unwrap(),
-        ],
-        None,
-    );
+    let o = plan_study(&p, 4, &plan, &[], None);
     assert_refused(&o, &needles);
     assert!(!plan.exists(), "no plan is written");
     let slurm = dir.path().join("slurm");
@@ -288,18 +282,7 @@ fn plan_of_a_large_sparse_grid_needs_yes() {
     assert_refused(&o, &needles);
     assert!(!out.exists(), "refused before the design");
     // With --yes it is planned.
-    let o = driver(
-        &[
-            "plan",
-            p.to_str().unwrap(),
-            "--shards",
-            "4",
-            "--out",
-            plan.to_str().unwrap(),
-            "--yes",
-        ],
-        None,
-    );
+    let o = plan_study(&p, 4, &plan, &["--yes"], None);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let design = std::fs::read_to_string(plan.join("design.csv")).unwrap();
     assert_eq!(design.lines().count() as f64, runs + 1.0);

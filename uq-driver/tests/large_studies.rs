@@ -4,12 +4,15 @@
 //! and the limit, whatever `--yes` says, before anything is allocated, with the output folder
 //! as it was. A study of more than 100 000 runs starts only with `--yes`.
 
+#[path = "support/refusal.rs"]
+mod refusal;
 #[path = "support/wheel.rs"]
 mod wheel;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use refusal::assert_refused;
 use wheel::{fmu_dir, wheel_fmu};
 
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
@@ -51,14 +54,6 @@ fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 }
 
 /// A refusal: exit status 1 (an error, not an abort), a message, no panic.
-fn assert_refused(o: &Output, needles: &[&str]) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "missing '{n}' in: {err}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
-}
 
 #[test]
 fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {

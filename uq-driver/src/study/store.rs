@@ -239,15 +239,7 @@ impl Store {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
         }
         // A planted link (the folder may be shared, the run root's) is never written through.
-        if fs::symlink_metadata(&sdir).is_ok_and(|m| m.file_type().is_symlink()) {
-            return Err(StoreError::Io {
-                path: sdir,
-                source: std::io::Error::other(
-                    "is a symbolic link; uq-driver does not write through it (remove it)",
-                ),
-            });
-        }
-        fs::create_dir_all(&sdir).map_err(io_err(&sdir))?;
+        crate::out_file::sub_folder(&sdir).map_err(io_err(&sdir))?;
         check_manifest(dir, &sdir.join("manifest.json"), manifest)?;
         let path = sdir.join("records.bin");
         let mut file = OpenOptions::new()

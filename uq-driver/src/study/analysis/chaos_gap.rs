@@ -33,9 +33,19 @@ pub(crate) fn chaos_gap_warnings(a: &Analysed, askey_hint: bool) -> Vec<String> 
     out
 }
 
+/// Whether a column whose Std is `s` is resolved among the columns of Std `std`: above 1e-3
+/// of the largest finite Std (below, rounding dominates a relative comparison).
+fn resolved(std: &[f64]) -> impl Fn(f64) -> bool {
+    let largest = std
+        .iter()
+        .filter(|s| s.is_finite())
+        .fold(0.0_f64, |m, s| m.max(s.abs()));
+    move |s| s.abs() > 1e-3 * largest
+}
+
 /// Warnings where a chaos's own estimate of its truncation error (`loo`, `level_difference`:
 /// relative to the variance; not SCM's `order_difference`) exceeds [`CHAOS_ERROR`] at some time (where
-/// the Std is at least 1e-3 of its largest) or for a quantity: its mean, Std, quantiles,
+/// the Std is above 1e-3 of its largest) or for a quantity: its mean, Std, quantiles,
 /// P(q > limit) and Sobol' indices may then be far off, and any interval printed with them
 /// covers only the sampling of the chaos, not this error (found by QA: a 30-input G function
 /// at level 2 gave a mean of 0.013 against 1 with a level difference of 1.45 and no warning).
@@ -49,17 +59,13 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
             // share of the top degree) is checked by chaos_gap_warnings instead.
             Some(e) if e.kind == ChaosErrorKind::OrderDifference => {}
             Some(e) => {
-                let largest = o
-                    .std
-                    .iter()
-                    .filter(|s| s.is_finite())
-                    .fold(0.0_f64, |m, s| m.max(s.abs()));
+                let resolved = resolved(&o.std);
                 let worst = e
                     .values
                     .iter()
                     .zip(&o.std)
                     .enumerate()
-                    .filter(|(_, (v, s))| v.is_finite() && s.abs() >= 1e-3 * largest)
+                    .filter(|(_, (v, s))| v.is_finite() && resolved(**s))
                     .max_by(|a, b| a.1 .0.total_cmp(b.1 .0));
                 if let Some((k, (&v, _))) = worst {
                     if v > CHAOS_ERROR {
@@ -113,15 +119,12 @@ fn chaos_gap(
     times: Option<&[f64]>,
     askey_hint: bool,
 ) -> Option<String> {
-    let largest = std
-        .iter()
-        .filter(|s| s.is_finite())
-        .fold(0.0_f64, |m, s| m.max(s.abs()));
+    let resolved = resolved(std);
     let (k, gap) = std
         .iter()
         .zip(std_chaos)
         .enumerate()
-        .filter(|(_, (s, c))| s.is_finite() && c.is_finite() && s.abs() > 1e-3 * largest)
+        .filter(|(_, (s, c))| s.is_finite() && c.is_finite() && resolved(**s))
         .map(|(k, (s, c))| (k, (s * s - c * c).abs() / (s * s)))
         .fold(None, |w: Option<(usize, f64)>, (k, g)| match w {
             Some((_, best)) if best >= g => w,
