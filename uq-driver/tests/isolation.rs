@@ -162,6 +162,28 @@ fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
 }
 
 #[test]
+fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnable() {
+    // QA round 3, H-1: after one point's fmi2Fatal in-process, every later point was refused by
+    // the FMU layer and stored as *failed*; with --allow-failures the study then analysed the
+    // points that happened to finish first (a thread-count-dependent subset), exit 0. Now the
+    // study stops at the Fatal, naming the point and --isolate; only that point is stored as
+    // failed, and a re-run with --isolate runs the others.
+    for threads in ["1", "2"] {
+        let Some(c) = case(7) else { return };
+        let o = c.run(&["-t", threads]);
+        assert!(!o.status.success(), "an in-process Fatal stops the study");
+        let err = stderr(&o);
+        assert!(err.contains("After fmi2Fatal"), "{err}");
+        assert!(err.contains("--isolate"), "{err}");
+        assert!(!err.contains("an earlier call returned Fatal"), "{err}");
+        let o = c.run(&["--isolate", "-t", threads]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        // Every point at or below 1 failed by its own Fatal, every other one is ok.
+        c.check_failed_with("returned Fatal");
+    }
+}
+
+#[test]
 fn isolate_errors_nan_and_warnings_behave_as_in_process() {
     for (mode, needle) in [(1, "returned Error"), (6, "non-finite value")] {
         let Some(c) = case(mode) else { return };

@@ -66,6 +66,34 @@ pub enum PointError {
     },
 }
 
+impl PointError {
+    /// The FMI error behind this failure, if any.
+    fn fmu_error(&self) -> Option<&FmuError> {
+        match self {
+            PointError::Fmu(e) => Some(e),
+            PointError::SpeedRun { source, .. } => source.fmu_error(),
+            _ => None,
+        }
+    }
+
+    /// Whether a call of this run was refused because a call (of this run or of another
+    /// instance of the same library) had returned fmi2Fatal: the point itself is not at fault.
+    pub fn refused_after_fatal(&self) -> bool {
+        matches!(self.fmu_error(), Some(FmuError::Unusable { .. }))
+    }
+
+    /// Whether a call of this run returned fmi2Fatal.
+    pub fn returned_fatal(&self) -> bool {
+        matches!(
+            self.fmu_error(),
+            Some(FmuError::Call {
+                status: Status::Fatal,
+                ..
+            })
+        )
+    }
+}
+
 /// What one run recorded.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trace {

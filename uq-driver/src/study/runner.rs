@@ -132,6 +132,24 @@ pub enum RunError {
         /// What happened.
         why: String,
     },
+    /// A call returned fmi2Fatal in-process: FMI 2.0 forbids any further call to the FMU in
+    /// this process, so the study stops. The point is stored as failed; points that another
+    /// thread was running then are not (they are run by a re-run).
+    #[error(
+        "point {point} ({values}): {message}. After fmi2Fatal, FMI 2.0 forbids any further call \
+         to this FMU in this process, so the study stops here: finished points are kept in the \
+         results store, point {point} is recorded as failed, and the points not finished are \
+         run by a re-run. Run again with --isolate: there a Fatal fails its point only and the \
+         study goes on (add --allow-failures, for Monte Carlo and LHS, to analyse the others)"
+    )]
+    Fatal {
+        /// The point whose call returned fmi2Fatal.
+        point: usize,
+        /// Its parameter values.
+        values: String,
+        /// Why it failed, with what the FMU logged.
+        message: String,
+    },
     /// The thread pool could not be built.
     #[error("cannot start the worker threads")]
     Pool(#[source] rayon::ThreadPoolBuildError),
@@ -453,18 +471,28 @@ impl Batch<'_> {
                             return Ok(None);
                         }
                     }
-                    let rec = match self.run_one(slot, i) {
-                        Ok(rec) => rec,
+                    let (rec, fatal) = match self.run_one(slot, i) {
+                        Ok(Outcome::Done(rec)) => (rec, false),
+                        Ok(Outcome::Fatal(rec)) => (rec, true),
+                        // Refused after another instance's Fatal: not run, not stored.
+                        Ok(Outcome::Refused) => return Ok(None),
                         Err(e) => {
                             stop.store(true, Ordering::Relaxed);
                             return Err(e);
                         }
                     };
-                    if matches!(rec, Record::Failed(_)) && self.stop_on_failure {
+                    if fatal || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
                         stop.store(true, Ordering::Relaxed);
                     }
                     let entry = self.store.append(i, &rec)?;
                     progress.inc();
+                    if let (true, Record::Failed(message)) = (fatal, rec) {
+                        return Err(RunError::Fatal {
+                            point: i,
+                            values: describe_values(self.study, &self.design.values[i]),
+                            message,
+                        });
+                    }
                     Ok(Some((i, entry)))
                 },
             )
@@ -473,24 +501,39 @@ impl Batch<'_> {
     }
 
     /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
-    fn run_one(&self, slot: &mut Option<Instance>, i: usize) -> Result<Record, RunError> {
+    fn run_one(&self, slot: &mut Option<Instance>, i: usize) -> Result<Outcome, RunError> {
         let values = &self.design.values[i];
         let _running = self.guard.running(i, describe_values(self.study, values));
         let Some(workers) = &self.workers else {
             let fmu = self.fmus.current()?;
             return Ok(
                 match run_point(&fmu, slot, &self.iface, values, &self.times) {
-                    Ok(v) => Record::Ok(v),
-                    Err(e) => Record::Failed(e.to_string()),
+                    Ok(v) => Outcome::Done(Record::Ok(v)),
+                    Err(e) if e.refused_after_fatal() => Outcome::Refused,
+                    // This point's own call returned Fatal.
+                    Err(e) if e.returned_fatal() => Outcome::Fatal(Record::Failed(e.to_string())),
+                    Err(e) => Outcome::Done(Record::Failed(e.to_string())),
                 },
             );
         };
         match workers.run(values) {
-            Ok(v) => Ok(Record::Ok(v)),
-            Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => Ok(Record::Failed(m)),
+            Ok(v) => Ok(Outcome::Done(Record::Ok(v))),
+            Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => {
+                Ok(Outcome::Done(Record::Failed(m)))
+            }
             Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
         }
     }
+}
+
+/// How a point ended.
+enum Outcome {
+    /// Run: its record.
+    Done(Record),
+    /// Its own call returned fmi2Fatal in-process: its (failed) record, and the study stops.
+    Fatal(Record),
+    /// Refused in-process because another point's call had returned fmi2Fatal: not run.
+    Refused,
 }
 
 /// What is known of the failures: "3 of 200 points failed" when every point was run, else

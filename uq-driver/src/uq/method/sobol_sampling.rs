@@ -206,12 +206,17 @@ impl Method for SobolSampling {
             ),
         };
         d.insert("intervals".into(), intervals.into());
-        d.insert(
-            "standard_error".into(),
-            "Monte Carlo formula std / sqrt(2 samples) over the runs of A and B (exact for \
-             base = \"mc\", an overestimate for lhs and, typically, qmc)"
-                .into(),
-        );
+        let standard_error = match self.base {
+            Base::Qmc => {
+                "replicates: the spread of the replicate means over the runs of A and B, \
+                 sd(replicate means) / sqrt(replicates)"
+            }
+            Base::Mc | Base::Lhs => {
+                "Monte Carlo formula std / sqrt(2 samples) over the runs of A and B (exact for \
+                 base = \"mc\", an overestimate for lhs)"
+            }
+        };
+        d.insert("standard_error".into(), standard_error.into());
         s
     }
 
@@ -391,6 +396,10 @@ impl SobolSampling {
         let (m, d) = (blocks.complete.len(), blocks.d);
         let order: Vec<usize> = (0..d + 2).flat_map(|b| blocks.block_rows(b)).collect();
         let contiguous = order.iter().enumerate().all(|(i, &r)| i == r);
+        let replicate_of = match self.intervals() {
+            Intervals::Replicates(per) => Some(blocks.replicate_of(per, self.replicate_count())),
+            _ => None,
+        };
         let (moments, values): (Vec<Estimate>, Vec<Option<Vec<f64>>>) = data
             .as_slice()
             .par_chunks(data.nrows().max(1))
@@ -402,7 +411,17 @@ impl SobolSampling {
                 };
                 // The moments of the column over A and B, as of the whole matrix's rows.
                 let ab = DMatrix::from_column_slice(2 * m, 1, &values[..2 * m]);
-                (Estimate::from_sample(&ab), centred(values, m))
+                let mut moments = Estimate::from_sample(&ab);
+                if let Some(replicate_of) = &replicate_of {
+                    // No spread, no error (the replicate means differ there by rounding only).
+                    let se = if has_variance(&values[..2 * m]) {
+                        replicate_standard_error(&values[..2 * m], replicate_of)
+                    } else {
+                        0.0
+                    };
+                    moments.std_error_mean = Some(vec![se]);
+                }
+                (moments, centred(values, m))
             })
             .unzip();
         let mut moments = moments.into_iter();
@@ -475,6 +494,27 @@ impl SobolSampling {
     }
 }
 
+/// The standard error of the mean of the rows of `A` and `B` (`ab`: the `m` rows of `A`, then
+/// those of `B`) from the spread of the replicate means, `sd(replicate means) / sqrt(R')`,
+/// over the `R'` replicates with at least 2 complete base rows (as the intervals of the
+/// indices); `replicate_of[i]` is the replicate of complete row `i`. NaN with fewer than 2.
+fn replicate_standard_error(ab: &[f64], replicate_of: &[usize]) -> f64 {
+    let m = replicate_of.len();
+    let count = replicate_of.iter().max().map_or(0, |&r| r + 1);
+    let mut sums = vec![(0.0, 0usize); count];
+    for (i, v) in ab.iter().enumerate() {
+        let r = replicate_of[i % m.max(1)];
+        sums[r].0 += v;
+        sums[r].1 += 1;
+    }
+    let means: Vec<f64> = sums
+        .iter()
+        .filter(|(_, k)| *k >= 4)
+        .map(|(s, k)| s / *k as f64)
+        .collect();
+    sensitivity::replicate_summary(&means).std_error
+}
+
 /// The `values` of a column in the blocks `A`, `B`, `AB_1`, ... at the `m` complete rows,
 /// less their mean over `A` and `B`; `None` for a column without variance.
 fn centred(mut values: Vec<f64>, m: usize) -> Option<Vec<f64>> {
@@ -536,6 +576,14 @@ impl PickFreezeRows {
 
     /// The number of complete rows of each of the `replicates` replicates of `per` base rows
     /// (base row `k` in replicate `k / per`).
+    /// The replicate of each complete base row (replicates of `per` base rows).
+    fn replicate_of(&self, per: usize, replicates: usize) -> Vec<usize> {
+        self.complete
+            .iter()
+            .map(|&k| (k / per.max(1)).min(replicates.saturating_sub(1)))
+            .collect()
+    }
+
     fn replicate_sizes(&self, per: usize, replicates: usize) -> Vec<usize> {
         let mut sizes = vec![0; replicates.max(1)];
         for &k in &self.complete {
@@ -659,6 +707,66 @@ mod tests {
         assert!(s.intervals.is_none());
     }
 
+    /// The `qmc` base's standard error of the mean was the Monte Carlo formula over the runs
+    /// of A and B, many times the error of the scrambled nets' mean; it is now the spread of
+    /// the replicate means. Mean of exp(x1) sin(x2 + x3) on U(0, 1)^3: (e - 1)(2 sin 1 - sin 2).
+    #[test]
+    fn qmc_base_standard_error_of_the_mean_is_the_replicate_spread_and_covers_the_mean() {
+        let params = uniform_params(3, 0.0, 1.0);
+        let m = SobolSampling {
+            samples: 256,
+            base: Base::Qmc,
+            replicates: None,
+            bootstrap: None,
+            confidence: 0.95,
+        };
+        let f = |x: &[f64]| x[0].exp() * (x[1] + x[2]).sin();
+        let exact = (1f64.exp() - 1.0) * (2.0 * 1f64.sin() - 2f64.sin());
+        let (n, per) = (m.samples, m.samples / m.replicate_count());
+        let mut covered = 0;
+        for seed in 0..20 {
+            let design = m.design(&params, seed).unwrap();
+            let values: Vec<f64> = design.values.iter().map(|x| f(x)).collect();
+            let data = DMatrix::from_column_slice(values.len(), 1, &values);
+            let rows: Vec<usize> = (0..design.len()).collect();
+            let e = m.estimate(&design, &rows, &data).unwrap();
+            let se = e.std_error_mean.unwrap()[0];
+            // Independently: base row k of replicate k / per, at row k of A and n + k of B.
+            let means: Vec<f64> = (0..m.replicate_count())
+                .map(|r| {
+                    let ks = r * per..(r + 1) * per;
+                    ks.map(|k| values[k] + values[n + k]).sum::<f64>() / (2 * per) as f64
+                })
+                .collect();
+            let avg = means.iter().sum::<f64>() / means.len() as f64;
+            let var = means.iter().map(|v| (v - avg).powi(2)).sum::<f64>() / 7.0;
+            assert!((se - (var / 8.0).sqrt()).abs() <= 1e-12 * se, "seed {seed}");
+            // Far below the Monte Carlo formula of before.
+            assert!(se < 0.2 * e.std[0] / ((2 * n) as f64).sqrt(), "seed {seed}");
+            // t(7) at 97.5 %: 2.365.
+            if (e.mean[0] - exact).abs() <= 2.365 * se {
+                covered += 1;
+            }
+        }
+        assert!(covered >= 16, "the interval covered the mean in {covered} of 20 seeds");
+        // The other bases keep the Monte Carlo formula.
+        let lhs = SobolSampling {
+            base: Base::Lhs,
+            bootstrap: Some(0),
+            ..m.clone()
+        };
+        let design = lhs.design(&params, 1).unwrap();
+        let values: Vec<f64> = design.values.iter().map(|x| f(x)).collect();
+        let data = DMatrix::from_column_slice(values.len(), 1, &values);
+        let rows: Vec<usize> = (0..design.len()).collect();
+        let e = lhs.estimate(&design, &rows, &data).unwrap();
+        let se = e.std_error_mean.unwrap()[0];
+        assert!((se - e.std[0] / ((2 * n) as f64).sqrt()).abs() <= 1e-12 * se);
+        // A column without spread has no error, whatever the rounding of replicate means.
+        let e = run(&m, &params, |_| 0.1);
+        assert_eq!(e.std_error_mean.unwrap(), vec![0.0]);
+    }
+
     #[test]
     fn moments_from_the_gathered_columns_are_those_of_the_selected_rows_bit_for_bit() {
         // Issue 15: the moments are taken from each column as gathered for the indices (in
@@ -693,8 +801,20 @@ mod tests {
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&e.mean), bits(&want.mean), "skip {skip}");
             assert_eq!(bits(&e.std), bits(&want.std), "skip {skip}");
+            // The Monte Carlo standard error of the mc base (the qmc base's comes from its
+            // replicates: qmc_base_standard_error_of_the_mean_is_the_replicate_spread_...).
+            let mc = SobolSampling {
+                base: Base::Mc,
+                ..m.clone()
+            };
+            let mc_design = mc.design(&params, 5).unwrap();
+            let mc_data = DMatrix::from_fn(rows.len(), 7, |r, c| {
+                mc_design.values[rows[r]][0] * (c as f64 + 1.0) + mc_design.values[rows[r]][1]
+            });
+            let se = mc.estimate(&mc_design, &rows, &mc_data).unwrap();
+            let want = Estimate::from_sample(&mc_data.select_rows(&ab));
             assert_eq!(
-                bits(e.std_error_mean.as_ref().unwrap()),
+                bits(se.std_error_mean.as_ref().unwrap()),
                 bits(want.std_error_mean.as_ref().unwrap()),
                 "skip {skip}"
             );
