@@ -83,6 +83,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     };
     size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
+    uq_driver::study::interface::check_step_sizes(&fmu, &times)?;
     let params: Vec<(String, FixedValue)> = a
         .set
         .into_iter()

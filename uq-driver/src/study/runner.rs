@@ -337,6 +337,7 @@ pub fn run_points(
     let iface = Interface::resolve(study, fmu)?;
     iface.check_design(fmu, &design.values)?;
     let times = study.times();
+    super::interface::check_step_sizes(fmu, &times)?;
     let workers = opts.isolate.as_ref().map(|exe| {
         WorkerPool::new(
             IsolateOptions {
