@@ -759,14 +759,24 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     let driver = env!("CARGO_BIN_EXE_uq-driver");
     let simulate = |stop: &str| {
         Command::new(driver)
-            .args(["simulate", fmu.to_str().unwrap(), "--stop", stop, "--step", "0.1"])
+            .args([
+                "simulate",
+                fmu.to_str().unwrap(),
+                "--stop",
+                stop,
+                "--step",
+                "0.1",
+            ])
             .output()
             .unwrap()
     };
     let o = simulate("1.05");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{err}");
-    assert!(err.contains("canHandleVariableCommunicationStepSize"), "{err}");
+    assert!(
+        err.contains("canHandleVariableCommunicationStepSize"),
+        "{err}"
+    );
     assert!(err.contains("give a stop time of 1 or 1.1 s"), "{err}");
     assert!(simulate("1.0").status.success());
     let study = dir.path().join("s.toml");
@@ -783,10 +793,18 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     .unwrap();
     let out = dir.path().join("out");
     let o = Command::new(driver)
-        .args(["run", study.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{err}");
-    assert!(err.contains("canHandleVariableCommunicationStepSize"), "{err}");
+    assert!(
+        err.contains("canHandleVariableCommunicationStepSize"),
+        "{err}"
+    );
 }
