@@ -137,7 +137,11 @@ fn a_single_run_has_no_density_and_says_so() {
     let out = dir.path().join("out");
     let stdout = run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(stdout.contains("q_end = "), "{stdout}");
-    assert!(stdout.contains("(every run;"), "{stdout}");
+    assert!(stdout.contains("(nominal run;"), "{stdout}");
+    assert!(
+        stdout.contains("is below the limit 1 m (nominal run; no probability)"),
+        "{stdout}"
+    );
     for f in [
         "q_pdf.svg",
         "q_pdf.png",
@@ -149,11 +153,34 @@ fn a_single_run_has_no_density_and_says_so() {
         assert!(!out.join(f).exists(), "{f} drawn for a single run");
     }
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    // QA round 3, M3: a nominal run is a value against each limit, not a probability
+    // ("0 of 1 runs exceeded 1 (95 % upper bound of P: 0.950)"), and its inputs were held at
+    // their means, not sampled.
     assert!(
-        html.contains("there is 1 run: it is deterministic in this study"),
+        html.contains("from the one nominal run (every parameter at its mean)"),
         "{html}"
     );
     assert!(html.contains("no density"));
+    assert!(
+        html.contains("is below the limit 1 m (nominal run; no probability)"),
+        "{html}"
+    );
+    for wrong in [
+        "upper bound of P",
+        "0 of 1 run",
+        "quantile 0.",
+        "<td>Std</td>",
+        "CoV",
+    ] {
+        assert!(!html.contains(wrong), "{wrong} on a nominal page:\n{html}");
+    }
+    assert!(html.contains("<th>value used</th>"), "{html}");
+    assert!(
+        html.contains("normal, mean 100, std 10 (cov 0.1) (not sampled)"),
+        "{html}"
+    );
+    assert!(html.contains("1 model run ("), "{html}");
+    assert!(!html.contains("1 model runs"), "{html}");
     assert!(!html.contains("Some("), "Rust debug text in the page");
     assert!(!html.contains("Normal {"), "Rust debug text in the page");
     let s = json(&out.join("summary.json"));
@@ -262,10 +289,7 @@ fn units_reach_axes_summary_and_sidecar() {
     assert!(v[0] <= v[2] + 1e-12 && v[1] <= v[3] + 1e-12, "{v:?}");
     // Inputs as written.
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
-    assert!(
-        html.contains("normal, mean 20.0, std 2.00 (cov 0.100)"),
-        "{html}"
-    );
+    assert!(html.contains("normal, mean 20, std 2 (cov 0.1)"), "{html}");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
@@ -442,4 +466,45 @@ fn a_missing_fmu_lists_every_place_searched() {
     assert!(err.contains(&dir.path().join("Nowhere.fmu").display().to_string()));
     assert!(err.contains("share/railuq/fmu/Nowhere.fmu"), "{err}");
     assert!(err.contains(&fmu_dir().join("Nowhere.fmu").display().to_string()));
+}
+
+#[test]
+fn a_one_letter_signal_is_described_after_its_name() {
+    // QA round 3, H3: with `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
+    // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
+    // description went after the first "a" of the sentence, inside "peak".
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("a.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
+             [method]\nkind = \"lhs\"\nsamples = 10\n\
+             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+             [outputs]\nvariables = [\"a\"]\n\
+             [[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
+             to = 2.0\nlimits = [1.0]\n",
+            wheel_fmu().display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let stdout = run_ok(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let expected = "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s";
+    let s = json(&out.join("summary.json"));
+    assert_eq!(
+        s["quantities"]["a_range"]["definition"]["text"], expected,
+        "summary.json"
+    );
+    assert_eq!(
+        s["quantities"]["a_range"]["definition"]["settings"]["signal_description"],
+        "Acceleration q''"
+    );
+    assert!(stdout.contains(expected), "{stdout}");
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        html.contains(&expected.replace('\'', "&#39;")),
+        "{expected} not on the page"
+    );
+    assert!(!html.contains("pea ("), "{html}");
 }

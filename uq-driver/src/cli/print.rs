@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use uq_driver::report::units::with_unit;
-use uq_driver::results::sig;
+use uq_driver::results::numbers::count;
 use uq_driver::study::{StudyResult, SuiteResult};
 
 /// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings;
@@ -14,12 +14,19 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
         eprintln!("uq-driver: warning: {w}");
     }
     let t = &s.timing;
+    let runs = if s.fmu.is_none() {
+        // An intrusive method (SGM): its own system, solved once; no model run.
+        "the Galerkin system solved once".to_owned()
+    } else {
+        format!(
+            "{} ({} resumed)",
+            count(s.model_runs, "model run", "model runs"),
+            s.runs_resumed
+        )
+    };
     println!(
-        "{}: {} model runs ({} resumed); wall time: runs {:.2} s, analysis {:.2} s, report \
-         {:.2} s; {}",
+        "{}: {runs}; wall time: runs {:.2} s, analysis {:.2} s, report {:.2} s; {}",
         s.study,
-        s.model_runs,
-        s.runs_resumed,
         t.runs_s,
         t.analysis_s,
         t.report_s,
@@ -32,16 +39,35 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
             format!("report: {}", out.join("index.html").display())
         }
     );
+    let nominal = s.method.kind == "nominal";
     for q in &r.quantities {
         let u = q.unit.as_deref();
         let v = |x: f64| with_unit(&six_digits(x), u);
         if q.deterministic {
             println!(
-                "  {} = {} (every run; {})",
+                "  {} = {} ({}; {})",
                 q.name,
                 v(q.mean),
+                if nominal { "nominal run" } else { "every run" },
                 q.definition.text
             );
+            if nominal {
+                for e in &q.exceedance_counts {
+                    let relation = if q.mean > e.limit {
+                        "exceeds"
+                    } else if q.mean == e.limit {
+                        "equals"
+                    } else {
+                        "is below"
+                    };
+                    println!(
+                        "  {} = {} {relation} the limit {} (nominal run; no probability)",
+                        q.name,
+                        v(q.mean),
+                        with_unit(&e.limit.to_string(), u)
+                    );
+                }
+            }
         } else {
             println!(
                 "  {}: mean {}, Std {} ({} valid runs; {})",
@@ -52,7 +78,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
                 q.definition.text
             );
             for e in &q.exceedance_counts {
-                println!("  P({} > {}): {}", q.name, sig(e.limit), e.describe());
+                println!("  P({} > {}): {}", q.name, e.limit, e.describe());
             }
         }
     }
@@ -80,8 +106,16 @@ pub(crate) fn print_suite(r: &SuiteResult, out: &Path) {
     );
     for v in &r.summary.variants {
         println!(
-            "  {:<12} {:<16} {:>7} model runs, wall time {:.2} s",
-            v.name, v.method, v.model_runs, v.wall_time_s
+            "  {:<12} {:<16} {:>7} {}, wall time {:.2} s",
+            v.name,
+            v.method,
+            v.model_runs,
+            if v.model_runs == 1 {
+                "model run"
+            } else {
+                "model runs"
+            },
+            v.wall_time_s
         );
     }
 }

@@ -176,6 +176,42 @@ pub enum QoiError {
     NeedsOwnRuns(String),
 }
 
+/// What the model says of its variables, for the text of a quantity's definition
+/// ([`QoiSpec::definition_with`]): the description of the quantity's (first) signal and the
+/// unit of each variable. The default knows nothing (names and plain numbers only).
+#[derive(Default)]
+pub struct Words<'a> {
+    /// The signal the description belongs to, and the description.
+    pub description: Option<(&'a str, &'a str)>,
+    /// The declared unit of a variable (`None`: not declared).
+    pub unit: Option<&'a UnitOf<'a>>,
+}
+
+/// The declared unit of a variable by name (`None`: not declared).
+pub type UnitOf<'a> = dyn Fn(&str) -> Option<String> + 'a;
+
+impl Words<'_> {
+    /// `signal`, followed by its description in parentheses if it is the described one.
+    fn signal(&self, signal: &str) -> String {
+        match self.description {
+            Some((s, d)) if s == signal => format!("{signal} ({d})"),
+            _ => signal.to_owned(),
+        }
+    }
+
+    /// `x` in the unit of variable `of`: `0.0001 m`, or `0.0001` when it has none.
+    fn value(&self, x: f64, of: &str) -> String {
+        match self
+            .unit
+            .and_then(|u| u(of))
+            .filter(|u| !u.is_empty() && u != "1")
+        {
+            Some(u) => format!("{x} {u}"),
+            None => format!("{x}"),
+        }
+    }
+}
+
 impl QoiSpec {
     /// The name of the `[[qoi]]` entry (of its first quantity).
     pub fn name(&self) -> &str {
@@ -236,8 +272,18 @@ impl QoiSpec {
     }
 
     /// How the quantity is computed, every setting explicit (defaults included), with a
-    /// line of text for the report.
+    /// line of text for the report (no description of the signal, no units: see
+    /// [`Self::definition_with`]).
     pub fn definition(&self) -> QuantityDefinition {
+        self.definition_with(&Words::default())
+    }
+
+    /// [`Self::definition`] with what the model says of its variables in the text: the
+    /// description of the first signal after its name (`peak-to-peak (max − min) of a
+    /// (Acceleration q'') over 0.5–2 s`) and the units of thresholds and speeds (`0.0001 m`,
+    /// `to 0.02 m/s`). The sentence is built from its parts: a signal's name is never searched
+    /// for in the text (a short name such as `a` occurs inside other words).
+    pub fn definition_with(&self, words: &Words) -> QuantityDefinition {
         let mut settings = match serde_json::to_value(self) {
             Ok(serde_json::Value::Object(m)) => m,
             _ => serde_json::Map::new(),
@@ -256,8 +302,9 @@ impl QoiSpec {
                 ..
             } => format!(
                 "critical speed (speed-ramp estimate, the paper's method): the {speed} at which \
-                 the largest |{signal}| over a sliding {window} s window last exceeds \
-                 {threshold}"
+                 the largest |{}| over a sliding {window} s window last exceeds {}",
+                words.signal(signal),
+                words.value(*threshold, signal)
             ),
             QoiSpec::Sperling {
                 signal,
@@ -285,38 +332,50 @@ impl QoiSpec {
                     Statistic::Mean => "the mean of the segment W",
                 };
                 format!(
-                    "Sperling index of {signal}, {direction} weighting, {segment} s segments, \
-                     {window}, {statistic}, {f_min}–{f_max} Hz, first {skip} s left out"
+                    "Sperling index of {}, {direction} weighting, {segment} s segments, \
+                     {window}, {statistic}, {f_min}–{f_max} Hz, first {skip} s left out",
+                    words.signal(signal)
                 )
             }
             QoiSpec::MaxAbs {
                 signal, from, to, ..
-            } => match to {
-                Some(to) => format!("largest |{signal}| over {from}–{to} s"),
-                None => format!("largest |{signal}| from {from} s to the end"),
-            },
+            } => {
+                let signal = words.signal(signal);
+                match to {
+                    Some(to) => format!("largest |{signal}| over {from}–{to} s"),
+                    None => format!("largest |{signal}| from {from} s to the end"),
+                }
+            }
             QoiSpec::Range {
                 signal, from, to, ..
-            } => match to {
-                Some(to) => format!("peak-to-peak (max − min) of {signal} over {from}–{to} s"),
-                None => format!("peak-to-peak (max − min) of {signal} from {from} s to the end"),
-            },
-            QoiSpec::Final { signal, .. } => format!("{signal} at the stop time"),
-            QoiSpec::HuntingSpeed(h) => format!(
-                "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs of \
-                 {} s; a run keeps hunting when max |{}| over its last {} s is at least {} \
-                 ({} = lowest speed seen hunting, {}_decay = highest seen dying out)",
-                h.speed_parameter,
-                h.low,
-                h.high,
-                h.tolerance,
-                h.duration,
-                h.signal,
-                h.window,
-                h.threshold,
-                h.name,
-                h.name
-            ),
+            } => {
+                let signal = words.signal(signal);
+                match to {
+                    Some(to) => format!("peak-to-peak (max − min) of {signal} over {from}–{to} s"),
+                    None => {
+                        format!("peak-to-peak (max − min) of {signal} from {from} s to the end")
+                    }
+                }
+            }
+            QoiSpec::Final { signal, .. } => format!("{} at the stop time", words.signal(signal)),
+            QoiSpec::HuntingSpeed(h) => {
+                let speed = |x: f64| words.value(x, &h.speed_parameter);
+                format!(
+                    "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs \
+                     of {} s; a run keeps hunting when max |{}| over its last {} s is at least \
+                     {} ({} = lowest speed seen hunting, {}_decay = highest seen dying out)",
+                    h.speed_parameter,
+                    h.low,
+                    speed(h.high),
+                    speed(h.tolerance),
+                    h.duration,
+                    words.signal(&h.signal),
+                    h.window,
+                    words.value(h.threshold, &h.signal),
+                    h.name,
+                    h.name
+                )
+            }
         };
         QuantityDefinition {
             kind,
@@ -691,5 +750,53 @@ mod tests {
         let q_max: QoiSpec = toml::from_str(&format!("{base}\nwindow = \"hann\"")).unwrap();
         let (max, _) = evaluate(&q_max, &times, |_| &a[..]).unwrap();
         assert!(mean < max, "{mean} {max}");
+    }
+
+    #[test]
+    fn a_one_letter_signal_is_described_after_its_name_not_inside_a_word() {
+        // QA round 3, H3: the description was put after the first "a" of the sentence, the
+        // one inside "peak": "pea (Acceleration q'')k-to-peak (max − min) of a over 0.5–2 s".
+        let q: QoiSpec = toml::from_str(
+            "kind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\nto = 2.0",
+        )
+        .unwrap();
+        let unit = |v: &str| (v == "a").then(|| "m/s2".to_owned());
+        let words = Words {
+            description: Some(("a", "Acceleration q''")),
+            unit: Some(&unit),
+        };
+        assert_eq!(
+            q.definition_with(&words).text,
+            "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s"
+        );
+        assert_eq!(
+            q.definition().text,
+            "peak-to-peak (max − min) of a over 0.5–2 s"
+        );
+        // `x` sits inside "max"; `V` and `Y` beside other capitals.
+        let q: QoiSpec =
+            toml::from_str("kind = \"max_abs\"\nname = \"x_max\"\nsignal = \"x\"").unwrap();
+        let words = Words {
+            description: Some(("x", "track position")),
+            unit: None,
+        };
+        assert_eq!(
+            q.definition_with(&words).text,
+            "largest |x (track position)| from 0 s to the end"
+        );
+        let q: QoiSpec = toml::from_str(
+            "kind = \"critical_speed\"\nname = \"v_cr\"\nsignal = \"a\"\nspeed = \"V\"",
+        )
+        .unwrap();
+        let unit = |v: &str| Some(if v == "V" { "m/s" } else { "m" }.to_owned());
+        let words = Words {
+            description: Some(("a", "lateral displacement")),
+            unit: Some(&unit),
+        };
+        assert_eq!(
+            q.definition_with(&words).text,
+            "critical speed (speed-ramp estimate, the paper's method): the V at which the \
+             largest |a (lateral displacement)| over a sliding 1 s window last exceeds 0.0001 m"
+        );
     }
 }

@@ -3,28 +3,39 @@
 //! support, instead of the parameters of the implementation (e.g. the lognormal's μ and σ
 //! of ln X, shown beside).
 
-use crate::results::sig;
+use crate::results::numbers::{as_written, computed, written as num};
 use crate::uq::distributions::RandomParameter;
 
 /// One row of the inputs table: `[parameter, unit, distribution as written, mean, Std, CoV,
-/// support]`.
+/// support]`. Mean and Std read as a study file writes them, in one notation (`182300` and
+/// `18230`, or `1.773e6` and `1.773e5`).
 pub fn row(p: &RandomParameter, unit: Option<&str>) -> Vec<String> {
     let d = &p.distribution;
     let (mean, std) = (d.mean(), d.std());
     let cov = if mean != 0.0 {
-        format!("{} %", sig(100.0 * std / mean.abs()))
+        format!("{} %", computed(&[100.0 * std / mean.abs()])[0])
     } else {
         "–".into()
     };
     let (lo, hi) = d.support();
+    // The mean and Std of a normal or lognormal are the numbers written (up to round-off);
+    // those of other kinds are computed.
+    let kind = serde_json::to_value(d)
+        .ok()
+        .and_then(|j| j.get("kind").and_then(|k| k.as_str()).map(str::to_owned));
+    let ms = match kind.as_deref() {
+        Some("normal" | "log_normal") => as_written(&[mean, std]),
+        _ => computed(&[mean, std]),
+    };
+    let bounds = as_written(&[lo, hi]);
     vec![
         p.name.clone(),
         unit.unwrap_or("").to_owned(),
         written(p),
-        sig(mean),
-        sig(std),
+        ms[0].clone(),
+        ms[1].clone(),
         cov,
-        format!("{} … {}", bound(lo), bound(hi)),
+        format!("{} … {}", bounds[0], bounds[1]),
     ]
 }
 
@@ -44,61 +55,81 @@ pub fn header() -> Vec<String> {
     .collect()
 }
 
-fn bound(x: f64) -> String {
-    if x == f64::INFINITY {
-        "∞".into()
-    } else if x == f64::NEG_INFINITY {
-        "−∞".into()
-    } else {
-        sig(x)
-    }
+/// One row of the inputs table of a nominal study, which ran once with every parameter at
+/// its nominal value: `[parameter, unit, value used, distribution (not sampled)]`.
+pub fn nominal_row(p: &RandomParameter, unit: Option<&str>) -> Vec<String> {
+    vec![
+        p.name.clone(),
+        unit.unwrap_or("").to_owned(),
+        num(p.distribution.nominal()),
+        format!("{} (not sampled)", written(p)),
+    ]
 }
 
-/// The distribution in the terms of a study file, e.g. `normal, mean 100, std 10`,
-/// `lognormal, mean 100, cov 0.1 (ln X ~ N(4.6, 0.0998²))`, `uniform, low 1, high 2`.
-/// Kinds this function does not know are listed with their fields.
+/// The header of [`nominal_row`].
+pub fn nominal_header() -> Vec<String> {
+    [
+        "parameter",
+        "unit",
+        "value used",
+        "distribution in the study file",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+/// The distribution in the terms of a study file, e.g. `normal, mean 100, std 10 (cov 0.1)`,
+/// `lognormal, mean 100, std 10 (cov 0.1) (ln X ~ N(4.6002, 0.099751²))`,
+/// `uniform, low 1, high 2`; each number the shortest text that reads back as it, mean and
+/// Std in one notation. Kinds this function does not know are listed with their fields.
 pub fn written(p: &RandomParameter) -> String {
     let d = &p.distribution;
     let json = serde_json::to_value(d).unwrap_or_default();
     let field = |k: &str| json.get(k).and_then(serde_json::Value::as_f64);
     let kind = json.get("kind").and_then(|k| k.as_str()).unwrap_or("?");
-    let spread = |mean: f64, std: f64| {
+    let moments = |mean: f64, std: f64| {
+        let ms = as_written(&[mean, std]);
         if mean != 0.0 {
-            format!("std {} (cov {})", sig(std), sig(std / mean.abs()))
+            format!(
+                "mean {}, std {} (cov {})",
+                ms[0],
+                ms[1],
+                computed(&[std / mean.abs()])[0]
+            )
         } else {
-            format!("std {}", sig(std))
+            format!("mean {}, std {}", ms[0], ms[1])
         }
     };
+    // The lognormal's parameters are computed: five significant digits say enough.
+    let five = |x: f64| computed(&[format!("{x:.4e}").parse().unwrap_or(x)]).swap_remove(0);
     match kind {
-        "normal" => format!(
-            "normal, mean {}, {}",
-            sig(d.mean()),
-            spread(d.mean(), d.std())
-        ),
+        "normal" => format!("normal, {}", moments(d.mean(), d.std())),
         "log_normal" => format!(
-            "lognormal, mean {}, {} (ln X ~ N({}, {}²))",
-            sig(d.mean()),
-            spread(d.mean(), d.std()),
-            sig(field("mu").unwrap_or(f64::NAN)),
-            sig(field("sigma").unwrap_or(f64::NAN)),
+            "lognormal, {} (ln X ~ N({}, {}²))",
+            moments(d.mean(), d.std()),
+            five(field("mu").unwrap_or(f64::NAN)),
+            five(field("sigma").unwrap_or(f64::NAN)),
         ),
-        "uniform" => format!(
-            "uniform, low {}, high {}",
-            sig(field("low").unwrap_or(f64::NAN)),
-            sig(field("high").unwrap_or(f64::NAN))
-        ),
+        "uniform" => {
+            let b = as_written(&[
+                field("low").unwrap_or(f64::NAN),
+                field("high").unwrap_or(f64::NAN),
+            ]);
+            format!("uniform, low {}, high {}", b[0], b[1])
+        }
         "truncated_normal" => {
             let (m, s) = (
                 field("mean").unwrap_or(f64::NAN),
                 field("std").unwrap_or(f64::NAN),
             );
             let (lo, hi) = d.support();
+            let b = as_written(&[lo, hi]);
             format!(
-                "truncated_normal, mean {}, {}, low {}, high {} (of the normal before truncation)",
-                sig(m),
-                spread(m, s),
-                bound(lo),
-                bound(hi)
+                "truncated_normal, {}, low {}, high {} (of the normal before truncation)",
+                moments(m, s),
+                b[0],
+                b[1]
             )
         }
         other => {
@@ -108,7 +139,7 @@ pub fn written(p: &RandomParameter) -> String {
                 .flatten()
                 .filter(|(k, _)| k.as_str() != "kind")
                 .map(|(k, v)| match v.as_f64() {
-                    Some(x) => format!("{k} {}", sig(x)),
+                    Some(x) => format!("{k} {}", num(x)),
                     None => format!("{k} {v}"),
                 })
                 .collect();
@@ -132,23 +163,41 @@ mod tests {
     #[test]
     fn inputs_read_as_written() {
         let n = param(Distribution::normal(100.0, 10.0).unwrap());
-        assert_eq!(written(&n), "normal, mean 100, std 10.0 (cov 0.100)");
+        assert_eq!(written(&n), "normal, mean 100, std 10 (cov 0.1)");
         let r = row(&n, Some("N/m"));
         assert_eq!(r[1], "N/m");
-        assert_eq!(r[5], "10.0 %");
+        assert_eq!(r[5], "10 %");
         assert_eq!(r[6], "−∞ … ∞");
         let l = param(Distribution::lognormal_from_mean_std(100.0, 10.0).unwrap());
         let text = written(&l);
         assert!(
-            text.starts_with("lognormal, mean 100, std 10.0 (cov 0.100)"),
+            text.starts_with("lognormal, mean 100, std 10 (cov 0.1)"),
             "{text}"
         );
-        assert!(text.contains("ln X ~ N(4.60"), "{text}");
+        assert!(text.contains("ln X ~ N(4.6002, 0.099751²)"), "{text}");
         assert!(!text.contains("LogNormal {"), "{text}");
         let u = param(Distribution::uniform(1.0, 2.0).unwrap());
-        assert_eq!(written(&u), "uniform, low 1.00, high 2.00");
-        assert_eq!(row(&u, None)[6], "1.00 … 2.00");
+        assert_eq!(written(&u), "uniform, low 1, high 2");
+        assert_eq!(row(&u, None)[6], "1 … 2");
         let t = param(Distribution::truncated_normal(1.0, 0.5, 0.0, f64::INFINITY).unwrap());
         assert!(written(&t).contains("low 0, high ∞"), "{}", written(&t));
+    }
+
+    #[test]
+    fn inputs_keep_the_digits_the_study_file_wrote() {
+        // QA round 3, M5: `mean = 0.1823e6, cov = 0.1` was shown as "mean 1.82e5, std 18230"
+        // (a digit dropped, two notations in one row).
+        let k = param(Distribution::normal(0.1823e6, 0.1 * 0.1823e6).unwrap());
+        assert_eq!(written(&k), "normal, mean 182300, std 18230 (cov 0.1)");
+        let r = row(&k, None);
+        assert_eq!((r[3].as_str(), r[4].as_str()), ("182300", "18230"));
+        let k = param(Distribution::normal(1773000.0, 177300.0).unwrap());
+        assert_eq!(written(&k), "normal, mean 1.773e6, std 1.773e5 (cov 0.1)");
+        let r = row(&k, None);
+        assert_eq!((r[3].as_str(), r[4].as_str()), ("1.773e6", "1.773e5"));
+        // A nominal study shows the value it used, and the distribution as not sampled.
+        let r = nominal_row(&k, Some("N/m"));
+        assert_eq!(r[2], "1.773e6");
+        assert!(r[3].ends_with("(not sampled)"), "{}", r[3]);
     }
 }

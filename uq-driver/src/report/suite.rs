@@ -11,7 +11,8 @@ use super::{
     palette, write_bytes, write_columns, DensityPlot, LinePlot, ReportError, ReportPage, Section,
     Series, Table,
 };
-use crate::results::{self, OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::results::numbers::to_spread;
+use crate::results::{self, group_digits, sig, OutputStats, ScalarStats, SuiteSummary, Summary};
 use crate::spec::PaperValue;
 
 /// One variant's results.
@@ -98,13 +99,21 @@ fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usiz
         .iter()
         .map(|s| s.to_string())
         .collect();
+    // The unit of a variable or quantity, from any variant that ran the model.
+    let unit_of = |name: &str| {
+        variants
+            .iter()
+            .find_map(|d| d.summary.units.get(name))
+            .map(String::as_str)
+    };
     for s in reference.outputs {
-        header.push(format!("max |Δmean {}| vs {ref_name}", s.name));
-        header.push(format!("max |ΔStd {}| vs {ref_name}", s.name));
+        let u = unit_of(&s.name);
+        header.push(label(&format!("max |Δmean {}| vs {ref_name}", s.name), u));
+        header.push(label(&format!("max |ΔStd {}| vs {ref_name}", s.name), u));
     }
     for (n, ls) in names.iter().zip(&limits) {
-        header.push(format!("mean {n}"));
-        header.push(format!("Std {n}"));
+        header.push(label(&format!("mean {n}"), unit_of(n)));
+        header.push(label(&format!("Std {n}"), unit_of(n)));
         for l in ls {
             header.push(format!("P({n} > {l})"));
         }
@@ -116,18 +125,23 @@ fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usiz
             let mut row = vec![
                 v.name.clone(),
                 v.method.clone(),
-                v.model_runs.to_string(),
+                group_digits(v.model_runs),
                 format!("{:.3}", v.wall_time_s),
             ];
             for o in &v.outputs {
-                row.push(format!("{:.3e}", o.max_abs_mean_diff_vs_reference));
-                row.push(format!("{:.3e}", o.max_abs_std_diff_vs_reference));
+                if v.name == *ref_name {
+                    // Against itself: no difference to show ("0.000e0").
+                    row.extend(["(reference)".to_string(), "(reference)".to_string()]);
+                } else {
+                    row.push(sig(o.max_abs_mean_diff_vs_reference));
+                    row.push(sig(o.max_abs_std_diff_vs_reference));
+                }
             }
             for (n, ls) in names.iter().zip(&limits) {
                 match find(&v.quantities, n) {
                     Some(q) => {
-                        row.push(format!("{:.5}", q.mean));
-                        row.push(format!("{:.5}", q.std));
+                        row.push(to_spread(q.mean, q.std));
+                        row.push(to_spread(q.std, q.std));
                         row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
                     }
                     None => row.extend(std::iter::repeat_n(String::new(), 2 + ls.len())),
@@ -456,7 +470,7 @@ fn paper_section(summary: &SuiteSummary) -> Section {
                 pv.quantity.clone(),
                 pv.statistic.clone(),
                 format!("{}", pv.value),
-                ours.map(|v| format!("{v:.5}"))
+                ours.map(|v| to_spread(v, 0.0))
                     .unwrap_or_else(|| "n/a".into()),
                 ours.map(|v| format!("{:+.2} %", 100.0 * (v - pv.value) / pv.value))
                     .unwrap_or_default(),

@@ -7,6 +7,7 @@
 use std::collections::BTreeMap;
 
 use crate::fmu::{ModelDescription, VariableKind};
+use crate::qoi::scalar::Words;
 use crate::qoi::QoiSpec;
 use crate::results::{OutputStats, ScalarStats};
 use crate::spec::Study;
@@ -86,32 +87,35 @@ pub fn annotate(
     }
 }
 
-/// Adds to each quantity's definition what the FMU says of the signal it is computed from
-/// (`settings.signal_description`, and in the text after the signal's name): for a Sperling
-/// index, where on the carbody the acceleration is taken (`Zc_acc_front`: "above the front
-/// bogie centre").
+/// Writes each quantity's definition again with what the FMU says of its variables: the
+/// description of the signal it is computed from (`settings.signal_description`, and in the
+/// text after the signal's name; for a Sperling index, where on the carbody the acceleration
+/// is taken: `Zc_acc_front`, "above the front bogie centre") and the declared units of its
+/// thresholds and speeds. The text is built anew from the quantity's parts
+/// ([`QoiSpec::definition_with`]), never by searching the old text for the signal's name.
 pub fn describe_signals(quantities: &mut [ScalarStats], qoi: &[QoiSpec], md: &ModelDescription) {
+    let unit = |name: &str| unit_of(md, name);
     for q in quantities.iter_mut() {
         let Some(spec) = qoi.iter().find(|s| s.quantity_names().contains(&q.name)) else {
             continue;
         };
-        let Some(signal) = spec.signals().first().map(|s| s.to_string()) else {
-            continue;
+        let signal = spec.signals().first().map(|s| s.to_string());
+        let description = signal.as_deref().and_then(|s| {
+            md.variable(s)
+                .and_then(|v| v.description.clone())
+                .filter(|d| !d.is_empty())
+                .map(|d| (s, d))
+        });
+        if let Some((_, text)) = &description {
+            q.definition
+                .settings
+                .insert("signal_description".into(), text.clone().into());
+        }
+        let words = Words {
+            description: description.as_ref().map(|(s, d)| (*s, d.as_str())),
+            unit: Some(&unit),
         };
-        let Some(text) = md
-            .variable(&signal)
-            .and_then(|v| v.description.clone())
-            .filter(|d| !d.is_empty())
-        else {
-            continue;
-        };
-        q.definition
-            .settings
-            .insert("signal_description".into(), text.clone().into());
-        q.definition.text = q
-            .definition
-            .text
-            .replacen(&signal, &format!("{signal} ({text})"), 1);
+        q.definition.text = spec.definition_with(&words).text;
     }
 }
 

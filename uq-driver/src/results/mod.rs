@@ -5,6 +5,7 @@
 //! keys of `summary.json`): add fields, rename none.
 
 mod nested;
+pub mod numbers;
 
 use crate::report::file_name::stem;
 use std::collections::BTreeMap;
@@ -242,11 +243,15 @@ impl ExceedanceCount {
         let outer = self.outer_samples.map_or(String::new(), |k| {
             format!(" over {} outer samples", group_digits(k))
         });
+        // "0 of 1 run", not "0 of 1 runs".
+        let what = match (self.of, self.of_what.as_str()) {
+            (1, "runs") => "run",
+            (_, w) => w,
+        };
         let head = format!(
-            "{} of {} {}{outer} exceeded {}",
+            "{} of {} {what}{outer} exceeded {}",
             group_digits(self.exceeded),
             group_digits(self.of),
-            self.of_what,
             self.limit
         );
         let kind = match self.outer_samples {

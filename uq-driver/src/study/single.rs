@@ -47,10 +47,10 @@ pub(crate) fn run_single(
                 size::check_runs(study, design.len(), opts)?;
             }
             eprintln!(
-                "{}: {} with {} model runs",
+                "{}: {} with {}",
                 study.name,
                 study.method().label(study.parameters.len()),
-                design.len()
+                crate::results::numbers::count(design.len(), "model run", "model runs")
             );
             let early = ranges::range_warnings(study, &fmu, &design);
             for w in &early {
@@ -331,6 +331,12 @@ fn solve(
         &[],
     );
     summary.units = units::study_units(study, None);
+    // The page shows the system that was solved.
+    let system: Vec<report::Section> = study
+        .system
+        .iter()
+        .map(report::study::system_section)
+        .collect();
     summary.timing.report_s = report::study::write(
         out_dir,
         &StudyReport {
@@ -339,7 +345,7 @@ fn solve(
             quantities: &[],
             qoi: &study.qoi,
             points: None,
-            extra: &[],
+            extra: &system,
             plots: !opts.no_report,
         },
     )?;

@@ -15,7 +15,10 @@ use super::inputs;
 use super::units::with_unit;
 use super::{write_bytes, ReportError, ReportPage, Section, Table};
 use crate::qoi::QoiSpec;
-use crate::results::{self, sig, OutputStats, PointTable, ScalarStats, Summary};
+use crate::results::numbers::{as_written, count, to_spread, written};
+use crate::results::{self, group_digits, sig, OutputStats, PointTable, ScalarStats, Summary};
+use crate::uq::galerkin::system::{Coefficient, SystemSpec};
+use crate::uq::method::{ChaosErrorKind, Draws};
 
 pub use files::points_csv as write_points_csv;
 
@@ -88,7 +91,7 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
                 files::convergence_csv(dir, &q.name, c)?;
             }
             r.plots
-                .then(|| quantity_section(dir, q, &r.summary.study, &names))
+                .then(|| quantity_section(dir, q, r.summary, &names))
                 .transpose()
         })
         .collect::<Result<_, _>>()?;
@@ -139,21 +142,39 @@ fn head_sections(r: &StudyReport, s: &Summary) -> Vec<Section> {
         images.insert(0, "points.csv".into());
     }
     let t = &s.timing;
-    let mut text = format!(
-        "{}\n\nMethod: {}. {} model runs ({} this time, {} resumed from earlier), {} failed, \
-         on {} threads. Wall time of this invocation: runs {:.3} s, analysis {:.3} s, report \
-         {:.3} s.",
-        s.description,
-        s.method.kind,
-        s.model_runs,
-        s.runs_this_invocation,
-        s.runs_resumed,
-        s.failed_runs,
-        s.threads,
-        t.runs_s,
-        t.analysis_s,
-        t.report_s,
-    );
+    let nominal = is_nominal(s);
+    let mut text = if s.fmu.is_none() {
+        // An intrusive method (SGM): no model, no runs; its own system, solved once.
+        format!(
+            "{}\n\nMethod: {}. No model runs: the Galerkin system (the system of the study \
+             file, shown at the end of this page) was solved once. Wall time of this \
+             invocation: solve {:.3} s, analysis {:.3} s, report {:.3} s.",
+            s.description, s.method.kind, t.runs_s, t.analysis_s, t.report_s,
+        )
+    } else {
+        format!(
+            "{}\n\nMethod: {}. {} ({} this time, {} resumed from earlier), {} failed, on {}. \
+             Wall time of this invocation: runs {:.3} s, analysis {:.3} s, report {:.3} s.",
+            s.description,
+            s.method.kind,
+            count(s.model_runs, "model run", "model runs"),
+            group_digits(s.runs_this_invocation),
+            group_digits(s.runs_resumed),
+            group_digits(s.failed_runs),
+            count(s.threads, "thread", "threads"),
+            t.runs_s,
+            t.analysis_s,
+            t.report_s,
+        )
+    };
+    if nominal {
+        text.push_str(
+            "\n\nNominal study: one run with every random parameter held at its mean (a \
+             discrete one at the value of its support nearest the mean). The distributions \
+             below were not sampled, so the results have no spread, no density and no \
+             probability.",
+        );
+    }
     if !s.fixed.is_empty() {
         let fixed: Vec<String> = s
             .fixed
@@ -162,33 +183,117 @@ fn head_sections(r: &StudyReport, s: &Summary) -> Vec<Section> {
             .collect();
         text.push_str(&format!("\n\nFixed values: {}.", fixed.join(", ")));
     }
-    text.push_str(
+    text.push_str(if s.fmu.is_none() {
+        "\n\nUnits: no FMU, and the study's system declares no unit (time in s); the CSV \
+         files keep plain column names (units.csv lists time only)."
+    } else {
         "\n\nUnits are those the FMU declares in its modelDescription (time in s); the CSV \
          files keep plain column names, their units are listed in units.csv and in \
-         summary.json (units).",
-    );
-    let mut head = vec![Section {
-        heading: "Study".into(),
-        text,
-        images,
-        table: Some(Table {
+         summary.json (units)."
+    });
+    let unit =
+        |p: &crate::uq::distributions::RandomParameter| s.units.get(&p.name).map(String::as_str);
+    let table = if nominal {
+        Table {
+            header: inputs::nominal_header(),
+            rows: s
+                .parameters
+                .iter()
+                .map(|p| inputs::nominal_row(p, unit(p)))
+                .collect(),
+        }
+    } else {
+        Table {
             header: inputs::header(),
             rows: s
                 .parameters
                 .iter()
-                .map(|p| inputs::row(p, s.units.get(&p.name).map(String::as_str)))
+                .map(|p| inputs::row(p, unit(p)))
                 .collect(),
-        }),
+        }
+    };
+    let mut head = vec![Section {
+        heading: "Study".into(),
+        text,
+        images,
+        table: Some(table),
     }];
     if !s.warnings.is_empty() {
+        let warnings: Vec<String> = s.warnings.iter().map(|w| plain_quotes(w)).collect();
         head.push(Section {
             heading: "Warnings".into(),
-            text: s.warnings.join("\n\n"),
+            text: warnings.join("\n\n"),
             images: vec![],
             table: None,
         });
     }
     head
+}
+
+/// A nominal study: one deterministic run at the parameters' means.
+fn is_nominal(s: &Summary) -> bool {
+    s.method.kind == "nominal"
+}
+
+/// Markdown code spans of a message (`order`) as quotes (‘order’): the page is not Markdown.
+fn plain_quotes(text: &str) -> String {
+    let mut open = false;
+    text.chars()
+        .map(|c| match c {
+            '`' => {
+                open = !open;
+                if open {
+                    '‘'
+                } else {
+                    '’'
+                }
+            }
+            c => c,
+        })
+        .collect()
+}
+
+/// Where the quantiles come from (they are empirical: order statistics of the runs or of the
+/// draws; the kernel density is only the PDF's).
+fn quantile_source(draws: Draws) -> &'static str {
+    match draws {
+        Draws::Runs => "empirical, of the runs",
+        Draws::Chaos => "empirical, of a large sample of the chaos surrogate",
+    }
+}
+
+/// The words for a kind of chaos truncation-error estimate.
+fn chaos_error_words(kind: ChaosErrorKind) -> &'static str {
+    match kind {
+        ChaosErrorKind::Loo => "the corrected leave-one-out error of the regression",
+        ChaosErrorKind::LevelDifference => {
+            "the difference between the chaoses of the last two sparse-grid levels"
+        }
+        ChaosErrorKind::OrderDifference => {
+            "the difference between the chaoses of the last two orders"
+        }
+    }
+}
+
+/// The sentence on an output's chaos truncation error: its largest value over time.
+fn chaos_error_sentence(s: &OutputStats) -> Option<String> {
+    let e = s.chaos_error.as_ref()?;
+    let (i, max) = e
+        .values
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(format!(
+        "\n\nTruncation error of the chaos, estimated by {}: largest {} (relative to the \
+         variance) at t = {} s (every time: column {} of {}.csv).",
+        chaos_error_words(e.kind),
+        sig(max),
+        to_spread(s.times.get(i).copied().unwrap_or(f64::NAN), 0.0),
+        e.kind.name(),
+        stem(&s.name)
+    ))
 }
 
 /// The plots and the section of an output.
@@ -201,7 +306,12 @@ fn output_section(
     let v = &s.name;
     plots::band(dir, s, summary)?;
     let mut images = vec![format!("{}_band.svg", stem(v))];
-    let mut text = if s.deterministic {
+    let mut text = if s.deterministic && is_nominal(summary) {
+        format!(
+            "{v} of the one nominal run (every parameter at its mean): no spread and no \
+             density. The plot shows its value."
+        )
+    } else if s.deterministic {
         format!(
             "{v} has the same value in every run at every time: it is deterministic in this \
              study, so it has no spread and no density. The plot shows its value."
@@ -210,17 +320,18 @@ fn output_section(
         format!(
             "Mean, standard deviation and the μ ± 3σ band of {v} over time, with its quantiles \
              ({}).",
-            s.draws.describe()
+            quantile_source(s.draws)
         )
     };
     if plots::pdf_heatmap(dir, s)? {
         images.push(format!("{}_pdf.svg", stem(v)));
         text.push_str(&format!(
-            "\n\nPDF evolution: the density of {v} at {} times (columns) on a grid of {} \
-             values, colour from 0 upwards. Columns where every run has the same value (for \
+            "\n\nPDF evolution: the density of {v} ({}) at {} times (columns) on a grid of \
+             {} values, colour from 0 upwards. Columns where every run has the same value (for \
              instance a fixed initial state) have no density and are left blank.",
-            s.pdf_times.len(),
-            s.pdf_grid.len()
+            s.draws.describe(),
+            group_digits(s.pdf_times.len()),
+            group_digits(s.pdf_grid.len())
         ));
     }
     if s.sobol.is_some() && !s.deterministic {
@@ -249,10 +360,13 @@ fn output_section(
         text.push_str(&format!(
             "\n\nConvergence: mean and Std of {v} at t = {} s (where its Std is largest) \
              against {}.",
-            sig(s.convergence_time.unwrap_or(f64::NAN)),
-            convergence_axis(c)
+            to_spread(s.convergence_time.unwrap_or(f64::NAN), 0.0),
+            convergence_axis(c, &summary.method.kind)
         ));
         images.push(format!("{}_convergence.csv", stem(v)));
+    }
+    if let Some(e) = chaos_error_sentence(s) {
+        text.push_str(&e);
     }
     images.push(format!("{}.csv", stem(v)));
     images.push(format!("{}_pdf.csv", stem(v)));
@@ -270,15 +384,27 @@ fn output_section(
     })
 }
 
-fn convergence_axis(c: &results::Convergence) -> &'static str {
+/// What the convergence plot's x axis is, in words that fit the method `kind`.
+fn convergence_axis(c: &results::Convergence, kind: &str) -> String {
     if c.axis == "runs" {
-        "the number of runs (running estimates over the first n runs in design order; for a \
-         Latin hypercube the first n points are not a Latin hypercube themselves)"
+        let lhs = if kind == "lhs" {
+            "; for a Latin hypercube the first n points are not a Latin hypercube themselves"
+        } else {
+            ""
+        };
+        format!("the number of runs (running estimates over the first n runs in design order{lhs})")
     } else {
-        "the total order of the chaos: the Std of the terms of each order alone (a fast \
-         decay means the expansion has converged) and of the expansion truncated there (each \
-         term is projected on its own, so the truncation is the lower-order chaos of the same \
-         runs)"
+        let truncation = if kind == "scm" {
+            "each term is projected on its own, so the truncation is the lower-order chaos of \
+             the same runs"
+        } else {
+            "the chaos with its higher-order terms dropped, not computed again"
+        };
+        format!(
+            "the total order of the chaos: the Std of the terms of each order alone (a fast \
+             decay means the expansion has converged) and of the expansion truncated there \
+             ({truncation})"
+        )
     }
 }
 
@@ -286,19 +412,33 @@ fn convergence_axis(c: &results::Convergence) -> &'static str {
 fn quantity_section(
     dir: &Path,
     q: &ScalarStats,
-    study: &str,
+    summary: &Summary,
     names: &[&str],
 ) -> Result<Section, ReportError> {
     let name = &q.name;
     let unit = q.unit.as_deref();
-    let num = |v: f64| with_unit(&format!("{v:.6}"), unit);
+    // Means, quantiles and extremes to the resolution the Std allows.
+    let num = |v: f64| with_unit(&to_spread(v, q.std), unit);
+    let nominal = is_nominal(summary);
     let mut images = Vec::new();
     let mut text = format!("{name}: {}.", q.definition.text);
-    if q.deterministic {
+    if nominal {
+        text.push_str(&format!(
+            "\n\n{name} = {} from the one nominal run (every parameter at its mean): no \
+             spread, no density and no probability.",
+            num(q.mean)
+        ));
+        for e in &q.exceedance_counts {
+            text.push_str(&format!("\n\n{}", against_limit(q, e.limit)));
+        }
+    } else if q.deterministic {
         let why = if q.n_valid < 2 {
-            format!("there is {} run", q.n_valid)
+            format!("there is {}", count(q.n_valid, "run", "runs"))
         } else {
-            format!("every one of the {} runs gives the same value", q.n_valid)
+            format!(
+                "every one of the {} runs gives the same value",
+                group_digits(q.n_valid)
+            )
         };
         text.push_str(&format!(
             "\n\n{name} = {} — {why}: it is deterministic in this study, so it has no \
@@ -306,11 +446,12 @@ fn quantity_section(
             num(q.mean)
         ));
     } else {
-        plots::scalar_pdf(dir, q, study)?;
+        plots::scalar_pdf(dir, q, &summary.study)?;
         images.push(format!("{}_pdf.svg", stem(name)));
         text.push_str(&format!(
-            "\n\nDistribution of {name} ({}).",
-            q.draws.describe()
+            "\n\nDistribution of {name} ({}; the table's quantiles are {}).",
+            q.draws.describe(),
+            quantile_source(q.draws)
         ));
         if plots::sobol_bars(dir, q, names, None)? {
             images.push(format!("{}_sobol.svg", stem(name)));
@@ -319,43 +460,142 @@ fn quantity_section(
             images.extend(plots::convergence(dir, name, unit, c)?);
             text.push_str(&format!(
                 "\n\nConvergence: mean and Std against {}.",
-                convergence_axis(c)
+                convergence_axis(c, &summary.method.kind)
             ));
             images.push(format!("{}_convergence.csv", stem(name)));
         }
     }
+    if let Some(e) = &q.chaos_error {
+        text.push_str(&format!(
+            "\n\nTruncation error of the chaos, estimated by {}: {} (relative to the variance).",
+            chaos_error_words(kind_of(e.kind)),
+            sig(e.value)
+        ));
+    }
     images.push(format!("{}_pdf.csv", stem(name)));
     images.push(format!("{}_samples.csv", stem(name)));
+    let rows = if nominal {
+        nominal_rows(q)
+    } else {
+        statistics_rows(q, names)
+    };
+    Ok(Section {
+        heading: format!("Quantity {name}"),
+        text,
+        images,
+        table: Some(Table {
+            header: vec!["statistic".into(), "value".into()],
+            rows,
+        }),
+    })
+}
+
+/// `W = 2.31 is below the limit 2.5 (nominal run; no probability)`, or `exceeds`.
+fn against_limit(q: &ScalarStats, limit: f64) -> String {
+    let unit = q.unit.as_deref();
+    let relation = if q.mean > limit {
+        "exceeds"
+    } else if q.mean == limit {
+        "equals"
+    } else {
+        "is below"
+    };
+    format!(
+        "{} = {} {relation} the limit {} (nominal run; no probability)",
+        q.name,
+        with_unit(&to_spread(q.mean, 0.0), unit),
+        with_unit(&limit.to_string(), unit)
+    )
+}
+
+/// The kind of a scalar's truncation-error estimate from its name in `summary.json`.
+fn kind_of(name: &str) -> ChaosErrorKind {
+    match name {
+        "loo" => ChaosErrorKind::Loo,
+        "level_difference" => ChaosErrorKind::LevelDifference,
+        _ => ChaosErrorKind::OrderDifference,
+    }
+}
+
+/// The table of a quantity of a nominal study: its definition, unit and value, and where it
+/// stands against each limit.
+fn nominal_rows(q: &ScalarStats) -> Vec<Vec<String>> {
+    let unit = q.unit.as_deref();
     let mut rows = vec![
         vec!["computed as".to_string(), q.definition.text.clone()],
         vec!["unit".into(), unit.unwrap_or("(not declared)").to_owned()],
-        vec!["mean".into(), num(q.mean)],
-        vec!["Std".into(), num(q.std)],
+        vec![
+            "value (nominal run)".into(),
+            with_unit(&to_spread(q.mean, 0.0), unit),
+        ],
     ];
-    if let Some(se) = q.std_error_mean.filter(|&se| se > 0.0) {
+    for e in &q.exceedance_counts {
         rows.push(vec![
-            "standard error of the mean".into(),
-            with_unit(&sig(se), unit),
+            format!(
+                "{} against {}",
+                q.name,
+                with_unit(&e.limit.to_string(), unit)
+            ),
+            against_limit(q, e.limit),
         ]);
     }
-    rows.push(vec!["valid runs".into(), q.n_valid.to_string()]);
-    rows.push(vec![
-        "smallest / largest run".into(),
-        format!("{} / {}", num(q.min), num(q.max)),
-    ]);
+    rows
+}
+
+/// The table of statistics of a quantity (no Std, quantiles or extremes when it is the same
+/// in every run).
+fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
+    let name = &q.name;
+    let unit = q.unit.as_deref();
+    let num = |v: f64| with_unit(&to_spread(v, q.std), unit);
+    let mut rows = vec![
+        vec!["computed as".to_string(), q.definition.text.clone()],
+        vec!["unit".into(), unit.unwrap_or("(not declared)").to_owned()],
+    ];
+    if q.deterministic {
+        rows.push(vec!["value (every run)".into(), num(q.mean)]);
+    } else {
+        rows.push(vec!["mean".into(), num(q.mean)]);
+        rows.push(vec![
+            "Std".into(),
+            with_unit(&to_spread(q.std, q.std), unit),
+        ]);
+        // A deterministic value's standard error is round-off: left out.
+        if let Some(se) = q.std_error_mean.filter(|&se| se > 0.0) {
+            rows.push(vec![
+                "standard error of the mean".into(),
+                with_unit(&sig(se), unit),
+            ]);
+        }
+    }
+    rows.push(vec!["valid runs".into(), group_digits(q.n_valid)]);
+    if !q.deterministic {
+        rows.push(vec![
+            "smallest / largest run".into(),
+            format!("{} / {}", num(q.min), num(q.max)),
+        ]);
+    }
     if q.n_never_hunts + q.n_never_stops > 0 {
         rows.push(vec![
             "never hunt / never stop".into(),
             format!("{} / {}", q.n_never_hunts, q.n_never_stops),
         ]);
     }
-    for (p, v) in &q.quantiles {
-        rows.push(vec![format!("quantile {p}"), num(*v)]);
+    if !q.deterministic {
+        for (p, v) in &q.quantiles {
+            rows.push(vec![format!("quantile {p}"), num(*v)]);
+        }
     }
     for e in &q.exceedance_counts {
         rows.push(vec![
             format!("P({name} > {})", with_unit(&e.limit.to_string(), unit)),
             e.describe(),
+        ]);
+    }
+    if let Some(e) = &q.chaos_error {
+        rows.push(vec![
+            format!("chaos truncation error ({}, relative)", e.kind),
+            sig(e.value),
         ]);
     }
     if let (Some(f), Some(t)) = (&q.sobol_first, &q.sobol_total) {
@@ -378,13 +618,62 @@ fn quantity_section(
             ]);
         }
     }
-    Ok(Section {
-        heading: format!("Quantity {name}"),
-        text,
-        images,
+    rows
+}
+
+/// The section that shows the system an intrusive method (SGM) solved, from `[system]` of the
+/// study file: `M q̈ + C q̇ + K q = f` with its constant parts and how each random parameter
+/// enters.
+pub fn system_section(sys: &SystemSpec) -> Section {
+    let vector = |v: &[f64]| format!("[{}]", as_written(v).join(", "));
+    let matrix = |m: &[Vec<f64>]| {
+        let rows: Vec<String> = m.iter().map(|r| vector(r)).collect();
+        format!("[{}]", rows.join(", "))
+    };
+    let n = sys.dofs.len();
+    let or_zeros = |v: &[f64]| {
+        if v.is_empty() {
+            vector(&vec![0.0; n])
+        } else {
+            vector(v)
+        }
+    };
+    let mut rows = vec![
+        vec!["degrees of freedom q".to_string(), sys.dofs.join(", ")],
+        vec!["M (constant part)".into(), matrix(&sys.m)],
+        vec!["C (constant part)".into(), matrix(&sys.c)],
+        vec!["K (constant part)".into(), matrix(&sys.k)],
+        vec!["q0 (constant part)".into(), or_zeros(&sys.q0)],
+        vec!["v0 (constant part)".into(), or_zeros(&sys.v0)],
+        vec!["f (constant load)".into(), or_zeros(&sys.force)],
+    ];
+    for d in &sys.dependence {
+        let part = serde_json::to_value(d.matrix)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_owned))
+            .unwrap_or_default();
+        let coefficient = match &d.d {
+            Coefficient::Matrix(m) => matrix(m),
+            Coefficient::Vector(v) => vector(v),
+        };
+        rows.push(vec![
+            format!("{part} depends on {}", d.parameter),
+            format!("{part} += {} · {coefficient}", d.parameter),
+        ]);
+    }
+    Section {
+        heading: "System".into(),
+        text: format!(
+            "The system the stochastic Galerkin method solved ([system] of the study file): \
+             M q̈ + C q̇ + K q = f, q(0) = q0, q̇(0) = v0, each of M, C, K, q0, v0 its \
+             constant part plus each random parameter times its coefficient (below). \
+             Integrated by RK4 with steps of at most {} s. No unit is declared.",
+            written(sys.step)
+        ),
+        images: vec![],
         table: Some(Table {
-            header: vec!["statistic".into(), "value".into()],
+            header: vec!["part".into(), "value".into()],
             rows,
         }),
-    })
+    }
 }
