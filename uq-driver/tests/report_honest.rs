@@ -508,3 +508,35 @@ fn a_one_letter_signal_is_described_after_its_name() {
     );
     assert!(!html.contains("pea ("), "{html}");
 }
+
+#[test]
+fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
+    // QA round 3, L10 and M8: a variant's page was headed "railuq study scm" with no word of
+    // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("s.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
+             [method]\nkind = \"scm\"\nnodes = 2\n\
+             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+             [outputs]\nvariables = [\"q\"]\n\
+             [[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
+             [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
+            wheel_fmu().display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    run_ok(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let page = std::fs::read_to_string(out.join("lhs/index.html")).unwrap();
+    assert!(
+        page.contains("railuq study lhs, a variant of the suite"),
+        "{page}"
+    );
+    assert!(page.contains("href=\"../index.html\""), "{page}");
+    let suite = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!suite.contains("0.000e0"), "{suite}");
+    assert!(suite.contains("(reference)"), "{suite}");
+}

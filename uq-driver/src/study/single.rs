@@ -50,7 +50,10 @@ pub(crate) fn run_single(
                 "{}: {} with {}",
                 study.name,
                 study.method().label(study.parameters.len()),
-                crate::results::numbers::count(design.len(), "model run", "model runs")
+                match design.len() {
+                    1 => "1 model run".to_owned(),
+                    n => format!("{n} model runs"),
+                }
             );
             let early = ranges::range_warnings(study, &fmu, &design);
             for w in &early {

@@ -124,8 +124,15 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
         let mut page = head_sections(r, &summary);
         page.extend(sections);
         page.extend(r.extra.iter().cloned());
+        let title = match variant_of(r.summary) {
+            Some(suite) => format!(
+                "railuq study {}, a variant of the suite {suite}",
+                r.summary.study
+            ),
+            None => format!("railuq study {}", r.summary.study),
+        };
         ReportPage {
-            title: format!("railuq study {}", r.summary.study),
+            title,
             summary_json: json.clone(),
             sections: page,
         }
@@ -167,6 +174,14 @@ fn head_sections(r: &StudyReport, s: &Summary) -> Vec<Section> {
             t.report_s,
         )
     };
+    if let Some(suite) = variant_of(s) {
+        text.push_str(&format!(
+            "\n\nThis is the variant {} of the suite {suite}; the suite's page (../index.html, \
+             linked below) compares it with the other variants.",
+            s.study
+        ));
+        images.push("../index.html".into());
+    }
     if nominal {
         text.push_str(
             "\n\nNominal study: one run with every random parameter held at its mean (a \
@@ -228,6 +243,14 @@ fn head_sections(r: &StudyReport, s: &Summary) -> Vec<Section> {
         });
     }
     head
+}
+
+/// The suite a study is a variant of (its origin reads `<suite origin> (variant <name>)`),
+/// whose page is in the folder above.
+fn variant_of(s: &Summary) -> Option<&str> {
+    s.origin
+        .strip_suffix(&format!(" (variant {})", s.study))
+        .filter(|o| !o.is_empty())
 }
 
 /// A nominal study: one deterministic run at the parameters' means.
