@@ -121,11 +121,18 @@ fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usiz
     let rows = summary
         .variants
         .iter()
-        .map(|v| {
+        .zip(variants)
+        .map(|(v, d)| {
+            // An intrusive method (SGM) runs no model: it solves its own system once.
+            let runs = if d.summary.fmu.is_none() {
+                "none (Galerkin system solved once)".to_owned()
+            } else {
+                group_digits(v.model_runs)
+            };
             let mut row = vec![
                 v.name.clone(),
                 v.method.clone(),
-                group_digits(v.model_runs),
+                runs,
                 format!("{:.3}", v.wall_time_s),
             ];
             for o in &v.outputs {
