@@ -192,6 +192,14 @@ pub(crate) struct SafetyArgs {
     /// Run again the points that failed in an earlier run into the same folder.
     #[arg(long)]
     pub(crate) retry_failed: bool,
+    /// Run every point on a fresh FMU instance (fmi2FreeInstance, then fmi2Instantiate)
+    /// instead of reusing one through fmi2Reset.
+    #[arg(long)]
+    pub(crate) fresh_instances: bool,
+    /// Instantiate the FMU with loggingOn = true (many FMUs log only then); its messages are
+    /// kept with failed points.
+    #[arg(long)]
+    pub(crate) fmu_logging: bool,
 }
 
 impl SafetyArgs {
@@ -199,6 +207,8 @@ impl SafetyArgs {
     pub(crate) fn apply(&self, opts: &mut RunOptions) -> Result<()> {
         opts.retry_failed = self.retry_failed;
         opts.timeout_per_run = self.timeout_per_run;
+        opts.fresh_instances = self.fresh_instances;
+        opts.fmu_logging = self.fmu_logging;
         if self.isolate {
             opts.isolate = Some(
                 uq_driver::study::isolate::default_exe()
@@ -278,6 +288,10 @@ pub(crate) struct SimulateArgs {
     /// CSV file to write (default: standard output).
     #[arg(long, short)]
     pub(crate) out: Option<PathBuf>,
+    /// Instantiate the FMU with loggingOn = true (many FMUs log only then) and print its
+    /// messages on stderr as they come.
+    #[arg(long)]
+    pub(crate) fmu_logging: bool,
 }
 
 pub(crate) fn parse_assignment(s: &str) -> Result<(String, String), String> {

@@ -79,10 +79,16 @@ impl fmt::Display for LogMessage {
     }
 }
 
-/// Formats the FMU's log lines for an error message.
-fn log_lines(messages: &[LogMessage]) -> String {
-    if messages.is_empty() {
+/// Formats the FMU's log lines for an error message; `logging_on`: whether the instance was
+/// asked to log (many FMUs send nothing otherwise, not even at fmi2Error or fmi2Fatal).
+fn log_lines(messages: &[LogMessage], logging_on: bool) -> String {
+    if messages.is_empty() && logging_on {
         return " (the FMU logged nothing)".to_string();
+    }
+    if messages.is_empty() {
+        return " (the FMU logged nothing; many FMUs log only when instantiated with loggingOn = \
+                true: run again with --fmu-logging)"
+            .to_string();
     }
     let mut out = String::from("; FMU log:");
     for m in messages {
@@ -241,7 +247,7 @@ pub enum FmuError {
         reason: String,
     },
     /// `fmi2Instantiate` returned no instance, or the instance could not be created.
-    #[error("{}: cannot instantiate '{instance}': {reason}{}", .path.display(), log_lines(.messages))]
+    #[error("{}: cannot instantiate '{instance}': {reason}{}", .path.display(), log_lines(.messages, *.logging_on))]
     InstantiateFailed {
         /// The `.fmu` file.
         path: PathBuf,
@@ -251,11 +257,13 @@ pub enum FmuError {
         reason: String,
         /// What the FMU logged meanwhile.
         messages: Vec<LogMessage>,
+        /// Whether the instance was asked to log (`loggingOn`).
+        logging_on: bool,
     },
     /// An FMI function returned a status other than OK or Warning.
     #[error(
         "{}: {function} returned {status} for instance '{instance}'{}",
-        .path.display(), log_lines(.messages)
+        .path.display(), log_lines(.messages, *.logging_on)
     )]
     Call {
         /// The `.fmu` file.
@@ -268,6 +276,8 @@ pub enum FmuError {
         status: Status,
         /// The messages the FMU logged during the call (or, if none, its last messages).
         messages: Vec<LogMessage>,
+        /// Whether the instance was asked to log (`loggingOn`).
+        logging_on: bool,
     },
     /// The FMU returned something that breaks the FMI 2.0 contract (e.g. a null string).
     #[error("{}: {function} of instance '{instance}' misbehaved: {reason}", .path.display())]
@@ -401,6 +411,7 @@ mod tests {
                 category: "logStatusError".into(),
                 message: "step size must be positive".into(),
             }],
+            logging_on: false,
         };
         let text = e.to_string();
         assert!(text.starts_with("/x/Model.fmu: fmi2DoStep returned Error for instance 'w0'"));

@@ -339,6 +339,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         wall_time: 0.0,
         threads: 0,
         fmu_sha256: p.manifest.fmu_sha256.clone(),
+        warnings: Vec::new(),
     };
     finish(&study, method, &fmu, &design, outcome, out, opts).map_err(ShardError::Run)
 }
