@@ -22,7 +22,8 @@
  *     11 raises SIGTERM on itself   12 prints a line to stdout (fd 1) and goes on
  *   reset_bug: a broken fmi2Reset, as FMUs from other tools have: 1 returns fmi2Error (logged),
  *   2 returns fmi2OK but forgets the start values (every variable keeps its value of the run
- *   before, u_integral included, which then starts where that run ended)
+ *   before, u_integral included, which then starts where that run ended), 3 returns fmi2Error
+ *   (logged) after a run with gain < 1.5 only
  *   quiet: the model's own messages (these misbehaviours, read_file) reach the importer only
  *   with logging on, errors included (as pythonfmu FMUs log)
  *   name_dir: not empty: at the end of initialization gain is written to the file
@@ -124,7 +125,7 @@ static const Variable VARIABLES[] = {
     VAR("string_param", TYPE_STRING, 0, KIND_FIXED_PARAMETER, string_param),
     VAR("read_file", TYPE_STRING, 1, KIND_FIXED_PARAMETER, read_file),
     VAR("string_out", TYPE_STRING, 2, KIND_OUTPUT, string_out),
-    {"reset_bug", TYPE_INTEGER, 8, KIND_FIXED_PARAMETER, offsetof(Data, reset_bug), 1, 0, 2},
+    {"reset_bug", TYPE_INTEGER, 8, KIND_FIXED_PARAMETER, offsetof(Data, reset_bug), 1, 0, 3},
     VAR("quiet", TYPE_BOOLEAN, 4, KIND_FIXED_PARAMETER, quiet),
     VAR("name_dir", TYPE_STRING, 3, KIND_FIXED_PARAMETER, name_dir),
 };
@@ -251,6 +252,11 @@ static fmi2Status reset(Instance *inst) {
     Data *d = (Data *)inst->data;
     if (d->reset_bug == 1) {
         M_ERROR(inst, "reset_bug = 1: fmi2Reset fails on purpose");
+        return fmi2Error;
+    }
+    if (d->reset_bug == 3 && d->gain < 1.5) {
+        M_ERROR(inst, "reset_bug = 3: fmi2Reset fails on purpose after a run with gain %g < 1.5",
+                d->gain);
         return fmi2Error;
     }
     return fmi2OK;
