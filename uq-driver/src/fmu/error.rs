@@ -417,4 +417,26 @@ mod tests {
         assert!(text.starts_with("/x/Model.fmu: fmi2DoStep returned Error for instance 'w0'"));
         assert!(text.contains("[Error] logStatusError: step size must be positive"));
     }
+
+    /// QA3 M-2: an FMU that logs only with loggingOn gave "the FMU logged nothing" and no way
+    /// out; the message names --fmu-logging unless logging was on.
+    #[test]
+    fn an_empty_log_names_fmu_logging_when_logging_was_off() {
+        let call = |logging_on| {
+            FmuError::Call {
+                path: PathBuf::from("/x/Model.fmu"),
+                instance: "w0".into(),
+                function: "fmi2DoStep",
+                status: Status::Fatal,
+                messages: Vec::new(),
+                logging_on,
+            }
+            .to_string()
+        };
+        let off = call(false);
+        assert!(off.contains("(the FMU logged nothing; "), "{off}");
+        assert!(off.contains("run again with --fmu-logging)"), "{off}");
+        let on = call(true);
+        assert!(on.ends_with("(the FMU logged nothing)"), "{on}");
+    }
 }
