@@ -357,33 +357,39 @@ impl Worker {
     }
 
     /// The second half of the reset self-check: the point just run, again after `fmi2Reset`.
-    /// Returns the verdict and whether the worker lives on.
-    pub fn check_reset(&mut self, values: &[f64], timeout: Option<Duration>) -> (ResetCheck, bool) {
+    /// Returns the verdict and whether the worker lives on, or the message of a worker stopped
+    /// from outside (the driver is being stopped).
+    pub fn check_reset(
+        &mut self,
+        values: &[f64],
+        timeout: Option<Duration>,
+    ) -> Result<(ResetCheck, bool), String> {
         let doing = "running the point again after fmi2Reset (the reset self-check)";
-        match self.request(b'C', &f64s_to_bytes(values), timeout, doing) {
-            Ok((b'V', v)) if !v.is_empty() => {
-                let why = String::from_utf8_lossy(&v[1..]).into_owned();
-                match v[0] {
-                    0 => (ResetCheck::Passed, true),
-                    1 => (ResetCheck::Failed(why), true),
-                    _ => (ResetCheck::Failed(why), false),
+        Ok(
+            match self.request(b'C', &f64s_to_bytes(values), timeout, doing) {
+                Ok((b'V', v)) if !v.is_empty() => {
+                    let why = String::from_utf8_lossy(&v[1..]).into_owned();
+                    match v[0] {
+                        0 => (ResetCheck::Passed, true),
+                        1 => (ResetCheck::Failed(why), true),
+                        _ => (ResetCheck::Failed(why), false),
+                    }
                 }
-            }
-            Ok((tag, _)) => {
-                let WorkerFailure::Died(m) = self.protocol_error(tag) else {
-                    unreachable!("protocol errors are deaths")
-                };
-                (ResetCheck::Failed(m), false)
-            }
-            Err(
-                WorkerFailure::Point(m) | WorkerFailure::Died(m) | WorkerFailure::Interrupted(m),
-            ) => (
-                ResetCheck::Failed(format!(
+                Ok((tag, _)) => {
+                    let WorkerFailure::Died(m) = self.protocol_error(tag) else {
+                        unreachable!("protocol errors are deaths")
+                    };
+                    (ResetCheck::Failed(m), false)
+                }
+                Err(WorkerFailure::Interrupted(m)) => return Err(m),
+                Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => (
+                    ResetCheck::Failed(format!(
                     "the FMU's run after fmi2Reset failed where a fresh instance's succeeded: {m}"
                 )),
-                false,
-            ),
-        }
+                    false,
+                ),
+            },
+        )
     }
 
     fn protocol_error(&mut self, tag: u8) -> WorkerFailure {
@@ -620,16 +626,17 @@ impl WorkerPool {
     }
 
     /// The reset self-check's second run, of the point `values` the pool has just run (alone)
-    /// successfully, in the worker that ran it.
-    pub fn check_reset(&self, values: &[f64]) -> ResetCheck {
+    /// successfully, in the worker that ran it; `Err` when the worker was stopped from outside
+    /// (the driver is being stopped).
+    pub fn check_reset(&self, values: &[f64]) -> Result<ResetCheck, String> {
         let Some(mut worker) = self.take_idle() else {
-            return ResetCheck::NotRun;
+            return Ok(ResetCheck::NotRun);
         };
-        let (check, lives) = worker.check_reset(values, self.opts.timeout);
+        let (check, lives) = worker.check_reset(values, self.opts.timeout)?;
         if lives {
             self.give_back(worker);
         }
-        check
+        Ok(check)
     }
 
     /// Why a worker's `fmi2Reset` failed (its point then ran on a fresh instance), once.

@@ -637,7 +637,14 @@ impl Batch<'_> {
             let _running = running();
             workers.check_reset(values)
         };
-        (from_worker(i, first), check)
+        match check {
+            Ok(check) => (from_worker(i, first), check),
+            // Stopped from outside: the study stops, a re-run computes the point.
+            Err(why) => (
+                Err(RunError::Interrupted { point: i, why }),
+                ResetCheck::NotRun,
+            ),
+        }
     }
 }
 
