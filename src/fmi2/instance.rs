@@ -364,7 +364,19 @@ impl Instance {
                 )));
             }
         }
-        self.model.do_step(current, h)?;
+        match self.model.do_step(current, h) {
+            Ok(()) => {}
+            Err(e @ ModelError::EndOfSimulation { .. }) => {
+                // fmi2Discard with fmi2Terminated: the time stays at `current`, where the
+                // outputs are valid; only status queries, getters, reset, terminate and free
+                // are allowed now (FMI 2.0 slaveStepFailed).
+                self.state = State::StepFailed;
+                return Err(Failure::discard(format!(
+                    "{e}; fmi2Terminated is true, fmi2LastSuccessfulTime = {current}"
+                )));
+            }
+            Err(e) => return Err(e.into()),
+        }
         self.time = current + h;
         Ok(FMI2_OK)
     }

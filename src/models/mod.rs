@@ -265,6 +265,16 @@ pub enum ModelError {
     /// A serialized state could not be read.
     #[error("corrupt model state: {0}")]
     CorruptState(String),
+    /// The model cannot take the step and the simulation ends at its current time (fmi2DoStep
+    /// returns fmi2Discard, fmi2Terminated becomes true, fmi2LastSuccessfulTime stays the
+    /// current time; the outputs there stay valid).
+    #[error("the simulation ends at t = {time} s: {reason}")]
+    EndOfSimulation {
+        /// The last time reached (s).
+        time: f64,
+        /// Why the model cannot go on.
+        reason: String,
+    },
     /// Any other failure (file not found, bad resource, …).
     #[error("{0}")]
     Other(String),

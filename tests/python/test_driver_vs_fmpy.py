@@ -60,3 +60,25 @@ def test_vehicle_track_trajectory_matches_fmpy(tmp_path):
         assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * scale, name
     # The dip makes an impact: the leading wheel's force rises well above the static load.
     assert np.max(ref["P1"]) > 1.2 * 69.0e3
+
+
+def test_bogie_run_past_the_speed_limit_ends_early_and_both_keep_the_rows(tmp_path):
+    # V0 = 10 m/s, ramp 1 s2/m: V = 10 - t reaches the 1 m/s limit at t = 9 s. The FMU ends the
+    # simulation there (fmi2Discard, fmi2Terminated true, last successful time 8.9 s) instead of
+    # returning fmi2Error: fmpy keeps the result up to 8.9 s (before, it raised and kept
+    # nothing), and uq-driver's simulate writes the same rows.
+    bogie = fmu_path("Bogie")
+    values = {"V0": 10.0, "ramp": 1.0}
+    outputs = ("Y", "V")
+    ours = driver_simulate(bogie, values, 12.0, 0.1, tmp_path, outputs)
+    ref = simulate_fmu(bogie, start_values=values, output_interval=0.1, stop_time=12.0,
+                       output=list(outputs))
+    assert abs(ref["time"][-1] - 8.9) < 1e-9, ref["time"][-1]
+    # fmpy records the last successful time once more after the discarded step.
+    if ref["time"][-1] == ref["time"][-2]:
+        ref = ref[:-1]
+    assert len(ours) == len(ref) == 90
+    assert np.max(np.abs(ours["time"] - ref["time"])) < 1e-12
+    for name in outputs:
+        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12, name
+    assert abs(ref["V"][-1] - 1.1) < 1e-9

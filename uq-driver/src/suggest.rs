@@ -36,6 +36,9 @@ pub fn closest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
 /// expected ones: ``unknown field `nodse`, expected `nodes` or `order` `` gives
 /// ``did you mean `nodes`?``. `None` when the message is not of that form or nothing is close.
 pub fn for_serde_message(message: &str) -> Option<String> {
+    if let Some(hint) = missing_table(message) {
+        return Some(hint.to_owned());
+    }
     let rest = message
         .strip_prefix("unknown field `")
         .or_else(|| message.strip_prefix("unknown variant `"))
@@ -54,6 +57,19 @@ pub fn for_serde_message(message: &str) -> Option<String> {
     closest(wrong, names.iter().copied()).map(|c| format!("did you mean `{c}`?"))
 }
 
+/// What to write for a top-level table a study file lacks.
+fn missing_table(message: &str) -> Option<&'static str> {
+    let field = message.split_once("missing field `")?.1.split('`').next()?;
+    Some(match field {
+        "experiment" => {
+            "add the time grid: [experiment] with start, stop and step (s), e.g. \
+             `[experiment]` `stop = 5.0` `step = 0.01` (start defaults to 0)"
+        }
+        "method" => "add [method] with its kind, e.g. `[method]` `kind = \"lhs\"` `samples = 100`",
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -67,6 +83,19 @@ mod tests {
         assert_eq!(closest("vehicle", builtins), None);
         assert_eq!(closest("wheel-scm", builtins), None, "not a typo");
         assert_eq!(closest("Kzp", ["Kpz", "Cpz", "Ksz"]), Some("Kpz"));
+    }
+
+    #[test]
+    fn a_missing_experiment_or_method_table_says_what_to_write() {
+        let hint = for_serde_message("missing field `experiment`").unwrap();
+        assert!(
+            hint.contains("[experiment]") && hint.contains("step"),
+            "{hint}"
+        );
+        assert!(for_serde_message("missing field `method`")
+            .unwrap()
+            .contains("kind"));
+        assert_eq!(for_serde_message("missing field `name`"), None);
     }
 
     #[test]

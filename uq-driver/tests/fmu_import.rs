@@ -742,3 +742,69 @@ fn symlink_entry_is_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
+    // QA round 3, L-1: an FMU declaring canHandleVariableCommunicationStepSize="false" was sent
+    // a shorter last step (stop - start not a whole number of steps) without a word; fmpy ends
+    // such a run at the last whole step instead. Now `simulate` and `run` refuse, naming the
+    // stop times that fit; a whole number of steps runs as before.
+    let Some(bins) = binaries() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let xml = model_description().replace(
+        "canHandleVariableCommunicationStepSize=\"true\"",
+        "canHandleVariableCommunicationStepSize=\"false\"",
+    );
+    let fmu = write_fmu(dir.path(), "Fixed.fmu", &xml, Some(&bins.full));
+    let driver = env!("CARGO_BIN_EXE_uq-driver");
+    let simulate = |stop: &str| {
+        Command::new(driver)
+            .args([
+                "simulate",
+                fmu.to_str().unwrap(),
+                "--stop",
+                stop,
+                "--step",
+                "0.1",
+            ])
+            .output()
+            .unwrap()
+    };
+    let o = simulate("1.05");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("canHandleVariableCommunicationStepSize"),
+        "{err}"
+    );
+    assert!(err.contains("give a stop time of 1 or 1.1 s"), "{err}");
+    assert!(simulate("1.0").status.success());
+    let study = dir.path().join("s.toml");
+    fs::write(
+        &study,
+        format!(
+            "name = \"fixed\"\nfmu = {:?}\n[experiment]\nstop = 1.05\nstep = 0.1\n\
+             [method]\nkind = \"mc\"\nsamples = 4\n\
+             [[parameters]]\nname = \"k\"\ndistribution = \"uniform\"\nlow = 1.0\nhigh = 2.0\n\
+             [outputs]\nvariables = [\"x\"]\n",
+            fmu.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(driver)
+        .args([
+            "run",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("canHandleVariableCommunicationStepSize"),
+        "{err}"
+    );
+}

@@ -5,6 +5,9 @@
 #[path = "support/wheel.rs"]
 mod wheel;
 
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+
 use std::os::unix::fs::symlink;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -202,4 +205,59 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
     assert!(!t.contains("index.html: "), "{t}");
     assert!(!t.contains("report: "), "{t}");
     assert!(t.contains("--no-report"), "{t}");
+}
+
+#[test]
+fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
+    // QA round 3, L-2: a study that stopped at its first failure, or had too few successful
+    // runs to analyse, left only store/: the per-point messages could not be read. Now
+    // points.csv is written with every point's status (the Features FMU fails its step at
+    // t = misbehave_at with mode 1, an fmi2Error).
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for (name, extra, failures) in [
+        ("stopped", "", "stopped at the first failure"),
+        (
+            "none-ok",
+            "[analysis]\nallow_failures = true\n",
+            "successful runs",
+        ),
+    ] {
+        let low = if name == "none-ok" { 0.1 } else { 0.3 };
+        let study = dir.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &study,
+            format!(
+                "name = \"{name}\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+                 [method]\nkind = \"mc\"\nsamples = 8\n\
+                 [[parameters]]\nname = \"misbehave_at\"\ndistribution = \"uniform\"\n\
+                 low = {low}\nhigh = {}\n\
+                 [fixed]\nmisbehave = 1\nread_file = \"\"\n\
+                 [outputs]\nvariables = [\"u_integral\"]\n{extra}",
+                fmu.to_str().unwrap(),
+                if name == "none-ok" { 0.9 } else { 1.8 },
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join(name);
+        let o = run(&[
+            "run",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "-t",
+            "1",
+        ]);
+        let all = text(&o);
+        assert!(!o.status.success(), "{all}");
+        assert!(all.contains(failures), "{all}");
+        let points = std::fs::read_to_string(out.join("points.csv")).unwrap_or_default();
+        assert!(
+            points.starts_with("index,misbehave_at,status"),
+            "{name}: {all}"
+        );
+        assert!(points.contains("fails on purpose"), "{name}: {points}");
+    }
 }

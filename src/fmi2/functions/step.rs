@@ -178,7 +178,9 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
     })
 }
 
-/// fmi2GetBooleanStatus: fmi2Terminated is always false (the slave never asks to stop).
+/// fmi2GetBooleanStatus: fmi2Terminated is true after fmi2Terminate, and after a step the model
+/// could not take (fmi2Discard: the simulation ends at the current time, e.g. the bogie's speed
+/// ramp reaching 1 m/s).
 ///
 /// # Safety
 /// FMI 2.0 contract: `c` from fmi2Instantiate; `value` writable.
@@ -190,7 +192,10 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
 ) -> Fmi2Status {
     status_query(c, "fmi2GetBooleanStatus", value, |inst| {
         if kind == FMI2_TERMINATED {
-            Ok(Fmi2Boolean::from(inst.state == State::Terminated))
+            Ok(Fmi2Boolean::from(matches!(
+                inst.state,
+                State::Terminated | State::StepFailed
+            )))
         } else {
             Err(no_such_status(kind))
         }

@@ -134,7 +134,7 @@ impl Bogie {
         } else {
             String::new()
         };
-        ModelError::SolverFailure {
+        ModelError::EndOfSimulation {
             time: t,
             reason: format!(
                 "running speed V = {v} m/s is at or below {MIN_SPEED} m/s (the creepages divide by V){limit}"

@@ -83,6 +83,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     };
     size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
+    uq_driver::study::interface::check_step_sizes(&fmu, &times)?;
     let params: Vec<(String, FixedValue)> = a
         .set
         .into_iter()
@@ -164,6 +165,13 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
         cs.can_serialize_fmu_state,
         cs.provides_directional_derivative
     )?;
+    if cs.needs_execution_tool {
+        writeln!(
+            o,
+            "  needs its execution tool (needsExecutionTool=\"true\"): the exporting tool or \
+             runtime must be installed where it runs"
+        )?;
+    }
     if let Some(de) = &md.default_experiment {
         let plain = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |x| x.to_string());
         writeln!(
@@ -190,7 +198,10 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
     )?;
     for v in &md.variables {
         let (start, unit) = match &v.kind {
-            VariableKind::Real { start, unit, .. } => (start.map(|s| s.to_string()), unit.clone()),
+            VariableKind::Real { start, .. } => (
+                start.map(|s| s.to_string()),
+                uq_driver::report::units::unit_of(md, &v.name),
+            ),
             VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
                 (start.map(|s| s.to_string()), None)
             }

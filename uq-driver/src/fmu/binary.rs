@@ -162,6 +162,23 @@ macro_rules! resolve {
     }};
 }
 
+/// The dynamic loader's `reason`, with a hint where it names a symbol of the Python runtime:
+/// FMUs with embedded Python (e.g. made with pythonfmu) may expect the host to provide it.
+fn with_load_hint(reason: String) -> String {
+    let python = reason
+        .split_once("undefined symbol: ")
+        .is_some_and(|(_, symbol)| symbol.starts_with("_Py") || symbol.starts_with("Py"));
+    if !python {
+        return reason;
+    }
+    format!(
+        "{reason} (the FMU's library needs the Python runtime, which it does not link itself: an \
+         FMU with embedded Python, e.g. made with pythonfmu. Start uq-driver with the libpython it \
+         was built for preloaded, e.g. LD_PRELOAD=/usr/lib/x86_64-linux-gnu/libpython3.11.so.1.0, \
+         and PYTHONHOME/PYTHONPATH pointing at that Python and the modules the FMU imports)"
+    )
+}
+
 impl FmuLibrary {
     /// Loads the shared library at `path`, resolves the FMI 2.0 Co-Simulation functions and
     /// checks that `fmi2GetVersion()` is `"2.0"` and `fmi2GetTypesPlatform()` is `"default"`.
@@ -174,7 +191,7 @@ impl FmuLibrary {
         }
         let library = open_library(path).map_err(|e| FmuError::Load {
             path: path.to_path_buf(),
-            reason: e.to_string(),
+            reason: with_load_hint(e.to_string()),
         })?;
         let api = Functions {
             get_types_platform: resolve!(library, path, "fmi2GetTypesPlatform"),
@@ -302,5 +319,18 @@ mod tests {
         let err = FmuLibrary::load(Path::new("/nonexistent/x.so")).unwrap_err();
         assert!(matches!(err, FmuError::Load { .. }), "{err}");
         assert!(err.to_string().starts_with("/nonexistent/x.so: "), "{err}");
+    }
+
+    #[test]
+    fn an_fmu_needing_the_python_runtime_gets_a_hint_to_preload_it() {
+        // QA round 3, I-1: a pythonfmu 0.7.0 FMU's library does not link libpython.
+        let reason = "/tmp/x/Osc.so: undefined symbol: _Py_NoneStruct".to_owned();
+        let hinted = with_load_hint(reason.clone());
+        assert!(
+            hinted.starts_with(&reason) && hinted.contains("LD_PRELOAD"),
+            "{hinted}"
+        );
+        let other = "/tmp/x/A.so: undefined symbol: cblas_dgemm".to_owned();
+        assert_eq!(with_load_hint(other.clone()), other);
     }
 }

@@ -201,6 +201,9 @@ pub struct ModelDescription {
     pub default_experiment: Option<DefaultExperiment>,
     /// `UnitDefinitions`.
     pub unit_definitions: Vec<Unit>,
+    /// The `unit` of each Real `SimpleType` of `TypeDefinitions` that has one: (type name,
+    /// unit). A Real variable with this `declaredType` and no `unit` of its own has this unit.
+    pub type_units: Vec<(String, String)>,
     /// `LogCategories`: (name, description).
     pub log_categories: Vec<(String, Option<String>)>,
     /// `ModelVariables`, in document order (index `i` is the variable `i + 1` of `ModelStructure`).

@@ -255,8 +255,9 @@ impl QoiSpec {
                 threshold,
                 ..
             } => format!(
-                "critical speed: the {speed} at which the largest |{signal}| over a sliding \
-                 {window} s window last exceeds {threshold}"
+                "critical speed (speed-ramp estimate, the paper's method): the {speed} at which \
+                 the largest |{signal}| over a sliding {window} s window last exceeds \
+                 {threshold}"
             ),
             QoiSpec::Sperling {
                 signal,

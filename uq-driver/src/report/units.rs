@@ -14,10 +14,21 @@ use crate::spec::Study;
 /// The unit of a dimensionless quantity (FMI writes no unit, or `"1"`).
 pub const DIMENSIONLESS: &str = "1";
 
-/// The declared unit of variable `name`, if it is a Real with a `unit` attribute.
+/// The declared unit of variable `name`, if it is a Real with a `unit` attribute, or with a
+/// `declaredType` whose `SimpleType` has one (the variable's own unit wins, as FMI 2.0 says).
 pub fn unit_of(md: &ModelDescription, name: &str) -> Option<String> {
     match &md.variable(name)?.kind {
-        VariableKind::Real { unit, .. } => unit.clone().filter(|u| !u.is_empty()),
+        VariableKind::Real {
+            unit,
+            declared_type,
+            ..
+        } => unit.clone().filter(|u| !u.is_empty()).or_else(|| {
+            let t = declared_type.as_deref()?;
+            md.type_units
+                .iter()
+                .find(|(name, _)| name == t)
+                .map(|(_, u)| u.clone())
+        }),
         _ => None,
     }
 }
@@ -159,5 +170,36 @@ mod tests {
         assert_eq!(per(None), None);
         assert_eq!(with_unit("64.9", Some("m/s")), "64.9 m/s");
         assert_eq!(with_unit("2.31", Some("1")), "2.31");
+    }
+
+    #[test]
+    fn units_given_through_a_declared_type_are_resolved() {
+        // QA round 3, L-3: Modelica tools give most units through TypeDefinitions (e.g. the
+        // Reference FMU BouncingBall's `v` with declaredType "Velocity"); they were not shown.
+        let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="M" guid="g">
+  <CoSimulation modelIdentifier="M"/>
+  <TypeDefinitions>
+    <SimpleType name="Mode"><Enumeration><Item name="a" value="1"/></Enumeration></SimpleType>
+    <SimpleType name="Velocity"><Real quantity="Velocity" unit="m/s"/></SimpleType>
+    <SimpleType name="Plain"><Real/></SimpleType>
+  </TypeDefinitions>
+  <ModelVariables>
+    <ScalarVariable name="v" valueReference="0" causality="output"><Real declaredType="Velocity"/></ScalarVariable>
+    <ScalarVariable name="w" valueReference="1" causality="output"><Real declaredType="Velocity" unit="km/h"/></ScalarVariable>
+    <ScalarVariable name="p" valueReference="2" causality="output"><Real declaredType="Plain"/></ScalarVariable>
+    <ScalarVariable name="x" valueReference="3" causality="output"><Real declaredType="Unknown"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1"/><Unknown index="2"/><Unknown index="3"/><Unknown index="4"/></Outputs></ModelStructure>
+</fmiModelDescription>"#;
+        let md = ModelDescription::parse(xml.as_bytes()).unwrap();
+        assert_eq!(unit_of(&md, "v").as_deref(), Some("m/s"));
+        assert_eq!(
+            unit_of(&md, "w").as_deref(),
+            Some("km/h"),
+            "its own unit wins"
+        );
+        assert_eq!(unit_of(&md, "p"), None);
+        assert_eq!(unit_of(&md, "x"), None);
     }
 }

@@ -238,7 +238,8 @@ pub struct StudyFile {
     pub experiment: Spanned<Experiment>,
     /// Method.
     pub method: Spanned<MethodSpec>,
-    /// Random parameters.
+    /// Random parameters (none is refused with its own message, not serde's).
+    #[serde(default)]
     pub parameters: Vec<Spanned<ParameterSpec>>,
     /// Correlations between random parameters (a Gaussian copula).
     #[serde(default)]

@@ -166,7 +166,12 @@ fn parameters(
     file: &StudyFile,
 ) -> Result<Vec<RandomParameter>, StudyError> {
     if specs.is_empty() {
-        return Err(cx.invalid(None, "no random [[parameters]]"));
+        return Err(cx.invalid(
+            None,
+            "no random [[parameters]]: a study needs at least one (a `nominal` study runs the \
+             FMU at their means); to run the FMU once at its start values, use `uq-driver \
+             simulate`",
+        ));
     }
     let mut out: Vec<RandomParameter> = Vec::new();
     for (span, p) in specs {

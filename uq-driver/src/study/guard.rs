@@ -158,13 +158,24 @@ fn describe(s: &State) -> String {
 }
 
 /// Ends the process on purpose: prints `message`, removes the temporary folders of opened
-/// FMUs and exits with `code` (the `atexit` handler stays quiet). The results store needs no
+/// FMUs, flushes the C streams and ends with `code` by `_exit`. The results store needs no
 /// closing: every record was written whole when its point finished.
+///
+/// Not `exit()`: another thread may still be inside an FMU (a run past `--timeout-per-run`,
+/// a study interrupted by Ctrl-C), and the exit handlers and library destructors that `exit()`
+/// runs can tear down a runtime under it (an embedded-Python FMU then ended the process with
+/// "FATAL: exception not rethrown" and SIGABRT, exit status 134, instead of the status meant).
 pub fn exit_now(code: i32, message: &str) -> ! {
     DELIBERATE.store(true, Ordering::Release);
     eprintln!("{message}");
     crate::fmu::cleanup::remove_all();
-    std::process::exit(code)
+    // SAFETY: fflush(NULL) flushes every C stream (what FMU code printed); `_exit` then ends
+    // the process with `code` without running exit handlers or destructors, which is the point.
+    // Rust's stdout is line-buffered: whole lines were written already.
+    unsafe {
+        libc::fflush(std::ptr::null_mut());
+        libc::_exit(code)
+    }
 }
 
 /// Installs the handler of SIGINT, SIGTERM and SIGHUP: it names a study in progress (its

@@ -19,6 +19,43 @@ use crate::fmu::{Fmu, FmuError, Instance, ScalarVariable, VariableKind};
 use crate::qoi::QoiSpec;
 use crate::spec::{FixedValue, Study};
 
+/// Why a fixed value does not fit an Integer: a fraction, or a whole number beyond 32 bits.
+fn not_whole_why(value: f64) -> &'static str {
+    if value.is_finite() && value.fract() == 0.0 {
+        "is outside the 32-bit range of an FMI Integer (-2147483648 to 2147483647)"
+    } else {
+        "is not a whole number"
+    }
+}
+
+/// Refuses a grid whose steps differ (a shorter last step) for an FMU that declares
+/// `canHandleVariableCommunicationStepSize="false"`: it would get a step it says it cannot take
+/// (fmpy ends such a run at the last whole step instead, leaving out the stop time).
+pub fn check_step_sizes(fmu: &Fmu, times: &[f64]) -> Result<(), InterfaceError> {
+    if fmu
+        .description()
+        .co_simulation
+        .can_handle_variable_communication_step_size
+        || times.len() < 3
+    {
+        return Ok(());
+    }
+    let (step, n) = (times[1] - times[0], times.len());
+    let last = times[n - 1] - times[n - 2];
+    if (last - step).abs() <= 1e-6 * step.abs() {
+        return Ok(());
+    }
+    Err(InterfaceError {
+        fmu: fmu.path().to_path_buf(),
+        problem: VariableProblem::FixedStepOnly {
+            step,
+            last,
+            whole: times[n - 2],
+            next: times[n - 2] + step,
+        },
+    })
+}
+
 /// A study variable that does not fit the FMU.
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {problem}", fmu.display())]
@@ -76,7 +113,7 @@ pub enum VariableProblem {
         variability: &'static str,
     },
     /// A fractional value for an Integer.
-    #[error("'{name}' is an {found}; {value} is not a whole number (32-bit)")]
+    #[error("'{name}' is an {found}; {value} {}", not_whole_why(*.value))]
     NotWhole {
         /// The variable.
         name: String,
@@ -102,6 +139,22 @@ pub enum VariableProblem {
         min: Option<i32>,
         /// Declared `max`.
         max: Option<i32>,
+    },
+    /// A grid with a shorter last step for an FMU that cannot vary its communication step.
+    #[error(
+        "the FMU declares canHandleVariableCommunicationStepSize=\"false\", but stop - start is \
+         not a whole number of steps of {step} s, so the last step would be {last} s: give a stop \
+         time of {whole} or {next} s"
+    )]
+    FixedStepOnly {
+        /// The step (s).
+        step: f64,
+        /// The shorter last step (s).
+        last: f64,
+        /// The last whole step's end (s).
+        whole: f64,
+        /// One step further (s).
+        next: f64,
     },
     /// A design value that is not a whole number for an Integer or Enumeration random
     /// parameter.
@@ -573,7 +626,7 @@ impl<'a> Variables<'a> {
                     let b = match v {
                         FixedValue::Bool(b) => *b,
                         FixedValue::Number(x) if *x == 0.0 || *x == 1.0 => *x == 1.0,
-                        FixedValue::Text(t) => match t.trim() {
+                        FixedValue::Text(t) => match t.trim().to_ascii_lowercase().as_str() {
                             "true" | "1" => true,
                             "false" | "0" => false,
                             _ => return Err(wrong("is not true/false (or 1/0)")),

@@ -87,6 +87,13 @@ pub fn range_warnings(study: &Study, fmu: &Fmu, design: &Design) -> Vec<String> 
 /// A warning when the value `value` given for variable `name` (e.g. `simulate --set`) is a
 /// number outside the range the FMU declares for it.
 pub fn value_warning(fmu: &Fmu, name: &str, value: &FixedValue) -> Option<String> {
+    // A fixed Integer outside its declared range is refused, not warned about (and not both).
+    if !matches!(
+        fmu.description().variable(name)?.kind,
+        VariableKind::Real { .. }
+    ) {
+        return None;
+    }
     let (min, max) = declared_range(fmu, name)?;
     let v = match value {
         FixedValue::Number(v) => *v,

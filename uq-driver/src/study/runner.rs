@@ -350,6 +350,7 @@ pub fn run_points(
     let iface = Interface::resolve(study, fmu)?;
     iface.check_design(fmu, &design.values)?;
     let times = study.times();
+    super::interface::check_step_sizes(fmu, &times)?;
     let policy = InstancePolicy {
         reuse: false,
         logging_on: opts.fmu_logging,

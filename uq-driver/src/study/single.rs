@@ -149,7 +149,8 @@ pub(crate) fn finish(
         entries,
         opts.allow_failures(study),
         opts.points.as_deref(),
-    )?;
+    )
+    .map_err(|e| with_points_csv(study, design, entries, out_dir, e.into()))?;
     if done < design.len() {
         return Err(StudyRunError::Incomplete {
             done,
@@ -157,7 +158,8 @@ pub(crate) fn finish(
         });
     }
     let started = Instant::now();
-    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.runs)?;
+    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.runs)
+        .map_err(|e| with_points_csv(study, design, entries, out_dir, e.into()))?;
     let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
@@ -376,6 +378,30 @@ fn write_surrogate(
 }
 
 /// The design with the status of each point.
+/// `error`, after writing `points.csv` (every point's status and message) when points failed:
+/// a study that stops on its failures, or has too few successful runs to analyse, still says
+/// what happened to each point (QA round 3, L-2: before, only the store held the messages).
+fn with_points_csv(
+    study: &Study,
+    design: &Design,
+    records: &[Option<Entry>],
+    out_dir: &Path,
+    error: StudyRunError,
+) -> StudyRunError {
+    if !records.iter().any(|r| matches!(r, Some(Entry::Failed(_)))) {
+        return error;
+    }
+    let path = out_dir.join("points.csv");
+    match report::study::write_points_csv(&path, &point_table(study, design, records)) {
+        Ok(()) => eprintln!(
+            "uq-driver: note: the status and message of every point: {}",
+            path.display()
+        ),
+        Err(e) => eprintln!("uq-driver: warning: {e}"),
+    }
+    error
+}
+
 fn point_table(study: &Study, design: &Design, records: &[Option<Entry>]) -> PointTable {
     PointTable {
         names: study.parameters.iter().map(|p| p.name.clone()).collect(),

@@ -80,6 +80,9 @@ pub(super) fn parse(xml: &[u8], limits: ParseLimits) -> Result<ModelDescription,
 enum Elem {
     Root,
     UnitDefinitions,
+    TypeDefinitions,
+    /// A `SimpleType` (its name kept in `Builder::simple_type`).
+    SimpleType,
     LogCategories,
     ModelVariables,
     ScalarVariable,
@@ -115,6 +118,8 @@ struct Builder {
     model_exchange_present: bool,
     default_experiment: Option<DefaultExperiment>,
     unit_definitions: Vec<Unit>,
+    type_units: Vec<(String, String)>,
+    simple_type: Option<String>,
     log_categories: Vec<(String, Option<String>)>,
     variables: Vec<ScalarVariable>,
     outputs: Vec<usize>,
@@ -274,6 +279,18 @@ impl Builder {
             (Some(Elem::UnitDefinitions), "Unit") => {
                 let name = attrs()?.required("name")?;
                 self.unit_definitions.push(Unit { name });
+                Elem::Other
+            }
+            (Some(Elem::Root), "TypeDefinitions") => Elem::TypeDefinitions,
+            (Some(Elem::TypeDefinitions), "SimpleType") => {
+                self.simple_type = attrs()?.string("name");
+                Elem::SimpleType
+            }
+            (Some(Elem::SimpleType), "Real") => {
+                let unit = attrs()?.string("unit").filter(|u| !u.is_empty());
+                if let (Some(name), Some(unit)) = (self.simple_type.take(), unit) {
+                    self.type_units.push((name, unit));
+                }
                 Elem::Other
             }
             (Some(Elem::Root), "LogCategories") => Elem::LogCategories,
@@ -449,6 +466,7 @@ impl Builder {
             model_exchange_present: self.model_exchange_present,
             default_experiment: self.default_experiment,
             unit_definitions: self.unit_definitions,
+            type_units: self.type_units,
             log_categories: self.log_categories,
             variables: self.variables,
             outputs: self.outputs,
