@@ -173,10 +173,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Inspect { fmu } => inspect(&fmu),
-        Command::Simulate(args) => {
-            uq_driver::study::runner::set_simulate_fmu_logging(args.fmu_logging);
-            simulate(args)
-        }
+        Command::Simulate(args) => simulate(args),
         Command::Surrogate(cmd) => surrogate(cmd),
         Command::Compare { dirs, out } => {
             uq_driver::report::compare::write(&dirs, &out)?;

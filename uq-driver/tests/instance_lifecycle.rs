@@ -190,6 +190,12 @@ fn a_reset_that_forgets_start_values_gives_the_numbers_of_fresh_instances() {
         );
         check_closed_form(&c.out(name));
         csvs.push(c.csv(name, "u_integral.csv"));
+        // Kept in summary.json too (printed once, during the run).
+        let summary = c.csv(name, "summary.json");
+        assert!(
+            summary.contains("differ from a fresh instance"),
+            "{summary}"
+        );
     }
     assert!(csvs.iter().all(|s| *s == csvs[0]));
 }

@@ -3,7 +3,6 @@
 //! run ends there.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::inputs::isclose;
 use super::instances::{first_difference, same_record, InstancePolicy, ResetCheck, Slot};
@@ -304,16 +303,6 @@ pub fn check_reset(
     (check, fatal)
 }
 
-/// `simulate --fmu-logging`, for [`simulate`] (set by the command line; [`simulate_with`]
-/// takes it as an argument).
-static SIMULATE_FMU_LOGGING: AtomicBool = AtomicBool::new(false);
-
-/// Sets whether [`simulate`] instantiates with `loggingOn = true` (its messages then echoed to
-/// stderr as they come).
-pub fn set_simulate_fmu_logging(on: bool) {
-    SIMULATE_FMU_LOGGING.store(on, Ordering::Relaxed);
-}
-
 /// One deterministic run: its times and, per recorded variable, the series.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
@@ -340,8 +329,7 @@ pub fn simulate(
     inputs: Option<&Path>,
     times: &[f64],
 ) -> Result<Simulation, RunError> {
-    let logging_on = SIMULATE_FMU_LOGGING.load(Ordering::Relaxed);
-    simulate_with(fmu, params, outputs, inputs, times, logging_on)
+    simulate_with(fmu, params, outputs, inputs, times, false)
 }
 
 /// [`simulate`], instantiating with `loggingOn = logging_on` (the FMU's messages then echoed

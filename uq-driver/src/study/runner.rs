@@ -14,9 +14,7 @@ use super::instances::{self, InstancePolicy, ResetCheck, Slot};
 use super::interface::{Interface, InterfaceError};
 use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
 use super::lock::{FolderLock, LockError};
-pub use super::point::{
-    run_point, set_simulate_fmu_logging, simulate, simulate_with, PointError, Simulation, Trace,
-};
+pub use super::point::{run_point, simulate, simulate_with, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
 use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
 use super::worker_fmu::WorkerFmus;
