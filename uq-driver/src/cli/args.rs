@@ -203,6 +203,27 @@ pub(crate) struct SafetyArgs {
 }
 
 impl SafetyArgs {
+    /// The same options as `run-shard` arguments (for the Slurm array job).
+    pub(crate) fn as_args(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        if self.isolate {
+            v.push("--isolate".to_owned());
+        }
+        if let Some(t) = self.timeout_per_run {
+            v.push(format!("--timeout-per-run={}", t.as_secs_f64()));
+        }
+        for (on, flag) in [
+            (self.retry_failed, "--retry-failed"),
+            (self.fresh_instances, "--fresh-instances"),
+            (self.fmu_logging, "--fmu-logging"),
+        ] {
+            if on {
+                v.push(flag.to_owned());
+            }
+        }
+        v
+    }
+
     /// Fills the runner options.
     pub(crate) fn apply(&self, opts: &mut RunOptions) -> Result<()> {
         opts.retry_failed = self.retry_failed;
@@ -258,6 +279,9 @@ pub(crate) struct SlurmArgs {
     /// The merge job writes the CSV files and summary.json only: no plots, no index.html.
     #[arg(long)]
     pub(crate) no_report: bool,
+    /// How each shard runs its points (passed on to `run-shard`).
+    #[command(flatten)]
+    pub(crate) safety: SafetyArgs,
 }
 
 #[derive(Args)]
