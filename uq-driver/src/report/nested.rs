@@ -11,6 +11,7 @@
 //! - for a suite of nested variants, `variance_split.csv`: one row per variant and quantity.
 
 use crate::report::file_name::stem;
+use crate::results::numbers::to_spread;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -72,9 +73,16 @@ pub fn write(
     Ok(sections)
 }
 
-/// `a [lo, hi]` with 4 significant digits.
+/// `a [lo, hi]`, each to the resolution the interval allows (rounded at the second
+/// significant digit of its half-width: `115 131 [115 090, 115 170]`, `0.0123 [0.0100, 0.0150]`).
 fn with_ci(x: f64, ci: [f64; 2]) -> String {
-    format!("{x:.4} [{:.4}, {:.4}]", ci[0], ci[1])
+    let half = (ci[1] - ci[0]).abs() / 2.0;
+    format!(
+        "{} [{}, {}]",
+        to_spread(x, half),
+        to_spread(ci[0], half),
+        to_spread(ci[1], half)
+    )
 }
 
 fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> Section {
@@ -473,4 +481,19 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
             rows,
         }),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_ci;
+
+    #[test]
+    fn intervals_read_to_their_own_resolution() {
+        // QA round 3, M8: four fixed decimals whatever the size ("115131.0736 [...]").
+        assert_eq!(
+            with_ci(115131.0736, [115090.2, 115170.9]),
+            "115\u{202f}131 [115\u{202f}090, 115\u{202f}171]"
+        );
+        assert_eq!(with_ci(0.0123, [0.01, 0.015]), "0.0123 [0.0100, 0.0150]");
+    }
 }
