@@ -451,9 +451,7 @@ fn quantity_section(
              spread, no density and no probability.",
             num(q.mean)
         ));
-        for e in &q.exceedance_counts {
-            text.push_str(&format!("\n\n{}", against_limit(q, e.limit)));
-        }
+        // Each limit: a row of the table below.
     } else if q.deterministic {
         let why = if q.n_valid < 2 {
             format!("there is {}", count(q.n_valid, "run", "runs"))
