@@ -698,3 +698,17 @@ pub fn system_section(sys: &SystemSpec) -> Section {
         }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warnings_on_the_page_have_no_markdown_backticks() {
+        // QA round 3, L5: "raise `order` (below `nodes`)" was shown with its backticks.
+        assert_eq!(
+            plain_quotes("raise `order` (below `nodes`) or `nodes`"),
+            "raise ‘order’ (below ‘nodes’) or ‘nodes’"
+        );
+    }
+}
