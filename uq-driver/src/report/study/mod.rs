@@ -4,6 +4,7 @@
 
 mod files;
 mod plots;
+mod system;
 
 use crate::report::file_name::stem;
 use std::path::Path;
@@ -15,12 +16,12 @@ use super::inputs;
 use super::units::with_unit;
 use super::{write_bytes, ReportError, ReportPage, Section, Table};
 use crate::qoi::QoiSpec;
-use crate::results::numbers::{as_written, count, to_spread, written};
+use crate::results::numbers::{count, to_spread};
 use crate::results::{self, group_digits, sig, OutputStats, PointTable, ScalarStats, Summary};
-use crate::uq::galerkin::system::{Coefficient, SystemSpec};
 use crate::uq::method::{ChaosErrorKind, Draws};
 
 pub use files::points_csv as write_points_csv;
+pub use system::system_section;
 
 /// Everything a study's report shows.
 #[derive(Clone, Copy, Debug)]
@@ -640,63 +641,6 @@ fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
         }
     }
     rows
-}
-
-/// The section that shows the system an intrusive method (SGM) solved, from `[system]` of the
-/// study file: `M q̈ + C q̇ + K q = f` with its constant parts and how each random parameter
-/// enters.
-pub fn system_section(sys: &SystemSpec) -> Section {
-    let vector = |v: &[f64]| format!("[{}]", as_written(v).join(", "));
-    let matrix = |m: &[Vec<f64>]| {
-        let rows: Vec<String> = m.iter().map(|r| vector(r)).collect();
-        format!("[{}]", rows.join(", "))
-    };
-    let n = sys.dofs.len();
-    let or_zeros = |v: &[f64]| {
-        if v.is_empty() {
-            vector(&vec![0.0; n])
-        } else {
-            vector(v)
-        }
-    };
-    let mut rows = vec![
-        vec!["degrees of freedom q".to_string(), sys.dofs.join(", ")],
-        vec!["M (constant part)".into(), matrix(&sys.m)],
-        vec!["C (constant part)".into(), matrix(&sys.c)],
-        vec!["K (constant part)".into(), matrix(&sys.k)],
-        vec!["q0 (constant part)".into(), or_zeros(&sys.q0)],
-        vec!["v0 (constant part)".into(), or_zeros(&sys.v0)],
-        vec!["f (constant load)".into(), or_zeros(&sys.force)],
-    ];
-    for d in &sys.dependence {
-        let part = serde_json::to_value(d.matrix)
-            .ok()
-            .and_then(|v| v.as_str().map(str::to_owned))
-            .unwrap_or_default();
-        let coefficient = match &d.d {
-            Coefficient::Matrix(m) => matrix(m),
-            Coefficient::Vector(v) => vector(v),
-        };
-        rows.push(vec![
-            format!("{part} depends on {}", d.parameter),
-            format!("{part} += {} · {coefficient}", d.parameter),
-        ]);
-    }
-    Section {
-        heading: "System".into(),
-        text: format!(
-            "The system the stochastic Galerkin method solved ([system] of the study file): \
-             M q̈ + C q̇ + K q = f, q(0) = q0, q̇(0) = v0, each of M, C, K, q0, v0 its \
-             constant part plus each random parameter times its coefficient (below). \
-             Integrated by RK4 with steps of at most {} s. No unit is declared.",
-            written(sys.step)
-        ),
-        images: vec![],
-        table: Some(Table {
-            header: vec!["part".into(), "value".into()],
-            rows,
-        }),
-    }
 }
 
 #[cfg(test)]
