@@ -540,3 +540,32 @@ fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_diff
     assert!(!suite.contains("0.000e0"), "{suite}");
     assert!(suite.contains("(reference)"), "{suite}");
 }
+
+#[test]
+fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
+    // QA round 3, M2: the SGM page said "1 model runs … on 1 threads" and "Units are those the
+    // FMU declares" (there is no FMU), and its description promised a system "given below"
+    // that the page did not show.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sgm");
+    let stdout = run_ok(&["run", "builtin:wheel-sgm", "--out", out.to_str().unwrap()]);
+    assert!(
+        stdout.contains("the Galerkin system solved once"),
+        "{stdout}"
+    );
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    for wrong in [
+        "1 model runs",
+        "1 threads",
+        "Units are those the FMU declares",
+    ] {
+        assert!(!html.contains(wrong), "{wrong}:\n{html}");
+    }
+    assert!(html.contains("No model runs"), "{html}");
+    assert!(html.contains("declares no unit"), "{html}");
+    assert!(
+        html.contains("<td>M (constant part)</td><td>[[10]]</td>"),
+        "{html}"
+    );
+    assert!(html.contains("K += K · [[1]]"), "{html}");
+}
