@@ -88,14 +88,15 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
                 files::convergence_csv(dir, &q.name, c)?;
             }
             r.plots
-                .then(|| quantity_section(dir, q, &r.summary.study, &names))
+                .then(|| quantity_section(dir, q, r.summary, &names))
                 .transpose()
         })
         .collect::<Result<_, _>>()?;
     let mut sections: Vec<Section> = outputs.into_iter().chain(quantities).flatten().collect();
     if r.plots {
         for spec in r.qoi {
-            if let Some(file) = plots::speed_plot(dir, spec, r.outputs, &r.summary.study)? {
+            let file = plots::speed_plot(dir, spec, r.outputs, r.quantities, &r.summary.study)?;
+            if let Some(file) = file {
                 let heading = format!("Quantity {}", spec.name());
                 if let Some(sec) = sections.iter_mut().find(|s| s.heading == heading) {
                     sec.images.insert(0, file);
@@ -201,6 +202,9 @@ fn output_section(
     let v = &s.name;
     plots::band(dir, s, summary)?;
     let mut images = vec![format!("{}_band.svg", stem(v))];
+    if plots::std_plot(dir, s)? {
+        images.push(format!("{}_std.svg", stem(v)));
+    }
     let mut text = if s.deterministic {
         format!(
             "{v} has the same value in every run at every time: it is deterministic in this \
@@ -286,9 +290,10 @@ fn convergence_axis(c: &results::Convergence) -> &'static str {
 fn quantity_section(
     dir: &Path,
     q: &ScalarStats,
-    study: &str,
+    summary: &Summary,
     names: &[&str],
 ) -> Result<Section, ReportError> {
+    let study = &summary.study;
     let name = &q.name;
     let unit = q.unit.as_deref();
     let num = |v: f64| with_unit(&format!("{v:.6}"), unit);
@@ -312,7 +317,7 @@ fn quantity_section(
             "\n\nDistribution of {name} ({}).",
             q.draws.describe()
         ));
-        if plots::sobol_bars(dir, q, names, None)? {
+        if plots::sobol_bars(dir, q, names, &summary.method)? {
             images.push(format!("{}_sobol.svg", stem(name)));
         }
         if let Some(c) = &q.convergence {

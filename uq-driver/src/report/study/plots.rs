@@ -6,16 +6,16 @@
 use crate::report::file_name::stem;
 use std::path::Path;
 
-use super::super::svg::{BarChart, BarGroup};
-use super::super::units::{label, per, DIMENSIONLESS};
+use super::super::svg::{finite_range, BarChart, BarGroup};
+use super::super::units::{label, per, with_unit, DIMENSIONLESS};
 use super::super::{
     histogram_density, palette, write_bytes, Band, DensityPlot, Heatmap, LinePlot, ReportError,
     Series,
 };
-use super::files::column;
 use super::quantile_column;
 use crate::qoi::QoiSpec;
-use crate::results::{Convergence, OutputStats, ScalarStats, Summary};
+use crate::results::{sig, Convergence, OutputStats, ScalarStats, Summary};
+use crate::uq::method::MethodSummary;
 use crate::uq::method::Sobol;
 
 /// `<V>_band.svg`: mean ± 3σ and the quantiles other than the median (only the value, for
@@ -37,21 +37,148 @@ pub(super) fn band(dir: &Path, s: &OutputStats, summary: &Summary) -> Result<(),
         ));
     } else {
         push_band(&mut plot, &s.times, s, "mean".into());
+        // Over a long or fast series dashes break up into noise: thin solid lines there.
+        let long = s.times.len() > LONG_SERIES;
         for (i, (p, q)) in s.quantiles.iter().enumerate() {
             if *p != 0.5 {
-                plot.series.push(
-                    Series::new(
-                        format!("{} quantile", quantile_column(*p)),
-                        s.times.clone(),
-                        q.clone(),
-                        palette(i + 2),
-                    )
-                    .dashed(),
-                );
+                let line = Series::new(
+                    format!("{} quantile", quantile_column(*p)),
+                    s.times.clone(),
+                    q.clone(),
+                    palette(i + 2),
+                )
+                .thin(1.0, 0.9);
+                plot.series.push(if long { line } else { line.dashed() });
             }
         }
     }
     plot.write(&dir.join(format!("{}_band.svg", stem(v))))
+}
+
+/// More time points than this make a series "long": its quantile lines are drawn solid.
+const LONG_SERIES: usize = 1000;
+
+/// Below this multiple of the largest value, a Std or an error estimate is round-off: on a
+/// log axis such values (and zeros) are drawn at this level.
+const ROUND_OFF: f64 = 1e-13;
+/// Below this multiple of an output's largest magnitude, its Std is round-off.
+const VALUE_ROUND_OFF: f64 = 1e-12;
+
+/// `<V>_std.svg`: the Std over time, the Std of the chaos surrogate where the method gives
+/// one, and the chaos's truncation-error estimate (loo, order or level difference, a share
+/// of the variance ε) as the Std it stands for, √ε · Std, in the same unit. On a log axis
+/// when the curves span more than two decades, values below [`ROUND_OFF`] of the largest
+/// (round-off, and zeros) drawn at that level (a note in the legend says so). Not written
+/// for a deterministic output; returns whether it was written.
+pub(super) fn std_plot(dir: &Path, s: &OutputStats) -> Result<bool, ReportError> {
+    if s.deterministic || !s.std.iter().any(|d| *d > 0.0) {
+        return Ok(false);
+    }
+    let v = &s.name;
+    let unit = s.unit.as_deref();
+    // Where every run agrees (Std exactly 0, e.g. a fixed initial state) there is no spread
+    // to show: those times are left out of every curve, and the legend says so.
+    let agree = s.std.iter().filter(|d| **d == 0.0).count();
+    let std_label = if agree > 0 {
+        format!("Std of {v} (0 at {agree} times where every run agrees: not drawn)")
+    } else {
+        format!("Std of {v}")
+    };
+    let mut curves: Vec<(String, Vec<f64>, &str, bool)> =
+        vec![(std_label, s.std.clone(), palette(0), false)];
+    if let Some(sp) = &s.std_pce {
+        curves.push((
+            "Std of the chaos surrogate (std_pce)".into(),
+            sp.clone(),
+            palette(1),
+            true,
+        ));
+    }
+    if let Some(e) = &s.chaos_error {
+        let kind = e.kind.name();
+        let err = e
+            .values
+            .iter()
+            .zip(&s.std)
+            .map(|(eps, sd)| eps.max(0.0).sqrt() * sd)
+            .collect();
+        curves.push((
+            format!("truncation-error estimate √{kind} × Std ({kind}: a share of the variance)"),
+            err,
+            palette(3),
+            false,
+        ));
+    }
+    for c in &mut curves {
+        for (y, d) in c.1.iter_mut().zip(&s.std) {
+            if *d == 0.0 {
+                *y = f64::NAN;
+            }
+        }
+    }
+    let top = curves
+        .iter()
+        .flat_map(|c| c.1.iter().copied())
+        .filter(|x| x.is_finite())
+        .fold(0.0, f64::max);
+    let smallest = curves
+        .iter()
+        .flat_map(|c| c.1.iter().copied())
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    // Round-off: a Std below 1e-12 of the output's magnitude cannot be told from zero.
+    let magnitude = s
+        .mean
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(0.0, |m: f64, x| m.max(x.abs()));
+    let floor = (ROUND_OFF * top).max(VALUE_ROUND_OFF * magnitude);
+    let log = top / smallest.max(floor) > 100.0;
+    let mut plot = LinePlot::new(
+        format!("Std of {v} over time"),
+        "time [s]",
+        label(&format!("Std {v}"), unit),
+    );
+    plot.log_y = log;
+    let mut clipped = false;
+    for (name, y, color, dashed) in curves {
+        let y: Vec<f64> = if log {
+            y.iter()
+                .map(|&x| {
+                    if x.is_finite() && x < floor {
+                        clipped = true;
+                        floor
+                    } else {
+                        x
+                    }
+                })
+                .collect()
+        } else {
+            y
+        };
+        let line = Series::new(name, s.times.clone(), y, color);
+        plot.series.push(if dashed { line.dashed() } else { line });
+    }
+    if clipped {
+        plot.series.push(
+            Series::new(
+                "round-off level (1e-12 × |mean| or 1e-13 × the largest Std): smaller \
+                 values and zeros are drawn on it",
+                vec![s.times[0], s.times[s.times.len() - 1]],
+                vec![floor; 2],
+                "#999999",
+            )
+            .thin(1.0, 0.8)
+            .dashed(),
+        );
+    }
+    if log {
+        let lo = if clipped { floor } else { smallest.max(floor) };
+        plot.y_range = Some((lo / 2.0, top * 3.0));
+    }
+    plot.write(&dir.join(format!("{}_std.svg", stem(v))))?;
+    Ok(true)
 }
 
 /// Adds the mean ± 3σ band of `s` (unless its Std is zero throughout) and its mean, both
@@ -109,12 +236,10 @@ pub(super) fn pdf_heatmap(dir: &Path, s: &OutputStats) -> Result<bool, ReportErr
             .map(|c| c.iter().map(|x| if *x > cap { cap } else { *x }).collect())
             .collect(),
         colorbar_label: format!("PDF of {v}{density_unit}, clipped at its 99th percentile"),
-        overlay: vec![Series::new(
-            "mean",
-            s.times.clone(),
-            s.mean.clone(),
-            "#ffffff",
-        )],
+        // Thin and see-through: the density ridge under it stays visible.
+        overlay: vec![
+            Series::new("mean", s.times.clone(), s.mean.clone(), "#ffffff").thin(1.0, 0.6),
+        ],
         log_scale: false,
     };
     let png = heat.to_png().map_err(|source| ReportError::Png {
@@ -129,12 +254,14 @@ pub(super) fn pdf_heatmap(dir: &Path, s: &OutputStats) -> Result<bool, ReportErr
     Ok(true)
 }
 
-/// Relative Std below which Sobol' indices over time are undefined (no variance to share).
-const NO_VARIANCE: f64 = 1e-9;
+/// Share of the largest Std below which the Sobol' indices over time are not drawn: there is
+/// little variance to share, and its shares flicker with noise (a fast signal's quiet times).
+const LITTLE_VARIANCE: f64 = 0.05;
 
 /// `<V>_sobol.svg`: the first-order indices of every parameter stacked over time, and on top
 /// the share of the variance from interactions, 1 − ΣS (one area each; readable for any
-/// number of parameters). Where the Std vanishes the indices are undefined: left blank.
+/// number of parameters). Where the Std is below [`LITTLE_VARIANCE`] of its largest value
+/// the indices are not drawn: those times are greyed out (they are in the CSV).
 pub(super) fn sobol_over_time(
     dir: &Path,
     s: &OutputStats,
@@ -144,27 +271,33 @@ pub(super) fn sobol_over_time(
         return Ok(());
     };
     let v = &s.name;
-    let max_std = s.std.iter().copied().fold(0.0, f64::max);
-    let defined: Vec<bool> = s.std.iter().map(|d| *d > NO_VARIANCE * max_std).collect();
-    let mut plot = LinePlot::new(
-        format!("Sobol' indices of {v} over time (first order stacked, interactions on top)"),
-        "time [s]",
-        "share of the variance [-]",
-    );
+    let (times, var, shares) = windowed_shares(&s.times, &s.std, first, names.len());
+    let max_var = var.iter().copied().fold(0.0, f64::max);
+    let defined: Vec<bool> = var
+        .iter()
+        .map(|d| *d > LITTLE_VARIANCE * LITTLE_VARIANCE * max_var)
+        .collect();
+    let window = s.times.len().div_ceil(times.len().max(1));
+    let title = if window > 1 {
+        format!("Sobol' indices of {v} over time, in variance-weighted windows of {window} steps")
+    } else {
+        format!("Sobol' indices of {v} over time (first order stacked, interactions on top)")
+    };
+    let mut plot = LinePlot::new(title, "time [s]", "share of the variance [-]");
     plot.y_range = Some((0.0, 1.0));
-    let mut lower = vec![0.0; s.times.len()];
+    let mut lower = vec![0.0; times.len()];
     for (j, name) in names.iter().enumerate() {
-        let col = column(first, j);
+        let col = &shares[j];
         let upper: Vec<f64> = lower
             .iter()
-            .zip(&col)
+            .zip(col)
             .zip(&defined)
             .map(|((l, c), ok)| if *ok { l + c.max(0.0) } else { f64::NAN })
             .collect();
         plot.bands.push(
             Band::new(
                 format!("S {name}"),
-                s.times.clone(),
+                times.clone(),
                 lower.clone(),
                 upper.clone(),
                 palette(j),
@@ -179,15 +312,79 @@ pub(super) fn sobol_over_time(
         .collect();
     plot.bands.push(
         Band::new(
-            "interactions 1 − ΣS",
-            s.times.clone(),
+            "interactions 1 − ΣS (a negative estimate of S is drawn as 0)",
+            times.clone(),
             lower,
             top,
             "#bbbbbb",
         )
         .opacity(0.75),
     );
+    let grey: Vec<f64> = defined
+        .iter()
+        .map(|ok| if *ok { f64::NAN } else { 1.0 })
+        .collect();
+    if grey.iter().any(|g| g.is_finite()) {
+        plot.bands.push(
+            Band::new(
+                format!(
+                    "Std below {:.0} % of its largest: indices not drawn",
+                    LITTLE_VARIANCE * 100.0
+                ),
+                times.clone(),
+                vec![0.0; times.len()],
+                grey,
+                "#e0e0e0",
+            )
+            .opacity(0.9),
+        );
+    }
     plot.write(&dir.join(format!("{}_sobol.svg", stem(v))))
+}
+
+/// More time steps than this are drawn as windows ([`windowed_shares`]).
+const MAX_SHARE_STEPS: usize = 1000;
+/// The number of windows a long series' indices are drawn in.
+const SHARE_WINDOWS: usize = 150;
+
+/// The first-order indices over time, as drawn: at every time for a series of at most
+/// [`MAX_SHARE_STEPS`] steps, else over [`SHARE_WINDOWS`] windows of equal numbers of steps,
+/// each the variance-weighted mean of its steps' indices, S_i = Σ Var(t) S_i(t) / Σ Var(t)
+/// (the indices of the window's variance, as the indices of the whole series are; a fast
+/// signal's indices flicker from step to step). Returns the times (window centres), the
+/// variance (window mean) and `shares[parameter][time]`; NaN indices do not count.
+fn windowed_shares(
+    times: &[f64],
+    std: &[f64],
+    first: &[Vec<f64>],
+    parameters: usize,
+) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+    let nt = times.len().min(std.len()).min(first.len());
+    let width = if nt > MAX_SHARE_STEPS {
+        nt.div_ceil(SHARE_WINDOWS)
+    } else {
+        1
+    };
+    let (mut t, mut var) = (Vec::new(), Vec::new());
+    let mut shares = vec![Vec::new(); parameters];
+    for start in (0..nt).step_by(width) {
+        let end = (start + width).min(nt);
+        t.push(0.5 * (times[start] + times[end - 1]));
+        let v: Vec<f64> = std[start..end].iter().map(|s| s * s).collect();
+        var.push(v.iter().sum::<f64>() / v.len() as f64);
+        for (j, share) in shares.iter_mut().enumerate() {
+            let (mut num, mut den) = (0.0, 0.0);
+            for (k, w) in (start..end).zip(&v) {
+                let x = first[k].get(j).copied().unwrap_or(f64::NAN);
+                if x.is_finite() {
+                    num += w * x;
+                    den += w;
+                }
+            }
+            share.push(if den > 0.0 { num / den } else { f64::NAN });
+        }
+    }
+    (t, var, shares)
 }
 
 /// `<q>_pdf.svg`: the density, a histogram of the runs (more than 10) and the limits. The
@@ -236,16 +433,14 @@ pub(super) fn scalar_pdf(dir: &Path, q: &ScalarStats, study: &str) -> Result<(),
     .write(&dir.join(format!("{}_pdf.svg", stem(name))))
 }
 
-/// 95 % intervals of the first-order and the total indices, per parameter (where given).
-pub(super) type SobolIntervals<'a> = (&'a [Option<(f64, f64)>], &'a [Option<(f64, f64)>]);
-
-/// `<q>_sobol.svg`: first-order and total Sobol' indices per parameter as bars (with their
-/// intervals where the method gives them).
+/// `<q>_sobol.svg`: first-order and total Sobol' indices per parameter as bars, with a
+/// whisker for the interval of each where the method gives them (`first_ci`, `total_ci` of
+/// the quantity's summary), labelled from the method's summary ([`interval_label`]).
 pub(super) fn sobol_bars(
     dir: &Path,
     q: &ScalarStats,
     names: &[&str],
-    intervals: Option<SobolIntervals>,
+    method: &MethodSummary,
 ) -> Result<bool, ReportError> {
     let (Some(first), Some(total)) = (&q.sobol_first, &q.sobol_total) else {
         return Ok(false);
@@ -254,14 +449,52 @@ pub(super) fn sobol_bars(
         // No variance: the indices are undefined, there is nothing to draw.
         return Ok(false);
     }
-    let (fi, ti) = match intervals {
-        Some((f, t)) => (f.to_vec(), t.to_vec()),
-        None => (vec![None; first.len()], vec![None; total.len()]),
-    };
+    let of =
+        |ci: Option<&std::collections::BTreeMap<String, [f64; 2]>>| -> Vec<Option<(f64, f64)>> {
+            names
+                .iter()
+                .map(|n| ci.and_then(|m| m.get(*n)).map(|[lo, hi]| (*lo, *hi)))
+                .collect()
+        };
+    let summary = q.sobol.as_ref();
+    let fi = of(summary.and_then(|s| s.first_ci.as_ref()));
+    let ti = of(summary.and_then(|s| s.total_ci.as_ref()));
+    let level = summary.and_then(|s| s.ci_level);
     let title = format!("Sobol' indices of {}", q.name);
     let file = dir.join(format!("{}_sobol.svg", stem(&q.name)));
-    bars(&title, names, (first, fi), (total, ti), &file)?;
+    bars(
+        &title,
+        names,
+        (first, fi),
+        (total, ti),
+        &interval_label(method, level),
+        &file,
+    )?;
     Ok(true)
+}
+
+/// The legend text of the intervals of Sobol' indices, in the words of the method's summary:
+/// "95 % interval (8 replicates, Student t)", "95 % interval (percentile bootstrap, 500
+/// resamples)", or "95 % interval".
+pub(super) fn interval_label(method: &MethodSummary, level: Option<f64>) -> String {
+    let level = level.unwrap_or(0.95);
+    let head = format!("{} % interval", sig(100.0 * level));
+    let d = &method.details;
+    let words = d.get("intervals").and_then(|w| w.as_str()).unwrap_or("");
+    if let Some(r) = d.get("replicates").and_then(|r| r.as_u64()) {
+        if words.contains("Student") || words.starts_with("replicates") {
+            return format!("{head} ({r} replicates, Student t)");
+        }
+    }
+    if let Some(b) = d.get("bootstrap").and_then(|b| b.as_u64()) {
+        if words.contains("bootstrap") {
+            return format!("{head} (percentile bootstrap, {b} resamples)");
+        }
+    }
+    match words.split_once(':') {
+        Some((kind, _)) if !kind.is_empty() => format!("{head} ({kind})"),
+        _ => head,
+    }
 }
 
 /// `<V>_sobol_overall.svg`: the bar chart of the Sobol' indices of the whole series of an
@@ -276,7 +509,14 @@ pub(super) fn sobol_overall_bars(
     let title = format!("Sobol' indices of {output} over the whole series");
     let none = vec![None; first.len()];
     let file = dir.join(format!("{}_sobol_overall.svg", stem(output)));
-    bars(&title, names, (first, none.clone()), (total, none), &file)
+    bars(
+        &title,
+        names,
+        (first, none.clone()),
+        (total, none),
+        "",
+        &file,
+    )
 }
 
 /// Indices per parameter with their intervals (`None` where there are none).
@@ -288,6 +528,7 @@ fn bars(
     names: &[&str],
     first: Indices,
     total: Indices,
+    interval_label: &str,
     file: &Path,
 ) -> Result<(), ReportError> {
     BarChart {
@@ -310,16 +551,17 @@ fn bars(
             },
         ],
         y_range: Some((0.0, 1.0)),
+        interval_label: interval_label.to_owned(),
     }
     .write(file)?;
     Ok(())
 }
 
 /// Convergence plots; returns the files written. Runs: `<name>_convergence.svg`, the running
-/// mean over the first n runs with ±2 standard errors, and `<name>_std_convergence.svg`,
-/// the running Std (log axis of runs). Chaos: `<name>_convergence.svg`, the Std of the
-/// terms of each total order (log axis: its decay shows the convergence) with the Std of
-/// the expansion truncated there.
+/// mean over the first n runs with ±2 iid standard errors (Std/√n of those runs), and
+/// `<name>_std_convergence.svg`, the running Std (log axis of runs). Chaos:
+/// `<name>_convergence.svg`, the Std of the terms of each total order (log axis: its decay
+/// shows the convergence) with the Std of the expansion truncated there.
 pub(super) fn convergence(
     dir: &Path,
     name: &str,
@@ -327,30 +569,8 @@ pub(super) fn convergence(
     c: &Convergence,
 ) -> Result<Vec<String>, ReportError> {
     if c.axis != "runs" {
-        let mut p = LinePlot::new(
-            format!("{name}: Std by chaos order"),
-            "total order of the chaos",
-            label(&format!("Std {name}"), unit),
-        );
-        p.log_y = true;
-        let (x, y) = (c.x[1..].to_vec(), c.std_of_order[1..].to_vec());
-        p.series.push(Series::new(
-            "Std of the terms of that order",
-            x.clone(),
-            y,
-            palette(1),
-        ));
-        p.series.push(
-            Series::new(
-                "Std of the chaos up to that order",
-                x,
-                c.std[1..].to_vec(),
-                palette(0),
-            )
-            .dashed(),
-        );
         let file = format!("{}_convergence.svg", stem(name));
-        p.write(&dir.join(&file))?;
+        chaos_convergence(name, unit, c).write(&dir.join(&file))?;
         return Ok(vec![file]);
     }
     let mut mean = LinePlot::new(
@@ -366,7 +586,8 @@ pub(super) fn convergence(
         .map(|(s, n)| 2.0 * s / n.sqrt())
         .collect();
     mean.bands.push(Band::new(
-        "± 2 standard errors",
+        "± 2 iid standard errors of the first n runs (Std/√n; a replicate estimate in the \
+         table may be smaller)",
         c.x.clone(),
         c.mean.iter().zip(&se).map(|(m, e)| m - e).collect(),
         c.mean.iter().zip(&se).map(|(m, e)| m + e).collect(),
@@ -391,12 +612,93 @@ pub(super) fn convergence(
     Ok(files)
 }
 
+/// The Std of the terms of each chaos order and of the chaos truncated there, against the
+/// order: integer ticks, a dot at every order, values below [`ROUND_OFF`] of the total Std
+/// (round-off, and zeros) drawn on that level (a dashed line and a legend note say so), and
+/// room above the largest value.
+fn chaos_convergence(name: &str, unit: Option<&str>, c: &Convergence) -> LinePlot {
+    let mut p = LinePlot::new(
+        format!("{name}: Std by chaos order"),
+        "total order of the chaos",
+        label(&format!("Std {name}"), unit),
+    );
+    p.log_y = true;
+    p.integer_x = true;
+    let x = c.x.get(1..).unwrap_or_default().to_vec();
+    let top = c
+        .std
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let floor = ROUND_OFF * top;
+    let mut clipped = false;
+    let mut clip = |y: &[f64]| -> Vec<f64> {
+        y.get(1..)
+            .unwrap_or_default()
+            .iter()
+            .map(|&v| {
+                if v.is_finite() && v < floor {
+                    clipped = true;
+                    floor
+                } else {
+                    v
+                }
+            })
+            .collect()
+    };
+    let (of_order, upto) = (clip(&c.std_of_order), clip(&c.std));
+    p.series.push(
+        Series::new(
+            "Std of the terms of that order",
+            x.clone(),
+            of_order,
+            palette(1),
+        )
+        .with_markers(),
+    );
+    p.series.push(
+        Series::new(
+            "Std of the chaos up to that order",
+            x.clone(),
+            upto,
+            palette(0),
+        )
+        .dashed()
+        .with_markers(),
+    );
+    if clipped && !x.is_empty() {
+        p.series.push(
+            Series::new(
+                format!("round-off level ({ROUND_OFF:e} × Std): zeros and smaller values are drawn on it"),
+                vec![x[0], x[x.len() - 1]],
+                vec![floor; 2],
+                "#999999",
+            )
+            .thin(1.0, 0.8)
+            .dashed(),
+        );
+    }
+    if top > 0.0 {
+        let smallest = p
+            .series
+            .iter()
+            .flat_map(|s| s.y.iter().copied())
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .fold(top, f64::min);
+        // Headroom: the total Std is not drawn on the frame.
+        p.y_range = Some((smallest / 3.0, top * 4.0));
+    }
+    p
+}
+
 /// `<signal>_vs_<speed>.svg` for a critical-speed quantity whose signal and speed are both
 /// outputs (the paper's Fig. 5a): the file name, or `None` when there is no such plot.
 pub(super) fn speed_plot(
     dir: &Path,
     spec: &QoiSpec,
     outputs: &[OutputStats],
+    quantities: &[ScalarStats],
     study: &str,
 ) -> Result<Option<String>, ReportError> {
     let QoiSpec::CriticalSpeed {
@@ -417,19 +719,58 @@ pub(super) fn speed_plot(
         label(speed, v.unit.as_deref()),
         label(signal, y.unit.as_deref()),
     );
-    push_band(&mut plot, &v.mean, y, format!("{signal} (mean)"));
+    let what = if y.deterministic {
+        format!("{signal} (the same in every run)")
+    } else {
+        format!("{signal} (mean)")
+    };
+    push_band(&mut plot, &v.mean, y, what);
     let ends = vec![v.mean[0], v.mean[v.mean.len() - 1]];
+    let threshold_label = with_unit(&format!("threshold ±{threshold}"), y.unit.as_deref());
     plot.series.push(
         Series::new(
-            format!("threshold ±{threshold}"),
+            threshold_label,
             ends.clone(),
             vec![*threshold; 2],
             palette(3),
         )
+        .thin(1.0, 0.8)
         .dashed(),
     );
-    plot.series
-        .push(Series::new("", ends, vec![-*threshold; 2], palette(3)).dashed());
+    plot.series.push(
+        Series::new("", ends, vec![-*threshold; 2], palette(3))
+            .thin(1.0, 0.8)
+            .dashed(),
+    );
+    // The critical speed the study computed, where it has that quantity (Fig. 5a marks it).
+    if let Some(q) = quantities.iter().find(|q| q.name == spec.name()) {
+        if q.mean.is_finite() {
+            let (lo, hi) = finite_range(
+                y.lower_3sigma
+                    .iter()
+                    .chain(&y.upper_3sigma)
+                    .chain(&y.mean)
+                    .copied(),
+                false,
+            )
+            .unwrap_or((-1.0, 1.0));
+            let text = if q.deterministic {
+                format!(
+                    "{} = {}",
+                    q.name,
+                    with_unit(&sig(q.mean), v.unit.as_deref())
+                )
+            } else {
+                format!(
+                    "mean {} = {}",
+                    q.name,
+                    with_unit(&sig(q.mean), v.unit.as_deref())
+                )
+            };
+            plot.series
+                .push(Series::new(text, vec![q.mean; 2], vec![lo, hi], palette(2)).thin(1.5, 0.9));
+        }
+    }
     let file = format!("{}_vs_{}.svg", stem(signal), stem(speed));
     plot.write(&dir.join(&file))?;
     Ok(Some(file))
