@@ -478,7 +478,12 @@ pub(super) fn sobol_bars(
 /// resamples)", or "95 % interval".
 pub(super) fn interval_label(method: &MethodSummary, level: Option<f64>) -> String {
     let level = level.unwrap_or(0.95);
-    let head = format!("{} % interval", sig(100.0 * level));
+    let percent = 100.0 * level;
+    let head = if (percent - percent.round()).abs() < 1e-9 {
+        format!("{percent:.0} % interval")
+    } else {
+        format!("{} % interval", sig(percent))
+    };
     let d = &method.details;
     let words = d.get("intervals").and_then(|w| w.as_str()).unwrap_or("");
     if let Some(r) = d.get("replicates").and_then(|r| r.as_u64()) {

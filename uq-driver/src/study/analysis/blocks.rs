@@ -355,6 +355,52 @@ mod tests {
         assert_eq!(whole.picked(), tasks.picked());
     }
 
+    /// QA3 H1: a two-column event between evenly spaced columns is among the picked
+    /// columns (the extremes of its quantiles, mean and Std), whatever the blocks.
+    #[test]
+    fn picked_columns_catch_a_short_event_whatever_the_blocks() {
+        let (rows, nt) = (40, 1000);
+        // A slow ramp, and at columns 505 and 506 a peak with a larger spread.
+        let all: Vec<f64> = (0..rows * nt)
+            .map(|i| {
+                let (k, r) = (i / rows, (i % rows) as f64);
+                let base = k as f64 * 1e-3 + 0.01 * (r * 0.37).sin();
+                match k {
+                    505 => base + 50.0 + r,
+                    506 => base - 30.0 - 0.5 * r,
+                    _ => base,
+                }
+            })
+            .collect();
+        let even: Vec<usize> = (0..nt).step_by(10).chain([nt - 1]).collect();
+        let qs = [0.01, 0.5, 0.99];
+        let mut whole = SeriesColumns::new(nt, even.clone(), &qs);
+        whole.add_slice(0, rows, &all);
+        let mut blocked = SeriesColumns::new(nt, even.clone(), &qs);
+        for (j0, w) in blocks(nt, 96) {
+            blocked.add_slice(j0, rows, &all[j0 * rows..(j0 + w) * rows]);
+        }
+        let mut generated = SeriesColumns::new(nt, even.clone(), &qs);
+        for (j0, w) in blocks(nt, 64) {
+            generated.add_generated(j0, rows, w, 32, &|j, buf| {
+                buf.copy_from_slice(&all[j * rows..j * rows + buf.len()])
+            });
+        }
+        let picked = whole.picked();
+        assert!(
+            picked.0.contains(&505) && picked.0.contains(&506),
+            "{:?}",
+            picked.0
+        );
+        // The extremes take the places of their nearest evenly spaced columns.
+        assert_eq!(picked.0.len(), even.len());
+        assert!(picked.0.windows(2).all(|w| w[0] < w[1]));
+        let k = picked.0.iter().position(|&c| c == 505).unwrap();
+        assert_eq!(picked.1[k], all[505 * rows..506 * rows].to_vec());
+        assert_eq!(blocked.picked(), picked);
+        assert_eq!(generated.picked(), picked);
+    }
+
     #[test]
     fn sparse_chaoses_of_column_blocks_join_into_the_chaos_of_all_columns() {
         // Per-column sets, as sparse regression gives them.
