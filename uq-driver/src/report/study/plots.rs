@@ -61,8 +61,9 @@ const LONG_SERIES: usize = 1000;
 /// Below this multiple of the largest value, a Std or an error estimate is round-off: on a
 /// log axis such values (and zeros) are drawn at this level.
 const ROUND_OFF: f64 = 1e-13;
-/// Below this multiple of an output's largest magnitude, its Std is round-off.
-const VALUE_ROUND_OFF: f64 = 1e-12;
+/// A Std at most this multiple of an output's largest |mean| is no spread (every run agrees;
+/// the analysis's own threshold).
+const NO_SPREAD: f64 = 1e-9;
 
 /// `<V>_std.svg`: the Std over time, the Std of the chaos surrogate where the method gives
 /// one, and the chaos's truncation-error estimate (loo, order or level difference, a share
@@ -76,11 +77,20 @@ pub(super) fn std_plot(dir: &Path, s: &OutputStats) -> Result<bool, ReportError>
     }
     let v = &s.name;
     let unit = s.unit.as_deref();
-    // Where every run agrees (Std exactly 0, e.g. a fixed initial state) there is no spread
-    // to show: those times are left out of every curve, and the legend says so.
-    let agree = s.std.iter().filter(|d| **d == 0.0).count();
+    // Where every run agrees (a Std at most 1e-9 of the output's magnitude, as the analysis
+    // counts no spread: e.g. a fixed initial state, or its round-off) there is no spread to
+    // show: those times are left out of every curve, and the legend says so.
+    let magnitude = s
+        .mean
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(0.0, |m: f64, x| m.max(x.abs()));
+    let agrees: Vec<bool> = s.std.iter().map(|d| *d <= NO_SPREAD * magnitude).collect();
+    let agree = agrees.iter().filter(|a| **a).count();
     let std_label = if agree > 0 {
-        format!("Std of {v} (0 at {agree} times where every run agrees: not drawn)")
+        let times = if agree == 1 { "time" } else { "times" };
+        format!("Std of {v} (no spread at {agree} {times} where every run agrees: not drawn)")
     } else {
         format!("Std of {v}")
     };
@@ -110,8 +120,8 @@ pub(super) fn std_plot(dir: &Path, s: &OutputStats) -> Result<bool, ReportError>
         ));
     }
     for c in &mut curves {
-        for (y, d) in c.1.iter_mut().zip(&s.std) {
-            if *d == 0.0 {
+        for (y, a) in c.1.iter_mut().zip(&agrees) {
+            if *a {
                 *y = f64::NAN;
             }
         }
@@ -126,14 +136,7 @@ pub(super) fn std_plot(dir: &Path, s: &OutputStats) -> Result<bool, ReportError>
         .flat_map(|c| c.1.iter().copied())
         .filter(|x| x.is_finite() && *x > 0.0)
         .fold(f64::INFINITY, f64::min);
-    // Round-off: a Std below 1e-12 of the output's magnitude cannot be told from zero.
-    let magnitude = s
-        .mean
-        .iter()
-        .copied()
-        .filter(|x| x.is_finite())
-        .fold(0.0, |m: f64, x| m.max(x.abs()));
-    let floor = (ROUND_OFF * top).max(VALUE_ROUND_OFF * magnitude);
+    let floor = ROUND_OFF * top;
     let log = top / smallest.max(floor) > 100.0;
     let mut plot = LinePlot::new(
         format!("Std of {v} over time"),
@@ -163,8 +166,8 @@ pub(super) fn std_plot(dir: &Path, s: &OutputStats) -> Result<bool, ReportError>
     if clipped {
         plot.series.push(
             Series::new(
-                "round-off level (1e-12 × |mean| or 1e-13 × the largest Std): smaller \
-                 values and zeros are drawn on it",
+                "round-off level (1e-13 × the largest Std): smaller values and zeros are \
+                 drawn on it",
                 vec![s.times[0], s.times[s.times.len() - 1]],
                 vec![floor; 2],
                 "#999999",

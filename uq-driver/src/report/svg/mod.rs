@@ -284,7 +284,10 @@ impl DensityPlot {
 
         let mut legend: Vec<LegendEntry> = Vec::new();
         if self.histogram.is_some() {
-            legend.push(LegendEntry::fill("histogram of the runs", HISTOGRAM_COLOR));
+            legend.push(
+                LegendEntry::fill("histogram of the runs", HISTOGRAM_COLOR)
+                    .with_opacity(HISTOGRAM_OPACITY),
+            );
         }
         for s in &self.curves {
             legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
@@ -340,7 +343,7 @@ fn histogram(frame: &Frame, out: &mut String, bars: impl Iterator<Item = (f64, f
         let _ = writeln!(
             out,
             "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{HISTOGRAM_COLOR}\" \
-             fill-opacity=\"0.55\" stroke=\"#fff\" stroke-width=\"0.5\"/>",
+             fill-opacity=\"{HISTOGRAM_OPACITY}\" stroke=\"#fff\" stroke-width=\"0.5\"/>",
             c(xl),
             c(yt.min(y0)),
             c(xr - xl),
@@ -614,6 +617,8 @@ pub fn palette(i: usize) -> &'static str {
 }
 
 const HISTOGRAM_COLOR: &str = "#8c9db5";
+/// Fill opacity of histogram bars (and of their legend swatch).
+const HISTOGRAM_OPACITY: f64 = 0.55;
 /// Fill opacity of the bars of a [`BarChart`] (and of their legend swatches).
 const BAR_OPACITY: f64 = 0.8;
 
