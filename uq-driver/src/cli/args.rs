@@ -192,13 +192,44 @@ pub(crate) struct SafetyArgs {
     /// Run again the points that failed in an earlier run into the same folder.
     #[arg(long)]
     pub(crate) retry_failed: bool,
+    /// Run every point on a fresh FMU instance (fmi2FreeInstance, then fmi2Instantiate)
+    /// instead of reusing one through fmi2Reset.
+    #[arg(long)]
+    pub(crate) fresh_instances: bool,
+    /// Instantiate the FMU with loggingOn = true (many FMUs log only then); its messages are
+    /// kept with failed points.
+    #[arg(long)]
+    pub(crate) fmu_logging: bool,
 }
 
 impl SafetyArgs {
+    /// The same options as `run-shard` arguments (for the Slurm array job).
+    pub(crate) fn as_args(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        if self.isolate {
+            v.push("--isolate".to_owned());
+        }
+        if let Some(t) = self.timeout_per_run {
+            v.push(format!("--timeout-per-run={}", t.as_secs_f64()));
+        }
+        for (on, flag) in [
+            (self.retry_failed, "--retry-failed"),
+            (self.fresh_instances, "--fresh-instances"),
+            (self.fmu_logging, "--fmu-logging"),
+        ] {
+            if on {
+                v.push(flag.to_owned());
+            }
+        }
+        v
+    }
+
     /// Fills the runner options.
     pub(crate) fn apply(&self, opts: &mut RunOptions) -> Result<()> {
         opts.retry_failed = self.retry_failed;
         opts.timeout_per_run = self.timeout_per_run;
+        opts.fresh_instances = self.fresh_instances;
+        opts.fmu_logging = self.fmu_logging;
         if self.isolate {
             opts.isolate = Some(
                 uq_driver::study::isolate::default_exe()
@@ -248,6 +279,9 @@ pub(crate) struct SlurmArgs {
     /// The merge job writes the CSV files and summary.json only: no plots, no index.html.
     #[arg(long)]
     pub(crate) no_report: bool,
+    /// How each shard runs its points (passed on to `run-shard`).
+    #[command(flatten)]
+    pub(crate) safety: SafetyArgs,
 }
 
 #[derive(Args)]
@@ -278,6 +312,10 @@ pub(crate) struct SimulateArgs {
     /// CSV file to write (default: standard output).
     #[arg(long, short)]
     pub(crate) out: Option<PathBuf>,
+    /// Instantiate the FMU with loggingOn = true (many FMUs log only then) and print its
+    /// messages on stderr as they come.
+    #[arg(long)]
+    pub(crate) fmu_logging: bool,
 }
 
 pub(crate) fn parse_assignment(s: &str) -> Result<(String, String), String> {

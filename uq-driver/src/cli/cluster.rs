@@ -63,6 +63,7 @@ pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
         cpus_per_task: a.cpus_per_task,
         extra: a.sbatch,
         no_report: a.no_report,
+        shard_args: a.safety.as_args(),
     };
     let (array_script, merge_script) = shard::write_sbatch(&a.out, &driver, a.shards, &o)?;
     if a.dry_run {

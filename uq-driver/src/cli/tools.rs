@@ -98,7 +98,14 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         // An FMU that calls exit() is reported; what it prints stays out of a CSV on stdout.
         let _exit = guard::SimulationGuard::begin(&a.fmu);
         let _stdout = a.out.is_none().then(guard::StdoutToStderr::begin);
-        runner::simulate(&fmu, &params, &a.outputs, a.input.as_deref(), &times)?
+        runner::simulate_with(
+            &fmu,
+            &params,
+            &a.outputs,
+            a.input.as_deref(),
+            &times,
+            a.fmu_logging,
+        )?
     };
     for (name, why) in &sim.skipped {
         eprintln!("uq-driver: note: output '{name}' not recorded: {why}");

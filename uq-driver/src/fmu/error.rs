@@ -79,10 +79,16 @@ impl fmt::Display for LogMessage {
     }
 }
 
-/// Formats the FMU's log lines for an error message.
-fn log_lines(messages: &[LogMessage]) -> String {
-    if messages.is_empty() {
+/// Formats the FMU's log lines for an error message; `logging_on`: whether the instance was
+/// asked to log (many FMUs send nothing otherwise, not even at fmi2Error or fmi2Fatal).
+fn log_lines(messages: &[LogMessage], logging_on: bool) -> String {
+    if messages.is_empty() && logging_on {
         return " (the FMU logged nothing)".to_string();
+    }
+    if messages.is_empty() {
+        return " (the FMU logged nothing; many FMUs log only when instantiated with loggingOn = \
+                true: run again with --fmu-logging)"
+            .to_string();
     }
     let mut out = String::from("; FMU log:");
     for m in messages {
@@ -241,7 +247,7 @@ pub enum FmuError {
         reason: String,
     },
     /// `fmi2Instantiate` returned no instance, or the instance could not be created.
-    #[error("{}: cannot instantiate '{instance}': {reason}{}", .path.display(), log_lines(.messages))]
+    #[error("{}: cannot instantiate '{instance}': {reason}{}", .path.display(), log_lines(.messages, *.logging_on))]
     InstantiateFailed {
         /// The `.fmu` file.
         path: PathBuf,
@@ -251,11 +257,13 @@ pub enum FmuError {
         reason: String,
         /// What the FMU logged meanwhile.
         messages: Vec<LogMessage>,
+        /// Whether the instance was asked to log (`loggingOn`).
+        logging_on: bool,
     },
     /// An FMI function returned a status other than OK or Warning.
     #[error(
         "{}: {function} returned {status} for instance '{instance}'{}",
-        .path.display(), log_lines(.messages)
+        .path.display(), log_lines(.messages, *.logging_on)
     )]
     Call {
         /// The `.fmu` file.
@@ -268,6 +276,8 @@ pub enum FmuError {
         status: Status,
         /// The messages the FMU logged during the call (or, if none, its last messages).
         messages: Vec<LogMessage>,
+        /// Whether the instance was asked to log (`loggingOn`).
+        logging_on: bool,
     },
     /// The FMU returned something that breaks the FMI 2.0 contract (e.g. a null string).
     #[error("{}: {function} of instance '{instance}' misbehaved: {reason}", .path.display())]
@@ -401,9 +411,32 @@ mod tests {
                 category: "logStatusError".into(),
                 message: "step size must be positive".into(),
             }],
+            logging_on: false,
         };
         let text = e.to_string();
         assert!(text.starts_with("/x/Model.fmu: fmi2DoStep returned Error for instance 'w0'"));
         assert!(text.contains("[Error] logStatusError: step size must be positive"));
+    }
+
+    /// QA3 M-2: an FMU that logs only with loggingOn gave "the FMU logged nothing" and no way
+    /// out; the message names --fmu-logging unless logging was on.
+    #[test]
+    fn an_empty_log_names_fmu_logging_when_logging_was_off() {
+        let call = |logging_on| {
+            FmuError::Call {
+                path: PathBuf::from("/x/Model.fmu"),
+                instance: "w0".into(),
+                function: "fmi2DoStep",
+                status: Status::Fatal,
+                messages: Vec::new(),
+                logging_on,
+            }
+            .to_string()
+        };
+        let off = call(false);
+        assert!(off.contains("(the FMU logged nothing; "), "{off}");
+        assert!(off.contains("run again with --fmu-logging)"), "{off}");
+        let on = call(true);
+        assert!(on.ends_with("(the FMU logged nothing)"), "{on}");
     }
 }

@@ -293,7 +293,24 @@ impl Fmu {
     /// `logging_on` asks the FMU for debug logging and echoes its messages to stderr; errors
     /// are logged and kept whatever it is.
     pub fn instantiate(&self, instance_name: &str, logging_on: bool) -> Result<Instance, FmuError> {
-        Instance::new(Arc::clone(&self.inner), instance_name, logging_on)
+        Instance::new(
+            Arc::clone(&self.inner),
+            instance_name,
+            logging_on,
+            logging_on,
+        )
+    }
+
+    /// As [`Fmu::instantiate`], with the echo of the FMU's messages to stderr chosen apart from
+    /// `logging_on`: a study asks its FMU to log (`--fmu-logging`) but keeps the messages with
+    /// the failing points (capped) instead of flooding the terminal.
+    pub fn instantiate_with(
+        &self,
+        instance_name: &str,
+        logging_on: bool,
+        echo: bool,
+    ) -> Result<Instance, FmuError> {
+        Instance::new(Arc::clone(&self.inner), instance_name, logging_on, echo)
     }
 }
 

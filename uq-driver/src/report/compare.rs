@@ -354,20 +354,44 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         "time [s]",
         label(&format!("Std {v}"), unit),
     );
+    // The studies whose output varies; a deterministic one (a nominal run: Std 0 at every time)
+    // is drawn as its value only, and has no Std curve.
+    let varies = |c: &Csv| c.column("std").is_some_and(|s| s.iter().any(|&x| x > 0.0));
+    let mut deterministic = Vec::new();
+    let mut edges = Vec::new();
     for (i, (f, c)) in have.iter().enumerate() {
         let (Some(t), Some(m), Some(s)) = (c.column("time"), c.column("mean"), c.column("std"))
         else {
             continue;
         };
         let name = f.name();
+        if !varies(c) {
+            deterministic.push(name.clone());
+            bands.series.push(Series::new(
+                format!("{name} (deterministic)"),
+                t.to_vec(),
+                m.to_vec(),
+                palette(i),
+            ));
+            continue;
+        }
         let (lo, hi) = crate::results::OutputStats::band(m, s, 3.0);
-        bands.bands.push(Band::new(
-            format!("{name} ±3σ"),
-            t.to_vec(),
-            lo,
-            hi,
-            palette(i),
-        ));
+        if bands.bands.is_empty() {
+            // The first study that varies: a filled band; the others as outlines, so that
+            // overlapping bands do not blend into a colour no legend entry has.
+            bands.bands.push(Band::new(
+                format!("{name} ±3σ"),
+                t.to_vec(),
+                lo,
+                hi,
+                palette(i),
+            ));
+        } else {
+            edges.push(
+                Series::new(format!("{name} ±3σ (outline)"), t.to_vec(), hi, palette(i)).dashed(),
+            );
+            edges.push(Series::new("", t.to_vec(), lo, palette(i)).dashed());
+        }
         bands.series.push(Series::new(
             format!("{name} mean"),
             t.to_vec(),
@@ -375,20 +399,44 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
             palette(i),
         ));
         let line = Series::new(name, t.to_vec(), s.to_vec(), palette(i));
-        std.series.push(if i > 0 { line.dashed() } else { line });
+        std.series.push(if std.series.is_empty() {
+            line
+        } else {
+            line.dashed()
+        });
     }
+    bands.series.splice(0..0, edges);
     bands.write(&out.join(format!("{}_bands.svg", stem(v))))?;
-    std.write(&out.join(format!("{}_std.svg", stem(v))))?;
-    let mut images = vec![
-        format!("{}_bands.svg", stem(v)),
-        format!("{}_std.svg", stem(v)),
-    ];
+    let mut images = vec![format!("{}_bands.svg", stem(v))];
+    if !std.series.is_empty() {
+        std.write(&out.join(format!("{}_std.svg", stem(v))))?;
+        images.push(format!("{}_std.svg", stem(v)));
+    }
     let mut text = format!(
-        "{v} in {} studies: their μ ± 3σ bands and Std over time.",
-        have.len()
+        "{v} in {}: their μ ± 3σ bands (the first filled, the others outlined) and Std over \
+         time.",
+        count(have.len(), "study", "studies")
     );
-    // Differences against the first study, where the time grids agree.
-    if let Some((f0, c0)) = have.first() {
+    if !deterministic.is_empty() {
+        text.push_str(&format!(
+            " {} {} the same value in every run (deterministic): drawn as {} value only, \
+             without a band or a Std.",
+            deterministic.join(", "),
+            if deterministic.len() == 1 {
+                "has"
+            } else {
+                "have"
+            },
+            if deterministic.len() == 1 {
+                "its"
+            } else {
+                "their"
+            },
+        ));
+    }
+    // Differences against the first study that varies, where the time grids agree.
+    let varying: Vec<&(&Folder, Csv)> = have.iter().filter(|(_, c)| varies(c)).collect();
+    if let Some((f0, c0)) = varying.first() {
         let t0 = c0.column("time").unwrap_or(&[]);
         let mut diff = LinePlot::new(
             format!("|Std − Std({})| of {v} (log axis)", f0.name()),
@@ -398,6 +446,7 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         diff.log_y = true;
         let mut header = vec!["time".to_string()];
         let mut cols: Vec<Vec<f64>> = vec![t0.to_vec()];
+        let mut largest = 0.0f64;
         for (i, (f, c)) in have.iter().enumerate() {
             if c.column("time") != Some(t0) {
                 continue;
@@ -406,7 +455,7 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
             cols.push(c.column("mean").unwrap_or(&[]).to_vec());
             header.push(format!("std_{}", f.name()));
             cols.push(c.column("std").unwrap_or(&[]).to_vec());
-            if i > 0 {
+            if f.dir != f0.dir && varies(c) {
                 let d: Vec<f64> = c
                     .column("std")
                     .unwrap_or(&[])
@@ -414,22 +463,40 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
                     .zip(c0.column("std").unwrap_or(&[]))
                     .map(|(a, b)| (a - b).abs())
                     .collect();
+                largest = d
+                    .iter()
+                    .copied()
+                    .filter(|x| x.is_finite())
+                    .fold(largest, f64::max);
                 diff.series
                     .push(Series::new(f.name(), t0.to_vec(), d, palette(i)));
+            }
+        }
+        // One near-zero difference (e.g. at the first time step) must not stretch the log axis
+        // over decades where no curve lies: the axis starts 6 decades below the largest.
+        let floor = largest * 1e-6;
+        for s in &mut diff.series {
+            for y in &mut s.y {
+                if *y < floor {
+                    *y = f64::NAN;
+                }
             }
         }
         if cols.len() > 3 {
             let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
             let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
             write_columns(&out.join(format!("{}_compare.csv", stem(v))), &hdr, &refs)?;
-            diff.write(&out.join(format!("{}_std_diff.svg", stem(v))))?;
-            images.push(format!("{}_std_diff.svg", stem(v)));
+            if !diff.series.is_empty() && largest > 0.0 {
+                diff.write(&out.join(format!("{}_std_diff.svg", stem(v))))?;
+                images.push(format!("{}_std_diff.svg", stem(v)));
+                text.push_str(&format!(
+                    " The difference of each Std from that of {} is on a log axis (it spans \
+                     decades between methods; differences below 1e-6 of the largest are not \
+                     drawn).",
+                    f0.name()
+                ));
+            }
             images.push(format!("{}_compare.csv", stem(v)));
-            text.push_str(&format!(
-                " The difference of each Std from that of {} is on a log axis (it spans decades \
-                 between methods).",
-                f0.name()
-            ));
         }
     }
     Ok(Section {
@@ -438,6 +505,11 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         images,
         table: None,
     })
+}
+
+/// "1 study", "3 studies".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 /// PDFs of quantity `q` in every study that has one, and a table of its statistics.
@@ -453,14 +525,30 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
         ..DensityPlot::default()
     };
     let mut rows = Vec::new();
+    let mut limits: Vec<f64> = Vec::new();
+    let mut fixed = Vec::new();
     for (i, f) in have.iter().enumerate() {
         let s = &f.summary["quantities"][q];
         let deterministic = s["deterministic"].as_bool().unwrap_or(false);
-        if !deterministic {
+        if deterministic {
+            // No density: its value as a marker line.
+            if let Some(x) = s["mean"].as_f64() {
+                plot.markers
+                    .push((x, format!("{} (deterministic): {}", f.name(), sig(x))));
+            }
+            fixed.push(f.name());
+        } else {
             let c = Csv::read(&f.dir.join(format!("{}_pdf.csv", stem(q))))?;
             if let (Some(x), Some(d)) = (c.column("x"), c.column("density")) {
                 plot.curves
                     .push(Series::new(f.name(), x.to_vec(), d.to_vec(), palette(i)));
+            }
+        }
+        for e in s["exceedance_counts"].as_array().into_iter().flatten() {
+            if let Some(l) = e["limit"].as_f64() {
+                if !limits.contains(&l) {
+                    limits.push(l);
+                }
             }
         }
         let exceed: Vec<String> = s["exceedance_counts"]
@@ -481,12 +569,15 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
             num(&s["mean"]),
             num(&s["std"]),
             if deterministic {
-                "deterministic (no density)".into()
+                format!("{} (deterministic)", num(&s["n_valid"]))
             } else {
                 num(&s["n_valid"])
             },
             exceed.join("; "),
         ]);
+    }
+    for l in limits {
+        plot.markers.push((l, format!("limit {q} = {}", sig(l))));
     }
     let mut images = Vec::new();
     if !plot.curves.is_empty() {
@@ -495,7 +586,16 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
     }
     Ok(Section {
         heading: format!("Quantity {q}"),
-        text: format!("{q} in {} studies.", have.len()),
+        text: if fixed.is_empty() {
+            format!("{q} in {}.", count(have.len(), "study", "studies"))
+        } else {
+            format!(
+                "{q} in {}; {} deterministic (its value is marked by a line, without a \
+                 density). The limits of the studies are marked.",
+                count(have.len(), "study", "studies"),
+                fixed.join(", ")
+            )
+        },
         images,
         table: Some(Table {
             header: ["study", "mean", "Std", "valid runs", "exceedance"]
@@ -591,6 +691,63 @@ mod tests {
         // The same folder twice.
         let got = labels(&[(s("ishi"), a), (s("ishi"), a)]);
         assert_eq!(got, ["borehole", "borehole-2"]);
+    }
+
+    #[test]
+    fn a_deterministic_study_is_compared_by_its_value_without_a_std_or_density() {
+        // QA round 3 (report M4): a nominal study got a "±3σ" entry, a flat Std curve on a
+        // −1…1 axis, and its W dropped out of the PDF plot, which also left out the limits.
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path();
+        study_folder(&p.join("a"), "a", 1.0);
+        study_folder(&p.join("b"), "b", 1.5);
+        let nominal = p.join("nominal");
+        std::fs::create_dir_all(&nominal).unwrap();
+        let quantity = |mean: f64, deterministic: bool| {
+            serde_json::json!({"mean": mean, "std": if deterministic { 0.0 } else { 0.1 },
+                "n_valid": 1, "deterministic": deterministic,
+                "exceedance_counts": [{"limit": 2.5, "exceeded": 0, "of": 1}]})
+        };
+        let summary = serde_json::json!({
+            "study": "nominal", "method": {"kind": "nominal"},
+            "outputs": {"y": {"mean_at_stop": 1.2, "std_at_stop": 0.0}},
+            "quantities": {"W": quantity(2.31, true)},
+        });
+        std::fs::write(nominal.join("summary.json"), summary.to_string()).unwrap();
+        std::fs::write(nominal.join("y.csv"), "time,mean,std\n0,1.2,0\n1,1.2,0\n").unwrap();
+        for f in ["a", "b"] {
+            let path = p.join(f).join("summary.json");
+            let mut s: Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            s["quantities"]["W"] = quantity(2.3, false);
+            std::fs::write(&path, s.to_string()).unwrap();
+            std::fs::write(
+                p.join(f).join("W_pdf.csv"),
+                "x,density\n2.2,1\n2.3,3\n2.4,1\n",
+            )
+            .unwrap();
+        }
+        let out = p.join("cmp");
+        write(&[p.join("a"), nominal.clone(), p.join("b")], &out).unwrap();
+        let std_svg = std::fs::read_to_string(out.join("y_std.svg")).unwrap();
+        assert!(
+            !std_svg.contains("nominal"),
+            "no Std curve for the deterministic study"
+        );
+        let bands = std::fs::read_to_string(out.join("y_bands.svg")).unwrap();
+        assert!(bands.contains("nominal (deterministic)") && !bands.contains("nominal ±3σ"));
+        let pdf = std::fs::read_to_string(out.join("W_pdf_compare.svg")).unwrap();
+        assert!(
+            pdf.contains("nominal (deterministic): 2.31"),
+            "its value is marked"
+        );
+        assert!(pdf.contains("limit W = 2.5"), "the limits are marked");
+        let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+        assert!(page.contains("deterministic"), "said in words");
+        // Only the deterministic study: no Std plot at all.
+        let only = p.join("only");
+        write(std::slice::from_ref(&nominal), &only).unwrap();
+        assert!(!only.join("y_std.svg").exists());
     }
 
     #[test]

@@ -3,8 +3,10 @@
 //!
 //! A worker is the uq-driver executable started with the hidden subcommand `worker`
 //! ([`serve`]). It opens the FMU from the folder the parent already extracted, creates one
-//! instance, and runs points one after the other exactly as the in-process runner does
-//! ([`run_point`]), so results are bit-identical. Parent and worker speak a small binary
+//! instance at a time, and runs points one after the other exactly as the in-process runner
+//! does ([`run_point`]; fresh or reset instances by the setup's [`InstancePolicy`], and the
+//! reset self-check of [`super::instances`] when the parent asks), so results are
+//! bit-identical. Parent and worker speak a small binary
 //! protocol over the worker's stdin and stdout (the worker moves its own stdout to stderr
 //! first, so an FMU that prints cannot garble it): frames of a tag byte, a little-endian u64
 //! length and the payload.
@@ -13,8 +15,11 @@
 //! | --- | --- | --- |
 //! | `S` | parent | the setup, JSON ([`Setup`]) |
 //! | `P` | parent | a point's parameter values, f64 LE |
+//! | `C` | parent | the reset self-check: the last point's values again, to run after `fmi2Reset` |
 //! | `R` | worker | ready (empty) |
 //! | `O` | worker | the point's record values, f64 LE |
+//! | `V` | worker | the self-check's verdict: a byte (0 passed, 1 failed, 2 failed and the worker ends after fmi2Fatal), then the reason, UTF-8 |
+//! | `N` | worker | before an answer: `fmi2Reset` failed and the point ran on a fresh instance; the reason, UTF-8 |
 //! | `F` | worker | the point failed: the message, UTF-8 |
 //! | `X` | worker | the point failed and the FMU is unusable (fmi2Fatal): the worker ends |
 //! | `E` | worker | the setup failed: the message, UTF-8 |
@@ -41,9 +46,11 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
+use super::instances::{InstancePolicy, ResetCheck, Slot};
 use super::interface::Interface;
+use super::point::check_reset;
 use super::runner::run_point;
-use crate::fmu::{Fmu, Instance};
+use crate::fmu::Fmu;
 
 /// How many of a worker's last stderr lines a failure message quotes.
 const TAIL_LINES: usize = 12;
@@ -69,6 +76,9 @@ pub struct Setup {
     pub interface: Interface,
     /// The communication points (s).
     pub times: Vec<f64>,
+    /// How the worker's runs get their instance.
+    #[serde(default)]
+    pub policy: InstancePolicy,
 }
 
 /// How workers are started.
@@ -311,13 +321,25 @@ impl Worker {
         }
     }
 
-    /// Runs one point: its record values, or why there are none.
+    /// Runs one point: its record values, or why there are none; with the reason of a failed
+    /// `fmi2Reset` before it, if one failed.
     pub fn run(
         &mut self,
         values: &[f64],
         timeout: Option<Duration>,
-    ) -> Result<Vec<f64>, WorkerFailure> {
-        match self.request(b'P', &f64s_to_bytes(values), timeout, "running the point")? {
+    ) -> (Result<Vec<f64>, WorkerFailure>, Option<String>) {
+        let mut note = None;
+        let mut answer = self.request(b'P', &f64s_to_bytes(values), timeout, "running the point");
+        while let Ok((b'N', why)) = &answer {
+            note.get_or_insert_with(|| String::from_utf8_lossy(why).into_owned());
+            answer = self.receive(timeout, "running the point");
+        }
+        (answer.and_then(|a| self.record(a)), note)
+    }
+
+    /// The record of a point's answer.
+    fn record(&mut self, answer: Frame) -> Result<Vec<f64>, WorkerFailure> {
+        match answer {
             (b'O', v) if v.len() % 8 == 0 => Ok(bytes_to_f64s(&v)),
             (b'O', v) => Err(self.malformed(
                 &format!("a record of {} bytes", v.len()),
@@ -332,6 +354,42 @@ impl Worker {
             )),
             (tag, _) => Err(self.protocol_error(tag)),
         }
+    }
+
+    /// The second half of the reset self-check: the point just run, again after `fmi2Reset`.
+    /// Returns the verdict and whether the worker lives on, or the message of a worker stopped
+    /// from outside (the driver is being stopped).
+    pub fn check_reset(
+        &mut self,
+        values: &[f64],
+        timeout: Option<Duration>,
+    ) -> Result<(ResetCheck, bool), String> {
+        let doing = "running the point again after fmi2Reset (the reset self-check)";
+        Ok(
+            match self.request(b'C', &f64s_to_bytes(values), timeout, doing) {
+                Ok((b'V', v)) if !v.is_empty() => {
+                    let why = String::from_utf8_lossy(&v[1..]).into_owned();
+                    match v[0] {
+                        0 => (ResetCheck::Passed, true),
+                        1 => (ResetCheck::Failed(why), true),
+                        _ => (ResetCheck::Failed(why), false),
+                    }
+                }
+                Ok((tag, _)) => {
+                    let WorkerFailure::Died(m) = self.protocol_error(tag) else {
+                        unreachable!("protocol errors are deaths")
+                    };
+                    (ResetCheck::Failed(m), false)
+                }
+                Err(WorkerFailure::Interrupted(m)) => return Err(m),
+                Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => (
+                    ResetCheck::Failed(format!(
+                    "the FMU's run after fmi2Reset failed where a fresh instance's succeeded: {m}"
+                )),
+                    false,
+                ),
+            },
+        )
     }
 
     fn protocol_error(&mut self, tag: u8) -> WorkerFailure {
@@ -362,6 +420,11 @@ impl Worker {
         if let Some(stdin) = self.stdin.as_mut() {
             let _ = write_frame(stdin, tag, payload);
         }
+        self.receive(timeout, doing)
+    }
+
+    /// Waits (at most `timeout`) for the worker's next frame.
+    fn receive(&mut self, timeout: Option<Duration>, doing: &str) -> Result<Frame, WorkerFailure> {
         let deadline = timeout.map(|t| Instant::now() + t);
         // When the answer pipe reached its end while the worker still ran.
         let mut pipe_closed: Option<Instant> = None;
@@ -497,35 +560,91 @@ impl Drop for Worker {
 #[derive(Debug)]
 pub struct WorkerPool {
     opts: IsolateOptions,
-    setup: Vec<u8>,
+    /// The setup new workers get (JSON), and what it says.
+    setup: Mutex<(Setup, Vec<u8>)>,
     idle: Mutex<Vec<Worker>>,
+    /// Why a worker's `fmi2Reset` failed, since the last [`WorkerPool::take_reset_failure`].
+    reset_failure: Mutex<Option<String>>,
 }
 
 impl WorkerPool {
     /// A pool that starts workers for `setup`.
     pub fn new(opts: IsolateOptions, setup: &Setup) -> WorkerPool {
+        let json = serde_json::to_vec(setup).expect("serializable");
         WorkerPool {
             opts,
-            setup: serde_json::to_vec(setup).expect("serializable"),
+            setup: Mutex::new((setup.clone(), json)),
             idle: Mutex::new(Vec::new()),
+            reset_failure: Mutex::new(None),
         }
+    }
+
+    /// Whether workers started from now on reuse instances (the reset self-check's verdict;
+    /// the worker that ran the check knows it already).
+    pub fn set_reuse(&self, reuse: bool) {
+        let mut setup = self.setup.lock().unwrap_or_else(|e| e.into_inner());
+        setup.0.policy.reuse = reuse;
+        setup.1 = serde_json::to_vec(&setup.0).expect("serializable");
+    }
+
+    fn take_idle(&self) -> Option<Worker> {
+        self.idle.lock().unwrap_or_else(|e| e.into_inner()).pop()
+    }
+
+    fn give_back(&self, worker: Worker) {
+        self.idle
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(worker);
     }
 
     /// Runs one point in a worker.
     pub fn run(&self, values: &[f64]) -> Result<Vec<f64>, WorkerFailure> {
-        let idle = self.idle.lock().unwrap_or_else(|e| e.into_inner()).pop();
-        let mut worker = match idle {
+        let mut worker = match self.take_idle() {
             Some(w) => w,
-            None => Worker::start(&self.opts, &self.setup)?,
+            None => {
+                let setup = self
+                    .setup
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .1
+                    .clone();
+                Worker::start(&self.opts, &setup)?
+            }
         };
-        let result = worker.run(values, self.opts.timeout);
-        if matches!(result, Ok(_) | Err(WorkerFailure::Point(_))) {
-            self.idle
+        let (result, note) = worker.run(values, self.opts.timeout);
+        if let Some(why) = note {
+            self.reset_failure
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
-                .push(worker);
+                .get_or_insert(why);
+        }
+        if matches!(result, Ok(_) | Err(WorkerFailure::Point(_))) {
+            self.give_back(worker);
         }
         result
+    }
+
+    /// The reset self-check's second run, of the point `values` the pool has just run (alone)
+    /// successfully, in the worker that ran it; `Err` when the worker was stopped from outside
+    /// (the driver is being stopped).
+    pub fn check_reset(&self, values: &[f64]) -> Result<ResetCheck, String> {
+        let Some(mut worker) = self.take_idle() else {
+            return Ok(ResetCheck::NotRun);
+        };
+        let (check, lives) = worker.check_reset(values, self.opts.timeout)?;
+        if lives {
+            self.give_back(worker);
+        }
+        Ok(check)
+    }
+
+    /// Why a worker's `fmi2Reset` failed (its point then ran on a fresh instance), once.
+    pub fn take_reset_failure(&self) -> Option<String> {
+        self.reset_failure
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take()
     }
 }
 
@@ -630,27 +749,59 @@ pub fn serve() -> i32 {
     if write_frame(&mut out, b'R', &[]).is_err() {
         return 1;
     }
-    let mut slot: Option<Instance> = None;
+    // The FMU's messages go to stderr, where the parent keeps the last lines.
+    let mut slot = Slot::new(setup.policy, true);
+    // The last point run successfully: its values and record (for the reset self-check).
+    let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
     while let Ok(Some((tag, payload))) = read_frame(&mut input) {
-        if tag != b'P' {
-            eprintln!("uq-driver worker: unexpected frame '{}'", char::from(tag));
-            return 1;
-        }
-        if slot.is_none() {
-            // The FMU's messages go to stderr, where the parent keeps the last lines.
-            if let Ok(inst) = fmu.instantiate("uq-driver", false) {
-                inst.set_log_echo(true);
-                slot = Some(inst);
-            }
-        }
         let values = bytes_to_f64s(&payload);
-        let sent = match run_point(&fmu, &mut slot, &setup.interface, &values, &setup.times) {
-            Ok(v) => write_frame(&mut out, b'O', &f64s_to_bytes(&v)),
-            Err(e) if fmu.is_unusable() => {
-                let _ = write_frame(&mut out, b'X', e.to_string().as_bytes());
-                return 0;
+        let sent = match tag {
+            b'P' => {
+                let result = run_point(&fmu, &mut slot, &setup.interface, &values, &setup.times);
+                if let Some(why) = slot.take_reset_failure() {
+                    if write_frame(&mut out, b'N', why.as_bytes()).is_err() {
+                        return 1;
+                    }
+                }
+                last = None;
+                match result {
+                    Ok(v) => {
+                        let sent = write_frame(&mut out, b'O', &f64s_to_bytes(&v));
+                        last = Some((values, v));
+                        sent
+                    }
+                    Err(e) if fmu.is_unusable() => {
+                        let _ = write_frame(&mut out, b'X', e.to_string().as_bytes());
+                        return 0;
+                    }
+                    Err(e) => write_frame(&mut out, b'F', e.to_string().as_bytes()),
+                }
             }
-            Err(e) => write_frame(&mut out, b'F', e.to_string().as_bytes()),
+            b'C' => {
+                let (check, _) = match &last {
+                    Some((v, first)) if *v == values => {
+                        check_reset(&fmu, &mut slot, &setup.interface, v, &setup.times, first)
+                    }
+                    _ => (ResetCheck::Failed("no run to compare with".into()), None),
+                };
+                let ends = fmu.is_unusable();
+                let (code, why) = match check {
+                    ResetCheck::Passed => (0, String::new()),
+                    ResetCheck::Failed(why) => (if ends { 2 } else { 1 }, why),
+                    ResetCheck::NotRun => (1, "not run".to_owned()),
+                };
+                let mut payload = vec![code];
+                payload.extend_from_slice(why.as_bytes());
+                let sent = write_frame(&mut out, b'V', &payload);
+                if ends {
+                    return 0;
+                }
+                sent
+            }
+            _ => {
+                eprintln!("uq-driver worker: unexpected frame '{}'", char::from(tag));
+                return 1;
+            }
         };
         if sent.is_err() {
             return 1;
@@ -666,13 +817,14 @@ pub fn serve() -> i32 {
     1
 }
 
-/// The worker setup of a study on `fmu`.
-pub fn setup(fmu: &Fmu, iface: &Interface, times: &[f64]) -> Setup {
+/// The worker setup of a study on `fmu`, whose runs get their instance by `policy`.
+pub fn setup(fmu: &Fmu, iface: &Interface, times: &[f64], policy: InstancePolicy) -> Setup {
     Setup {
         fmu_root: fmu.root().to_path_buf(),
         fmu_shown: fmu.path().to_path_buf(),
         interface: iface.clone(),
         times: times.to_vec(),
+        policy,
     }
 }
 
@@ -738,7 +890,7 @@ mod tests {
         let opts = fake_worker(dir.path(), "printf 'garbage12345'; sleep 30");
         let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
         let t0 = Instant::now();
-        match w.run(&[1.0], opts.timeout) {
+        match w.run(&[1.0], opts.timeout).0 {
             Err(WorkerFailure::Died(m)) => assert!(m.contains("malformed answer"), "{m}"),
             other => panic!("{other:?}"),
         }
@@ -749,7 +901,7 @@ mod tests {
             "printf 'O\\20\\0\\0\\0\\0\\0\\0\\0abc'; sleep 30",
         );
         let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
-        match w.run(&[1.0], opts.timeout) {
+        match w.run(&[1.0], opts.timeout).0 {
             Err(WorkerFailure::Died(m)) => assert!(m.contains("--timeout-per-run"), "{m}"),
             other => panic!("{other:?}"),
         }
@@ -764,7 +916,7 @@ mod tests {
         opts.timeout = None;
         let mut w = Worker::start(&opts, b"{}").unwrap_or_else(|_| panic!("starts"));
         let t0 = Instant::now();
-        match w.run(&[1.0], None) {
+        match w.run(&[1.0], None).0 {
             Err(WorkerFailure::Died(m)) => assert!(m.contains("SIGSEGV"), "{m}"),
             other => panic!("{other:?}"),
         }

@@ -11,6 +11,7 @@ mod crash;
 pub mod export;
 pub mod guard;
 pub mod inputs;
+pub mod instances;
 pub mod interface;
 pub mod isolate;
 pub mod lock;

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use super::inputs::isclose;
+use super::instances::{first_difference, same_record, InstancePolicy, ResetCheck, Slot};
 use super::interface::{Interface, RandomValueError};
 use super::runner::RunError;
 use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
@@ -109,25 +110,19 @@ pub struct Trace {
     pub ended: Option<(f64, Option<Vec<f64>>)>,
 }
 
-/// Starts (or resets) `slot`'s instance, sets the parameters (the fixed ones, the random
+/// Starts `slot`'s instance (fresh, or reset: [`Slot::start`]), sets the parameters (the fixed ones, the random
 /// `values`, then the Real `extra` values) and the inputs, initializes and records the signals
 /// at `times`, ending early where the FMU ends the simulation.
 pub(super) fn simulate_point(
     fmu: &Fmu,
-    slot: &mut Option<Instance>,
+    slot: &mut Slot,
     iface: &Interface,
     values: &[f64],
     times: &[f64],
     extra: &[(u32, f64)],
 ) -> Result<Trace, PointError> {
     let nt = times.len();
-    let inst = match slot {
-        Some(inst) => {
-            inst.reset()?;
-            inst
-        }
-        None => slot.insert(fmu.instantiate("uq-driver", false)?),
-    };
+    let inst = slot.start(fmu)?;
     iface.fixed.apply(inst)?;
     iface.set_random(inst, values).map_err(|e| match e {
         RandomValueError::Fmu(e) => PointError::Fmu(e),
@@ -212,14 +207,14 @@ fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f
     Some(end)
 }
 
-/// Runs one point on `slot`'s instance (created or reset as needed). Returns the record
+/// Runs one point on `slot`'s instance (fresh or reset, by its policy). Returns the record
 /// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
 /// (value, code) of each scalar quantity (a `hunting_speed` entry gives two, from its own
 /// constant-speed runs on the same instance after the point's run). A run the FMU ends
 /// before the stop time is a failed point ([`PointError::EndedEarly`]).
 pub fn run_point(
     fmu: &Fmu,
-    slot: &mut Option<Instance>,
+    slot: &mut Slot,
     iface: &Interface,
     values: &[f64],
     times: &[f64],
@@ -227,10 +222,10 @@ pub fn run_point(
     let nt = times.len();
     let trace = simulate_point(fmu, slot, iface, values, times, &[]).inspect_err(|_| {
         // A failed instance may be in Error state: start the next point on a fresh one.
-        *slot = None;
+        slot.discard();
     })?;
     if let Some((time, _)) = trace.ended {
-        *slot = None;
+        slot.discard();
         return Err(PointError::EndedEarly {
             time,
             stop: times[nt - 1],
@@ -238,7 +233,7 @@ pub fn run_point(
     }
     let traces = trace.values;
     if let Some(pos) = traces.iter().position(|v| !v.is_finite()) {
-        *slot = None;
+        slot.discard();
         return Err(PointError::NonFinite {
             signal: iface.signal_names[pos / nt].clone(),
             time: times[pos % nt],
@@ -274,6 +269,40 @@ pub fn run_point(
     Ok(out)
 }
 
+/// The second half of the reset self-check ([`super::instances`]): point `values`, whose run
+/// on a fresh instance gave `first`, run again on the same instance (held by `slot`) after
+/// `fmi2Reset`. Afterwards `slot` reuses instances if the check passed, else not (and holds
+/// none). Also returns the error of the second run when it returned fmi2Fatal (the FMU is then
+/// unusable in this process).
+pub fn check_reset(
+    fmu: &Fmu,
+    slot: &mut Slot,
+    iface: &Interface,
+    values: &[f64],
+    times: &[f64],
+    first: &[f64],
+) -> (ResetCheck, Option<PointError>) {
+    slot.set_reuse(true);
+    let second = run_point(fmu, slot, iface, values, times);
+    let reset_failure = slot.take_reset_failure();
+    let (check, fatal) = match (reset_failure, second) {
+        (Some(why), _) => (ResetCheck::Failed(format!("fmi2Reset failed: {why}")), None),
+        (None, Err(e)) => {
+            let check = ResetCheck::Failed(format!(
+                "the FMU's run after fmi2Reset failed where a fresh instance's succeeded: {e}"
+            ));
+            (check, e.returned_fatal().then_some(e))
+        }
+        (None, Ok(second)) if same_record(first, &second) => (ResetCheck::Passed, None),
+        (None, Ok(second)) => (ResetCheck::Failed(first_difference(first, &second)), None),
+    };
+    if !check.reuse() {
+        slot.set_reuse(false);
+        slot.discard();
+    }
+    (check, fatal)
+}
+
 /// One deterministic run: its times and, per recorded variable, the series.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
@@ -300,8 +329,26 @@ pub fn simulate(
     inputs: Option<&Path>,
     times: &[f64],
 ) -> Result<Simulation, RunError> {
+    simulate_with(fmu, params, outputs, inputs, times, false)
+}
+
+/// [`simulate`], instantiating with `loggingOn = logging_on` (the FMU's messages then echoed
+/// to stderr as they come).
+pub fn simulate_with(
+    fmu: &Fmu,
+    params: &[(String, FixedValue)],
+    outputs: &[String],
+    inputs: Option<&Path>,
+    times: &[f64],
+    logging_on: bool,
+) -> Result<Simulation, RunError> {
     let iface = Interface::for_run(fmu, params, outputs, inputs)?;
-    let trace = simulate_point(fmu, &mut None, &iface, &[], times, &[])?;
+    let policy = InstancePolicy {
+        reuse: false,
+        logging_on,
+    };
+    let mut slot = Slot::new(policy, logging_on);
+    let trace = simulate_point(fmu, &mut slot, &iface, &[], times, &[])?;
     let nt = times.len();
     let mut out_times = times[..trace.recorded].to_vec();
     let mut series: Vec<Vec<f64>> = trace

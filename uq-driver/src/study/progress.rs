@@ -105,6 +105,14 @@ impl Progress {
         }
     }
 
+    /// Prints a line on stderr without garbling the bar.
+    pub fn println(&self, line: &str) {
+        match &self.bar {
+            Some(b) => b.suspend(|| eprintln!("{line}")),
+            None => eprintln!("{line}"),
+        }
+    }
+
     /// The run is over (a last line with the count).
     pub fn finish(&self) {
         if let Some(b) = &self.bar {

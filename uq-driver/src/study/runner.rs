@@ -1,5 +1,6 @@
-//! The parallel runner: one FMU instance per worker, `fmi2Reset` between points, every
-//! finished point appended to the results store.
+//! The parallel runner: one FMU instance per worker, reused through `fmi2Reset` between
+//! points once the reset self-check has passed ([`super::instances`]), every finished point
+//! appended to the results store.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -9,14 +10,15 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::guard::{self, StudyGuard};
+use super::instances::{self, InstancePolicy, ResetCheck, Slot};
 use super::interface::{Interface, InterfaceError};
 use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
 use super::lock::{FolderLock, LockError};
-pub use super::point::{run_point, simulate, PointError, Simulation, Trace};
+pub use super::point::{run_point, simulate, simulate_with, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
 use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
 use super::worker_fmu::WorkerFmus;
-use crate::fmu::{Fmu, FmuError, Instance};
+use crate::fmu::{Fmu, FmuError};
 use crate::spec::Study;
 use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
 
@@ -50,6 +52,12 @@ pub struct RunOptions {
     pub timeout_per_run: Option<Duration>,
     /// Start a large study without asking (`--yes`; see [`super::size`]).
     pub yes: bool,
+    /// `--fresh-instances`: every run on a fresh FMU instance, never reused through
+    /// `fmi2Reset` (and no reset self-check).
+    pub fresh_instances: bool,
+    /// `--fmu-logging`: instantiate with `loggingOn = true` (the FMU's messages are kept with
+    /// failed points, capped, not printed).
+    pub fmu_logging: bool,
 }
 
 impl RunOptions {
@@ -251,6 +259,9 @@ pub struct RunOutcome {
     pub threads: usize,
     /// SHA-256 of the FMU.
     pub fmu_sha256: String,
+    /// Warnings of the runs (printed when they arose): a failed reset self-check or
+    /// `fmi2Reset`, for `summary.json`.
+    pub warnings: Vec<String>,
 }
 
 impl RunOutcome {
@@ -338,13 +349,17 @@ pub fn run_points(
     iface.check_design(fmu, &design.values)?;
     let times = study.times();
     super::interface::check_step_sizes(fmu, &times)?;
+    let policy = InstancePolicy {
+        reuse: false,
+        logging_on: opts.fmu_logging,
+    };
     let workers = opts.isolate.as_ref().map(|exe| {
         WorkerPool::new(
             IsolateOptions {
                 exe: exe.clone(),
                 timeout: opts.timeout_per_run,
             },
-            &isolate::setup(fmu, &iface, &times),
+            &isolate::setup(fmu, &iface, &times, policy),
         )
     });
     let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
@@ -359,6 +374,9 @@ pub fn run_points(
         max_new: opts.max_new_points,
         workers,
         guard: &guard,
+        policy,
+        check_reset: !opts.fresh_instances && missing.len() >= 2,
+        notes: Notes::default(),
     };
     let mode = match (opts.progress, opts.progress_lines) {
         (true, _) => ProgressMode::Bar,
@@ -377,6 +395,7 @@ pub fn run_points(
         new
     })?;
     progress.finish();
+    let warnings = batch.notes.into_warnings();
     let n_new = new.len();
     for (i, e) in new {
         runs.set(i, e);
@@ -389,6 +408,7 @@ pub fn run_points(
         wall_time: started.elapsed().as_secs_f64(),
         threads,
         fmu_sha256: manifest.fmu_sha256,
+        warnings,
     })
 }
 
@@ -449,81 +469,233 @@ struct Batch<'a> {
     /// `--isolate`: the worker processes.
     workers: Option<WorkerPool>,
     guard: &'a StudyGuard,
+    /// How in-process runs get their instance (before the reset self-check: never reused).
+    policy: InstancePolicy,
+    /// Run the first point as the reset self-check, and reuse instances if it passes.
+    check_reset: bool,
+    /// Warnings of the runs, each printed once.
+    notes: Notes,
+}
+
+/// Counters shared by the points of a batch.
+#[derive(Default)]
+struct Shared {
+    stop: AtomicBool,
+    started: AtomicUsize,
 }
 
 impl Batch<'_> {
     /// Runs `points`; returns where the result of each finished one is in the store (the
-    /// values are not kept).
+    /// values are not kept). With [`Batch::check_reset`], the first point runs alone first as
+    /// the reset self-check, which decides whether the others reuse instances.
     fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Entry)>, RunError> {
-        let stop = AtomicBool::new(false);
-        let started = AtomicUsize::new(0);
-        points
+        let shared = Shared::default();
+        let mut first = Vec::new();
+        let mut policy = self.policy;
+        let mut rest = points;
+        if let (true, Some((&i, others))) = (self.check_reset, points.split_first()) {
+            let mut check = ResetCheck::NotRun;
+            first.extend(self.point(i, &shared, progress, || {
+                let (outcome, c) = self.run_checked(i);
+                check = c;
+                outcome
+            })?);
+            if let Some(w) = check.warning(i) {
+                self.notes.add(w, progress);
+            }
+            policy.reuse = check.reuse();
+            if let Some(workers) = &self.workers {
+                workers.set_reuse(policy.reuse);
+            }
+            rest = others;
+        }
+        let new: Vec<(usize, Entry)> = rest
             .par_iter()
             .with_min_len(1)
             .map_init(
-                || None::<Instance>,
-                |slot, &i| -> Result<Option<(usize, Entry)>, RunError> {
-                    if stop.load(Ordering::Relaxed) {
-                        return Ok(None);
-                    }
-                    if let Some(max) = self.max_new {
-                        if started.fetch_add(1, Ordering::SeqCst) >= max {
-                            stop.store(true, Ordering::Relaxed);
-                            return Ok(None);
-                        }
-                    }
-                    let (rec, fatal) = match self.run_one(slot, i) {
-                        Ok(Outcome::Done(rec)) => (rec, false),
-                        Ok(Outcome::Fatal(rec)) => (rec, true),
-                        // Refused after another instance's Fatal: not run, not stored.
-                        Ok(Outcome::Refused) => return Ok(None),
-                        Err(e) => {
-                            stop.store(true, Ordering::Relaxed);
-                            return Err(e);
-                        }
-                    };
-                    if fatal || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
-                        stop.store(true, Ordering::Relaxed);
-                    }
-                    let entry = self.store.append(i, &rec)?;
-                    progress.inc();
-                    if let (true, Record::Failed(message)) = (fatal, rec) {
-                        return Err(RunError::Fatal {
-                            point: i,
-                            values: describe_values(self.study, &self.design.values[i]),
-                            message,
-                        });
-                    }
-                    Ok(Some((i, entry)))
-                },
+                || Slot::new(policy, false),
+                |slot, &i| self.point(i, &shared, progress, || self.run_one(slot, i, progress)),
             )
             .filter_map(Result::transpose)
-            .collect()
+            .collect::<Result<_, _>>()?;
+        first.extend(new);
+        Ok(first)
+    }
+
+    /// Runs point `i` by `run` unless the batch stopped, stores its record and says whether
+    /// the batch stops.
+    fn point(
+        &self,
+        i: usize,
+        shared: &Shared,
+        progress: &Progress,
+        run: impl FnOnce() -> Result<Outcome, RunError>,
+    ) -> Result<Option<(usize, Entry)>, RunError> {
+        let stop = &shared.stop;
+        if stop.load(Ordering::Relaxed) {
+            return Ok(None);
+        }
+        if let Some(max) = self.max_new {
+            if shared.started.fetch_add(1, Ordering::SeqCst) >= max {
+                stop.store(true, Ordering::Relaxed);
+                return Ok(None);
+            }
+        }
+        let (rec, fatal) = match run() {
+            Ok(Outcome::Done(rec)) => (rec, false),
+            Ok(Outcome::Fatal(rec)) => (rec, true),
+            // Refused after another instance's Fatal: not run, not stored.
+            Ok(Outcome::Refused) => return Ok(None),
+            Err(e) => {
+                stop.store(true, Ordering::Relaxed);
+                return Err(e);
+            }
+        };
+        if fatal || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
+            stop.store(true, Ordering::Relaxed);
+        }
+        let entry = self.store.append(i, &rec)?;
+        progress.inc();
+        if let (true, Record::Failed(message)) = (fatal, rec) {
+            return Err(RunError::Fatal {
+                point: i,
+                values: describe_values(self.study, &self.design.values[i]),
+                message,
+            });
+        }
+        if let Some(why) = self
+            .workers
+            .as_ref()
+            .and_then(WorkerPool::take_reset_failure)
+        {
+            self.notes.reset_failed(&why, progress);
+        }
+        Ok(Some((i, entry)))
     }
 
     /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
-    fn run_one(&self, slot: &mut Option<Instance>, i: usize) -> Result<Outcome, RunError> {
+    fn run_one(&self, slot: &mut Slot, i: usize, progress: &Progress) -> Result<Outcome, RunError> {
         let values = &self.design.values[i];
         let _running = self.guard.running(i, describe_values(self.study, values));
         let Some(workers) = &self.workers else {
             let fmu = self.fmus.current()?;
-            return Ok(
-                match run_point(&fmu, slot, &self.iface, values, &self.times) {
-                    Ok(v) => Outcome::Done(Record::Ok(v)),
-                    Err(e) if e.refused_after_fatal() => Outcome::Refused,
-                    // This point's own call returned Fatal.
-                    Err(e) if e.returned_fatal() => Outcome::Fatal(Record::Failed(e.to_string())),
-                    Err(e) => Outcome::Done(Record::Failed(e.to_string())),
-                },
-            );
-        };
-        match workers.run(values) {
-            Ok(v) => Ok(Outcome::Done(Record::Ok(v))),
-            Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => {
-                Ok(Outcome::Done(Record::Failed(m)))
+            let result = run_point(&fmu, slot, &self.iface, values, &self.times);
+            if let Some(why) = slot.take_reset_failure() {
+                self.notes.reset_failed(&why, progress);
             }
-            Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
+            return Ok(in_process(result));
+        };
+        from_worker(i, workers.run(values))
+    }
+
+    /// Runs point `i` as the reset self-check: on a fresh instance (its record is the point's),
+    /// then again after `fmi2Reset` of that instance, each run timed on its own.
+    fn run_checked(&self, i: usize) -> (Result<Outcome, RunError>, ResetCheck) {
+        let values = &self.design.values[i];
+        let running = || self.guard.running(i, describe_values(self.study, values));
+        let Some(workers) = &self.workers else {
+            let fmu = match self.fmus.current() {
+                Ok(f) => f,
+                Err(e) => return (Err(e.into()), ResetCheck::NotRun),
+            };
+            let mut slot = Slot::new(self.policy, false);
+            let first = {
+                let _running = running();
+                run_point(&fmu, &mut slot, &self.iface, values, &self.times)
+            };
+            let Ok(record) = &first else {
+                return (Ok(in_process(first)), ResetCheck::NotRun);
+            };
+            let (check, fatal) = {
+                let _running = running();
+                super::point::check_reset(&fmu, &mut slot, &self.iface, values, &self.times, record)
+            };
+            // Freed before the other points start (an FMU instantiable once per process).
+            drop(slot);
+            return match fatal {
+                // fmi2Fatal after the reset: no further call in this process.
+                Some(e) => (
+                    Ok(Outcome::Fatal(Record::Failed(format!(
+                        "{e} (in the second run of the point, after fmi2Reset, of the reset \
+                         self-check; its run on a fresh instance had succeeded; \
+                         --fresh-instances never resets)"
+                    )))),
+                    check,
+                ),
+                None => (Ok(in_process(first)), check),
+            };
+        };
+        let first = {
+            let _running = running();
+            workers.run(values)
+        };
+        if first.is_err() {
+            return (from_worker(i, first), ResetCheck::NotRun);
         }
+        let check = {
+            let _running = running();
+            workers.check_reset(values)
+        };
+        match check {
+            Ok(check) => (from_worker(i, first), check),
+            // Stopped from outside: the study stops, a re-run computes the point.
+            Err(why) => (
+                Err(RunError::Interrupted { point: i, why }),
+                ResetCheck::NotRun,
+            ),
+        }
+    }
+}
+
+/// The outcome of an in-process run.
+fn in_process(result: Result<Vec<f64>, PointError>) -> Outcome {
+    match result {
+        Ok(v) => Outcome::Done(Record::Ok(v)),
+        Err(e) if e.refused_after_fatal() => Outcome::Refused,
+        // This point's own call returned Fatal.
+        Err(e) if e.returned_fatal() => Outcome::Fatal(Record::Failed(e.to_string())),
+        Err(e) => Outcome::Done(Record::Failed(e.to_string())),
+    }
+}
+
+/// The outcome of a run in a worker process.
+fn from_worker(i: usize, result: Result<Vec<f64>, WorkerFailure>) -> Result<Outcome, RunError> {
+    match result {
+        Ok(v) => Ok(Outcome::Done(Record::Ok(v))),
+        Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => {
+            Ok(Outcome::Done(Record::Failed(m)))
+        }
+        Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
+    }
+}
+
+/// Warnings of a batch's runs: printed as they arise, each kind once, and kept.
+#[derive(Default)]
+struct Notes {
+    warnings: std::sync::Mutex<Vec<String>>,
+    reset_failed: AtomicBool,
+}
+
+impl Notes {
+    fn add(&self, warning: String, progress: &Progress) {
+        progress.println(&format!("uq-driver: warning: {warning}"));
+        self.warnings
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(warning);
+    }
+
+    /// A `fmi2Reset` failed (the run got a fresh instance): said once.
+    fn reset_failed(&self, why: &str, progress: &Progress) {
+        if !self.reset_failed.swap(true, Ordering::Relaxed) {
+            self.add(instances::reset_failed_warning(why), progress);
+        }
+    }
+
+    fn into_warnings(self) -> Vec<String> {
+        self.warnings
+            .into_inner()
+            .unwrap_or_else(|e| e.into_inner())
     }
 }
 

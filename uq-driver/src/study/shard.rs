@@ -339,6 +339,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         wall_time: 0.0,
         threads: 0,
         fmu_sha256: p.manifest.fmu_sha256.clone(),
+        warnings: Vec::new(),
     };
     finish(&study, method, &fmu, &design, outcome, out, opts).map_err(ShardError::Run)
 }
@@ -356,6 +357,9 @@ pub struct SlurmOptions {
     pub extra: Vec<String>,
     /// The merge writes the CSV files and `summary.json` only (`merge --no-report`).
     pub no_report: bool,
+    /// Options of every `run-shard` (e.g. `--isolate`, `--fresh-instances`): words without
+    /// blanks or quotes, written after the command.
+    pub shard_args: Vec<String>,
 }
 
 /// Writes `DIR/slurm/shard.sbatch` and `DIR/slurm/merge.sbatch`; returns their paths.
@@ -390,7 +394,8 @@ pub fn write_sbatch(
     let shard = format!(
         "#!/bin/bash\n#SBATCH --job-name=uq-shard\n#SBATCH --array=0-{last}\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --output={log}/shard-%a.out\n{common}\
          # One array task per shard; a re-submitted task resumes from its own store.\n\
-         exec {driver} run-shard {dir} --shard \"$SLURM_ARRAY_TASK_ID\" --threads \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"\n",
+         exec {driver} run-shard {dir} --shard \"$SLURM_ARRAY_TASK_ID\" --threads \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{args}\n",
+        args = o.shard_args.iter().map(|a| format!(" {}", q(Path::new(a)))).collect::<String>(),
         last = shards - 1,
         log = dir.join("slurm").display(),
         driver = q(driver),
@@ -414,6 +419,30 @@ pub fn write_sbatch(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_array_job_runs_its_shards_with_the_options_given_to_slurm() {
+        // QA round 3: `slurm --isolate` (or --fresh-instances, --fmu-logging) planned shards
+        // that ran without them.
+        let d = tempfile::tempdir().unwrap();
+        let o = SlurmOptions {
+            shard_args: vec!["--isolate".into(), "--timeout-per-run=2.5".into()],
+            ..SlurmOptions::default()
+        };
+        let (shard, merge) = write_sbatch(d.path(), Path::new("/bin/uq-driver"), 3, &o).unwrap();
+        let text = std::fs::read_to_string(shard).unwrap();
+        let exec = text.lines().last().unwrap();
+        assert!(
+            exec.starts_with("exec '/bin/uq-driver' run-shard"),
+            "{exec}"
+        );
+        assert!(
+            exec.ends_with(" '--isolate' '--timeout-per-run=2.5'"),
+            "{exec}"
+        );
+        let merge = std::fs::read_to_string(merge).unwrap();
+        assert!(!merge.contains("--isolate"));
+    }
 
     #[test]
     fn shards_partition_the_design() {

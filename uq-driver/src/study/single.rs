@@ -57,9 +57,11 @@ pub(crate) fn run_single(
                 eprintln!("uq-driver: warning: {w}");
             }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
+            let noted = outcome.warnings.len();
             let mut result = finish(study, method, &fmu, &design, outcome, out_dir, opts)?;
-            // finish puts the same range warnings first in the summary's list.
-            result.warnings_shown = early.len();
+            // finish puts the same range warnings first in the summary's list, then those the
+            // runs printed.
+            result.warnings_shown = early.len() + noted;
             Ok(result)
         }
     }
@@ -184,6 +186,8 @@ pub(crate) fn finish(
     };
     let method_summary = study.method().summary(study.parameters.len());
     warnings.splice(0..0, design.warnings.iter().cloned());
+    // What the runs noted (a failed fmi2Reset, the reset self-check), printed as they happened.
+    warnings.splice(0..0, outcome.warnings.iter().cloned());
     warnings.splice(0..0, ranges::range_warnings(study, fmu, design));
     let mut summary = summary(
         study,

@@ -65,7 +65,6 @@ use super::analysis::blocks;
 use super::guard::StudyGuard;
 use super::interface::Interface;
 use super::runner::{self, RunOptions};
-use crate::fmu::Instance;
 use crate::qoi::QoiSpec;
 use crate::spec::Study;
 use crate::uq::method::{Evaluation, MethodSpec};
@@ -655,7 +654,13 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
     let e = &study.experiment;
     let steps = ((e.stop - e.start) / e.step).round();
     let grid = |m: usize| -> Vec<f64> { (0..=m).map(|i| e.start + i as f64 * e.step).collect() };
-    let mut slot: Option<Instance> = None;
+    // Reused through fmi2Reset (a failed reset gets a fresh instance): the timing of a run,
+    // not of an instantiation.
+    let policy = super::instances::InstancePolicy {
+        reuse: true,
+        logging_on: false,
+    };
+    let mut slot = super::instances::Slot::new(policy, false);
     // The best of a few repeats: other work on the machine only ever adds time.
     let mut time = |m: usize, repeats: usize| -> Option<f64> {
         let times = grid(m);

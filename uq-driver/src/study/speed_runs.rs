@@ -6,9 +6,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::instances::Slot;
 use super::interface::{Interface, InterfaceError, Settings, VariableProblem, Variables};
 use super::point::{simulate_point, PointError};
-use crate::fmu::{Fmu, Instance, VariableKind};
+use crate::fmu::{Fmu, VariableKind};
 use crate::qoi::hunting_speed::{bisect, keeps_hunting, HuntingSpeed, HuntingSpeedSpec};
 use crate::qoi::scalar::Code;
 use crate::qoi::QoiSpec;
@@ -110,13 +111,13 @@ impl SpeedRuns {
     }
 
     /// The bisection at one design point (`values` of the random parameters) on `slot`'s
-    /// instance: the record's (value, code) pairs of both quantities, `name` then
+    /// instance (reset, or a fresh one, between runs, by its policy): the record's (value, code) pairs of both quantities, `name` then
     /// `name_decay`.
     pub fn evaluate(
         &self,
         h: &HuntingSpeedSpec,
         fmu: &Fmu,
-        slot: &mut Option<Instance>,
+        slot: &mut Slot,
         values: &[f64],
     ) -> Result<[f64; 4], PointError> {
         let outcome = bisect(h.low, h.high, h.tolerance, |v| {
@@ -149,7 +150,7 @@ impl SpeedRuns {
         &self,
         h: &HuntingSpeedSpec,
         fmu: &Fmu,
-        slot: &mut Option<Instance>,
+        slot: &mut Slot,
         values: &[f64],
         speed: f64,
     ) -> Result<bool, PointError> {
@@ -162,9 +163,9 @@ impl SpeedRuns {
             &self.times,
             &[(self.speed, speed)],
         )
-        .inspect_err(|_| *slot = None)?;
+        .inspect_err(|_| slot.discard())?;
         if let Some((time, _)) = trace.ended {
-            *slot = None;
+            slot.discard();
             return Err(PointError::EndedEarly {
                 time,
                 stop: self.times[nt - 1],
@@ -172,7 +173,7 @@ impl SpeedRuns {
         }
         let series = &trace.values[..nt];
         if let Some(k) = series.iter().position(|v| !v.is_finite()) {
-            *slot = None;
+            slot.discard();
             return Err(PointError::NonFinite {
                 signal: h.signal.clone(),
                 time: self.times[k],

@@ -83,6 +83,8 @@ pub struct Instance {
     component: NonNull<std::ffi::c_void>,
     state: InstanceState,
     name: String,
+    /// `fmi2Instantiate`'s loggingOn (errors say whether the FMU was asked to log).
+    logging_on: bool,
     // The FMU may call back into these until fmi2FreeInstance: both are boxed (stable addresses)
     // and dropped only after `Drop::drop` freed the instance.
     _callbacks: Box<CallbackFunctions>,
@@ -130,12 +132,14 @@ impl Instance {
         fmu: Arc<FmuInner>,
         instance_name: &str,
         logging_on: bool,
+        echo: bool,
     ) -> Result<Instance, FmuError> {
         let failed = |reason: String, messages: Vec<LogMessage>| FmuError::InstantiateFailed {
             path: fmu.path.clone(),
             instance: instance_name.to_string(),
             reason,
             messages,
+            logging_on,
         };
         if fmu.fatal.load(Ordering::Acquire) {
             return Err(FmuError::Unusable {
@@ -165,7 +169,7 @@ impl Instance {
             ));
         }
 
-        let sink = LogSink::new(logging_on);
+        let sink = LogSink::new(echo);
         let callbacks = CallbackFunctions::new(&sink);
         // SAFETY: all strings are NUL-terminated and outlive the call (the FMU copies them);
         // `callbacks` and the sink it points to are boxed and outlive the instance (see Drop).
@@ -188,6 +192,7 @@ impl Instance {
             component,
             state: InstanceState::Instantiated,
             name: instance_name.to_string(),
+            logging_on,
             _callbacks: callbacks,
             sink,
             fmu,
@@ -259,6 +264,7 @@ impl Instance {
             function,
             status,
             messages: self.sink.since(mark),
+            logging_on: self.logging_on,
         })
     }
 

@@ -289,9 +289,12 @@ fmi2Status fmi2Terminate(fmi2Component c) {
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
+    fmi2Status status;
     BEGIN(Reset)
+    status = MODEL.reset != NULL ? MODEL.reset(inst) : fmi2OK;
+    if (status > fmi2Warning) return finish(inst, status);
     reset_values(inst);
-    return fmi2OK;
+    return status;
 }
 
 /* ------------------------------------------------------------------------------------------ */

@@ -81,6 +81,9 @@ typedef struct {
      * inst->time to the time reached. fmi2Discard with inst->terminated set ends the
      * simulation (the FMU asks the importer to stop). */
     fmi2Status (*step)(Instance *inst, double h);
+    /* fmi2Reset, before the start values are restored (NULL: nothing): a status above
+     * fmi2Warning is returned as is and nothing is reset. */
+    fmi2Status (*reset)(Instance *inst);
 } ModelInfo;
 
 /* Provided by the model. */

@@ -20,6 +20,15 @@
  *     9 writes 12 bytes of garbage to file descriptor 3 and goes on
  *     10 starts a helper process that lives 20 s (holding every descriptor), then segfaults
  *     11 raises SIGTERM on itself   12 prints a line to stdout (fd 1) and goes on
+ *   reset_bug: a broken fmi2Reset, as FMUs from other tools have: 1 returns fmi2Error (logged),
+ *   2 returns fmi2OK but forgets the start values (every variable keeps its value of the run
+ *   before, u_integral included, which then starts where that run ended), 3 returns fmi2Error
+ *   (logged) after a run with gain < 1.5 only
+ *   quiet: the model's own messages (these misbehaviours, read_file) reach the importer only
+ *   with logging on, errors included (as pythonfmu FMUs log)
+ *   name_dir: not empty: at the end of initialization gain is written to the file
+ *   <name_dir>/<instanceName>.txt, and every step reads file_value back from it (an FMU that
+ *   keys its working files on its instance name)
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -70,9 +79,22 @@ typedef struct {
     fmi2Integer k_echo;
     fmi2Boolean flag_echo;
     double file_value;
+    fmi2Integer reset_bug;
+    fmi2Boolean quiet;
+    char name_dir[STRING_CAPACITY];
     /* internal */
     fmi2Boolean misbehaved; /* the misbehaviour has happened */
 } Data;
+
+/* The model's own messages: with `quiet`, only when logging is on (errors included). */
+#define QUIET(inst) (((Data *)(inst)->data)->quiet && !(inst)->logging_on)
+#define MODEL_LOG(inst, status, category, ...)                                   \
+    do {                                                                          \
+        if (!QUIET(inst)) fmu_log((inst), (status), (category), __VA_ARGS__);     \
+    } while (0)
+#define M_ERROR(inst, ...) MODEL_LOG((inst), fmi2Error, "logStatusError", __VA_ARGS__)
+#define M_WARNING(inst, ...) MODEL_LOG((inst), fmi2Warning, "logStatusWarning", __VA_ARGS__)
+#define M_INFO(inst, ...) MODEL_LOG((inst), fmi2OK, "logAll", __VA_ARGS__)
 
 #define VAR(name, type, vr, kind, field) {name, type, vr, kind, offsetof(Data, field), 0, 0, 0}
 
@@ -103,10 +125,15 @@ static const Variable VARIABLES[] = {
     VAR("string_param", TYPE_STRING, 0, KIND_FIXED_PARAMETER, string_param),
     VAR("read_file", TYPE_STRING, 1, KIND_FIXED_PARAMETER, read_file),
     VAR("string_out", TYPE_STRING, 2, KIND_OUTPUT, string_out),
+    {"reset_bug", TYPE_INTEGER, 8, KIND_FIXED_PARAMETER, offsetof(Data, reset_bug), 1, 0, 3},
+    VAR("quiet", TYPE_BOOLEAN, 4, KIND_FIXED_PARAMETER, quiet),
+    VAR("name_dir", TYPE_STRING, 3, KIND_FIXED_PARAMETER, name_dir),
 };
 
 static void set_defaults(void *data) {
     Data *d = (Data *)data;
+    /* reset_bug = 2: fmi2Reset forgets the start values (the data of a new instance is zero). */
+    if (d->reset_bug == 2) return;
     memset(d, 0, sizeof *d);
     d->int_param = 3;
     d->bool_param = fmi2False;
@@ -165,13 +192,13 @@ static fmi2Status read_value(Instance *inst, const char *name, double *value) {
     if (fmu_resource_path(inst, name, path, sizeof path) != 0) return fmi2Error;
     file = fopen(path, "rb");
     if (file == NULL) {
-        LOG_ERROR(inst, "read_file: cannot open '%s'", path);
+        M_ERROR(inst, "read_file: cannot open '%s'", path);
         return fmi2Error;
     }
     text = (char *)inst->cb.allocateMemory(FILE_LIMIT + 1, 1);
     if (text == NULL) {
         fclose(file);
-        LOG_ERROR(inst, "read_file: out of memory");
+        M_ERROR(inst, "read_file: out of memory");
         return fmi2Error;
     }
     n = fread(text, 1, FILE_LIMIT, file);
@@ -180,18 +207,58 @@ static fmi2Status read_value(Instance *inst, const char *name, double *value) {
     found = first_number(text, value);
     inst->cb.freeMemory(text);
     if (found != 0) {
-        LOG_ERROR(inst, "read_file: no number in the first %d bytes of '%s'", FILE_LIMIT, path);
+        M_ERROR(inst, "read_file: no number in the first %d bytes of '%s'", FILE_LIMIT, path);
         return fmi2Error;
     }
-    LOG_INFO(inst, "read_file: %s gives %.17g", path, *value);
+    M_INFO(inst, "read_file: %s gives %.17g", path, *value);
     return fmi2OK;
+}
+
+/* <name_dir>/<instanceName>.txt into path (capacity bytes); 0 when it fits. */
+static int name_file(Instance *inst, char *path, size_t capacity) {
+    Data *d = (Data *)inst->data;
+    int written = snprintf(path, capacity, "%s/%s.txt", d->name_dir, inst->name);
+    if (written < 0 || (size_t)written >= capacity) {
+        M_ERROR(inst, "name_dir: the path of the instance's file is too long");
+        return -1;
+    }
+    return 0;
+}
+
+/* name_dir: gain written to the instance's file, file_value read back from it. */
+static fmi2Status write_name_file(Instance *inst) {
+    Data *d = (Data *)inst->data;
+    char path[2 * STRING_CAPACITY + 64];
+    FILE *file;
+    if (name_file(inst, path, sizeof path) != 0) return fmi2Error;
+    file = fopen(path, "w");
+    if (file == NULL || fprintf(file, "%.17g\n", d->gain) < 0 || fclose(file) != 0) {
+        M_ERROR(inst, "name_dir: cannot write '%s'", path);
+        return fmi2Error;
+    }
+    return read_value(inst, path, &d->file_value);
 }
 
 static fmi2Status initialize(Instance *inst) {
     Data *d = (Data *)inst->data;
-    d->u_integral = 0.0;
+    /* u_integral starts at its start value 0 (set_defaults; kept by reset_bug = 2). */
     d->file_value = 0.0;
+    if (d->name_dir[0] != '\0') return write_name_file(inst);
     if (d->read_file[0] != '\0') return read_value(inst, d->read_file, &d->file_value);
+    return fmi2OK;
+}
+
+static fmi2Status reset(Instance *inst) {
+    Data *d = (Data *)inst->data;
+    if (d->reset_bug == 1) {
+        M_ERROR(inst, "reset_bug = 1: fmi2Reset fails on purpose");
+        return fmi2Error;
+    }
+    if (d->reset_bug == 3 && d->gain < 1.5) {
+        M_ERROR(inst, "reset_bug = 3: fmi2Reset fails on purpose after a run with gain %g < 1.5",
+                d->gain);
+        return fmi2Error;
+    }
     return fmi2OK;
 }
 
@@ -211,29 +278,29 @@ static fmi2Status misbehave(Instance *inst, double end) {
     d->misbehaved = fmi2True;
     switch (d->misbehave) {
     case MISBEHAVE_ERROR:
-        LOG_ERROR(inst, "misbehave = 1: fmi2DoStep fails on purpose at t = %g", end);
+        M_ERROR(inst, "misbehave = 1: fmi2DoStep fails on purpose at t = %g", end);
         return fmi2Error;
     /* 2..5 first log a warning, the last words an importer can show of the run. */
     case MISBEHAVE_SEGFAULT:
-        LOG_WARNING(inst, "misbehave = 2: segfaulting on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 2: segfaulting on purpose at t = %g", end);
         *null_pointer = 1;
         return fmi2Error;
     case MISBEHAVE_ABORT:
-        LOG_WARNING(inst, "misbehave = 3: calling abort() on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 3: calling abort() on purpose at t = %g", end);
         abort();
     case MISBEHAVE_EXIT:
-        LOG_WARNING(inst, "misbehave = 4: calling exit(0) on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 4: calling exit(0) on purpose at t = %g", end);
         exit(0);
     case MISBEHAVE_BLOCK:
-        LOG_WARNING(inst, "misbehave = 5: blocking forever on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 5: blocking forever on purpose at t = %g", end);
         block_forever();
         return fmi2Error;
     case MISBEHAVE_FATAL:
-        fmu_log(inst, fmi2Fatal, "logStatusFatal", "misbehave = 7: fatal error on purpose at t = %g",
+        MODEL_LOG(inst, fmi2Fatal, "logStatusFatal", "misbehave = 7: fatal error on purpose at t = %g",
                 end);
         return fmi2Fatal;
     case MISBEHAVE_WARNING:
-        LOG_WARNING(inst, "misbehave = 8: a warning on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 8: a warning on purpose at t = %g", end);
         return fmi2Warning;
     case MISBEHAVE_FD3: {
         static const char garbage[12] = "garbage\xff\x01\x02\x03!";
@@ -242,7 +309,7 @@ static fmi2Status misbehave(Instance *inst, double end) {
         return fmi2OK;
     }
     case MISBEHAVE_CHILD_SEGFAULT:
-        LOG_WARNING(inst, "misbehave = 10: starting a helper, then segfaulting at t = %g", end);
+        M_WARNING(inst, "misbehave = 10: starting a helper, then segfaulting at t = %g", end);
         if (fork() == 0) {
             const struct timespec life = {20, 0};
             nanosleep(&life, NULL);
@@ -251,7 +318,7 @@ static fmi2Status misbehave(Instance *inst, double end) {
         *null_pointer = 1;
         return fmi2Error;
     case MISBEHAVE_SIGTERM:
-        LOG_WARNING(inst, "misbehave = 11: raising SIGTERM on purpose at t = %g", end);
+        M_WARNING(inst, "misbehave = 11: raising SIGTERM on purpose at t = %g", end);
         raise(SIGTERM);
         return fmi2Error;
     case MISBEHAVE_STDOUT:
@@ -270,6 +337,11 @@ static fmi2Status step(Instance *inst, double h) {
     if (stop) end = d->stop_at > inst->time ? d->stop_at : inst->time;
     status = misbehave(inst, end);
     if (status > fmi2Warning) return status;
+    if (d->name_dir[0] != '\0') {
+        char path[2 * STRING_CAPACITY + 64];
+        if (name_file(inst, path, sizeof path) != 0) return fmi2Error;
+        if (read_value(inst, path, &d->file_value) != fmi2OK) return fmi2Error;
+    }
     d->u_integral += d->u * (end - inst->time);
     inst->time = end;
     if (d->misbehave == MISBEHAVE_NAN && d->misbehaved) {
@@ -280,7 +352,7 @@ static fmi2Status step(Instance *inst, double h) {
     }
     if (stop) {
         inst->terminated = fmi2True;
-        LOG_INFO(inst, "stop_at: the simulation ends at t = %g", end);
+        M_INFO(inst, "stop_at: the simulation ends at t = %g", end);
         return fmi2Discard;
     }
     return status;
@@ -295,4 +367,5 @@ const ModelInfo MODEL = {
     calculate,
     initialize,
     step,
+    reset,
 };

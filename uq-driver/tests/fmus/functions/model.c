@@ -200,4 +200,5 @@ const ModelInfo MODEL = {
     calculate,
     initialize,
     step,
+    NULL,
 };

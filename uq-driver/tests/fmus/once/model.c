@@ -107,4 +107,5 @@ const ModelInfo MODEL = {
     calculate,
     initialize,
     step,
+    NULL,
 };

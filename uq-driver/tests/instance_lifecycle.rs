@@ -1,0 +1,397 @@
+//! QA round 3, the instance lifecycle of a study, against the Features test FMU's `reset_bug`
+//! (a broken `fmi2Reset`), `name_dir` (working files keyed on the instance name) and `quiet`
+//! (messages only with logging on): H-2 (instances reused through a broken `fmi2Reset` gave
+//! failures or silently wrong numbers), M-3 (every instance was named `uq-driver`), M-2 (FMUs
+//! were always instantiated with `loggingOn = false`). Each test is named after the problem it
+//! pins. Reference values are in closed form: with `u` = 0.7 held, `u_integral`(t) = 0.7 t and
+//! `u_gain` = 0.7 gain.
+
+#[path = "support/test_fmus.rs"]
+mod test_fmus;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+
+/// Eight Monte Carlo points with gain ~ U(1, 2), u = 0.7, stop 1 s, step 0.1 s; `fixed`
+/// extra `[fixed]` lines.
+fn study_text(fmu: &Path, fixed: &str) -> String {
+    format!(
+        "name = \"lifecycle\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+         [method]\nkind = \"mc\"\nsamples = 8\n\
+         [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1.0\nhigh = 2.0\n\
+         [fixed]\nread_file = \"\"\nu = 0.7\n{fixed}\n\
+         [outputs]\nvariables = [\"u_integral\", \"u_gain\", \"file_value\"]\n\
+         [analysis]\nallow_failures = true\n",
+        fmu.to_str().unwrap()
+    )
+}
+
+struct Case {
+    dir: tempfile::TempDir,
+    study: PathBuf,
+}
+
+fn case(fixed: &str) -> Option<Case> {
+    let fmu = test_fmus::test_fmu("Features")?;
+    let dir = tempfile::tempdir().unwrap();
+    let study = dir.path().join("s.toml");
+    std::fs::write(&study, study_text(&fmu, fixed)).unwrap();
+    Some(Case { dir, study })
+}
+
+impl Case {
+    fn out(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+
+    /// `run` into folder `name` with `extra` options; must succeed.
+    fn run(&self, name: &str, extra: &[&str]) -> Output {
+        let o = self.try_run(name, extra);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        o
+    }
+
+    /// `run` into folder `name` with `extra` options.
+    fn try_run(&self, name: &str, extra: &[&str]) -> Output {
+        let out = self.out(name);
+        let mut args = vec![
+            "run",
+            self.study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-report",
+        ];
+        args.extend_from_slice(extra);
+        Command::new(DRIVER).args(&args).output().expect("runs")
+    }
+
+    fn csv(&self, name: &str, file: &str) -> String {
+        std::fs::read_to_string(self.out(name).join(file)).unwrap()
+    }
+
+    /// The statuses of points.csv, in point order.
+    fn statuses(&self, name: &str) -> Vec<String> {
+        let text = self.csv(name, "points.csv");
+        let mut rows = Vec::new();
+        let mut lines = text.lines().skip(1);
+        while let Some(line) = lines.next() {
+            let mut row = line.to_owned();
+            while row.matches('"').count() % 2 == 1 {
+                row.push('\n');
+                row.push_str(lines.next().unwrap());
+            }
+            rows.push(row.splitn(3, ',').nth(2).unwrap().to_owned());
+        }
+        rows
+    }
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The gain of each point, from points.csv (`index,gain,status`).
+fn gains(points: &str) -> Vec<f64> {
+    points
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(1)?.parse().ok())
+        .collect()
+}
+
+/// Rows of a CSV file with a header: the numbers of each row.
+fn numbers(text: &str) -> Vec<Vec<f64>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+/// Every run's series of output `name`, from `export --runs`: (run, time, value).
+fn runs(dir: &Path, name: &str) -> Vec<(usize, f64, f64)> {
+    let o = Command::new(DRIVER)
+        .args(["export", dir.to_str().unwrap(), "--runs"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(dir.join("runs/runs.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == name).expect("column");
+    numbers(&text)
+        .into_iter()
+        .map(|r| (r[0] as usize, r[1], r[col]))
+        .collect()
+}
+
+/// Checks `u_integral` = 0.7 t and `u_gain` = 0.7 gain (the design's gain of each run, read
+/// from `file_value` when `name_dir` is set, else only its range) in every run.
+fn check_closed_form(dir: &Path) {
+    let integral = runs(dir, "u_integral");
+    assert_eq!(integral.len(), 8 * 11);
+    for (run, t, v) in &integral {
+        assert!((v - 0.7 * t).abs() < 1e-12, "run {run} at t = {t}: {v}");
+    }
+    for (run, _, v) in runs(dir, "u_gain") {
+        assert!((0.7..=1.4).contains(&v), "run {run}: u_gain {v}");
+    }
+}
+
+#[test]
+fn a_reset_that_returns_error_fails_no_point_in_process_or_in_workers() {
+    // H-2 (a): every second point failed (every point under --isolate).
+    let Some(c) = case("reset_bug = 1") else {
+        return;
+    };
+    let mut csvs = Vec::new();
+    for (name, extra) in [
+        ("t1", &["-t", "1"][..]),
+        ("t2", &["-t", "2"]),
+        ("iso", &["--isolate", "-t", "2"]),
+    ] {
+        let o = c.run(name, extra);
+        assert!(c.statuses(name).iter().all(|s| s == "ok"), "{name}");
+        let err = stderr(&o);
+        assert_eq!(err.matches("warning: fmi2Reset failed").count(), 1, "{err}");
+        assert!(
+            err.contains("reset_bug = 1: fmi2Reset fails on purpose"),
+            "{err}"
+        );
+        assert!(
+            err.contains("every point now runs on a fresh instance"),
+            "{err}"
+        );
+        check_closed_form(&c.out(name));
+        csvs.push(c.csv(name, "u_integral.csv") + &c.csv(name, "u_gain.csv"));
+    }
+    assert!(csvs.iter().all(|s| *s == csvs[0]));
+}
+
+#[test]
+fn a_reset_that_forgets_start_values_gives_the_numbers_of_fresh_instances() {
+    // H-2 (b): silently wrong numbers, different per thread count and under --isolate.
+    let Some(c) = case("reset_bug = 2") else {
+        return;
+    };
+    let mut csvs = Vec::new();
+    for (name, extra) in [
+        ("t1", &["-t", "1"][..]),
+        ("t2", &["-t", "2"]),
+        ("iso", &["--isolate"]),
+    ] {
+        let o = c.run(name, extra);
+        let err = stderr(&o);
+        assert_eq!(
+            err.matches("the FMU's results after fmi2Reset differ from a fresh instance's")
+                .count(),
+            1,
+            "{err}"
+        );
+        check_closed_form(&c.out(name));
+        csvs.push(c.csv(name, "u_integral.csv"));
+        // Kept in summary.json too (printed once, during the run).
+        let summary = c.csv(name, "summary.json");
+        assert!(
+            summary.contains("differ from a fresh instance"),
+            "{summary}"
+        );
+    }
+    assert!(csvs.iter().all(|s| *s == csvs[0]));
+}
+
+#[test]
+fn a_reset_that_fails_after_some_runs_only_gives_a_fresh_instance_and_one_warning() {
+    // H-2: a reset that fails after the self-check passed (here after runs with gain < 1.5):
+    // the point runs on a fresh instance, never fails, and the warning comes once.
+    let Some(c) = case("reset_bug = 3") else {
+        return;
+    };
+    let design = |name: &str| gains(&c.csv(name, "points.csv"));
+    for (name, extra) in [("t1", &["-t", "1"][..]), ("iso", &["--isolate", "-t", "1"])] {
+        let o = c.run(name, extra);
+        let gains = design(name);
+        // The seed puts point 0 above 1.5 (the check passes) and later points below.
+        assert!(
+            gains[0] >= 1.5 && gains.iter().any(|g| *g < 1.5),
+            "{gains:?}"
+        );
+        assert!(c.statuses(name).iter().all(|s| s == "ok"), "{name}");
+        let err = stderr(&o);
+        assert!(!err.contains("differ from a fresh"), "{err}");
+        assert_eq!(err.matches("warning: fmi2Reset failed").count(), 1, "{err}");
+        assert!(err.contains("reset_bug = 3"), "{err}");
+        check_closed_form(&c.out(name));
+    }
+    assert_eq!(
+        c.csv("t1", "u_integral.csv"),
+        c.csv("iso", "u_integral.csv")
+    );
+}
+
+/// The instance files the Features FMU wrote in `dir` (`<instanceName>.txt`), by name.
+fn instance_files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Whether `file` is `uq-driver-<pid>-<n>.txt`.
+fn is_unique_name(file: &str) -> bool {
+    let Some(rest) = file
+        .strip_prefix("uq-driver-")
+        .and_then(|r| r.strip_suffix(".txt"))
+    else {
+        return false;
+    };
+    let parts: Vec<&str> = rest.split('-').collect();
+    parts.len() == 2 && parts.iter().all(|p| p.parse::<u64>().is_ok())
+}
+
+#[test]
+fn concurrent_instances_have_names_of_their_own() {
+    // M-3: every instance was named `uq-driver`; an FMU that keys its files on the instance
+    // name read another run's file (61 of 120 rows wrong with two threads).
+    let Some(c) = case("") else { return };
+    let base = std::fs::read_to_string(&c.study).unwrap();
+    for (name, extra) in [
+        ("reused", &["-t", "2"][..]),
+        ("fresh", &["-t", "2", "--fresh-instances"]),
+        ("iso", &["--isolate", "-t", "2", "--fresh-instances"]),
+    ] {
+        let files = c.dir.path().join(format!("names-{name}"));
+        std::fs::create_dir(&files).unwrap();
+        let text = base.replace(
+            "u = 0.7\n",
+            &format!("u = 0.7\nname_dir = {:?}\n", files.to_str().unwrap()),
+        );
+        std::fs::write(&c.study, text).unwrap();
+        c.run(name, extra);
+        let names = instance_files(&files);
+        assert!(names.iter().all(|n| is_unique_name(n)), "{names:?}");
+        // Fresh instances: one name per run. Reused (the self-check's instance, then one or a
+        // few per thread): fewer names than runs, each its own.
+        if name == "reused" {
+            assert!((2..8).contains(&names.len()), "{names:?}");
+        } else {
+            assert_eq!(names.len(), 8, "{names:?}");
+        }
+        // Each run read back its own gain.
+        let gains = gains(&c.csv(name, "points.csv"));
+        for (run, _, v) in runs(&c.out(name), "file_value") {
+            assert_eq!(v, gains[run], "{name}: run {run}");
+        }
+        check_closed_form(&c.out(name));
+    }
+}
+
+#[test]
+fn a_study_with_a_single_point_to_run_makes_no_reset_self_check() {
+    // The self-check costs one extra run per study, none when one point is left: a broken
+    // reset is then never called, and nothing warns.
+    let Some(c) = case("reset_bug = 1") else {
+        return;
+    };
+    // Seven points first (the self-check warns), then the one left.
+    let seven = c.try_run("one", &["--max-points", "7"]);
+    assert!(
+        stderr(&seven).contains("fmi2Reset failed"),
+        "{}",
+        stderr(&seven)
+    );
+    let one = c.run("one", &[]);
+    assert!(!stderr(&one).contains("fmi2Reset"), "{}", stderr(&one));
+    assert!(c.statuses("one").iter().all(|s| s == "ok"));
+}
+
+#[test]
+fn fresh_instances_and_fmu_logging_change_no_result_of_a_well_behaved_fmu() {
+    let Some(c) = case("") else { return };
+    let o = c.run("base", &["-t", "2"]);
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    for (name, extra) in [
+        ("fresh", &["--fresh-instances", "-t", "2"][..]),
+        ("logging", &["--fmu-logging", "-t", "1"]),
+        ("iso-logging", &["--fmu-logging", "--isolate"]),
+    ] {
+        let o = c.run(name, extra);
+        // Logging on: the FMU's info messages are kept, not printed.
+        assert!(!stderr(&o).contains("[fmu "), "{}", stderr(&o));
+        for file in [
+            "u_integral.csv",
+            "u_gain.csv",
+            "file_value.csv",
+            "points.csv",
+        ] {
+            assert_eq!(c.csv("base", file), c.csv(name, file), "{name}: {file}");
+        }
+    }
+}
+
+#[test]
+fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
+    // M-2: instances were always made with loggingOn = false, so an FMU that logs only when
+    // asked (pythonfmu) gave "the FMU logged nothing", even for its errors.
+    let Some(c) = case("misbehave = 1\nquiet = true") else {
+        return;
+    };
+    // misbehave_at ~ U(0.3, 1.8): the runs with misbehave_at <= 1 fail.
+    let text = std::fs::read_to_string(&c.study).unwrap().replace(
+        "name = \"gain\"\ndistribution = \"uniform\"\nlow = 1.0\nhigh = 2.0",
+        "name = \"misbehave_at\"\ndistribution = \"uniform\"\nlow = 0.3\nhigh = 1.8",
+    );
+    std::fs::write(&c.study, text).unwrap();
+    let said = "misbehave = 1: fmi2DoStep fails on purpose at t = ";
+    c.run("quiet", &[]);
+    let statuses = c.statuses("quiet");
+    assert!(
+        statuses.iter().filter(|s| *s != "ok").count() >= 2,
+        "{statuses:?}"
+    );
+    for s in statuses.iter().filter(|s| *s != "ok") {
+        assert!(s.contains("the FMU logged nothing"), "{s}");
+        assert!(s.contains("--fmu-logging"), "{s}");
+        assert!(!s.contains(said), "{s}");
+    }
+    for (name, extra) in [
+        ("logging", &["--fmu-logging"][..]),
+        ("iso", &["--fmu-logging", "--isolate"]),
+    ] {
+        c.run(name, extra);
+        let now = c.statuses(name);
+        for (before, s) in statuses.iter().zip(&now) {
+            assert_eq!(before == "ok", s == "ok", "{name}");
+            if s != "ok" {
+                assert!(s.contains(said), "{name}: {s}");
+                assert!(!s.contains("logged nothing"), "{name}: {s}");
+            }
+        }
+    }
+    // simulate: the message in the error, and on stderr as it comes.
+    let fmu = test_fmus::test_fmu("Features").unwrap();
+    let sim = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            fmu.to_str().unwrap(),
+            "--set",
+            "misbehave=1",
+            "--set",
+            "quiet=true",
+        ];
+        args.extend_from_slice(extra);
+        Command::new(DRIVER).args(&args).output().unwrap()
+    };
+    let quiet = sim(&[]);
+    assert!(!quiet.status.success());
+    assert!(
+        stderr(&quiet).contains("--fmu-logging"),
+        "{}",
+        stderr(&quiet)
+    );
+    let loud = sim(&["--fmu-logging"]);
+    assert!(!loud.status.success());
+    assert!(stderr(&loud).contains(said), "{}", stderr(&loud));
+}
