@@ -569,3 +569,181 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
     );
     assert!(html.contains("K += K · [[1]]"), "{html}");
 }
+
+/// Column `name` of a CSV file with a header row.
+fn csv_column(path: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("{name} not in {header:?} of {}", path.display()));
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// QA3 H1: the wheel-rail impact of `vehicle-track-defect` lasts about 2 ms, between two
+/// evenly spaced heat-map columns; the columns must include the times of the extremes of
+/// the quantiles and of the mean, and the grid must span the band over every time (the old
+/// heat map took its range from the sampled columns and cut the peak off).
+#[test]
+fn pdf_heat_map_columns_catch_a_short_event() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    run_ok(&[
+        "run",
+        "builtin:vehicle-track-defect",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let csv = out.join("P1.csv");
+    let t = csv_column(&csv, "time");
+    let pdf = out.join("P1_pdf.csv");
+    let (pdf_t, grid) = (csv_column(&pdf, "time"), csv_column(&pdf, "x"));
+    let at = |name: &str, largest: bool| {
+        let v = csv_column(&csv, name);
+        let k = (0..v.len())
+            .reduce(|a, b| {
+                let better = if largest { v[b] > v[a] } else { v[b] < v[a] };
+                if better {
+                    b
+                } else {
+                    a
+                }
+            })
+            .unwrap();
+        (t[k], v[k])
+    };
+    for (name, largest) in [
+        ("q99", true),
+        ("q1", false),
+        ("mean", true),
+        ("mean", false),
+    ] {
+        let (time, _) = at(name, largest);
+        assert!(
+            pdf_t.contains(&time),
+            "no heat-map column at t = {time}, where {name} is {}",
+            if largest { "largest" } else { "least" }
+        );
+    }
+    let lo = at("q1", false).1.min(at("lower_3sigma", false).1);
+    let hi = at("q99", true).1.max(at("upper_3sigma", true).1);
+    let (g0, g1) = grid
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    assert!(
+        g0 <= lo && g1 >= hi,
+        "grid {g0}..{g1} misses the band {lo}..{hi}"
+    );
+    assert!(plots_are_well_formed(&out) >= 6);
+}
+
+/// A wheel study by Sobol' sampling (QMC base, replicates), for the intervals and the
+/// convergence of the sampled estimates.
+fn sobol_sampling_study(dir: &Path) -> PathBuf {
+    let s = study(
+        dir,
+        "sobol",
+        "kind = \"sobol_sampling\"\nsamples = 256\nbase = \"qmc\"\nreplicates = 8",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
+    );
+    let out = dir.join("out");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    out
+}
+
+/// QA3 H2 and M9: the Sobol' bars of `sobol_sampling` carry the intervals the method
+/// computes (a whisker per bar, labelled in the words of the method's summary), and the
+/// running mean and Std of the convergence plot end at the reported mean and Std (they were
+/// taken over every pick-freeze row, the statistics over A and B only).
+#[test]
+fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = sobol_sampling_study(dir.path());
+    let s = json(&out.join("summary.json"));
+    let q = &s["quantities"]["q_peak"];
+    let ci = q["sobol"]["first_ci"]["C"]
+        .as_array()
+        .expect("first_ci of C");
+    assert_eq!(ci.len(), 2);
+    let bars = std::fs::read_to_string(out.join("q_peak_sobol.svg")).unwrap();
+    assert!(
+        bars.contains(">95 % interval (8 replicates,<") && bars.contains(">Student t)<"),
+        "{bars}"
+    );
+    // One whisker (a vertical stroke with two caps) per bar: 2 parameters × 2 groups.
+    assert_eq!(
+        bars.matches("stroke=\"#222\" stroke-width=\"1.3\"").count(),
+        4
+    );
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+    let conv = out.join("q_peak_convergence.csv");
+    let (mean, std) = (csv_column(&conv, "mean"), csv_column(&conv, "std"));
+    let (m, sd) = (q["mean"].as_f64().unwrap(), q["std"].as_f64().unwrap());
+    assert!(rel(*mean.last().unwrap(), m) < 1e-12, "{mean:?} vs {m}");
+    assert!(rel(*std.last().unwrap(), sd) < 1e-12, "{std:?} vs {sd}");
+    // The output's convergence (at the time of its largest Std) ends at q.csv's values.
+    let largest = csv_column(&out.join("q.csv"), "std")
+        .into_iter()
+        .fold(0.0, f64::max);
+    let conv = csv_column(&out.join("q_convergence.csv"), "std");
+    assert!(
+        rel(*conv.last().unwrap(), largest) < 1e-12,
+        "{conv:?} vs {largest}"
+    );
+    let runs = csv_column(&out.join("q_peak_convergence.csv"), "runs");
+    assert_eq!(*runs.last().unwrap(), 512.0, "A and B of 256 base rows");
+    let band = std::fs::read_to_string(out.join("q_peak_convergence.svg")).unwrap();
+    assert!(band.contains("iid standard errors"), "{band}");
+    // Scalar densities are per unit of the quantity (QA3 M10).
+    let pdf = std::fs::read_to_string(out.join("q_peak_pdf.svg")).unwrap();
+    assert!(pdf.contains("probability density [1/m]"), "{pdf}");
+    assert!(plots_are_well_formed(&out) >= 6);
+}
+
+/// QA3 H4, M6, M7: every single-study page shows Std(t) (`<V>_std.svg`, with the chaos's
+/// Std and its truncation-error estimate where there are), and the convergence against the
+/// chaos order has whole-number ticks and a dot at every order.
+#[test]
+fn std_over_time_and_chaos_convergence_read_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "stdplot",
+        "kind = \"scm\"\nnodes = 4",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
+    );
+    let out = dir.path().join("out");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("q_std.svg"), "Std plot not on the page");
+    let std = std::fs::read_to_string(out.join("q_std.svg")).unwrap();
+    assert!(
+        std.contains("Std q [m]") && std.contains("Std of q"),
+        "{std}"
+    );
+    assert!(
+        std.contains("std_pce") && std.contains("order_difference"),
+        "{std}"
+    );
+    let conv = std::fs::read_to_string(out.join("q_convergence.svg")).unwrap();
+    let orders = csv_column(&out.join("q_convergence.csv"), "order").len();
+    // Two curves, a dot at every order but 0 on each, plus two legend dots.
+    assert_eq!(
+        conv.matches("<circle").count(),
+        2 * (orders - 1) + 2,
+        "{conv}"
+    );
+    // Tick labels of the order axis are whole numbers.
+    for label in [">0.5<", ">1.5<", ">2.5<", ">1.2<", ">1.4<"] {
+        assert!(!conv.contains(label), "fractional order tick {label}");
+    }
+    assert!(plots_are_well_formed(&out) >= 6);
+}

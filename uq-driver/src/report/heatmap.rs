@@ -177,11 +177,8 @@ impl Heatmap {
             Some(s) => Axis::linear_exact(Some((s.lo, s.hi))),
             None => Axis::linear_exact(None),
         };
-        let mut entries: Vec<LegendEntry> = self
-            .overlay
-            .iter()
-            .map(|s| LegendEntry::line(&s.label, &s.color, s.dashed))
-            .collect();
+        let mut entries: Vec<LegendEntry> =
+            self.overlay.iter().map(LegendEntry::of_series).collect();
         entries.retain(|e| !e.label.is_empty());
         let bar_right = BAR_GAP + BAR_W + 10.0 + bar_axis.label_chars() as f64 * 6.4;
         let right = bar_right + BAR_LABEL_GAP + 12.0 + legend_width(&entries);

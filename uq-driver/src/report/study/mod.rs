@@ -99,7 +99,8 @@ pub fn write(dir: &Path, r: &StudyReport) -> Result<f64, ReportError> {
     let mut sections: Vec<Section> = outputs.into_iter().chain(quantities).flatten().collect();
     if r.plots {
         for spec in r.qoi {
-            if let Some(file) = plots::speed_plot(dir, spec, r.outputs, &r.summary.study)? {
+            let file = plots::speed_plot(dir, spec, r.outputs, r.quantities, &r.summary.study)?;
+            if let Some(file) = file {
                 let heading = format!("Quantity {}", spec.name());
                 if let Some(sec) = sections.iter_mut().find(|s| s.heading == heading) {
                     sec.images.insert(0, file);
@@ -330,6 +331,10 @@ fn output_section(
     let v = &s.name;
     plots::band(dir, s, summary)?;
     let mut images = vec![format!("{}_band.svg", stem(v))];
+    let std_plot = plots::std_plot(dir, s)?;
+    if std_plot {
+        images.push(format!("{}_std.svg", stem(v)));
+    }
     let mut text = if s.deterministic && is_nominal(summary) {
         format!(
             "{v} of the one nominal run (every parameter at its mean): no spread and no \
@@ -347,6 +352,12 @@ fn output_section(
             quantile_source(s.draws)
         )
     };
+    if std_plot {
+        text.push_str(&format!(
+            " The standard deviation of {v} over time is also plotted on its own ({}_std.svg).",
+            stem(v)
+        ));
+    }
     if plots::pdf_heatmap(dir, s)? {
         images.push(format!("{}_pdf.svg", stem(v)));
         text.push_str(&format!(
@@ -475,7 +486,7 @@ fn quantity_section(
             q.draws.describe(),
             quantile_source(q.draws)
         ));
-        if plots::sobol_bars(dir, q, names, None)? {
+        if plots::sobol_bars(dir, q, names, &summary.method)? {
             images.push(format!("{}_sobol.svg", stem(name)));
         }
         if let Some(c) = &q.convergence {

@@ -152,6 +152,24 @@ impl Axis {
         }
     }
 
+    /// A linear axis of whole numbers over the data range, half a unit beyond each end: a
+    /// tick at every integer (at most 20, else at 1-2-5 multiples), labelled without decimals.
+    pub fn integers(range: Option<(f64, f64)>) -> Self {
+        let (lo, hi) = range.unwrap_or((0.0, 1.0));
+        let (lo, hi) = (lo.floor() - 0.5, hi.ceil() + 0.5);
+        let mut axis = Self::linear(lo, hi);
+        let every = nice_step(0.0, hi - lo, 20).map_or(1.0, |s| s.value().max(1.0).round());
+        let (first, last) = (lo.ceil() as i64, hi.floor() as i64);
+        let every = every as i64;
+        axis.ticks = (first..=last)
+            .filter(|t| t.rem_euclid(every) == 0)
+            .map(|t| t as f64)
+            .collect();
+        axis.labels = axis.ticks.iter().map(|t| format!("{t:.0}")).collect();
+        axis.minor.clear();
+        axis
+    }
+
     /// A log10 axis over a positive range; `extend` widens it to whole decades.
     pub fn log(range: Option<(f64, f64)>, extend: bool) -> Self {
         let (mut lo, mut hi) = range.unwrap_or((1.0, 10.0));

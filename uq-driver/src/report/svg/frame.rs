@@ -28,6 +28,12 @@ pub(crate) struct LegendEntry {
     pub color: String,
     pub dashed: bool,
     pub filled: bool,
+    /// Opacity of the swatch (a fill) or of the line, as drawn in the plot.
+    pub opacity: f64,
+    /// An arrow glyph instead of a line: pointing left (`Some(false)`) or right.
+    pub arrow: Option<bool>,
+    /// A dot on the line, as on a series with markers.
+    pub marker: bool,
 }
 
 impl LegendEntry {
@@ -38,14 +44,34 @@ impl LegendEntry {
             color: color.to_string(),
             dashed,
             filled: false,
+            opacity: 1.0,
+            arrow: None,
+            marker: false,
         }
     }
 
+    /// A filled swatch, drawn with the opacity of the bars or areas it stands for.
     pub fn fill(label: &str, color: &str) -> Self {
         Self {
             filled: true,
+            opacity: 0.35,
             ..Self::line(label, color, false)
         }
+    }
+
+    /// The entry of a series, drawn as the series is (dash, opacity, markers).
+    pub fn of_series(s: &Series) -> Self {
+        Self {
+            opacity: s.opacity.unwrap_or(1.0),
+            marker: s.markers,
+            ..Self::line(&s.label, &s.color, s.dashed)
+        }
+    }
+
+    /// The same entry with another opacity.
+    pub fn with_opacity(mut self, opacity: f64) -> Self {
+        self.opacity = opacity;
+        self
     }
 
     fn height(&self) -> f64 {
@@ -311,12 +337,30 @@ impl Frame {
         } else {
             ""
         };
+        let opacity = match s.opacity {
+            Some(o) => format!(" stroke-opacity=\"{o}\""),
+            None => String::new(),
+        };
         let _ = writeln!(
             out,
-            "<path d=\"{d}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\" \
-             stroke-linejoin=\"round\" stroke-linecap=\"round\"{dash}/>",
-            escape_xml(&s.color)
+            "<path d=\"{d}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" \
+             stroke-linejoin=\"round\" stroke-linecap=\"round\"{dash}{opacity}/>",
+            escape_xml(&s.color),
+            s.width.unwrap_or(1.8)
         );
+        if s.markers {
+            for (x, y) in paired(&s.x, &s.y) {
+                if self.x.accepts(x) && self.y.accepts(y) {
+                    let _ = writeln!(
+                        out,
+                        "<circle cx=\"{}\" cy=\"{}\" r=\"3.2\" fill=\"{}\"/>",
+                        c(self.px(x)),
+                        c(self.py(y)),
+                        escape_xml(&s.color)
+                    );
+                }
+            }
+        }
     }
 
     /// A band as one `<path>` of closed polygons, one per run of finite points.
@@ -391,9 +435,32 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
             let _ = writeln!(
                 out,
                 "<rect x=\"{}\" y=\"{}\" width=\"24\" height=\"12\" fill=\"{color}\" \
-                 fill-opacity=\"0.35\" stroke=\"{color}\" stroke-width=\"0.8\"/>",
+                 fill-opacity=\"{}\" stroke=\"{color}\" stroke-width=\"0.8\"/>",
                 c(x),
-                c(cy - 6.0)
+                c(cy - 6.0),
+                e.opacity
+            );
+        } else if let Some(right) = e.arrow {
+            // The glyph of a marker beyond the plotted range: an arrow towards that side.
+            let (tail, tip, dir) = if right {
+                (x, x + 24.0, 1.0)
+            } else {
+                (x + 24.0, x, -1.0)
+            };
+            let _ = writeln!(
+                out,
+                "<path d=\"M{} {}L{} {}M{} {}L{} {}L{} {}Z\" stroke=\"{color}\" \
+                 fill=\"{color}\" stroke-width=\"1.5\"/>",
+                c(tail),
+                c(cy),
+                c(tip - dir * 6.0),
+                c(cy),
+                c(tip),
+                c(cy),
+                c(tip - dir * 7.0),
+                c(cy - 4.0),
+                c(tip - dir * 7.0),
+                c(cy + 4.0),
             );
         } else {
             let dash = if e.dashed {
@@ -410,12 +477,25 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
                     c(cy - 5.0)
                 );
             }
+            let opacity = if e.opacity < 1.0 {
+                format!(" stroke-opacity=\"{}\"", e.opacity)
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 out,
-                "<path d=\"M{} {}h24\" stroke=\"{color}\" stroke-width=\"2\"{dash}/>",
+                "<path d=\"M{} {}h24\" stroke=\"{color}\" stroke-width=\"2\"{dash}{opacity}/>",
                 c(x),
                 c(cy)
             );
+            if e.marker {
+                let _ = writeln!(
+                    out,
+                    "<circle cx=\"{}\" cy=\"{}\" r=\"3.2\" fill=\"{color}\"/>",
+                    c(x + 12.0),
+                    c(cy)
+                );
+            }
         }
         for (i, line) in e.lines.iter().enumerate() {
             let _ = writeln!(

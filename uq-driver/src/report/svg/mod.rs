@@ -34,6 +34,12 @@ pub struct Series {
     pub color: String,
     /// Draw dashed instead of solid.
     pub dashed: bool,
+    /// Stroke width in px (1.8 when `None`).
+    pub width: Option<f64>,
+    /// Stroke opacity (opaque when `None`).
+    pub opacity: Option<f64>,
+    /// A dot at every point (e.g. a few estimates against an integer order).
+    pub markers: bool,
 }
 
 impl Series {
@@ -50,12 +56,28 @@ impl Series {
             y,
             color: color.into(),
             dashed: false,
+            width: None,
+            opacity: None,
+            markers: false,
         }
     }
 
     /// The same line, dashed.
     pub fn dashed(mut self) -> Self {
         self.dashed = true;
+        self
+    }
+
+    /// The same line, `width` px wide and drawn with `opacity`.
+    pub fn thin(mut self, width: f64, opacity: f64) -> Self {
+        self.width = Some(width);
+        self.opacity = Some(opacity);
+        self
+    }
+
+    /// The same line with a dot at every point.
+    pub fn with_markers(mut self) -> Self {
+        self.markers = true;
         self
     }
 }
@@ -122,6 +144,9 @@ pub struct LinePlot {
     pub log_x: bool,
     /// Fixed vertical range instead of the data's (e.g. `(0, 1)` for indices).
     pub y_range: Option<(f64, f64)>,
+    /// The horizontal axis counts whole numbers (e.g. a chaos order): ticks at integers only,
+    /// half a unit of room at each end.
+    pub integer_x: bool,
 }
 
 impl LinePlot {
@@ -158,6 +183,8 @@ impl LinePlot {
             );
         let x_axis = if self.log_x {
             Axis::log(finite_range(xs, true), false)
+        } else if self.integer_x {
+            Axis::integers(finite_range(xs, false))
         } else {
             Axis::linear_exact(finite_range(xs, false))
         };
@@ -170,10 +197,10 @@ impl LinePlot {
 
         let mut legend: Vec<LegendEntry> = Vec::new();
         for b in &self.bands {
-            legend.push(LegendEntry::fill(&b.label, &b.color));
+            legend.push(LegendEntry::fill(&b.label, &b.color).with_opacity(b.opacity));
         }
         for s in &self.series {
-            legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
+            legend.push(LegendEntry::of_series(s));
         }
         legend.retain(|e| !e.label.is_empty());
 
@@ -210,7 +237,8 @@ pub struct DensityPlot {
     /// Title above the plot.
     pub title: String,
     /// Label of the horizontal axis (the quantity, with unit); the vertical axis is
-    /// "probability density".
+    /// "probability density" in the inverse of that unit (from a trailing `[unit]` of this
+    /// label: [`density_label`]).
     pub x_label: String,
     /// PDF curves (e.g. kernel density estimates, one per method).
     pub curves: Vec<Series>,
@@ -256,7 +284,10 @@ impl DensityPlot {
 
         let mut legend: Vec<LegendEntry> = Vec::new();
         if self.histogram.is_some() {
-            legend.push(LegendEntry::fill("histogram of the runs", HISTOGRAM_COLOR));
+            legend.push(
+                LegendEntry::fill("histogram of the runs", HISTOGRAM_COLOR)
+                    .with_opacity(HISTOGRAM_OPACITY),
+            );
         }
         for s in &self.curves {
             legend.push(LegendEntry::line(&s.label, &s.color, s.dashed));
@@ -269,11 +300,11 @@ impl DensityPlot {
             } else {
                 ""
             };
-            legend.push(LegendEntry::line(
-                &format!("{label}{side}"),
-                marker_color(i),
-                true,
-            ));
+            let mut entry = LegendEntry::line(&format!("{label}{side}"), marker_color(i), true);
+            if *x < x_axis.lo || *x > x_axis.hi {
+                entry.arrow = Some(*x > x_axis.hi);
+            }
+            legend.push(entry);
         }
         legend.retain(|e| !e.label.is_empty());
 
@@ -289,7 +320,8 @@ impl DensityPlot {
         }
         out.push_str("</g>\n");
         markers(&frame, &mut out, &self.markers);
-        frame.axes(&mut out, &self.title, &self.x_label, "probability density");
+        let y_label = density_label(&self.x_label);
+        frame.axes(&mut out, &self.title, &self.x_label, &y_label);
         frame.legend_outside(&mut out, &legend);
         out.push_str("</svg>\n");
         out
@@ -311,7 +343,7 @@ fn histogram(frame: &Frame, out: &mut String, bars: impl Iterator<Item = (f64, f
         let _ = writeln!(
             out,
             "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{HISTOGRAM_COLOR}\" \
-             fill-opacity=\"0.55\" stroke=\"#fff\" stroke-width=\"0.5\"/>",
+             fill-opacity=\"{HISTOGRAM_OPACITY}\" stroke=\"#fff\" stroke-width=\"0.5\"/>",
             c(xl),
             c(yt.min(y0)),
             c(xr - xl),
@@ -386,6 +418,9 @@ pub struct BarChart {
     pub groups: Vec<BarGroup>,
     /// Fixed vertical range (e.g. `(0, 1)`); the data's range when `None`.
     pub y_range: Option<(f64, f64)>,
+    /// Legend text of the whiskers (e.g. "95 % interval (8 replicates, Student t)");
+    /// "95 % interval" when empty.
+    pub interval_label: String,
 }
 
 /// One group of bars of a [`BarChart`].
@@ -433,14 +468,19 @@ impl BarChart {
         let mut legend: Vec<LegendEntry> = self
             .groups
             .iter()
-            .map(|g| LegendEntry::fill(&g.label, &g.color))
+            .map(|g| LegendEntry::fill(&g.label, &g.color).with_opacity(BAR_OPACITY))
             .collect();
         if self
             .groups
             .iter()
             .any(|g| g.intervals.iter().any(Option::is_some))
         {
-            legend.push(LegendEntry::line("95 % interval", "#222", false));
+            let label = if self.interval_label.is_empty() {
+                "95 % interval"
+            } else {
+                &self.interval_label
+            };
+            legend.push(LegendEntry::line(label, "#222", false));
         }
         legend.retain(|e| !e.label.is_empty());
         let mut frame = Frame::new(x_axis.clone(), y_axis, legend_width(&legend));
@@ -463,7 +503,7 @@ impl BarChart {
                     let _ = writeln!(
                         out,
                         "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" \
-                         fill-opacity=\"0.8\"/>",
+                         fill-opacity=\"{BAR_OPACITY}\"/>",
                         c(x),
                         c(yv.min(y0)),
                         c(bar_w * 0.92),
@@ -577,9 +617,36 @@ pub fn palette(i: usize) -> &'static str {
 }
 
 const HISTOGRAM_COLOR: &str = "#8c9db5";
+/// Fill opacity of histogram bars (and of their legend swatch).
+const HISTOGRAM_OPACITY: f64 = 0.55;
+/// Fill opacity of the bars of a [`BarChart`] (and of their legend swatches).
+const BAR_OPACITY: f64 = 0.8;
 
+/// The colour of limit marker `i`: eight distinct colours (none the blue of the curves or the
+/// grey-blue of the histogram) before they repeat.
 fn marker_color(i: usize) -> &'static str {
-    ["#d62728", "#222222", "#9467bd"][i % 3]
+    [
+        "#d62728", "#222222", "#9467bd", "#ff7f0e", "#2ca02c", "#8c564b", "#e377c2", "#17becf",
+    ][i % 8]
+}
+
+/// The label of a density axis for a quantity labelled `x_label`: "probability density
+/// [1/m]" for "q [m]", "[-]" for a dimensionless "W [-]", plain "probability density"
+/// without a unit.
+pub fn density_label(x_label: &str) -> String {
+    let unit = x_label
+        .trim_end()
+        .strip_suffix(']')
+        .and_then(|l| l.rsplit_once('['))
+        .map(|(_, u)| u.trim());
+    match unit {
+        Some("-") | Some("1") => "probability density [-]".into(),
+        Some(u) if !u.is_empty() => match super::units::per(Some(u)) {
+            Some(d) => format!("probability density [{d}]"),
+            None => "probability density".into(),
+        },
+        _ => "probability density".into(),
+    }
 }
 
 /// Points of `x` and `y` paired by index (the shorter length wins).

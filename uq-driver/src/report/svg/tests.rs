@@ -253,17 +253,12 @@ fn bar_chart_labels_categories_and_draws_intervals() {
             },
         ],
         y_range: Some((0.0, 1.0)),
+        interval_label: "95 % interval (8 replicates, Student t)".into(),
     };
     let svg = chart.to_svg();
+    assert!(svg.contains("95 % interval (8 replicates,") && svg.contains("Student t)"));
     assert!(balanced(&svg, "g") && balanced(&svg, "text"));
-    for name in [
-        "Kpz",
-        "Cpz",
-        "Ksz",
-        "first order S",
-        "total ST",
-        "95 % interval",
-    ] {
+    for name in ["Kpz", "Cpz", "Ksz", "first order S", "total ST"] {
         assert!(svg.contains(&format!(">{name}</text>")), "{name}");
     }
     // Five bars (the NaN has none) and one error bar.
@@ -355,4 +350,95 @@ fn density_markers_beyond_the_data_are_arrows_not_a_squashed_plot() {
     assert!(svg.contains(">limit 2.4</text>"));
     // The axis ends at the data (2.5), not at the far limit.
     assert!(svg.contains(">2.5</text>") && !svg.contains(">3.0</text>"));
+}
+
+/// QA3 L1: eight limits get eight colours (the palette wrapped after three), and a limit
+/// beyond the plotted range has an arrow glyph in the legend, not a dashed line.
+#[test]
+fn limit_markers_have_their_own_colours_and_arrow_glyphs() {
+    let x: Vec<f64> = (0..=100).map(|i| i as f64 * 0.01).collect();
+    let pdf = vec![1.0; x.len()];
+    let limits = [-1.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 2.0];
+    let plot = DensityPlot {
+        title: "t".into(),
+        x_label: "a [m/s2]".into(),
+        curves: vec![Series::new("KDE", x, pdf, palette(0))],
+        histogram: None,
+        markers: limits.iter().map(|&l| (l, format!("limit {l}"))).collect(),
+    };
+    let svg = plot.to_svg();
+    let colours: std::collections::BTreeSet<&str> = (0..limits.len()).map(marker_color).collect();
+    assert_eq!(colours.len(), limits.len());
+    assert!(!colours.contains(palette(0)) && !colours.contains(HISTOGRAM_COLOR));
+    // Legend: the six limits inside are dashed lines; the two outside are arrows (a path
+    // with a filled head), in their colours.
+    let legend = &svg[svg.find("<g class=\"legend\">").unwrap()..];
+    assert_eq!(legend.matches("stroke-dasharray").count(), 6, "{legend}");
+    for i in [0, 7] {
+        let c = marker_color(i);
+        assert!(
+            legend.contains(&format!("stroke=\"{c}\" fill=\"{c}\"")),
+            "no arrow glyph of limit {i}: {legend}"
+        );
+    }
+    // QA3 M10: the density axis in the inverse unit.
+    assert!(svg.contains("probability density [s2/m]"), "{svg}");
+}
+
+#[test]
+fn density_axis_labels_carry_the_inverse_unit() {
+    assert_eq!(density_label("q [m]"), "probability density [1/m]");
+    assert_eq!(density_label("W [-]"), "probability density [-]");
+    assert_eq!(density_label("v_cr [m/s]"), "probability density [s/m]");
+    assert_eq!(density_label("x"), "probability density");
+}
+
+/// QA3 L2: legend swatches are drawn with the opacity of what they stand for.
+#[test]
+fn legend_swatches_match_bars_and_bands() {
+    let chart = BarChart {
+        title: "t".into(),
+        categories: vec!["a".into()],
+        groups: vec![BarGroup {
+            label: "S".into(),
+            color: palette(0).into(),
+            values: vec![0.5],
+            intervals: vec![None],
+        }],
+        ..BarChart::default()
+    };
+    let svg = chart.to_svg();
+    let legend = &svg[svg.find("<g class=\"legend\">").unwrap()..];
+    assert!(
+        legend.contains(&format!("fill-opacity=\"{BAR_OPACITY}\"")),
+        "{legend}"
+    );
+    let mut plot = band_plot();
+    plot.bands[0].opacity = 0.75;
+    let svg = plot.to_svg();
+    let legend = &svg[svg.find("<g class=\"legend\">").unwrap()..];
+    assert!(legend.contains("fill-opacity=\"0.75\""), "{legend}");
+}
+
+/// QA3 M6: an axis of orders has whole-number ticks only, and dots mark every point.
+#[test]
+fn integer_axis_and_markers() {
+    let axis = Axis::integers(Some((1.0, 2.0)));
+    assert_eq!(axis.ticks, vec![1.0, 2.0]);
+    assert_eq!(axis.labels, vec!["1", "2"]);
+    assert!(axis.lo < 1.0 && axis.hi > 2.0);
+    let many = Axis::integers(Some((0.0, 60.0)));
+    assert!(many.ticks.iter().all(|t| t.fract() == 0.0) && many.ticks.len() <= 21);
+    let plot = LinePlot {
+        series: vec![
+            Series::new("s", vec![1.0, 2.0, 3.0], vec![1.0, 0.1, 0.01], palette(0)).with_markers(),
+        ],
+        log_y: true,
+        integer_x: true,
+        ..LinePlot::new("t", "order", "Std")
+    };
+    let svg = plot.to_svg();
+    // Three points and the legend's dot.
+    assert_eq!(svg.matches("<circle").count(), 4);
+    assert!(svg.contains(">2</text>") && !svg.contains(">1.5</text>"));
 }

@@ -140,15 +140,35 @@ fn merge_chaos(pces: &[&Pce]) -> Result<Pce, MethodError> {
 }
 
 /// The column summaries of a series taken block by block, and the draws of the columns
-/// whose densities are shown (at most `pdf_times + 1`, evenly spaced, with the last).
+/// whose densities are shown: at most `pdf_times + 1` evenly spaced (with the last), and
+/// the columns where a feature of the series is extreme ([`SeriesColumns::picked`]).
 pub(super) struct SeriesColumns {
     /// Summaries of the columns seen so far, in order.
     pub(super) cols: Vec<Column>,
-    /// The columns whose densities may be shown.
-    pub(super) candidates: Vec<usize>,
+    /// The evenly spaced columns whose densities may be shown.
+    candidates: Vec<usize>,
     /// Their draws, in the order of `candidates` (as far as seen).
-    pub(super) kept: Vec<Vec<f64>>,
+    kept: Vec<Vec<f64>>,
     quantiles: Vec<f64>,
+    /// Per feature ([`features`]): the first column where it is largest so far, with its
+    /// draws.
+    extremes: Vec<Option<Extreme>>,
+}
+
+/// The column where a feature of the series is largest (the first such), and its draws.
+struct Extreme {
+    index: usize,
+    score: f64,
+    draws: Vec<f64>,
+}
+
+/// The features of a column whose extreme columns get a density: the least and the
+/// greatest of each quantile and of the mean, and the largest Std (each as a score to
+/// maximise).
+fn features(c: &Column) -> Vec<f64> {
+    let mut f: Vec<f64> = c.quantiles.iter().flat_map(|&q| [-q, q]).collect();
+    f.extend([-c.mean, c.mean, c.std]);
+    f
 }
 
 impl SeriesColumns {
@@ -159,6 +179,7 @@ impl SeriesColumns {
             candidates,
             kept: Vec::new(),
             quantiles: quantiles.to_vec(),
+            extremes: Vec::new(),
         }
     }
 
@@ -183,12 +204,45 @@ impl SeriesColumns {
             self.kept
                 .push(all[(c - j0) * rows..(c - j0 + 1) * rows].to_vec());
         }
+        self.update_extremes(j0, &|k| all[(k - j0) * rows..(k - j0 + 1) * rows].to_vec());
+    }
+
+    /// Updates the extreme columns with the columns from `j0` on (the last block added);
+    /// `draws(k)` gives the draws of column `k` of that block. The first column wins a tie,
+    /// so the choice does not depend on the blocks.
+    fn update_extremes(&mut self, j0: usize, draws: &dyn Fn(usize) -> Vec<f64>) {
+        for (k, c) in self.cols.iter().enumerate().skip(j0) {
+            let f = features(c);
+            if self.extremes.len() < f.len() {
+                self.extremes.resize_with(f.len(), || None);
+            }
+            for (e, score) in self.extremes.iter_mut().zip(f) {
+                let better = match e {
+                    Some(e) => score > e.score,
+                    None => !score.is_nan(),
+                };
+                if better {
+                    // Draws are copied once the block's best is known (below).
+                    *e = Some(Extreme {
+                        index: k,
+                        score,
+                        draws: Vec::new(),
+                    });
+                }
+            }
+        }
+        for e in self.extremes.iter_mut().flatten() {
+            if e.index >= j0 && e.draws.is_empty() {
+                e.draws = draws(e.index);
+            }
+        }
     }
 
     /// Adds the next `ncols` columns of `rows` draws, starting at column `j0`, generated in
     /// parallel tasks of `task` columns: `fill(j, buf)` writes columns `j..j + w` (column-major)
     /// into a buffer of the thread, and they are summarised while still in cache. The same
-    /// summaries as [`SeriesColumns::add_slice`] of all the columns at once.
+    /// summaries as [`SeriesColumns::add_slice`] of all the columns at once (the draws of a
+    /// new extreme column are generated again, by its task).
     pub(super) fn add_generated(
         &mut self,
         j0: usize,
@@ -221,6 +275,42 @@ impl SeriesColumns {
             self.cols.extend(cols);
             self.kept.extend(kept);
         }
+        self.update_extremes(j0, &|k| {
+            let j = j0 + (k - j0) / task * task;
+            let w = task.min(j0 + ncols - j);
+            let mut buf = vec![0.0; rows * w];
+            fill(j, &mut buf);
+            buf[(k - j) * rows..(k - j + 1) * rows].to_vec()
+        });
+    }
+
+    /// The columns whose densities are shown, ascending, with their draws: the evenly spaced
+    /// ones, each extreme column taking the place of the nearest of them (so that a short
+    /// event, a peak between two evenly spaced columns, is among them; the count grows only
+    /// when two extremes would take the same place).
+    pub(super) fn picked(self) -> (Vec<usize>, Vec<Vec<f64>>) {
+        let mut chosen: Vec<(usize, Vec<f64>, bool)> = self
+            .candidates
+            .into_iter()
+            .zip(self.kept)
+            .map(|(k, d)| (k, d, false))
+            .collect();
+        for e in self.extremes.into_iter().flatten() {
+            if let Some(c) = chosen.iter_mut().find(|c| c.0 == e.index) {
+                c.2 = true;
+                continue;
+            }
+            let nearest = chosen
+                .iter_mut()
+                .filter(|c| !c.2)
+                .min_by_key(|c| c.0.abs_diff(e.index));
+            match nearest {
+                Some(c) => *c = (e.index, e.draws, true),
+                None => chosen.push((e.index, e.draws, true)),
+            }
+        }
+        chosen.sort_by_key(|c| c.0);
+        chosen.into_iter().map(|(k, d, _)| (k, d)).unzip()
     }
 }
 
@@ -262,6 +352,53 @@ mod tests {
         assert_eq!(format!("{:?}", whole.cols), format!("{:?}", tasks.cols));
         assert_eq!(whole.kept, tasks.kept);
         assert_eq!(tasks.kept.len(), 6);
+        assert_eq!(whole.picked(), tasks.picked());
+    }
+
+    /// QA3 H1: a two-column event between evenly spaced columns is among the picked
+    /// columns (the extremes of its quantiles, mean and Std), whatever the blocks.
+    #[test]
+    fn picked_columns_catch_a_short_event_whatever_the_blocks() {
+        let (rows, nt) = (40, 1000);
+        // A slow ramp, and at columns 505 and 506 a peak with a larger spread.
+        let all: Vec<f64> = (0..rows * nt)
+            .map(|i| {
+                let (k, r) = (i / rows, (i % rows) as f64);
+                let base = k as f64 * 1e-3 + 0.01 * (r * 0.37).sin();
+                match k {
+                    505 => base + 50.0 + r,
+                    506 => base - 30.0 - 0.5 * r,
+                    _ => base,
+                }
+            })
+            .collect();
+        let even: Vec<usize> = (0..nt).step_by(10).chain([nt - 1]).collect();
+        let qs = [0.01, 0.5, 0.99];
+        let mut whole = SeriesColumns::new(nt, even.clone(), &qs);
+        whole.add_slice(0, rows, &all);
+        let mut blocked = SeriesColumns::new(nt, even.clone(), &qs);
+        for (j0, w) in blocks(nt, 96) {
+            blocked.add_slice(j0, rows, &all[j0 * rows..(j0 + w) * rows]);
+        }
+        let mut generated = SeriesColumns::new(nt, even.clone(), &qs);
+        for (j0, w) in blocks(nt, 64) {
+            generated.add_generated(j0, rows, w, 32, &|j, buf| {
+                buf.copy_from_slice(&all[j * rows..j * rows + buf.len()])
+            });
+        }
+        let picked = whole.picked();
+        assert!(
+            picked.0.contains(&505) && picked.0.contains(&506),
+            "{:?}",
+            picked.0
+        );
+        // The extremes take the places of their nearest evenly spaced columns.
+        assert_eq!(picked.0.len(), even.len());
+        assert!(picked.0.windows(2).all(|w| w[0] < w[1]));
+        let k = picked.0.iter().position(|&c| c == 505).unwrap();
+        assert_eq!(picked.1[k], all[505 * rows..506 * rows].to_vec());
+        assert_eq!(blocked.picked(), picked);
+        assert_eq!(generated.picked(), picked);
     }
 
     #[test]

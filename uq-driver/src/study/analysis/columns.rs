@@ -16,6 +16,10 @@ pub(super) struct Column {
     pub quantiles: Vec<f64>,
     pub min: f64,
     pub max: f64,
+    /// Mean of the finite values.
+    pub mean: f64,
+    /// Their standard deviation (n − 1).
+    pub std: f64,
     /// Silverman's bandwidth.
     pub bandwidth: f64,
 }
@@ -50,6 +54,8 @@ pub(super) fn column(col: &[f64], ps: &[f64]) -> Column {
         quantiles: q[..ps.len()].to_vec(),
         min,
         max,
+        mean,
+        std,
         bandwidth: kde::silverman_from(n, mean, std, iqr),
     }
 }

@@ -199,8 +199,10 @@ fn summarise(
     settings: &Settings,
 ) -> Result<OutputStats, AnalysisError> {
     let a = settings.analysis;
-    let cols = &series.cols;
-    let quantiles = a
+    let mut series = series;
+    let all_cols = std::mem::take(&mut series.cols);
+    let cols = &all_cols;
+    let quantiles: Vec<(f64, Vec<f64>)> = a
         .quantiles
         .iter()
         .enumerate()
@@ -216,13 +218,9 @@ fn summarise(
     let (picked, kept): (Vec<usize>, Vec<Vec<f64>>) = if deterministic {
         (Vec::new(), Vec::new())
     } else {
-        (series.candidates, series.kept)
+        series.picked()
     };
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &k in &picked {
-        lo = lo.min(cols[k].min);
-        hi = hi.max(cols[k].max);
-    }
+    let (lo, hi) = density_range(estimate, &quantiles, cols, &picked);
     let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
     let grid = if picked.is_empty() {
         Vec::new()
@@ -281,6 +279,43 @@ fn summarise(
         convergence,
         convergence_time: k_max.map(|k| times[k]),
     })
+}
+
+/// The range of the density grid: the band of the whole series, from the least of its
+/// lowest quantile and of μ − 3σ to the greatest of its highest quantile and of μ + 3σ over
+/// every time (so that a short event between the columns is inside it); the range of the
+/// picked columns' draws where there is no finite band.
+fn density_range(
+    estimate: &Estimate,
+    quantiles: &[(f64, Vec<f64>)],
+    cols: &[Column],
+    picked: &[usize],
+) -> (f64, f64) {
+    let (lower, upper) = OutputStats::band(&estimate.mean, &estimate.std, 3.0);
+    let lowest = quantiles.iter().min_by(|a, b| a.0.total_cmp(&b.0));
+    let highest = quantiles.iter().max_by(|a, b| a.0.total_cmp(&b.0));
+    let finite = |v: &f64| v.is_finite();
+    let lo = lower
+        .iter()
+        .chain(lowest.map(|q| &q.1).into_iter().flatten())
+        .copied()
+        .filter(finite)
+        .fold(f64::INFINITY, f64::min);
+    let hi = upper
+        .iter()
+        .chain(highest.map(|q| &q.1).into_iter().flatten())
+        .copied()
+        .filter(finite)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if lo < hi {
+        return (lo, hi);
+    }
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &k in picked {
+        lo = lo.min(cols[k].min);
+        hi = hi.max(cols[k].max);
+    }
+    (lo, hi)
 }
 
 /// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
@@ -501,7 +536,17 @@ pub fn analyse_runs(
         let estimate = method
             .estimate(design, &qr.rows, &data)
             .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
-        quantities.push(scalar_stats(&name, q, &estimate, qr, &settings, None)?);
+        // The running estimate takes the rows the reported mean and Std use.
+        let moment_values = method.moment_rows(design, &qr.rows).map(|rows| {
+            rows.iter()
+                .filter_map(|&r| qr.valid.get(r).copied())
+                .collect::<Vec<_>>()
+        });
+        let mut stats = scalar_stats(&name, q, &estimate, qr, &settings, None)?;
+        if let Some(values) = moment_values {
+            stats.convergence = convergence(&estimate, 0, &values).filter(|_| !stats.deterministic);
+        }
+        quantities.push(stats);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
                 name: name.clone(),
@@ -547,7 +592,15 @@ fn output_in_blocks(
     if estimate.draws == Draws::Chaos {
         chaos_columns(name, &estimate, settings, &mut cols)?;
     }
-    let run_column = |k: usize| runs.column(o, nt, k);
+    // The running estimate takes the rows the reported mean and Std use.
+    let moment_rows = method.moment_rows(design, &runs.rows);
+    let run_column = |k: usize| {
+        let all = runs.column(o, nt, k)?;
+        Ok(match &moment_rows {
+            Some(rows) => rows.iter().filter_map(|&r| all.get(r).copied()).collect(),
+            None => all,
+        })
+    };
     let stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
     Ok((estimate, stats))
 }

@@ -346,6 +346,15 @@ impl Sampling for SobolSampling {
         })
     }
 
+    /// The runs of `A` and `B` at the complete base rows (those the mean and Std use),
+    /// alternating `A_k`, `B_k`.
+    fn moment_rows(&self, design: &Design, rows: &[usize]) -> Option<Vec<usize>> {
+        let d = design.points.first().map_or(0, Vec::len);
+        let blocks = PickFreezeRows::new(self.samples, d, rows);
+        let b: Vec<usize> = blocks.block_rows(1).collect();
+        Some(blocks.block_rows(0).zip(b).flat_map(|(a, b)| [a, b]).collect())
+    }
+
     fn planned_runs(&self, dim: usize) -> Option<f64> {
         Some(self.samples as f64 * (dim as f64 + 2.0))
     }

@@ -110,6 +110,13 @@ pub trait Sampling {
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError>;
 
+    /// The rows of `data` (indices into `rows`) that the estimate's mean and Std are taken
+    /// from, in the order a running estimate should take them, where they are not all the
+    /// rows in order (`None`): e.g. only the runs of `A` and `B` of a pick-freeze design.
+    fn moment_rows(&self, _design: &Design, _rows: &[usize]) -> Option<Vec<usize>> {
+        None
+    }
+
     /// The fewest successful runs the estimator can work with.
     fn min_runs(&self) -> usize {
         2

@@ -6,17 +6,22 @@
 use crate::report::file_name::stem;
 use std::path::Path;
 
-use super::super::svg::{BarChart, BarGroup};
-use super::super::units::{label, per, DIMENSIONLESS};
+use super::super::svg::{finite_range, BarChart, BarGroup};
+use super::super::units::{label, per, with_unit, DIMENSIONLESS};
 use super::super::{
     histogram_density, palette, write_bytes, Band, DensityPlot, Heatmap, LinePlot, ReportError,
     Series,
 };
-use super::files::column;
 use super::quantile_column;
 use crate::qoi::QoiSpec;
-use crate::results::{Convergence, OutputStats, ScalarStats, Summary};
-use crate::uq::method::Sobol;
+use crate::results::{sig, OutputStats, ScalarStats, Summary};
+use crate::uq::method::MethodSummary;
+
+mod convergence;
+mod over_time;
+
+pub(super) use convergence::convergence;
+pub(super) use over_time::{sobol_over_time, std_plot};
 
 /// `<V>_band.svg`: mean ± 3σ and the quantiles other than the median (only the value, for
 /// a deterministic output).
@@ -37,22 +42,26 @@ pub(super) fn band(dir: &Path, s: &OutputStats, summary: &Summary) -> Result<(),
         ));
     } else {
         push_band(&mut plot, &s.times, s, "mean".into());
+        // Over a long or fast series dashes break up into noise: thin solid lines there.
+        let long = s.times.len() > LONG_SERIES;
         for (i, (p, q)) in s.quantiles.iter().enumerate() {
             if *p != 0.5 {
-                plot.series.push(
-                    Series::new(
-                        format!("{} quantile", quantile_column(*p)),
-                        s.times.clone(),
-                        q.clone(),
-                        palette(i + 2),
-                    )
-                    .dashed(),
-                );
+                let line = Series::new(
+                    format!("{} quantile", quantile_column(*p)),
+                    s.times.clone(),
+                    q.clone(),
+                    palette(i + 2),
+                )
+                .thin(1.0, 0.9);
+                plot.series.push(if long { line } else { line.dashed() });
             }
         }
     }
     plot.write(&dir.join(format!("{}_band.svg", stem(v))))
 }
+
+/// More time points than this make a series "long": its quantile lines are drawn solid.
+const LONG_SERIES: usize = 1000;
 
 /// Adds the mean ± 3σ band of `s` (unless its Std is zero throughout) and its mean, both
 /// against `x`, to `plot`.
@@ -109,12 +118,10 @@ pub(super) fn pdf_heatmap(dir: &Path, s: &OutputStats) -> Result<bool, ReportErr
             .map(|c| c.iter().map(|x| if *x > cap { cap } else { *x }).collect())
             .collect(),
         colorbar_label: format!("PDF of {v}{density_unit}, clipped at its 99th percentile"),
-        overlay: vec![Series::new(
-            "mean",
-            s.times.clone(),
-            s.mean.clone(),
-            "#ffffff",
-        )],
+        // Thin and see-through: the density ridge under it stays visible.
+        overlay: vec![
+            Series::new("mean", s.times.clone(), s.mean.clone(), "#ffffff").thin(1.0, 0.6),
+        ],
         log_scale: false,
     };
     let png = heat.to_png().map_err(|source| ReportError::Png {
@@ -127,67 +134,6 @@ pub(super) fn pdf_heatmap(dir: &Path, s: &OutputStats) -> Result<bool, ReportErr
         heat.to_svg(&Heatmap::data_uri(&png)).as_bytes(),
     )?;
     Ok(true)
-}
-
-/// Relative Std below which Sobol' indices over time are undefined (no variance to share).
-const NO_VARIANCE: f64 = 1e-9;
-
-/// `<V>_sobol.svg`: the first-order indices of every parameter stacked over time, and on top
-/// the share of the variance from interactions, 1 − ΣS (one area each; readable for any
-/// number of parameters). Where the Std vanishes the indices are undefined: left blank.
-pub(super) fn sobol_over_time(
-    dir: &Path,
-    s: &OutputStats,
-    names: &[&str],
-) -> Result<(), ReportError> {
-    let Some(Sobol { first, .. }) = &s.sobol else {
-        return Ok(());
-    };
-    let v = &s.name;
-    let max_std = s.std.iter().copied().fold(0.0, f64::max);
-    let defined: Vec<bool> = s.std.iter().map(|d| *d > NO_VARIANCE * max_std).collect();
-    let mut plot = LinePlot::new(
-        format!("Sobol' indices of {v} over time (first order stacked, interactions on top)"),
-        "time [s]",
-        "share of the variance [-]",
-    );
-    plot.y_range = Some((0.0, 1.0));
-    let mut lower = vec![0.0; s.times.len()];
-    for (j, name) in names.iter().enumerate() {
-        let col = column(first, j);
-        let upper: Vec<f64> = lower
-            .iter()
-            .zip(&col)
-            .zip(&defined)
-            .map(|((l, c), ok)| if *ok { l + c.max(0.0) } else { f64::NAN })
-            .collect();
-        plot.bands.push(
-            Band::new(
-                format!("S {name}"),
-                s.times.clone(),
-                lower.clone(),
-                upper.clone(),
-                palette(j),
-            )
-            .opacity(0.75),
-        );
-        lower = upper;
-    }
-    let top: Vec<f64> = lower
-        .iter()
-        .map(|l| if l.is_finite() { l.max(1.0) } else { f64::NAN })
-        .collect();
-    plot.bands.push(
-        Band::new(
-            "interactions 1 − ΣS",
-            s.times.clone(),
-            lower,
-            top,
-            "#bbbbbb",
-        )
-        .opacity(0.75),
-    );
-    plot.write(&dir.join(format!("{}_sobol.svg", stem(v))))
 }
 
 /// `<q>_pdf.svg`: the density, a histogram of the runs (more than 10) and the limits. The
@@ -236,16 +182,14 @@ pub(super) fn scalar_pdf(dir: &Path, q: &ScalarStats, study: &str) -> Result<(),
     .write(&dir.join(format!("{}_pdf.svg", stem(name))))
 }
 
-/// 95 % intervals of the first-order and the total indices, per parameter (where given).
-pub(super) type SobolIntervals<'a> = (&'a [Option<(f64, f64)>], &'a [Option<(f64, f64)>]);
-
-/// `<q>_sobol.svg`: first-order and total Sobol' indices per parameter as bars (with their
-/// intervals where the method gives them).
+/// `<q>_sobol.svg`: first-order and total Sobol' indices per parameter as bars, with a
+/// whisker for the interval of each where the method gives them (`first_ci`, `total_ci` of
+/// the quantity's summary), labelled from the method's summary ([`interval_label`]).
 pub(super) fn sobol_bars(
     dir: &Path,
     q: &ScalarStats,
     names: &[&str],
-    intervals: Option<SobolIntervals>,
+    method: &MethodSummary,
 ) -> Result<bool, ReportError> {
     let (Some(first), Some(total)) = (&q.sobol_first, &q.sobol_total) else {
         return Ok(false);
@@ -254,14 +198,57 @@ pub(super) fn sobol_bars(
         // No variance: the indices are undefined, there is nothing to draw.
         return Ok(false);
     }
-    let (fi, ti) = match intervals {
-        Some((f, t)) => (f.to_vec(), t.to_vec()),
-        None => (vec![None; first.len()], vec![None; total.len()]),
-    };
+    let of =
+        |ci: Option<&std::collections::BTreeMap<String, [f64; 2]>>| -> Vec<Option<(f64, f64)>> {
+            names
+                .iter()
+                .map(|n| ci.and_then(|m| m.get(*n)).map(|[lo, hi]| (*lo, *hi)))
+                .collect()
+        };
+    let summary = q.sobol.as_ref();
+    let fi = of(summary.and_then(|s| s.first_ci.as_ref()));
+    let ti = of(summary.and_then(|s| s.total_ci.as_ref()));
+    let level = summary.and_then(|s| s.ci_level);
     let title = format!("Sobol' indices of {}", q.name);
     let file = dir.join(format!("{}_sobol.svg", stem(&q.name)));
-    bars(&title, names, (first, fi), (total, ti), &file)?;
+    bars(
+        &title,
+        names,
+        (first, fi),
+        (total, ti),
+        &interval_label(method, level),
+        &file,
+    )?;
     Ok(true)
+}
+
+/// The legend text of the intervals of Sobol' indices, in the words of the method's summary:
+/// "95 % interval (8 replicates, Student t)", "95 % interval (percentile bootstrap, 500
+/// resamples)", or "95 % interval".
+pub(super) fn interval_label(method: &MethodSummary, level: Option<f64>) -> String {
+    let level = level.unwrap_or(0.95);
+    let percent = 100.0 * level;
+    let head = if (percent - percent.round()).abs() < 1e-9 {
+        format!("{percent:.0} % interval")
+    } else {
+        format!("{} % interval", sig(percent))
+    };
+    let d = &method.details;
+    let words = d.get("intervals").and_then(|w| w.as_str()).unwrap_or("");
+    if let Some(r) = d.get("replicates").and_then(|r| r.as_u64()) {
+        if words.contains("Student") || words.starts_with("replicates") {
+            return format!("{head} ({r} replicates, Student t)");
+        }
+    }
+    if let Some(b) = d.get("bootstrap").and_then(|b| b.as_u64()) {
+        if words.contains("bootstrap") {
+            return format!("{head} (percentile bootstrap, {b} resamples)");
+        }
+    }
+    match words.split_once(':') {
+        Some((kind, _)) if !kind.is_empty() => format!("{head} ({kind})"),
+        _ => head,
+    }
 }
 
 /// `<V>_sobol_overall.svg`: the bar chart of the Sobol' indices of the whole series of an
@@ -276,7 +263,14 @@ pub(super) fn sobol_overall_bars(
     let title = format!("Sobol' indices of {output} over the whole series");
     let none = vec![None; first.len()];
     let file = dir.join(format!("{}_sobol_overall.svg", stem(output)));
-    bars(&title, names, (first, none.clone()), (total, none), &file)
+    bars(
+        &title,
+        names,
+        (first, none.clone()),
+        (total, none),
+        "",
+        &file,
+    )
 }
 
 /// Indices per parameter with their intervals (`None` where there are none).
@@ -288,6 +282,7 @@ fn bars(
     names: &[&str],
     first: Indices,
     total: Indices,
+    interval_label: &str,
     file: &Path,
 ) -> Result<(), ReportError> {
     BarChart {
@@ -310,85 +305,10 @@ fn bars(
             },
         ],
         y_range: Some((0.0, 1.0)),
+        interval_label: interval_label.to_owned(),
     }
     .write(file)?;
     Ok(())
-}
-
-/// Convergence plots; returns the files written. Runs: `<name>_convergence.svg`, the running
-/// mean over the first n runs with ±2 standard errors, and `<name>_std_convergence.svg`,
-/// the running Std (log axis of runs). Chaos: `<name>_convergence.svg`, the Std of the
-/// terms of each total order (log axis: its decay shows the convergence) with the Std of
-/// the expansion truncated there.
-pub(super) fn convergence(
-    dir: &Path,
-    name: &str,
-    unit: Option<&str>,
-    c: &Convergence,
-) -> Result<Vec<String>, ReportError> {
-    if c.axis != "runs" {
-        let mut p = LinePlot::new(
-            format!("{name}: Std by chaos order"),
-            "total order of the chaos",
-            label(&format!("Std {name}"), unit),
-        );
-        p.log_y = true;
-        let (x, y) = (c.x[1..].to_vec(), c.std_of_order[1..].to_vec());
-        p.series.push(Series::new(
-            "Std of the terms of that order",
-            x.clone(),
-            y,
-            palette(1),
-        ));
-        p.series.push(
-            Series::new(
-                "Std of the chaos up to that order",
-                x,
-                c.std[1..].to_vec(),
-                palette(0),
-            )
-            .dashed(),
-        );
-        let file = format!("{}_convergence.svg", stem(name));
-        p.write(&dir.join(&file))?;
-        return Ok(vec![file]);
-    }
-    let mut mean = LinePlot::new(
-        format!("{name}: running mean over the first n runs"),
-        "runs n (design order)",
-        label(&format!("mean {name}"), unit),
-    );
-    mean.log_x = true;
-    let se: Vec<f64> = c
-        .std
-        .iter()
-        .zip(&c.x)
-        .map(|(s, n)| 2.0 * s / n.sqrt())
-        .collect();
-    mean.bands.push(Band::new(
-        "± 2 standard errors",
-        c.x.clone(),
-        c.mean.iter().zip(&se).map(|(m, e)| m - e).collect(),
-        c.mean.iter().zip(&se).map(|(m, e)| m + e).collect(),
-        palette(0),
-    ));
-    mean.series
-        .push(Series::new("mean", c.x.clone(), c.mean.clone(), palette(0)));
-    let mut std = LinePlot::new(
-        format!("{name}: running Std over the first n runs"),
-        "runs n (design order)",
-        label(&format!("Std {name}"), unit),
-    );
-    std.log_x = true;
-    std.series
-        .push(Series::new("Std", c.x.clone(), c.std.clone(), palette(1)));
-    let files = vec![
-        format!("{}_convergence.svg", stem(name)),
-        format!("{}_std_convergence.svg", stem(name)),
-    ];
-    mean.write(&dir.join(&files[0]))?;
-    std.write(&dir.join(&files[1]))?;
-    Ok(files)
 }
 
 /// `<signal>_vs_<speed>.svg` for a critical-speed quantity whose signal and speed are both
@@ -397,6 +317,7 @@ pub(super) fn speed_plot(
     dir: &Path,
     spec: &QoiSpec,
     outputs: &[OutputStats],
+    quantities: &[ScalarStats],
     study: &str,
 ) -> Result<Option<String>, ReportError> {
     let QoiSpec::CriticalSpeed {
@@ -417,19 +338,58 @@ pub(super) fn speed_plot(
         label(speed, v.unit.as_deref()),
         label(signal, y.unit.as_deref()),
     );
-    push_band(&mut plot, &v.mean, y, format!("{signal} (mean)"));
+    let what = if y.deterministic {
+        format!("{signal} (the same in every run)")
+    } else {
+        format!("{signal} (mean)")
+    };
+    push_band(&mut plot, &v.mean, y, what);
     let ends = vec![v.mean[0], v.mean[v.mean.len() - 1]];
+    let threshold_label = with_unit(&format!("threshold ±{threshold}"), y.unit.as_deref());
     plot.series.push(
         Series::new(
-            format!("threshold ±{threshold}"),
+            threshold_label,
             ends.clone(),
             vec![*threshold; 2],
             palette(3),
         )
+        .thin(1.0, 0.8)
         .dashed(),
     );
-    plot.series
-        .push(Series::new("", ends, vec![-*threshold; 2], palette(3)).dashed());
+    plot.series.push(
+        Series::new("", ends, vec![-*threshold; 2], palette(3))
+            .thin(1.0, 0.8)
+            .dashed(),
+    );
+    // The critical speed the study computed, where it has that quantity (Fig. 5a marks it).
+    if let Some(q) = quantities.iter().find(|q| q.name == spec.name()) {
+        if q.mean.is_finite() {
+            let (lo, hi) = finite_range(
+                y.lower_3sigma
+                    .iter()
+                    .chain(&y.upper_3sigma)
+                    .chain(&y.mean)
+                    .copied(),
+                false,
+            )
+            .unwrap_or((-1.0, 1.0));
+            let text = if q.deterministic {
+                format!(
+                    "{} = {}",
+                    q.name,
+                    with_unit(&sig(q.mean), v.unit.as_deref())
+                )
+            } else {
+                format!(
+                    "mean {} = {}",
+                    q.name,
+                    with_unit(&sig(q.mean), v.unit.as_deref())
+                )
+            };
+            plot.series
+                .push(Series::new(text, vec![q.mean; 2], vec![lo, hi], palette(2)).thin(1.5, 0.9));
+        }
+    }
     let file = format!("{}_vs_{}.svg", stem(signal), stem(speed));
     plot.write(&dir.join(&file))?;
     Ok(Some(file))
