@@ -411,6 +411,26 @@ impl Frame {
 }
 
 /// Draws legend entries starting at (x, y); `boxed` adds a translucent white background.
+/// A horizontal arrow at height `y` from `tail` to `tip` (`dir` = +1 pointing right, −1 left),
+/// its head filled: the mark of a limit beyond the plotted range, and its legend glyph.
+pub(crate) fn arrow(out: &mut String, tail: f64, tip: f64, dir: f64, y: f64, color: &str) {
+    let _ = writeln!(
+        out,
+        "<path d=\"M{} {}L{} {}M{} {}L{} {}L{} {}Z\" stroke=\"{color}\" fill=\"{color}\" \
+         stroke-width=\"1.5\"/>",
+        c(tail),
+        c(y),
+        c(tip - dir * 6.0),
+        c(y),
+        c(tip),
+        c(y),
+        c(tip - dir * 7.0),
+        c(y - 4.0),
+        c(tip - dir * 7.0),
+        c(y + 4.0),
+    );
+}
+
 pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, boxed: bool) {
     if entries.is_empty() {
         return;
@@ -447,21 +467,7 @@ pub(crate) fn legend(out: &mut String, entries: &[LegendEntry], x: f64, y: f64, 
             } else {
                 (x + 24.0, x, -1.0)
             };
-            let _ = writeln!(
-                out,
-                "<path d=\"M{} {}L{} {}M{} {}L{} {}L{} {}Z\" stroke=\"{color}\" \
-                 fill=\"{color}\" stroke-width=\"1.5\"/>",
-                c(tail),
-                c(cy),
-                c(tip - dir * 6.0),
-                c(cy),
-                c(tip),
-                c(cy),
-                c(tip - dir * 7.0),
-                c(cy - 4.0),
-                c(tip - dir * 7.0),
-                c(cy + 4.0),
-            );
+            arrow(out, tail, tip, dir, cy, &color);
         } else {
             let dash = if e.dashed {
                 " stroke-dasharray=\"7 4\""

@@ -371,21 +371,7 @@ fn markers(frame: &Frame, out: &mut String, markers: &[(f64, String)]) {
             };
             // Inside the plot area, pointing at the edge beyond which the limit lies.
             let tip = edge - dir * 3.0;
-            let _ = writeln!(
-                out,
-                "<path d=\"M{} {}L{} {}M{} {}L{} {}L{} {}Z\" stroke=\"{color}\" fill=\"{color}\" \
-                 stroke-width=\"1.5\"/>",
-                c(tip - dir * 26.0),
-                c(y),
-                c(tip - dir * 6.0),
-                c(y),
-                c(tip),
-                c(y),
-                c(tip - dir * 7.0),
-                c(y - 4.0),
-                c(tip - dir * 7.0),
-                c(y + 4.0),
-            );
+            frame::arrow(out, tip - dir * 26.0, tip, dir, y, color);
             continue;
         }
         let px = frame.px(*x);
