@@ -395,3 +395,34 @@ fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
     assert!(!loud.status.success());
     assert!(stderr(&loud).contains(said), "{}", stderr(&loud));
 }
+
+#[test]
+fn a_fatal_reset_in_the_self_check_keeps_the_fresh_run_and_stops_the_study() {
+    // The reset self-check's second run found fmi2Reset returning fmi2Fatal: the point's own
+    // run on a fresh instance had succeeded but was stored as failed. Now it is kept, the
+    // study stops (no further call in this process), and a re-run with --isolate finishes
+    // with the numbers of fresh instances.
+    let Some(c) = case("reset_bug = 4") else {
+        return;
+    };
+    let o = c.try_run("t1", &["-t", "1"]);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("reset self-check") && err.contains("After fmi2Fatal"),
+        "{err}"
+    );
+    let o = c.run("t1", &["--isolate"]);
+    let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(
+        all.contains("(1 resumed)"),
+        "the fresh run of the first point was kept: {all}"
+    );
+    assert!(c.statuses("t1").iter().all(|s| s == "ok"));
+    check_closed_form(&c.out("t1"));
+    c.run("fresh", &["--fresh-instances"]);
+    assert_eq!(
+        c.csv("t1", "u_integral.csv"),
+        c.csv("fresh", "u_integral.csv")
+    );
+}

@@ -542,8 +542,8 @@ impl Batch<'_> {
             }
         }
         let (rec, fatal) = match run() {
-            Ok(Outcome::Done(rec)) => (rec, false),
-            Ok(Outcome::Fatal(rec)) => (rec, true),
+            Ok(Outcome::Done(rec)) => (rec, None),
+            Ok(Outcome::Fatal(rec, message)) => (rec, Some(message)),
             // Refused after another instance's Fatal: not run, not stored.
             Ok(Outcome::Refused) => return Ok(None),
             Err(e) => {
@@ -551,12 +551,12 @@ impl Batch<'_> {
                 return Err(e);
             }
         };
-        if fatal || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
+        if fatal.is_some() || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
             stop.store(true, Ordering::Relaxed);
         }
         let entry = self.store.append(i, &rec)?;
         progress.inc();
-        if let (true, Record::Failed(message)) = (fatal, rec) {
+        if let Some(message) = fatal {
             return Err(RunError::Fatal {
                 point: i,
                 values: describe_values(self.study, &self.design.values[i]),
@@ -612,17 +612,21 @@ impl Batch<'_> {
             };
             // Freed before the other points start (an FMU instantiable once per process).
             drop(slot);
-            return match fatal {
-                // fmi2Fatal after the reset: no further call in this process.
-                Some(e) => (
-                    Ok(Outcome::Fatal(Record::Failed(format!(
-                        "{e} (in the second run of the point, after fmi2Reset, of the reset \
-                         self-check; its run on a fresh instance had succeeded; \
-                         --fresh-instances never resets)"
-                    )))),
+            return match (fatal, first) {
+                // fmi2Fatal after the reset: no further call in this process. The point's own
+                // run (on a fresh instance) succeeded and is kept; the study stops.
+                (Some(e), Ok(v)) => (
+                    Ok(Outcome::Fatal(
+                        Record::Ok(v),
+                        format!(
+                            "{e} (in the second run of the point, after fmi2Reset, of the reset \
+                             self-check; its run on a fresh instance succeeded and is kept; \
+                             --fresh-instances never resets)"
+                        ),
+                    )),
                     check,
                 ),
-                None => (Ok(in_process(first)), check),
+                (_, first) => (Ok(in_process(first)), check),
             };
         };
         let first = {
@@ -653,7 +657,9 @@ fn in_process(result: Result<Vec<f64>, PointError>) -> Outcome {
         Ok(v) => Outcome::Done(Record::Ok(v)),
         Err(e) if e.refused_after_fatal() => Outcome::Refused,
         // This point's own call returned Fatal.
-        Err(e) if e.returned_fatal() => Outcome::Fatal(Record::Failed(e.to_string())),
+        Err(e) if e.returned_fatal() => {
+            Outcome::Fatal(Record::Failed(e.to_string()), e.to_string())
+        }
         Err(e) => Outcome::Done(Record::Failed(e.to_string())),
     }
 }
@@ -703,8 +709,10 @@ impl Notes {
 enum Outcome {
     /// Run: its record.
     Done(Record),
-    /// Its own call returned fmi2Fatal in-process: its (failed) record, and the study stops.
-    Fatal(Record),
+    /// A call of its run returned fmi2Fatal in-process: the record to keep (failed, or the
+    /// successful fresh run of a reset self-check whose second run returned Fatal) and the
+    /// message; the study stops.
+    Fatal(Record, String),
     /// Refused in-process because another point's call had returned fmi2Fatal: not run.
     Refused,
 }

@@ -23,7 +23,7 @@
  *   reset_bug: a broken fmi2Reset, as FMUs from other tools have: 1 returns fmi2Error (logged),
  *   2 returns fmi2OK but forgets the start values (every variable keeps its value of the run
  *   before, u_integral included, which then starts where that run ended), 3 returns fmi2Error
- *   (logged) after a run with gain < 1.5 only
+ *   (logged) after a run with gain < 1.5 only, 4 returns fmi2Fatal (logged)
  *   quiet: the model's own messages (these misbehaviours, read_file) reach the importer only
  *   with logging on, errors included (as pythonfmu FMUs log)
  *   name_dir: not empty: at the end of initialization gain is written to the file
@@ -125,7 +125,7 @@ static const Variable VARIABLES[] = {
     VAR("string_param", TYPE_STRING, 0, KIND_FIXED_PARAMETER, string_param),
     VAR("read_file", TYPE_STRING, 1, KIND_FIXED_PARAMETER, read_file),
     VAR("string_out", TYPE_STRING, 2, KIND_OUTPUT, string_out),
-    {"reset_bug", TYPE_INTEGER, 8, KIND_FIXED_PARAMETER, offsetof(Data, reset_bug), 1, 0, 3},
+    {"reset_bug", TYPE_INTEGER, 8, KIND_FIXED_PARAMETER, offsetof(Data, reset_bug), 1, 0, 4},
     VAR("quiet", TYPE_BOOLEAN, 4, KIND_FIXED_PARAMETER, quiet),
     VAR("name_dir", TYPE_STRING, 3, KIND_FIXED_PARAMETER, name_dir),
 };
@@ -253,6 +253,10 @@ static fmi2Status reset(Instance *inst) {
     if (d->reset_bug == 1) {
         M_ERROR(inst, "reset_bug = 1: fmi2Reset fails on purpose");
         return fmi2Error;
+    }
+    if (d->reset_bug == 4) {
+        MODEL_LOG(inst, fmi2Fatal, "logStatusFatal", "reset_bug = 4: fmi2Reset fails fatally on purpose");
+        return fmi2Fatal;
     }
     if (d->reset_bug == 3 && d->gain < 1.5) {
         M_ERROR(inst, "reset_bug = 3: fmi2Reset fails on purpose after a run with gain %g < 1.5",
