@@ -14,6 +14,7 @@ use super::{
     palette, write_columns, Band, DensityPlot, LinePlot, ReportError, ReportPage, Section, Series,
     Table,
 };
+use crate::results::numbers::count;
 use crate::results::sig;
 
 /// Why a folder cannot be compared.
@@ -505,11 +506,6 @@ fn output_section(studies: &[Folder], v: &str, out: &Path) -> Result<Section, Co
         images,
         table: None,
     })
-}
-
-/// "1 study", "3 studies".
-fn count(n: usize, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 /// PDFs of quantity `q` in every study that has one, and a table of its statistics.

@@ -7,8 +7,10 @@
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
 pub mod analysis;
+mod batch;
 mod crash;
 pub mod export;
+mod fingerprint;
 pub mod guard;
 pub mod inputs;
 pub mod instances;

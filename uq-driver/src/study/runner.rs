@@ -1,26 +1,27 @@
-//! The parallel runner: one FMU instance per worker, reused through `fmi2Reset` between
-//! points once the reset self-check has passed ([`super::instances`]), every finished point
-//! appended to the results store.
+//! Running a study's points: the options, the errors, the output folder (its lock, its store
+//! and the in-process time limit) and the failure policy. The points themselves run in
+//! `batch.rs` (one FMU instance per worker, reused through `fmi2Reset` once the reset
+//! self-check has passed: [`super::instances`]); what identifies the records is in
+//! `fingerprint.rs` (re-exported here).
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use rayon::prelude::*;
-use sha2::{Digest, Sha256};
-
+use super::batch::{Batch, Notes};
+pub use super::fingerprint::{manifest, sha256_file, study_hash};
 use super::guard::{self, StudyGuard};
-use super::instances::{self, InstancePolicy, ResetCheck, Slot};
+use super::instances::InstancePolicy;
 use super::interface::{Interface, InterfaceError};
-use super::isolate::{self, IsolateOptions, WorkerFailure, WorkerPool};
+use super::isolate::{self, IsolateOptions, WorkerPool};
 use super::lock::{FolderLock, LockError};
 pub use super::point::{run_point, simulate, simulate_with, PointError, Simulation, Trace};
 use super::progress::{Progress, ProgressMode};
-use super::store::{Entry, Manifest, Record, Store, StoreError, StoredRuns};
+use super::store::{Entry, Record, Store, StoreError, StoredRuns};
 use super::worker_fmu::WorkerFmus;
 use crate::fmu::{Fmu, FmuError};
 use crate::spec::Study;
-use crate::uq::method::{ChaosBasis, Design, MethodError, MethodSpec};
+use crate::uq::method::{Design, MethodError};
 
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
@@ -163,84 +164,6 @@ pub enum RunError {
     Pool(#[source] rayon::ThreadPoolBuildError),
 }
 
-/// SHA-256 of an FMU, hex: of the file, or, for an extracted FMU folder, of every file's
-/// relative path and content in sorted order.
-pub fn sha256_file(path: &Path) -> std::io::Result<String> {
-    fn walk(dir: &Path, root: &Path, h: &mut Sha256) -> std::io::Result<()> {
-        let mut entries: Vec<_> = std::fs::read_dir(dir)?.collect::<Result<_, _>>()?;
-        entries.sort_by_key(|e| e.file_name());
-        for e in entries {
-            let p = e.path();
-            if e.file_type()?.is_dir() {
-                walk(&p, root, h)?;
-            } else {
-                let rel = p
-                    .strip_prefix(root)
-                    .unwrap_or(&p)
-                    .to_string_lossy()
-                    .into_owned();
-                h.update(rel.as_bytes());
-                h.update([0]);
-                h.update(std::fs::read(&p)?);
-            }
-        }
-        Ok(())
-    }
-    if path.is_dir() {
-        let mut h = Sha256::new();
-        walk(path, path, &mut h)?;
-        return Ok(format!("{:x}", h.finalize()));
-    }
-    let bytes = std::fs::read(path)?;
-    Ok(format!("{:x}", Sha256::digest(&bytes)))
-}
-
-/// Hash of everything in a study that changes the stored records (not its name, description
-/// or analysis settings). The quantities of interest are stored with every run, so their
-/// settings are part of it (a study without any keeps the hash it always had).
-pub fn study_hash(study: &Study) -> String {
-    let mut key = serde_json::json!({
-        "seed": study.seed,
-        "experiment": study.experiment,
-        "method": study.method,
-        "parameters": study.parameters,
-        "fixed": study.fixed,
-        "outputs": { "variables": study.outputs },
-    });
-    if !study.qoi.is_empty() {
-        key["qoi"] = serde_json::json!(study.qoi);
-    }
-    if let Some(path) = &study.inputs {
-        // The signals themselves change the records, not the file's name. An unreadable file
-        // is refused before any run (Interface::resolve).
-        let content = std::fs::read(path)
-            .map(|b| format!("{:x}", Sha256::digest(&b)))
-            .unwrap_or_default();
-        key["inputs"] = serde_json::json!(content);
-    }
-    // Likewise the correlation: studies without one keep their hash.
-    if let Some(c) = &study.correlation {
-        key["correlation"] = serde_json::json!(c.pairs);
-    }
-    // SCM follows each input's Askey family since `chaos` became one of its keys: where that
-    // changes the design (an input with a non-Hermite germ) the hash says so, so that a store
-    // of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
-    if scm_askey(&study.method) && ChaosBasis::some_own_family(&study.parameters) {
-        key["scm_germ"] = serde_json::json!("askey");
-    }
-    format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
-}
-
-/// Whether `method` (or a nested study's inner method) is an SCM on the inputs' Askey
-/// families.
-fn scm_askey(method: &MethodSpec) -> bool {
-    match method {
-        MethodSpec::Scm(s) => s.chaos == ChaosBasis::Askey,
-        MethodSpec::Nested(n) => scm_askey(&n.inner),
-        _ => false,
-    }
-}
-
 /// What a run produced: every point's record, in design order, read in place from the
 /// results store (the series of the runs are not held in memory).
 #[derive(Debug)]
@@ -269,21 +192,6 @@ impl RunOutcome {
     pub fn records(&self) -> Result<Vec<Option<Record>>, StoreError> {
         self.runs.records()
     }
-}
-
-/// The store manifest of `study` on `fmu` with `design`.
-pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, RunError> {
-    let iface = Interface::resolve(study, fmu)?;
-    let fmu_sha256 = sha256_file(fmu.path()).map_err(|source| FmuError::Io {
-        path: fmu.path().to_path_buf(),
-        source,
-    })?;
-    Ok(Manifest {
-        study_hash: study_hash(study),
-        fmu_sha256,
-        n_points: design.len(),
-        n_values: iface.n_values(study.experiment.times().len()),
-    })
 }
 
 /// Runs every point of `design` not yet in the store of `out_dir` (with
@@ -453,270 +361,6 @@ fn watchdog(guard: &StudyGuard, limit: Duration, done: &AtomicBool) {
     }
 }
 
-/// Points to run in parallel, each appended to the store as it finishes.
-struct Batch<'a> {
-    /// The FMU of each worker thread.
-    fmus: WorkerFmus<'a>,
-    iface: Interface,
-    study: &'a Study,
-    design: &'a Design,
-    times: Vec<f64>,
-    store: &'a Store,
-    /// Stop at the first failure (failures not allowed, or a weighted design).
-    stop_on_failure: bool,
-    /// Stop after this many new points.
-    max_new: Option<usize>,
-    /// `--isolate`: the worker processes.
-    workers: Option<WorkerPool>,
-    guard: &'a StudyGuard,
-    /// How in-process runs get their instance (before the reset self-check: never reused).
-    policy: InstancePolicy,
-    /// Run the first point as the reset self-check, and reuse instances if it passes.
-    check_reset: bool,
-    /// Warnings of the runs, each printed once.
-    notes: Notes,
-}
-
-/// Counters shared by the points of a batch.
-#[derive(Default)]
-struct Shared {
-    stop: AtomicBool,
-    started: AtomicUsize,
-}
-
-impl Batch<'_> {
-    /// Runs `points`; returns where the result of each finished one is in the store (the
-    /// values are not kept). With [`Batch::check_reset`], the first point runs alone first as
-    /// the reset self-check, which decides whether the others reuse instances.
-    fn run(&self, points: &[usize], progress: &Progress) -> Result<Vec<(usize, Entry)>, RunError> {
-        let shared = Shared::default();
-        let mut first = Vec::new();
-        let mut policy = self.policy;
-        let mut rest = points;
-        if let (true, Some((&i, others))) = (self.check_reset, points.split_first()) {
-            let mut check = ResetCheck::NotRun;
-            first.extend(self.point(i, &shared, progress, || {
-                let (outcome, c) = self.run_checked(i);
-                check = c;
-                outcome
-            })?);
-            if let Some(w) = check.warning(i) {
-                self.notes.add(w, progress);
-            }
-            policy.reuse = check.reuse();
-            if let Some(workers) = &self.workers {
-                workers.set_reuse(policy.reuse);
-            }
-            rest = others;
-        }
-        let new: Vec<(usize, Entry)> = rest
-            .par_iter()
-            .with_min_len(1)
-            .map_init(
-                || Slot::new(policy, false),
-                |slot, &i| self.point(i, &shared, progress, || self.run_one(slot, i, progress)),
-            )
-            .filter_map(Result::transpose)
-            .collect::<Result<_, _>>()?;
-        first.extend(new);
-        Ok(first)
-    }
-
-    /// Runs point `i` by `run` unless the batch stopped, stores its record and says whether
-    /// the batch stops.
-    fn point(
-        &self,
-        i: usize,
-        shared: &Shared,
-        progress: &Progress,
-        run: impl FnOnce() -> Result<Outcome, RunError>,
-    ) -> Result<Option<(usize, Entry)>, RunError> {
-        let stop = &shared.stop;
-        if stop.load(Ordering::Relaxed) {
-            return Ok(None);
-        }
-        if let Some(max) = self.max_new {
-            if shared.started.fetch_add(1, Ordering::SeqCst) >= max {
-                stop.store(true, Ordering::Relaxed);
-                return Ok(None);
-            }
-        }
-        let (rec, fatal) = match run() {
-            Ok(Outcome::Done(rec)) => (rec, None),
-            Ok(Outcome::Fatal(rec, message)) => (rec, Some(message)),
-            // Refused after another instance's Fatal: not run, not stored.
-            Ok(Outcome::Refused) => return Ok(None),
-            Err(e) => {
-                stop.store(true, Ordering::Relaxed);
-                return Err(e);
-            }
-        };
-        if fatal.is_some() || (matches!(rec, Record::Failed(_)) && self.stop_on_failure) {
-            stop.store(true, Ordering::Relaxed);
-        }
-        let entry = self.store.append(i, &rec)?;
-        progress.inc();
-        if let Some(message) = fatal {
-            return Err(RunError::Fatal {
-                point: i,
-                values: describe_values(self.study, &self.design.values[i]),
-                message,
-            });
-        }
-        if let Some(why) = self
-            .workers
-            .as_ref()
-            .and_then(WorkerPool::take_reset_failure)
-        {
-            self.notes.reset_failed(&why, progress);
-        }
-        Ok(Some((i, entry)))
-    }
-
-    /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
-    fn run_one(&self, slot: &mut Slot, i: usize, progress: &Progress) -> Result<Outcome, RunError> {
-        let values = &self.design.values[i];
-        let _running = self.guard.running(i, describe_values(self.study, values));
-        let Some(workers) = &self.workers else {
-            let fmu = self.fmus.current()?;
-            let result = run_point(&fmu, slot, &self.iface, values, &self.times);
-            if let Some(why) = slot.take_reset_failure() {
-                self.notes.reset_failed(&why, progress);
-            }
-            return Ok(in_process(result));
-        };
-        from_worker(i, workers.run(values))
-    }
-
-    /// Runs point `i` as the reset self-check: on a fresh instance (its record is the point's),
-    /// then again after `fmi2Reset` of that instance, each run timed on its own.
-    fn run_checked(&self, i: usize) -> (Result<Outcome, RunError>, ResetCheck) {
-        let values = &self.design.values[i];
-        let running = || self.guard.running(i, describe_values(self.study, values));
-        let Some(workers) = &self.workers else {
-            let fmu = match self.fmus.current() {
-                Ok(f) => f,
-                Err(e) => return (Err(e.into()), ResetCheck::NotRun),
-            };
-            let mut slot = Slot::new(self.policy, false);
-            let first = {
-                let _running = running();
-                run_point(&fmu, &mut slot, &self.iface, values, &self.times)
-            };
-            let Ok(record) = &first else {
-                return (Ok(in_process(first)), ResetCheck::NotRun);
-            };
-            let (check, fatal) = {
-                let _running = running();
-                super::point::check_reset(&fmu, &mut slot, &self.iface, values, &self.times, record)
-            };
-            // Freed before the other points start (an FMU instantiable once per process).
-            drop(slot);
-            return match (fatal, first) {
-                // fmi2Fatal after the reset: no further call in this process. The point's own
-                // run (on a fresh instance) succeeded and is kept; the study stops.
-                (Some(e), Ok(v)) => (
-                    Ok(Outcome::Fatal(
-                        Record::Ok(v),
-                        format!(
-                            "{e} (in the second run of the point, after fmi2Reset, of the reset \
-                             self-check; its run on a fresh instance succeeded and is kept; \
-                             --fresh-instances never resets)"
-                        ),
-                    )),
-                    check,
-                ),
-                (_, first) => (Ok(in_process(first)), check),
-            };
-        };
-        let first = {
-            let _running = running();
-            workers.run(values)
-        };
-        if first.is_err() {
-            return (from_worker(i, first), ResetCheck::NotRun);
-        }
-        let check = {
-            let _running = running();
-            workers.check_reset(values)
-        };
-        match check {
-            Ok(check) => (from_worker(i, first), check),
-            // Stopped from outside: the study stops, a re-run computes the point.
-            Err(why) => (
-                Err(RunError::Interrupted { point: i, why }),
-                ResetCheck::NotRun,
-            ),
-        }
-    }
-}
-
-/// The outcome of an in-process run.
-fn in_process(result: Result<Vec<f64>, PointError>) -> Outcome {
-    match result {
-        Ok(v) => Outcome::Done(Record::Ok(v)),
-        Err(e) if e.refused_after_fatal() => Outcome::Refused,
-        // This point's own call returned Fatal.
-        Err(e) if e.returned_fatal() => {
-            Outcome::Fatal(Record::Failed(e.to_string()), e.to_string())
-        }
-        Err(e) => Outcome::Done(Record::Failed(e.to_string())),
-    }
-}
-
-/// The outcome of a run in a worker process.
-fn from_worker(i: usize, result: Result<Vec<f64>, WorkerFailure>) -> Result<Outcome, RunError> {
-    match result {
-        Ok(v) => Ok(Outcome::Done(Record::Ok(v))),
-        Err(WorkerFailure::Point(m) | WorkerFailure::Died(m)) => {
-            Ok(Outcome::Done(Record::Failed(m)))
-        }
-        Err(WorkerFailure::Interrupted(m)) => Err(RunError::Interrupted { point: i, why: m }),
-    }
-}
-
-/// Warnings of a batch's runs: printed as they arise, each kind once, and kept.
-#[derive(Default)]
-struct Notes {
-    warnings: std::sync::Mutex<Vec<String>>,
-    reset_failed: AtomicBool,
-}
-
-impl Notes {
-    fn add(&self, warning: String, progress: &Progress) {
-        progress.println(&format!("uq-driver: warning: {warning}"));
-        self.warnings
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(warning);
-    }
-
-    /// A `fmi2Reset` failed (the run got a fresh instance): said once.
-    fn reset_failed(&self, why: &str, progress: &Progress) {
-        if !self.reset_failed.swap(true, Ordering::Relaxed) {
-            self.add(instances::reset_failed_warning(why), progress);
-        }
-    }
-
-    fn into_warnings(self) -> Vec<String> {
-        self.warnings
-            .into_inner()
-            .unwrap_or_else(|e| e.into_inner())
-    }
-}
-
-/// How a point ended.
-enum Outcome {
-    /// Run: its record.
-    Done(Record),
-    /// A call of its run returned fmi2Fatal in-process: the record to keep (failed, or the
-    /// successful fresh run of a reset self-check whose second run returned Fatal) and the
-    /// message; the study stops.
-    Fatal(Record, String),
-    /// Refused in-process because another point's call had returned fmi2Fatal: not run.
-    Refused,
-}
-
 /// What is known of the failures: "3 of 200 points failed" when every point was run, else
 /// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
 fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
@@ -735,7 +379,7 @@ fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
 }
 
 /// "K = 1.2, C = 3" for messages.
-fn describe_values(study: &Study, values: &[f64]) -> String {
+pub(super) fn describe_values(study: &Study, values: &[f64]) -> String {
     study
         .parameters
         .iter()
@@ -832,65 +476,5 @@ mod tests {
         assert!(!two.contains("2 of 200 points failed"));
         // Every point run: the count is the whole truth.
         assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
-    }
-
-    #[test]
-    fn changed_quantity_settings_do_not_resume_stale_records() {
-        let base = crate::spec::builtin("bogie-lhs-500").unwrap();
-        let study = |text: &str| Study::parse(text, "t.toml", None).unwrap();
-        let a = study_hash(&study(base));
-        let b = study_hash(&study(
-            &base.replace("threshold = 1e-4", "threshold = 2e-4"),
-        ));
-        assert_ne!(a, b, "a record holds v_cr for one threshold only");
-        // Name, description and analysis settings do not change the records.
-        let renamed = base.replace("name = \"bogie-lhs-500\"", "name = \"renamed\"");
-        let c = study_hash(&study(&format!("{renamed}\n[analysis]\npdf_grid = 50\n")));
-        assert_eq!(a, c);
-    }
-
-    #[test]
-    fn an_scm_whose_design_follows_the_askey_families_does_not_resume_a_hermite_store() {
-        // SCM with a uniform input now runs Gauss–Legendre nodes; a store of the Gauss–Hermite
-        // design the same file gave before must not be resumed, so its hash differs from the
-        // hash of the same file with `chaos = "hermite"` and from the hash without the key
-        // as computed before (the method serialised without `chaos`, no `scm_germ`).
-        let text = |dist: &str, chaos: &str| {
-            format!(
-                "name = \"u\"\nfmu = \"Wheel.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
-                 [[parameters]]\nname = \"K\"\n{dist}\n\
-                 [outputs]\nvariables = [\"q\"]\n[method]\nkind = \"scm\"\nnodes = 3\n{chaos}"
-            )
-        };
-        let study = |t: String| Study::parse(&t, "t.toml", None).unwrap();
-        let uniform = "distribution = \"uniform\"\nlow = 90.0\nhigh = 110.0";
-        let askey = study(text(uniform, ""));
-        let hermite = study(text(uniform, "chaos = \"hermite\""));
-        assert_ne!(study_hash(&askey), study_hash(&hermite));
-        let mut old_key = serde_json::json!({
-            "seed": askey.seed,
-            "experiment": askey.experiment,
-            "method": askey.method,
-            "parameters": askey.parameters,
-            "fixed": askey.fixed,
-            "outputs": { "variables": askey.outputs },
-        });
-        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
-        assert_ne!(study_hash(&askey), old);
-        // A normal input: the design is the Gauss–Hermite one either way, the hash as before.
-        let normal = study(text("mean = 100.0\nstd = 10.0", ""));
-        old_key["parameters"] = serde_json::json!(normal.parameters);
-        old_key["seed"] = serde_json::json!(normal.seed);
-        let old = format!("{:x}", Sha256::digest(old_key.to_string().as_bytes()));
-        assert_eq!(study_hash(&normal), old);
-    }
-
-    #[test]
-    fn studies_without_quantities_keep_their_hash() {
-        // The hash of wheel-scm in the store/manifest.json that uq-driver wrote before the
-        // restructuring (commit 7b51554): old result folders still resume.
-        let s = Study::load("builtin:wheel-scm").unwrap();
-        let expected = "9c4270a27263cfdb71ef7669728eefc88c107f891685caf239948c85fa49637a";
-        assert_eq!(study_hash(&s), expected);
     }
 }

@@ -593,10 +593,11 @@ impl PickFreezeRows {
             .collect()
     }
 
+    /// The complete base rows of each replicate.
     fn replicate_sizes(&self, per: usize, replicates: usize) -> Vec<usize> {
         let mut sizes = vec![0; replicates.max(1)];
-        for &k in &self.complete {
-            sizes[(k / per.max(1)).min(replicates.saturating_sub(1))] += 1;
+        for r in self.replicate_of(per, replicates) {
+            sizes[r] += 1;
         }
         sizes
     }

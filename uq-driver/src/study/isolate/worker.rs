@@ -1,108 +1,24 @@
-//! `--isolate`: each point runs in a worker process, so that an FMU that segfaults, aborts,
-//! calls `exit()` or blocks fails that point instead of taking the driver with it.
-//!
-//! A worker is the uq-driver executable started with the hidden subcommand `worker`
-//! ([`serve`]). It opens the FMU from the folder the parent already extracted, creates one
-//! instance at a time, and runs points one after the other exactly as the in-process runner
-//! does ([`run_point`]; fresh or reset instances by the setup's [`InstancePolicy`], and the
-//! reset self-check of [`super::instances`] when the parent asks), so results are
-//! bit-identical. Parent and worker speak a small binary
-//! protocol over the worker's stdin and stdout (the worker moves its own stdout to stderr
-//! first, so an FMU that prints cannot garble it): frames of a tag byte, a little-endian u64
-//! length and the payload.
-//!
-//! | tag | from | payload |
-//! | --- | --- | --- |
-//! | `S` | parent | the setup, JSON ([`Setup`]) |
-//! | `P` | parent | a point's parameter values, f64 LE |
-//! | `C` | parent | the reset self-check: the last point's values again, to run after `fmi2Reset` |
-//! | `R` | worker | ready (empty) |
-//! | `O` | worker | the point's record values, f64 LE |
-//! | `V` | worker | the self-check's verdict: a byte (0 passed, 1 failed, 2 failed and the worker ends after fmi2Fatal), then the reason, UTF-8 |
-//! | `N` | worker | before an answer: `fmi2Reset` failed and the point ran on a fresh instance; the reason, UTF-8 |
-//! | `F` | worker | the point failed: the message, UTF-8 |
-//! | `X` | worker | the point failed and the FMU is unusable (fmi2Fatal): the worker ends |
-//! | `E` | worker | the setup failed: the message, UTF-8 |
-//!
-//! What the worker writes to stderr (the FMU's log messages, which the worker echoes, and
-//! anything the FMU prints) is kept by the parent, the last lines of it going into the message
-//! of a point whose worker died. A worker that dies (signal or exit; noticed by its exit
-//! status, not by the end of its pipes, which a program the FMU started may keep open) or
-//! outlives `--timeout-per-run` (then it is killed) fails its point; the next point starts a
-//! new worker. A worker killed by SIGINT, SIGTERM or SIGHUP while the driver itself is being
-//! stopped (Ctrl-C, `kill`, `scancel`) fails nothing: the study stops and a re-run computes
-//! the point; a worker that dies of such a signal otherwise (an FMU that raises SIGTERM on
-//! itself) fails its point like any crash. Workers ignore SIGINT (the
-//! terminal sends it to the whole process group; the parent handles it) and, on Linux, are
-//! killed when the parent dies.
+//! The parent's side of a worker process: starting it, sending it points and reading its
+//! answers, its stderr tail, and noticing its death or a run past the time limit.
 
 use std::collections::VecDeque;
-use std::io::{BufReader, Read, Write};
-use std::path::PathBuf;
+use std::io::Read;
 use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use serde::{Deserialize, Serialize};
-
-use super::instances::{InstancePolicy, ResetCheck, Slot};
-use super::interface::Interface;
-use super::point::check_reset;
-use super::runner::run_point;
-use crate::fmu::Fmu;
+use super::protocol::{bytes_to_f64s, f64s_to_bytes, read_frame, write_frame, Frame};
+use super::{IsolateOptions, WorkerFailure};
+use crate::study::instances::ResetCheck;
 
 /// How many of a worker's last stderr lines a failure message quotes.
 const TAIL_LINES: usize = 12;
-/// Largest frame accepted (bytes): far above any record, small enough to refuse garbage.
-const MAX_FRAME: u64 = 1 << 34;
-/// The worker's protocol descriptors are moved to this number or above, out of the way of an
-/// FMU that writes to (or closes) low descriptors.
-pub const PROTOCOL_FD_MIN: i32 = 100;
 /// How often a waiting parent checks whether its worker is still alive.
 const POLL: Duration = Duration::from_millis(20);
 /// How long the parent waits for the last frames and output of a worker that has ended, and
 /// for a worker that closed its answer pipe to end.
 const GRACE: Duration = Duration::from_millis(500);
-
-/// What a worker needs to run points.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Setup {
-    /// The extracted FMU folder.
-    pub fmu_root: PathBuf,
-    /// The FMU as the user named it (for messages).
-    pub fmu_shown: PathBuf,
-    /// The study's variables.
-    pub interface: Interface,
-    /// The communication points (s).
-    pub times: Vec<f64>,
-    /// How the worker's runs get their instance.
-    #[serde(default)]
-    pub policy: InstancePolicy,
-}
-
-/// How workers are started.
-#[derive(Clone, Debug)]
-pub struct IsolateOptions {
-    /// The uq-driver executable (which has the `worker` subcommand).
-    pub exe: PathBuf,
-    /// Longest a run may take before its worker is killed.
-    pub timeout: Option<Duration>,
-}
-
-/// Why a point run in a worker has no result.
-#[derive(Debug)]
-pub enum WorkerFailure {
-    /// The run failed normally (an FMI error, NaN outputs, ...); the worker lives on.
-    Point(String),
-    /// The worker died or was killed: the point failed; the worker is gone.
-    Died(String),
-    /// The worker was stopped from outside (SIGINT/SIGTERM/SIGHUP): the point has no result.
-    Interrupted(String),
-}
-
-/// A frame read by the reader thread.
-type Frame = (u8, Vec<u8>);
 
 /// What the reader thread passes on: a frame, or why the bytes were not one.
 type Answer = Result<Frame, String>;
@@ -154,53 +70,6 @@ impl std::fmt::Debug for Worker {
     }
 }
 
-fn f64s_to_bytes(v: &[f64]) -> Vec<u8> {
-    v.iter().flat_map(|x| x.to_le_bytes()).collect()
-}
-
-fn bytes_to_f64s(b: &[u8]) -> Vec<f64> {
-    b.chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-        .collect()
-}
-
-/// Writes one frame.
-pub fn write_frame(w: &mut impl Write, tag: u8, payload: &[u8]) -> std::io::Result<()> {
-    let mut head = [0u8; 9];
-    head[0] = tag;
-    head[1..].copy_from_slice(&(payload.len() as u64).to_le_bytes());
-    w.write_all(&head)?;
-    w.write_all(payload)?;
-    w.flush()
-}
-
-/// Reads one frame; `None` at a clean end of the stream.
-pub fn read_frame(r: &mut impl Read) -> std::io::Result<Option<Frame>> {
-    let mut head = [0u8; 9];
-    let mut got = 0;
-    while got < head.len() {
-        match r.read(&mut head[got..])? {
-            0 if got == 0 => return Ok(None),
-            0 => return Err(std::io::ErrorKind::UnexpectedEof.into()),
-            n => got += n,
-        }
-    }
-    let len = u64::from_le_bytes(head[1..].try_into().expect("8 bytes"));
-    if len > MAX_FRAME {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("frame of {len} bytes"),
-        ));
-    }
-    // Grown as the bytes come: a garbage length allocates nothing up front.
-    let mut payload = Vec::new();
-    r.take(len).read_to_end(&mut payload)?;
-    if payload.len() as u64 != len {
-        return Err(std::io::ErrorKind::UnexpectedEof.into());
-    }
-    Ok(Some((head[0], payload)))
-}
-
 /// A signal's name, for messages.
 #[cfg(unix)]
 fn signal_name(sig: i32) -> String {
@@ -232,7 +101,7 @@ fn describe_exit(status: ExitStatus) -> (String, bool) {
         use std::os::unix::process::ExitStatusExt;
         if let Some(sig) = status.signal() {
             let outside = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP].contains(&sig)
-                && super::guard::stop_requested_within(GRACE);
+                && crate::study::guard::stop_requested_within(GRACE);
             return (
                 format!(
                     "the worker process running the FMU was killed by {}",
@@ -555,312 +424,9 @@ impl Drop for Worker {
     }
 }
 
-/// Workers shared by the runner's threads: a point takes an idle one (or starts one) and gives
-/// it back when its run ends normally.
-#[derive(Debug)]
-pub struct WorkerPool {
-    opts: IsolateOptions,
-    /// The setup new workers get (JSON), and what it says.
-    setup: Mutex<(Setup, Vec<u8>)>,
-    idle: Mutex<Vec<Worker>>,
-    /// Why a worker's `fmi2Reset` failed, since the last [`WorkerPool::take_reset_failure`].
-    reset_failure: Mutex<Option<String>>,
-}
-
-impl WorkerPool {
-    /// A pool that starts workers for `setup`.
-    pub fn new(opts: IsolateOptions, setup: &Setup) -> WorkerPool {
-        let json = serde_json::to_vec(setup).expect("serializable");
-        WorkerPool {
-            opts,
-            setup: Mutex::new((setup.clone(), json)),
-            idle: Mutex::new(Vec::new()),
-            reset_failure: Mutex::new(None),
-        }
-    }
-
-    /// Whether workers started from now on reuse instances (the reset self-check's verdict;
-    /// the worker that ran the check knows it already).
-    pub fn set_reuse(&self, reuse: bool) {
-        let mut setup = self.setup.lock().unwrap_or_else(|e| e.into_inner());
-        setup.0.policy.reuse = reuse;
-        setup.1 = serde_json::to_vec(&setup.0).expect("serializable");
-    }
-
-    fn take_idle(&self) -> Option<Worker> {
-        self.idle.lock().unwrap_or_else(|e| e.into_inner()).pop()
-    }
-
-    fn give_back(&self, worker: Worker) {
-        self.idle
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(worker);
-    }
-
-    /// Runs one point in a worker.
-    pub fn run(&self, values: &[f64]) -> Result<Vec<f64>, WorkerFailure> {
-        let mut worker = match self.take_idle() {
-            Some(w) => w,
-            None => {
-                let setup = self
-                    .setup
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .1
-                    .clone();
-                Worker::start(&self.opts, &setup)?
-            }
-        };
-        let (result, note) = worker.run(values, self.opts.timeout);
-        if let Some(why) = note {
-            self.reset_failure
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .get_or_insert(why);
-        }
-        if matches!(result, Ok(_) | Err(WorkerFailure::Point(_))) {
-            self.give_back(worker);
-        }
-        result
-    }
-
-    /// The reset self-check's second run, of the point `values` the pool has just run (alone)
-    /// successfully, in the worker that ran it; `Err` when the worker was stopped from outside
-    /// (the driver is being stopped).
-    pub fn check_reset(&self, values: &[f64]) -> Result<ResetCheck, String> {
-        let Some(mut worker) = self.take_idle() else {
-            return Ok(ResetCheck::NotRun);
-        };
-        let (check, lives) = worker.check_reset(values, self.opts.timeout)?;
-        if lives {
-            self.give_back(worker);
-        }
-        Ok(check)
-    }
-
-    /// Why a worker's `fmi2Reset` failed (its point then ran on a fresh instance), once.
-    pub fn take_reset_failure(&self) -> Option<String> {
-        self.reset_failure
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .take()
-    }
-}
-
-// ------------------------------------------------------------------------------------------
-// The worker side.
-
-/// Makes the protocol channel safe from the FMU: moves the worker's stdin and stdout (the
-/// pipes to the parent) to descriptors at or above [`PROTOCOL_FD_MIN`], close-on-exec, and
-/// points descriptor 0 at /dev/null and descriptor 1 at stderr, so that whatever the FMU
-/// prints goes to stderr, a write to a low descriptor misses the pipes and a program the FMU
-/// starts does not inherit them. Returns (input, output).
-#[cfg(unix)]
-fn protocol_fds() -> std::io::Result<(std::fs::File, std::fs::File)> {
-    use std::os::fd::FromRawFd;
-    let last = std::io::Error::last_os_error;
-    // SAFETY: fcntl(F_DUPFD_CLOEXEC) on the process's own stdout/stdin; results are checked.
-    let out = unsafe { libc::fcntl(1, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
-    if out < 0 {
-        return Err(last());
-    }
-    // SAFETY: `out` is a fresh descriptor owned by nothing else.
-    let out = unsafe { std::fs::File::from_raw_fd(out) };
-    // SAFETY: as above, for stdin.
-    let input = unsafe { libc::fcntl(0, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
-    if input < 0 {
-        return Err(last());
-    }
-    // SAFETY: `input` is a fresh descriptor owned by nothing else.
-    let input = unsafe { std::fs::File::from_raw_fd(input) };
-    // SAFETY: 2 and 1 are the process's own stderr and stdout; nothing in this process holds a
-    // Rust handle that relies on fd 1 staying the pipe (only `out` is used for the protocol).
-    if unsafe { libc::dup2(2, 1) } < 0 {
-        return Err(last());
-    }
-    let null = std::fs::File::open("/dev/null")?;
-    // SAFETY: `null` is an open descriptor; fd 0 is the process's stdin, which nothing reads
-    // any more (the protocol reads `input`).
-    if unsafe { libc::dup2(std::os::fd::AsRawFd::as_raw_fd(&null), 0) } < 0 {
-        return Err(last());
-    }
-    Ok((input, out))
-}
-
-/// Ignores SIGINT and, on Linux, asks to be killed when the parent dies.
-#[cfg(unix)]
-fn detach_from_terminal_signals() {
-    // SAFETY: setting SIGINT's disposition to ignore is async-signal-safe and affects only this
-    // process.
-    unsafe {
-        libc::signal(libc::SIGINT, libc::SIG_IGN);
-    }
-    #[cfg(target_os = "linux")]
-    {
-        // SAFETY: PR_SET_PDEATHSIG with a valid signal number; no pointers involved.
-        unsafe {
-            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
-        }
-        // The parent may have died before the prctl: then nobody reads our answers.
-        let expected = std::env::var("UQ_DRIVER_PARENT_PID")
-            .ok()
-            .and_then(|p| p.parse::<i32>().ok());
-        // SAFETY: getppid has no preconditions.
-        let parent = unsafe { libc::getppid() };
-        if expected.is_some_and(|p| p != parent) {
-            std::process::exit(0);
-        }
-    }
-}
-
-/// The `uq-driver worker` subcommand: serves points until stdin closes. Returns the exit
-/// status.
-#[cfg(unix)]
-pub fn serve() -> i32 {
-    detach_from_terminal_signals();
-    let (mut input, mut out) = match protocol_fds() {
-        Ok((i, o)) => (BufReader::new(i), std::io::BufWriter::new(o)),
-        Err(e) => {
-            eprintln!("uq-driver worker: {e}");
-            return 1;
-        }
-    };
-    let setup: Setup = match read_frame(&mut input) {
-        Ok(Some((b'S', payload))) => match serde_json::from_slice(&payload) {
-            Ok(s) => s,
-            Err(e) => {
-                let _ = write_frame(&mut out, b'E', format!("bad setup: {e}").as_bytes());
-                return 1;
-            }
-        },
-        _ => {
-            eprintln!("uq-driver worker: expected a setup frame on stdin");
-            return 1;
-        }
-    };
-    let fmu = match Fmu::open_extracted(&setup.fmu_root, &setup.fmu_shown) {
-        Ok(f) => f,
-        Err(e) => {
-            let _ = write_frame(&mut out, b'E', e.to_string().as_bytes());
-            return 1;
-        }
-    };
-    if write_frame(&mut out, b'R', &[]).is_err() {
-        return 1;
-    }
-    // The FMU's messages go to stderr, where the parent keeps the last lines.
-    let mut slot = Slot::new(setup.policy, true);
-    // The last point run successfully: its values and record (for the reset self-check).
-    let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
-    while let Ok(Some((tag, payload))) = read_frame(&mut input) {
-        let values = bytes_to_f64s(&payload);
-        let sent = match tag {
-            b'P' => {
-                let result = run_point(&fmu, &mut slot, &setup.interface, &values, &setup.times);
-                if let Some(why) = slot.take_reset_failure() {
-                    if write_frame(&mut out, b'N', why.as_bytes()).is_err() {
-                        return 1;
-                    }
-                }
-                last = None;
-                match result {
-                    Ok(v) => {
-                        let sent = write_frame(&mut out, b'O', &f64s_to_bytes(&v));
-                        last = Some((values, v));
-                        sent
-                    }
-                    Err(e) if fmu.is_unusable() => {
-                        let _ = write_frame(&mut out, b'X', e.to_string().as_bytes());
-                        return 0;
-                    }
-                    Err(e) => write_frame(&mut out, b'F', e.to_string().as_bytes()),
-                }
-            }
-            b'C' => {
-                let (check, _) = match &last {
-                    Some((v, first)) if *v == values => {
-                        check_reset(&fmu, &mut slot, &setup.interface, v, &setup.times, first)
-                    }
-                    _ => (ResetCheck::Failed("no run to compare with".into()), None),
-                };
-                let ends = fmu.is_unusable();
-                let (code, why) = match check {
-                    ResetCheck::Passed => (0, String::new()),
-                    ResetCheck::Failed(why) => (if ends { 2 } else { 1 }, why),
-                    ResetCheck::NotRun => (1, "not run".to_owned()),
-                };
-                let mut payload = vec![code];
-                payload.extend_from_slice(why.as_bytes());
-                let sent = write_frame(&mut out, b'V', &payload);
-                if ends {
-                    return 0;
-                }
-                sent
-            }
-            _ => {
-                eprintln!("uq-driver worker: unexpected frame '{}'", char::from(tag));
-                return 1;
-            }
-        };
-        if sent.is_err() {
-            return 1;
-        }
-    }
-    0
-}
-
-/// The `uq-driver worker` subcommand (not available on this platform).
-#[cfg(not(unix))]
-pub fn serve() -> i32 {
-    eprintln!("uq-driver worker: --isolate is supported on Unix only");
-    1
-}
-
-/// The worker setup of a study on `fmu`, whose runs get their instance by `policy`.
-pub fn setup(fmu: &Fmu, iface: &Interface, times: &[f64], policy: InstancePolicy) -> Setup {
-    Setup {
-        fmu_root: fmu.root().to_path_buf(),
-        fmu_shown: fmu.path().to_path_buf(),
-        interface: iface.clone(),
-        times: times.to_vec(),
-        policy,
-    }
-}
-
-/// The uq-driver executable to start workers from: `$UQ_DRIVER_EXE` if set, else this
-/// program.
-pub fn default_exe() -> std::io::Result<PathBuf> {
-    match std::env::var_os("UQ_DRIVER_EXE") {
-        Some(p) => Ok(PathBuf::from(p)),
-        None => std::env::current_exe(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn frames_round_trip_and_a_torn_frame_is_an_error() {
-        let mut buf = Vec::new();
-        write_frame(&mut buf, b'P', &f64s_to_bytes(&[1.5, -0.0, f64::NAN])).unwrap();
-        write_frame(&mut buf, b'R', &[]).unwrap();
-        let mut r = &buf[..];
-        let (tag, p) = read_frame(&mut r).unwrap().unwrap();
-        assert_eq!(tag, b'P');
-        let v = bytes_to_f64s(&p);
-        assert_eq!(v[0], 1.5);
-        assert!(v[1] == 0.0 && v[1].is_sign_negative());
-        assert!(v[2].is_nan());
-        assert_eq!(read_frame(&mut r).unwrap(), Some((b'R', Vec::new())));
-        assert_eq!(read_frame(&mut r).unwrap(), None);
-        let torn = &buf[..12];
-        assert!(read_frame(&mut &torn[..]).is_err());
-        let mut huge = vec![b'O'];
-        huge.extend_from_slice(&u64::MAX.to_le_bytes());
-        assert!(read_frame(&mut &huge[..]).is_err());
-    }
 
     /// A fake worker: a shell script that reads the setup, answers "ready", then `then`.
     #[cfg(unix)]
