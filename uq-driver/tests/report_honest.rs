@@ -202,7 +202,7 @@ fn zero_spread_and_no_exceedance_read_as_such() {
         "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
     );
     let out = dir.path().join("out");
-    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let printed = run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(
         !out.join("q_pdf.svg").exists(),
         "heat map of a deterministic output"
@@ -216,8 +216,13 @@ fn zero_spread_and_no_exceedance_read_as_such() {
     assert!(html.contains("q has the same value in every run at every time"));
     // No run exceeds the limit: a count with its upper bound, not "0 ± 0".
     assert!(
-        html.contains("0 of 20 runs exceeded 1 (95 % upper bound of P: 0.139)"),
+        html.contains("0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)"),
         "{html}"
+    );
+    // The terminal says the same, the limit with its unit.
+    assert!(
+        printed.contains("P(q_end > 1 m): 0 of 20 runs exceeded 1 m (95 % upper bound"),
+        "{printed}"
     );
     assert!(!html.contains("± 0"), "{html}");
     let s = json(&out.join("summary.json"));

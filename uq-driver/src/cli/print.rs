@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use uq_driver::report::units::with_unit;
-use uq_driver::results::numbers::count;
+use uq_driver::results::numbers::{count, to_spread};
+use uq_driver::results::ScalarStats;
 use uq_driver::study::{StudyResult, SuiteResult};
 
 /// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings;
@@ -51,7 +52,10 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
                 if nominal { "nominal run" } else { "every run" },
                 q.definition.text
             );
-            if nominal {
+            if !nominal {
+                // Every run gave the same value: still a count over the runs, as on the page.
+                print_exceedances(q);
+            } else {
                 for e in &q.exceedance_counts {
                     let relation = if q.mean > e.limit {
                         "exceeds"
@@ -69,17 +73,17 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
                 }
             }
         } else {
+            // As the report page writes them: to the resolution the spread allows.
+            let spread = |x: f64| with_unit(&to_spread(x, q.std).replace('\u{202f}', ""), u);
             println!(
-                "  {}: mean {}, Std {} ({} valid runs; {})",
+                "  {}: mean {}, Std {} ({}; {})",
                 q.name,
-                v(q.mean),
-                v(q.std),
-                q.n_valid,
+                spread(q.mean),
+                spread(q.std),
+                count(q.n_valid, "valid run", "valid runs"),
                 q.definition.text
             );
-            for e in &q.exceedance_counts {
-                println!("  P({} > {}): {}", q.name, e.limit, e.describe());
-            }
+            print_exceedances(q);
         }
     }
     if s.failed_runs > 0 {
@@ -89,6 +93,15 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
             "points"
         };
         println!("{} {points} failed (see points.csv)", s.failed_runs);
+    }
+}
+
+/// `P(W > 2.5): 75 of 5 000 runs exceeded 2.5: P = 0.015 (95 % interval …)` for each limit
+/// of a quantity, the limit with its unit.
+fn print_exceedances(q: &ScalarStats) {
+    for e in &q.exceedance_counts {
+        let limit = with_unit(&e.limit.to_string(), q.unit.as_deref());
+        println!("  P({} > {limit}): {}", q.name, e.describe_limit(&limit));
     }
 }
 

@@ -240,6 +240,12 @@ impl ExceedanceCount {
     /// Nested studies used to print the Clopper–Pearson interval of the pooled runs, as if
     /// they were independent: it held the true P in 3 of 30 seeds (found by QA).
     pub fn describe(&self) -> String {
+        self.describe_limit(&self.limit.to_string())
+    }
+
+    /// [`Self::describe`] with the limit written as `limit` (e.g. with its unit:
+    /// `0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)`).
+    pub fn describe_limit(&self, limit: &str) -> String {
         let outer = self.outer_samples.map_or(String::new(), |k| {
             format!(" over {} outer samples", group_digits(k))
         });
@@ -249,10 +255,9 @@ impl ExceedanceCount {
             (_, w) => w,
         };
         let head = format!(
-            "{} of {} {what}{outer} exceeded {}",
+            "{} of {} {what}{outer} exceeded {limit}",
             group_digits(self.exceeded),
             group_digits(self.of),
-            self.limit
         );
         let kind = match self.outer_samples {
             Some(_) => ", bootstrap over the outer samples",

@@ -163,11 +163,11 @@ pub(crate) fn finish(
         });
     }
     let started = Instant::now();
-    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.runs)
-        .map_err(|e| with_points_csv(study, design, entries, out_dir, e.into()))?;
-    let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     let md = fmu.description();
     let units = units::study_units(study, Some(md));
+    let (analysed, splits, mut warnings) = analyse(study, method, design, &outcome.runs, &units)
+        .map_err(|e| with_points_csv(study, design, entries, out_dir, e.into()))?;
+    let (mut outputs, mut quantities) = (analysed.outputs, analysed.quantities);
     units::annotate(&units, &mut outputs, &mut quantities);
     units::describe_signals(&mut quantities, &study.qoi, md);
     let analysis_time = started.elapsed().as_secs_f64();
@@ -238,6 +238,7 @@ fn analyse(
     method: &dyn Sampling,
     design: &Design,
     records: &StoredRuns,
+    units: &BTreeMap<String, String>,
 ) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
     Ok(match &study.method {
         MethodSpec::Nested(nested) => {
@@ -249,7 +250,7 @@ fn analyse(
             // Inputs with an Askey family of their own that the design maps through the normal.
             let askey_hint =
                 design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);
-            let mut warnings = analysis::chaos_gap_warnings(&analysed, askey_hint);
+            let mut warnings = analysis::chaos_gap_warnings(&analysed, askey_hint, units);
             let no_estimate = matches!(study.method, MethodSpec::SparseGrid(_)).then_some(
                 "a sparse grid has one only at a level above 0 with nested rules; Beta and \
                  Gamma inputs, and the gauss_* rules, are not nested",

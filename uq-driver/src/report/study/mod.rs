@@ -620,9 +620,10 @@ fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
         }
     }
     for e in &q.exceedance_counts {
+        let limit = with_unit(&e.limit.to_string(), unit);
         rows.push(vec![
-            format!("P({name} > {})", with_unit(&e.limit.to_string(), unit)),
-            e.describe(),
+            format!("P({name} > {limit})"),
+            e.describe_limit(&limit),
         ]);
     }
     if let Some(e) = &q.chaos_error {

@@ -1,7 +1,11 @@
 //! Checks of a chaos: against the method's own variance (SCM: the quadrature's), and its own
 //! estimate of its truncation error.
 
+use std::collections::BTreeMap;
+
 use super::Analysed;
+use crate::report::units::with_unit;
+use crate::results::numbers::computed;
 use crate::uq::method::ChaosErrorKind;
 
 /// A chaos whose own truncation-error estimate (relative to the variance) exceeds this at some
@@ -17,20 +21,43 @@ const CHAOS_GAP: f64 = 0.01;
 /// runs): the chaos's Sobol' indices, quantiles and densities then miss (or invent) that part,
 /// and the quadrature itself may not have converged. `askey_hint`: the design maps inputs
 /// that have an Askey family of their own through the normal (`chaos = "hermite"`), so the
-/// warning suggests their own families.
-pub(crate) fn chaos_gap_warnings(a: &Analysed, askey_hint: bool) -> Vec<String> {
+/// warning suggests their own families. `units`: the unit of each output and quantity, where
+/// known (the Stds are written with it).
+pub(crate) fn chaos_gap_warnings(
+    a: &Analysed,
+    askey_hint: bool,
+    units: &BTreeMap<String, String>,
+) -> Vec<String> {
     let mut out = Vec::new();
+    let unit = |name: &str| units.get(name).map(String::as_str);
     for o in &a.outputs {
         if let Some(sc) = &o.std_pce {
-            out.extend(chaos_gap(&o.name, &o.std, sc, Some(&o.times), askey_hint));
+            let column = Column {
+                name: &o.name,
+                unit: unit(&o.name),
+                times: Some(&o.times),
+            };
+            out.extend(chaos_gap(&column, &o.std, sc, askey_hint));
         }
     }
     for c in &a.quantity_chaos {
         if let Some(q) = a.quantities.iter().find(|q| q.name == c.name) {
-            out.extend(chaos_gap(&q.name, &[q.std], &c.pce.std(), None, askey_hint));
+            let column = Column {
+                name: &q.name,
+                unit: unit(&q.name),
+                times: None,
+            };
+            out.extend(chaos_gap(&column, &[q.std], &c.pce.std(), askey_hint));
         }
     }
     out
+}
+
+/// What a warning names: an output (with its `times`) or a quantity (`None`), and its unit.
+struct Column<'a> {
+    name: &'a str,
+    unit: Option<&'a str>,
+    times: Option<&'a [f64]>,
 }
 
 /// Whether a column whose Std is `s` is resolved among the columns of Std `std`: above 1e-3
@@ -112,13 +139,7 @@ fn error_warning(name: &str, at: &str, kind: &str, value: f64) -> String {
 /// The warning of one output (`times`) or quantity (`None`) whose Std is `std` by the method
 /// and `std_chaos` by its chaos, at the column where they differ most (columns whose Std is
 /// below 1e-3 of the largest are left out: rounding dominates there).
-fn chaos_gap(
-    name: &str,
-    std: &[f64],
-    std_chaos: &[f64],
-    times: Option<&[f64]>,
-    askey_hint: bool,
-) -> Option<String> {
+fn chaos_gap(column: &Column, std: &[f64], std_chaos: &[f64], askey_hint: bool) -> Option<String> {
     let resolved = resolved(std);
     let (k, gap) = std
         .iter()
@@ -133,13 +154,21 @@ fn chaos_gap(
     if gap <= CHAOS_GAP {
         return None;
     }
-    let at = times.map_or(String::new(), |t| format!(" at t = {} s", t[k]));
+    let at = column
+        .times
+        .map_or(String::new(), |t| format!(" at t = {} s", t[k]));
     let (s, c) = (std[k], std_chaos[k]);
+    let [c_text, s_text] = <[String; 2]>::try_from(computed(&[c, s])).expect("two numbers");
+    let (c_text, s_text) = (
+        with_unit(&c_text, column.unit),
+        with_unit(&s_text, column.unit),
+    );
     Some(format!(
-        "{name}{at}: the chaos holds {:.1} % {} variance than the method's own estimate \
-         (Std {c:.6e} against {s:.6e}); its Sobol' indices, quantiles and densities {} that \
+        "{}{at}: the chaos holds {:.1} % {} variance than the method's own estimate \
+         (Std {c_text} against {s_text}); its Sobol' indices, quantiles and densities {} that \
          part, and the estimate may not have converged either: raise `order` (below `nodes`) \
          or `nodes`{}",
+        column.name,
         100.0 * gap,
         if c < s { "less" } else { "more" },
         if c < s { "miss" } else { "add" },
