@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
-use super::estimate::Estimate;
+use super::estimate::{Draws, Estimate};
 use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
 use super::MethodSpec;
 use crate::uq::distributions::RandomParameter;
@@ -96,13 +96,31 @@ pub struct Conditional {
 
 impl Conditional {
     /// The estimates of column `col` of the outer samples that have one, for [`split`].
+    ///
+    /// The conditional variance of a sampled inner design of `n` runs is
+    /// `v = (n − 1)/n · s² + se²` (`s²` its sample variance, `se²` its squared standard error
+    /// of the mean): since `E[Σ (y − ȳ)²] = n σ² − n Var(ȳ)` for any design whose points each
+    /// follow the inputs' law, this is unbiased whenever `se²` is. For Monte Carlo
+    /// (`se² = s²/n`) it is `s²` itself; for a replicated quasi-Monte Carlo design, whose
+    /// mean varies far less than `σ²/n`, it drops the `n/(n − 1)` excess of `s²` (found by QA:
+    /// inner designs of 16 runs gave 2.48 ± 0.05 for a true 2.33). A Latin hypercube's `se²`
+    /// is the Monte Carlo one, an upper bound, so its `v` stays `s²`, at most `n/(n − 1)`
+    /// high. Quadrature and chaos estimates (no `se²`) keep their own variance.
     pub fn column(&self, col: usize) -> Conditionals {
         let mut c = Conditionals::default();
-        for e in self.estimates.iter().flatten() {
+        for (e, rows) in self.estimates.iter().zip(&self.data_rows) {
+            let Some(e) = e else { continue };
+            let s2 = e.std[col] * e.std[col];
+            let se2 = e.std_error_mean.as_ref().map_or(0.0, |s| s[col] * s[col]);
+            let n = rows.len() as f64;
+            let sampled = e.draws == Draws::Runs && e.std_error_mean.is_some() && n > 1.0;
             c.mean.push(e.mean[col]);
-            c.var.push(e.std[col] * e.std[col]);
-            c.se2
-                .push(e.std_error_mean.as_ref().map_or(0.0, |s| s[col] * s[col]));
+            c.var.push(if sampled && se2.is_finite() {
+                (n - 1.0) / n * s2 + se2
+            } else {
+                s2
+            });
+            c.se2.push(se2);
         }
         c
     }

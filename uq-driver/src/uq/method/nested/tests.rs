@@ -305,3 +305,25 @@ fn integer_uniform_covers_its_range_uniformly_in_every_sampling_design() {
     assert!(chi_square(&c) < CHI2_11_999, "{c:?}");
     assert_eq!(n.design(&inputs, 5).unwrap().values, d.values);
 }
+
+#[test]
+fn small_quasi_monte_carlo_inner_designs_give_unbiased_conditional_variances() {
+    // QA round 4: the conditional variance of an inner design of 16 scrambled Sobol' points
+    // was its sample variance, whose divisor n − 1 overstates σ² by n/(n − 1) when the
+    // design's mean hardly varies (2.48 ± 0.05 for a true 2.33). The inner variance of
+    // y = x1 + x2² + u is 1 + 2 = 3 at every u.
+    for inner in [
+        "{ kind = \"qmc\", samples = 8, replicates = 2 }",
+        "{ kind = \"mc\", samples = 16 }",
+    ] {
+        let n = nested("{ kind = \"mc\", samples = 4000 }", inner);
+        let (design, data) = run(&n, 11);
+        let blocks = n.blocks(&design).unwrap();
+        let rows: Vec<usize> = (0..design.len()).collect();
+        let cond = n.conditional(&blocks, &rows, &data).unwrap();
+        let s = Split::all(&cond.column(0));
+        // Sampling error of the mean of 4000 conditional variances: about 0.02; the
+        // n/(n − 1) excess would be 0.2.
+        assert!((s.var_inner - 3.0).abs() < 0.08, "{inner}: {}", s.var_inner);
+    }
+}
