@@ -752,3 +752,125 @@ fn std_over_time_and_chaos_convergence_read_as_such() {
     }
     assert!(plots_are_well_formed(&out) >= 6);
 }
+
+/// The header fields of a CSV file (RFC 4180 quoting of the header is not needed for the
+/// plain names these studies use).
+fn csv_header(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let first = text.lines().next().unwrap_or("");
+    first.split(',').map(str::to_owned).collect()
+}
+
+/// Columns that are counts or text, which have no unit.
+const UNITLESS: [&str; 5] = ["index", "status", "run", "runs", "order"];
+
+/// Checks `out/units.csv` against the CSV files of `out`: every numeric column of every file
+/// has a row, no row names a file or column that does not exist, and the truncation-error
+/// estimates are dimensionless.
+fn units_match_the_files(out: &Path) {
+    let units = std::fs::read_to_string(out.join("units.csv")).unwrap();
+    let rows: Vec<(String, String, String)> = units
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(f.len(), 3, "{l}");
+            (f[0].to_owned(), f[1].to_owned(), f[2].to_owned())
+        })
+        .collect();
+    let mut files = 0;
+    for e in std::fs::read_dir(out).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_str().unwrap().to_owned();
+        if !name.ends_with(".csv") || name == "units.csv" {
+            continue;
+        }
+        files += 1;
+        for col in csv_header(&p) {
+            if UNITLESS.contains(&col.as_str()) {
+                continue;
+            }
+            assert!(
+                rows.iter().any(|(f, c, _)| *f == name && *c == col),
+                "{name},{col} has no row in units.csv of {}:\n{units}",
+                out.display()
+            );
+        }
+    }
+    assert!(files >= 4, "{files} CSV files in {}", out.display());
+    for (f, c, u) in &rows {
+        let p = out.join(f);
+        assert!(p.is_file(), "units.csv names {f}, which was not written");
+        assert!(
+            csv_header(&p).contains(c),
+            "units.csv names {f},{c}, but {f} has no such column"
+        );
+        if ["order_difference", "level_difference", "loo"].contains(&c.as_str()) {
+            assert_eq!(u, "1", "{f},{c}: a share of the variance is dimensionless");
+        }
+    }
+}
+
+#[test]
+fn units_csv_names_every_column_written_and_no_other() {
+    // README audit F3/F4: the truncation-error columns had the output's unit, the
+    // `<V>_convergence.csv` columns and the Sobol' interval columns were missing, and a
+    // sampling method's `<q>_convergence.csv` was listed with a `std_of_order` it lacks.
+    let dir = tempfile::tempdir().unwrap();
+    let params = "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+                  [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1";
+    for (name, method) in [
+        ("lhs", "kind = \"lhs\"\nsamples = 40"),
+        ("scm", "kind = \"scm\"\nnodes = 3"),
+        ("sparse", "kind = \"sparse_grid\"\nlevel = 2"),
+        (
+            "sobol",
+            "kind = \"sobol_sampling\"\nsamples = 64\nbase = \"qmc\"\nreplicates = 4",
+        ),
+        (
+            "pce",
+            "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 40\norder = 3",
+        ),
+    ] {
+        let s = study(dir.path(), name, method, params);
+        let out = dir.path().join(name);
+        run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        units_match_the_files(&out);
+    }
+    let u = std::fs::read_to_string(dir.path().join("sobol/units.csv")).unwrap();
+    assert!(u.lines().any(|l| l == "q_sobol.csv,ST_C_hi,1"), "{u}");
+    let u = std::fs::read_to_string(dir.path().join("scm/units.csv")).unwrap();
+    assert!(u.lines().any(|l| l == "q.csv,order_difference,1"), "{u}");
+    assert!(
+        u.lines().any(|l| l == "q_convergence.csv,std_of_order,m"),
+        "{u}"
+    );
+}
+
+#[test]
+fn nominal_studies_write_no_header_only_density_files() {
+    // README audit F11: a nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
+    // and no rows, although the README says none is written for a deterministic result.
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "nom",
+        "kind = \"nominal\"",
+        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
+    );
+    let out = dir.path().join("out");
+    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    for f in ["q_pdf.csv", "q_end_pdf.csv", "q_peak_pdf.csv"] {
+        assert!(!out.join(f).exists(), "{f} written for a nominal study");
+    }
+    assert!(out.join("q.csv").is_file() && out.join("q_end_samples.csv").is_file());
+    let s = json(&out.join("summary.json"));
+    assert!(
+        s["outputs"]["q"]["pdf_csv"].is_null(),
+        "{}",
+        s["outputs"]["q"]
+    );
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!html.contains("_pdf.csv"), "the page links a missing file");
+    units_match_the_files(&out);
+}

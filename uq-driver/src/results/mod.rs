@@ -398,8 +398,8 @@ impl Default for Versions {
 pub struct OutputSummary {
     /// `<V>.csv`.
     pub csv: String,
-    /// `<V>_pdf.csv`.
-    pub pdf_csv: String,
+    /// `<V>_pdf.csv`; `null` for a deterministic output, which has no density (no file).
+    pub pdf_csv: Option<String>,
     /// Mean at the stop time.
     pub mean_at_stop: f64,
     /// Std at the stop time.
@@ -424,7 +424,7 @@ impl OutputSummary {
             .unwrap_or(0);
         OutputSummary {
             csv: format!("{}.csv", stem(&s.name)),
-            pdf_csv: format!("{}_pdf.csv", stem(&s.name)),
+            pdf_csv: (!s.deterministic).then(|| format!("{}_pdf.csv", stem(&s.name))),
             mean_at_stop: s.mean[last],
             std_at_stop: s.std[last],
             max_std: s.std[imax],

@@ -7,13 +7,18 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::super::csv::{push_field, push_shortest};
+use super::super::units::DIMENSIONLESS;
 use super::super::{write_bytes, write_columns, write_grid, ReportError};
 use super::quantile_column;
 use crate::results::{Convergence, OutputStats, PointStatus, PointTable, ScalarStats};
 use crate::uq::method::Sobol;
 
-/// `<V>_pdf.csv`: the PDF evolution in long format (empty for a deterministic output).
+/// `<V>_pdf.csv`: the PDF evolution in long format; none for a deterministic output (the
+/// same in every run: no density).
 pub(super) fn pdf_csv(dir: &Path, s: &OutputStats) -> Result<(), ReportError> {
+    if s.deterministic {
+        return Ok(());
+    }
     write_grid(
         &dir.join(format!("{}_pdf.csv", stem(&s.name))),
         &s.pdf_times,
@@ -71,17 +76,14 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
         return Ok(());
     };
     let mut header = vec!["time".to_string()];
-    header.extend(names.iter().map(|n| format!("S_{n}")));
-    header.extend(names.iter().map(|n| format!("ST_{n}")));
+    header.extend(sobol_columns(names, intervals.is_some()));
     let mut data: Vec<Vec<f64>> = (0..names.len())
         .map(|j| column(first, j))
         .chain((0..names.len()).map(|j| column(total, j)))
         .collect();
     if let Some(ci) = intervals {
-        for (label, rows) in [("S", &ci.first), ("ST", &ci.total)] {
-            for (j, n) in names.iter().enumerate() {
-                header.push(format!("{label}_{n}_lo"));
-                header.push(format!("{label}_{n}_hi"));
+        for rows in [&ci.first, &ci.total] {
+            for j in 0..names.len() {
                 data.push(rows.iter().map(|r| r[j].0).collect());
                 data.push(rows.iter().map(|r| r[j].1).collect());
             }
@@ -97,6 +99,22 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
     )
 }
 
+/// The index columns of `<V>_sobol.csv` after `time`: `S_<p>...,ST_<p>...`, then with
+/// intervals `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...`.
+fn sobol_columns(names: &[&str], intervals: bool) -> Vec<String> {
+    let mut header: Vec<String> = names.iter().map(|n| format!("S_{n}")).collect();
+    header.extend(names.iter().map(|n| format!("ST_{n}")));
+    if intervals {
+        for label in ["S", "ST"] {
+            for n in names {
+                header.push(format!("{label}_{n}_lo"));
+                header.push(format!("{label}_{n}_hi"));
+            }
+        }
+    }
+    header
+}
+
 /// `<V>_sobol_overall.csv`: one row, `S_<p>...,ST_<p>...`, the Sobol' indices of the whole
 /// series ([`Sobol::integrated`]); not written where the output has no indices or no spread.
 pub(super) fn sobol_overall_csv(
@@ -107,11 +125,7 @@ pub(super) fn sobol_overall_csv(
     let Some((first, total)) = overall_sobol(s) else {
         return Ok(());
     };
-    let header: Vec<String> = names
-        .iter()
-        .map(|n| format!("S_{n}"))
-        .chain(names.iter().map(|n| format!("ST_{n}")))
-        .collect();
+    let header = sobol_columns(names, false);
     let values: Vec<[f64; 1]> = first.iter().chain(&total).map(|&v| [v]).collect();
     let cols: Vec<&[f64]> = values.iter().map(|v| &v[..]).collect();
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
@@ -131,8 +145,11 @@ pub(super) fn overall_sobol(s: &OutputStats) -> Option<(Vec<f64>, Vec<f64>)> {
         .integrated(&s.times, &s.std)
 }
 
-/// `<q>_pdf.csv`: `x,density` (header only for a deterministic quantity).
+/// `<q>_pdf.csv`: `x,density`; none for a deterministic quantity (no density).
 pub(super) fn scalar_pdf_csv(dir: &Path, q: &ScalarStats) -> Result<(), ReportError> {
+    if q.deterministic {
+        return Ok(());
+    }
     write_columns(
         &dir.join(format!("{}_pdf.csv", stem(&q.name))),
         &["x", "density"],
@@ -155,14 +172,17 @@ pub(super) fn scalar_samples(dir: &Path, q: &ScalarStats) -> Result<(), ReportEr
 /// the terms of that order alone).
 pub(super) fn convergence_csv(dir: &Path, name: &str, c: &Convergence) -> Result<(), ReportError> {
     let path = dir.join(format!("{}_convergence.csv", stem(name)));
+    let header = convergence_columns(c);
+    let cols: [&[f64]; 4] = [&c.x, &c.mean, &c.std, &c.std_of_order];
+    write_columns(&path, header, &cols[..header.len()])
+}
+
+/// The columns of `<name>_convergence.csv`: `runs,mean,std` or `order,mean,std,std_of_order`.
+fn convergence_columns(c: &Convergence) -> &'static [&'static str] {
     if c.axis == "runs" {
-        write_columns(&path, &["runs", "mean", "std"], &[&c.x, &c.mean, &c.std])
+        &["runs", "mean", "std"]
     } else {
-        write_columns(
-            &path,
-            &["order", "mean", "std", "std_of_order"],
-            &[&c.x, &c.mean, &c.std, &c.std_of_order],
-        )
+        &["order", "mean", "std", "std_of_order"]
     }
 }
 
@@ -199,7 +219,10 @@ pub fn points_csv(path: &Path, t: &PointTable) -> Result<(), ReportError> {
 
 /// `units.csv`: `file,column,unit` for every numeric column of the CSV files written (the
 /// files keep their column names; this says what each number is measured in). Columns
-/// without a declared unit are left out; dimensionless ones have unit `1`.
+/// without a declared unit (and counts: `runs`, `order`, `run`, `index`) are left out;
+/// dimensionless ones (Sobol' indices and their intervals, the chaos truncation-error
+/// estimates `order_difference` / `level_difference` / `loo`, which are shares of the
+/// variance, and weights) have unit `1`. The columns are those the writers above write.
 pub(super) fn units_csv(
     dir: &Path,
     outputs: &[OutputStats],
@@ -214,46 +237,63 @@ pub(super) fn units_csv(
             rows.push((file.to_owned(), col.to_owned(), u.to_owned()));
         }
     };
+    let per = |u: Option<&str>| super::super::units::per(u);
     for s in outputs {
         let file = format!("{}.csv", stem(&s.name));
         let u = s.unit.as_deref();
+        let error = s.chaos_error.as_ref().map(|e| e.kind.name());
         for col in output_columns(s).0 {
-            push(&file, &col, if col == "time" { Some("s") } else { u });
+            let unit = match col.as_str() {
+                "time" => Some("s"),
+                c if Some(c) == error => Some(DIMENSIONLESS),
+                _ => u,
+            };
+            push(&file, &col, unit);
         }
-        let file = format!("{}_pdf.csv", stem(&s.name));
-        push(&file, "time", Some("s"));
-        push(&file, "x", u);
-        push(&file, "density", super::super::units::per(u).as_deref());
-        if s.sobol.is_some() {
+        if !s.deterministic {
+            let file = format!("{}_pdf.csv", stem(&s.name));
+            push(&file, "time", Some("s"));
+            push(&file, "x", u);
+            push(&file, "density", per(u).as_deref());
+        }
+        if let Some(sobol) = &s.sobol {
             let file = format!("{}_sobol.csv", stem(&s.name));
             push(&file, "time", Some("s"));
-            for n in names {
-                push(&file, &format!("S_{n}"), Some("1"));
-                push(&file, &format!("ST_{n}"), Some("1"));
+            for col in sobol_columns(names, sobol.intervals.is_some()) {
+                push(&file, &col, Some(DIMENSIONLESS));
             }
         }
         if overall_sobol(s).is_some() {
             let file = format!("{}_sobol_overall.csv", stem(&s.name));
-            for n in names {
-                push(&file, &format!("S_{n}"), Some("1"));
-                push(&file, &format!("ST_{n}"), Some("1"));
+            for col in sobol_columns(names, false) {
+                push(&file, &col, Some(DIMENSIONLESS));
+            }
+        }
+        if let Some(c) = &s.convergence {
+            let file = format!("{}_convergence.csv", stem(&s.name));
+            for col in &convergence_columns(c)[1..] {
+                push(&file, col, u);
             }
         }
     }
     for q in quantities {
         let u = q.unit.as_deref();
-        let file = format!("{}_pdf.csv", stem(&q.name));
-        push(&file, "x", u);
-        push(&file, "density", super::super::units::per(u).as_deref());
+        if !q.deterministic {
+            let file = format!("{}_pdf.csv", stem(&q.name));
+            push(&file, "x", u);
+            push(&file, "density", per(u).as_deref());
+        }
         push(&format!("{}_samples.csv", stem(&q.name)), &q.name, u);
-        let file = format!("{}_convergence.csv", stem(&q.name));
-        push(&file, "mean", u);
-        push(&file, "std", u);
-        push(&file, "std_of_order", u);
+        if let Some(c) = &q.convergence {
+            let file = format!("{}_convergence.csv", stem(&q.name));
+            for col in &convergence_columns(c)[1..] {
+                push(&file, col, u);
+            }
+        }
     }
     if let Some(t) = points {
         if t.weights.is_some() {
-            push("points.csv", "weight", Some("1"));
+            push("points.csv", "weight", Some(DIMENSIONLESS));
         }
         for n in &t.names {
             push("points.csv", n, units.get(n).map(String::as_str));

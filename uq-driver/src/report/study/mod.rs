@@ -404,7 +404,9 @@ fn output_section(
         text.push_str(&e);
     }
     images.push(format!("{}.csv", stem(v)));
-    images.push(format!("{}_pdf.csv", stem(v)));
+    if !s.deterministic {
+        images.push(format!("{}_pdf.csv", stem(v)));
+    }
     if s.sobol.is_some() {
         images.push(format!("{}_sobol.csv", stem(v)));
     }
@@ -505,7 +507,9 @@ fn quantity_section(
             sig(e.value)
         ));
     }
-    images.push(format!("{}_pdf.csv", stem(name)));
+    if !q.deterministic {
+        images.push(format!("{}_pdf.csv", stem(name)));
+    }
     images.push(format!("{}_samples.csv", stem(name)));
     let rows = if nominal {
         nominal_rows(q)
