@@ -229,6 +229,23 @@ fn chaos_input(germ: Germ, d: &Distribution) -> (Family, InputMap) {
 /// of allocating for it).
 pub const MAX_DEGREE: usize = 1000;
 
+/// `value` as `surrogate.json` spells it (`"askey"`, `{"family":"legendre"}`).
+fn json(value: &impl Serialize) -> String {
+    serde_json::to_string(value).unwrap_or_default()
+}
+
+/// An input's family and map as the file spells them, one object:
+/// `{"family":"hermite","map":"affine","offset":100.0,"scale":10.0}`.
+fn as_in_file(family: &Family, map: &InputMap) -> String {
+    let mut v = serde_json::to_value(family).unwrap_or_default();
+    if let (Some(o), Ok(serde_json::Value::Object(m))) =
+        (v.as_object_mut(), serde_json::to_value(map))
+    {
+        o.extend(m);
+    }
+    v.to_string()
+}
+
 /// Checks what [`Surrogate::new`] relies on beyond the format: a chaos germ, each input's
 /// family and map those of its distribution, sane multi-indices, and finite coefficients of
 /// the right count (one vector per time of an output, one for a quantity).
@@ -255,9 +272,11 @@ fn validate(f: &SurrogateFile) -> Result<(), String> {
         };
         if family != input.family || !same_map {
             return Err(format!(
-                "input '{}': family {:?} with map {:?} does not match its distribution with germ \
-                 {:?} (expected family {family:?} with map {map:?})",
-                input.name, input.family, input.map, f.germ
+                "input '{}': {} does not match its distribution under germ {} (expected {})",
+                input.name,
+                as_in_file(&input.family, &input.map),
+                json(&f.germ),
+                as_in_file(&family, &map),
             ));
         }
     }
@@ -851,7 +870,13 @@ mod tests {
         // Families and maps that are not those the evaluation uses.
         let mut f = good.clone();
         f.inputs[1].family = Family::Hermite;
-        assert!(refusal(f).contains("input 'b'"));
+        let m = refusal(f);
+        assert!(m.contains("input 'b'"));
+        // README audit F18: the message spoke Rust (`family Hermite with map Affine { .. }`),
+        // not the file's `"family":"hermite","map":"affine"`.
+        assert!(m.contains(r#"{"family":"hermite","map":"affine","#), "{m}");
+        assert!(m.contains(r#"germ "askey""#), "{m}");
+        assert!(!m.contains("Affine") && !m.contains("Hermite"), "{m}");
         let mut f = good.clone();
         f.inputs[0].map = InputMap::Affine {
             offset: 2.0,

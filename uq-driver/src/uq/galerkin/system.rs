@@ -78,6 +78,17 @@ pub enum Part {
 }
 
 impl Part {
+    /// The name as the study file spells it (`M`, `C`, `K`, `q0`, `v0`).
+    fn file_name(self) -> &'static str {
+        match self {
+            Part::M => "M",
+            Part::C => "C",
+            Part::K => "K",
+            Part::Q0 => "q0",
+            Part::V0 => "v0",
+        }
+    }
+
     fn is_vector(self) -> bool {
         matches!(self, Part::Q0 | Part::V0)
     }
@@ -125,9 +136,9 @@ fn dependence_value(d: &Dependence, n: usize) -> Result<DMatrix<f64>, InvalidSys
     };
     shaped.ok_or_else(|| {
         InvalidSystem(format!(
-            "system.dependence for '{}' on {:?}: d must be {}",
+            "system.dependence for '{}' on \"{}\": d must be {}",
             d.parameter,
-            d.matrix,
+            d.matrix.file_name(),
             if d.matrix.is_vector() {
                 format!("a list of {n} numbers")
             } else {
@@ -206,4 +217,25 @@ pub fn output_dof(sys: &SystemSpec, name: &str) -> Option<(usize, bool)> {
     }
     let base = name.strip_suffix("_dot")?;
     sys.dofs.iter().position(|d| d == base).map(|i| (i, true))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_misshaped_dependence_names_its_part_as_the_study_file_does() {
+        // README audit F18 (alike): `q0` was printed by its Rust name `Q0`.
+        let d = Dependence {
+            parameter: "x".into(),
+            matrix: Part::Q0,
+            d: Coefficient::Vector(vec![1.0]),
+        };
+        let e = dependence_value(&d, 2).unwrap_err();
+        assert!(e.0.contains("on \"q0\": d must be a list of 2"), "{}", e.0);
+        for p in [Part::M, Part::C, Part::K, Part::Q0, Part::V0] {
+            let spelt = serde_json::to_string(&p).unwrap();
+            assert_eq!(spelt, format!("\"{}\"", p.file_name()));
+        }
+    }
 }

@@ -51,6 +51,17 @@ pub enum RuleName {
 }
 
 impl RuleName {
+    /// The name as the study file spells it (`clenshaw_curtis`).
+    pub fn file_name(self) -> &'static str {
+        match self {
+            RuleName::GenzKeister => "genz_keister",
+            RuleName::GaussHermite => "gauss_hermite",
+            RuleName::GaussPatterson => "gauss_patterson",
+            RuleName::ClenshawCurtis => "clenshaw_curtis",
+            RuleName::GaussLegendre => "gauss_legendre",
+        }
+    }
+
     fn kind(self) -> RuleKind {
         match self {
             RuleName::GenzKeister => RuleKind::GenzKeister,
@@ -153,9 +164,9 @@ impl Method for SparseGrid {
         if let Some(named) = self.rule {
             if !rules.contains(&named.kind()) {
                 return Err(InvalidSettings(format!(
-                    "rule {:?} fits none of the inputs' germs (normal germs: genz_keister, \
+                    "rule \"{}\" fits none of the inputs' germs (normal germs: genz_keister, \
                      gauss_hermite; uniform germs: gauss_patterson, clenshaw_curtis, gauss_legendre)",
-                    named
+                    named.file_name()
                 )));
             }
         }
@@ -358,6 +369,16 @@ mod tests {
     }
 
     #[test]
+    fn a_misplaced_rule_is_named_as_the_study_file_spells_it() {
+        // README audit F8: messages named rules `ClenshawCurtis`, which no study file takes.
+        use RuleName::*;
+        for r in [GenzKeister, GaussHermite, GaussPatterson, ClenshawCurtis, GaussLegendre] {
+            let spelt = serde_json::to_string(&r).unwrap();
+            assert_eq!(spelt, format!("\"{}\"", r.file_name()));
+        }
+    }
+
+    #[test]
     fn settings_that_do_not_fit_the_inputs_are_refused() {
         let ins = inputs(vec![
             Distribution::normal(1.0, 0.1).unwrap(),
@@ -378,6 +399,8 @@ mod tests {
             .validate(&p)
             .unwrap_err();
         assert!(e.0.contains("fits none of the inputs"), "{e}");
+        // README audit F8: the rule was named by its Rust name `ClenshawCurtis`.
+        assert!(e.0.contains("rule \"clenshaw_curtis\" fits none"), "{e}");
         let e = method("level = 5").validate(&p).unwrap_err();
         assert!(e.0.contains("highest level of Genz-Keister (4)"), "{e}");
         assert!(method("level = 5\nrule = \"gauss_hermite\"")
