@@ -283,3 +283,20 @@ fn csv_records(text: &str) -> Vec<Vec<String>> {
     }
     records
 }
+
+#[test]
+fn inspect_prints_a_huge_start_value_in_exponent_form() {
+    // README audit F13: Once's `fail_above` (start 1e300) was printed as 301 digits.
+    let Some(fmu) = test_fmus::test_fmu("Once") else {
+        return;
+    };
+    let o = driver(&["inspect", fmu.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("fail_above"))
+        .expect("fail_above listed");
+    assert!(line.contains(" 1e300 "), "{line}");
+    assert!(line.len() < 200, "{line}");
+}

@@ -180,7 +180,7 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
         )?;
     }
     if let Some(de) = &md.default_experiment {
-        let plain = |v: Option<f64>| v.map_or_else(|| "–".to_string(), |x| x.to_string());
+        let plain = |v: Option<f64>| v.map_or_else(|| "–".to_string(), shortest);
         writeln!(
             o,
             "  default experiment: start {} s, stop {} s, step {} s",
@@ -206,7 +206,7 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
     for v in &md.variables {
         let (start, unit) = match &v.kind {
             VariableKind::Real { start, .. } => (
-                start.map(|s| s.to_string()),
+                start.map(shortest),
                 uq_driver::report::units::unit_of(md, &v.name),
             ),
             VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
@@ -232,6 +232,12 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// A number as the CSV files write it: plain between 1e-4 and 1e16, else in exponent form
+/// (`1e300`, not 301 digits).
+fn shortest(v: f64) -> String {
+    uq_driver::report::csv::shortest(v)
+}
+
 /// A variable's description, after its declared `min`/`max` (`range [0.5, 1]`, an open end
 /// as `-inf` or `inf`) when it declares either.
 fn described_range(kind: &VariableKind, description: &str) -> String {
@@ -245,7 +251,7 @@ fn described_range(kind: &VariableKind, description: &str) -> String {
     }
     let lo = min.unwrap_or(f64::NEG_INFINITY);
     let hi = max.unwrap_or(f64::INFINITY);
-    format!("range [{lo}, {hi}] {description}")
+    format!("range [{}, {}] {description}", shortest(lo), shortest(hi))
         .trim_end()
         .to_owned()
 }
