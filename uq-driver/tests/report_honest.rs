@@ -573,6 +573,18 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
         "{html}"
     );
     assert!(html.contains("K += K · [[1]]"), "{html}");
+    // README audit F20: `export --runs` of this folder failed with "cannot read
+    // .../store/manifest.json: No such file or directory"; an SGM study ran no model.
+    assert!(!out.join("points.csv").exists() && !out.join("store").exists());
+    let o = run(&["export", out.to_str().unwrap(), "--runs"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("an SGM study has no model runs to export"),
+        "{err}"
+    );
+    assert!(!err.contains("No such file"), "{err}");
+    assert!(!out.join("runs").exists());
 }
 
 /// Column `name` of a CSV file with a header row.

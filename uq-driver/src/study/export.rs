@@ -103,6 +103,22 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
     let sp = dir.join("summary.json");
     let summary: Value =
         serde_json::from_slice(&read(&sp)?).map_err(|e| invalid(&sp, format!("not JSON: {e}")))?;
+    if summary["fmu"].is_null() && summary["method"]["kind"].is_string() {
+        // An intrusive method (SGM) solves its own system once: no runs, no store.
+        let kind = summary["method"]["kind"].as_str().unwrap_or_default();
+        let what = if kind == "sgm" {
+            "an SGM study".to_string()
+        } else {
+            format!("a {kind} study")
+        };
+        return Err(invalid(
+            dir,
+            format!(
+                "{what} has no model runs to export (its Galerkin system was solved once, \
+                 without an FMU; the results are in the folder's CSV files)"
+            ),
+        ));
+    }
     let outputs: Vec<String> = serde_json::from_value(summary["record_layout"]["outputs"].clone())
         .map_err(|_| {
             invalid(
