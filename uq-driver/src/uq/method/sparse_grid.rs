@@ -34,6 +34,12 @@ use crate::uq::pce::Family;
 /// Most points of a sparse grid accepted here.
 const MAX_POINTS: usize = 1_000_000;
 
+/// The warning of a level-0 grid: a chaos of one term, from one run.
+const LEVEL_0: &str = "no truncation-error estimate (sparse grid level 0: one run at the \
+                       centre of the inputs, a chaos of its mean alone, so no spread and no \
+                       level_difference, which compares levels L and L - 1): nothing says \
+                       whether this chaos has converged; use level 1 or above";
+
 /// A one-dimensional rule named in a study file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -204,7 +210,11 @@ impl Sampling for SparseGrid {
         let germ = self.chaos.germ();
         // Nodes far in the tails (Genz–Keister: |z| up to 9 at level 4) that give a
         // positive-mean input a value <= 0 are reported by `Design::mapped`, with their weight.
-        Ok(Design::mapped(germ, grid.points, Some(grid.weights), inputs))
+        let mut design = Design::mapped(germ, grid.points, Some(grid.weights), inputs);
+        if self.level == 0 {
+            design.warnings.push(LEVEL_0.into());
+        }
+        Ok(design)
     }
 
     /// Needs every node (weighted design). The chaos of every column by the sparse
@@ -366,6 +376,26 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_level_0_grid_warns_that_it_has_no_truncation_error_estimate() {
+        // README audit F6: level 0 gave no warning at all, though the README promised one.
+        let ins = inputs(vec![
+            Distribution::normal(1.0, 0.1).unwrap(),
+            Distribution::normal(2.0, 0.1).unwrap(),
+        ]);
+        let d = method("level = 0").design(&ins, 0).unwrap();
+        assert_eq!(d.len(), 1);
+        assert!(
+            d.warnings
+                .iter()
+                .any(|w| w.starts_with("no truncation-error estimate (sparse grid level 0")),
+            "{:?}",
+            d.warnings
+        );
+        let d = method("level = 1").design(&ins, 0).unwrap();
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
     }
 
     #[test]
