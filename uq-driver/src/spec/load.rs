@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 use super::builtins::builtin;
-use super::error::{location, Location, StudyError};
+use super::error::{location, StudyError};
 use super::file::{quantile_column, Analysis, StudyFile, Variant};
 use super::parameter::{Level, ParameterSpec};
 use super::study::{Study, Suite};
@@ -34,7 +34,7 @@ impl Study {
     pub fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Study, StudyError> {
         let file: StudyFile = toml::from_str(text).map_err(|e| StudyError::Parse {
             origin: origin.to_owned(),
-            at: Location::of(text, e.span().map_or(0, |s| s.start)),
+            at: super::error::parse_error_location(text, e.span(), e.message()),
             message: e.message().to_owned(),
         })?;
         study(file, origin, base, text)

@@ -91,6 +91,28 @@ fn errors_point_at_the_line_and_column() {
 }
 
 #[test]
+fn an_unknown_key_is_pointed_at_not_its_table() {
+    // README audit F9: `level` in an scm [method] was reported at the `[method]` header line.
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let text = base.replace("order = 5", "order = 5\n\nlevel = 3");
+    let line = text.lines().position(|l| l == "level = 3").unwrap() + 1;
+    match Study::parse(&text, "t.toml", None).unwrap_err() {
+        StudyError::Parse { at, message, .. } => {
+            assert!(message.contains("unknown field `level`"), "{message}");
+            assert_eq!(at, Location { line, column: 1 }, "{message}");
+        }
+        e => panic!("{e}"),
+    }
+    // In the second [[parameters]] table (toml spans the array from its first header).
+    let text = base.replacen("std = 2.0", "std = 2.0\n  lowe = 1.0", 1);
+    let line = text.lines().position(|l| l.contains("lowe = 1.0")).unwrap() + 1;
+    match Study::parse(&text, "t.toml", None).unwrap_err() {
+        StudyError::Parse { at, message, .. } => assert_eq!(at.line, line, "{message}"),
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
 fn location_counts_lines_and_characters() {
     let text = "a = 1\nbé = 2\n";
     assert_eq!(Location::of(text, 0), Location { line: 1, column: 1 });
