@@ -149,8 +149,9 @@ paper: build fmu
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
 	@echo "reports: out/paper-*/index.html"
 
-# Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser and the
-# results store reader, FUZZ_SECONDS per target (default 60); not part of make test.
+# Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser, the
+# results store reader and the study-file parser, FUZZ_SECONDS per target (default 60); not
+# part of make test.
 .PHONY: fuzz
 fuzz:
 	uq-driver/fuzz/run.sh
