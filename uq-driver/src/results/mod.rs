@@ -435,6 +435,27 @@ impl OutputSummary {
     }
 }
 
+/// The random parameters with the mean and Std of each (QA round 4: a truncated normal's own
+/// moments, which the README promised in `summary.json`, were only on the page).
+fn parameters_with_moments<S: serde::Serializer>(
+    parameters: &[RandomParameter],
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct WithMoments<'a> {
+        name: &'a str,
+        distribution: &'a crate::uq::Distribution,
+        mean: f64,
+        std: f64,
+    }
+    s.collect_seq(parameters.iter().map(|p| WithMoments {
+        name: &p.name,
+        distribution: &p.distribution,
+        mean: p.distribution.mean(),
+        std: p.distribution.std(),
+    }))
+}
+
 /// `summary.json` of a study.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
@@ -450,7 +471,10 @@ pub struct Summary {
     pub seed: u64,
     /// Time grid.
     pub experiment: Experiment,
-    /// Random parameters.
+    /// Random parameters: each `{"name", "distribution", "mean", "std"}`, the last two those
+    /// of the input itself (a truncated normal's own, not its parent normal's; a lognormal's
+    /// of X, not of ln X). An infinite truncation bound is `null` (JSON has no infinity).
+    #[serde(serialize_with = "parameters_with_moments")]
     pub parameters: Vec<RandomParameter>,
     /// Their correlation: the requested pairs and the normal-space matrix of the Gaussian
     /// copula (absent when the inputs are independent).
