@@ -300,3 +300,28 @@ fn inspect_prints_a_huge_start_value_in_exponent_form() {
     assert!(line.contains(" 1e300 "), "{line}");
     assert!(line.len() < 200, "{line}");
 }
+
+#[test]
+fn simulate_set_of_an_integer_outside_its_range_is_refused_as_a_fixed_one_is() {
+    // README audit F10: the README promised a warning for any `simulate --set` outside the
+    // range; an Integer is refused (as a `[fixed]` one is by `run`), and the message no longer
+    // calls a `--set` value "the fixed value".
+    let Some(fmu) = test_fmus::test_fmu("Features") else {
+        return;
+    };
+    let o = driver(&[
+        "simulate",
+        fmu.to_str().unwrap(),
+        "--set",
+        "misbehave=13",
+        "--stop",
+        "0.1",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("'misbehave' is an Integer declared with min = 0, max = 12")
+            && err.contains("the value 13 given for it is outside that range"),
+        "{err}"
+    );
+}

@@ -338,7 +338,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         err.contains("'function' is an Integer declared with min = 1, max = 4")
-            && err.contains("the fixed value 7 is outside that range"),
+            && err.contains("the value 7 given for it is outside that range"),
         "{err}"
     );
     assert!(!err.contains("points failed"), "{err}");

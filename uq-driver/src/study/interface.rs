@@ -122,10 +122,11 @@ pub enum VariableProblem {
         /// The value.
         value: f64,
     },
-    /// A fixed whole number outside the `min`/`max` the modelDescription declares.
+    /// A whole number given for a variable (`[fixed]`, `simulate --set`) outside the
+    /// `min`/`max` the modelDescription declares.
     #[error(
-        "'{name}' is an {found} declared with {} in the modelDescription; the fixed value \
-         {value} is outside that range",
+        "'{name}' is an {found} declared with {} in the modelDescription; the value {value} \
+         given for it is outside that range",
         declared_range(*.min, *.max)
     )]
     OutOfRange {
