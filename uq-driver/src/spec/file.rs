@@ -74,7 +74,7 @@ impl Experiment {
     }
 
     /// Checks that start < stop and step > 0, all finite, and that the grid has at most
-    /// [`MAX_TIME_POINTS`] points (before anything allocates it).
+    /// `MAX_TIME_POINTS` (1e8) points (before anything allocates it).
     pub fn check(&self) -> Result<(), InvalidExperiment> {
         if self.step == 0.0 {
             return Err(InvalidExperiment::ZeroStep);
@@ -117,7 +117,7 @@ pub enum InvalidExperiment {
         /// Step (s).
         step: f64,
     },
-    /// More communication points than [`MAX_TIME_POINTS`].
+    /// More communication points than `MAX_TIME_POINTS` (1e8).
     #[error(
         "experiment: {points:.3e} communication points (step {step:e} s), more than the limit of \
          1e8 per run (each recorded variable would take {:.1e} bytes of memory); use a \
