@@ -64,10 +64,16 @@
 //!   and resumes what an earlier run there finished ([`study::RunOptions::fresh`] discards it);
 //! - it holds a lock on that folder while it runs (two studies into one folder are refused);
 //! - it runs the points on its own thread pool of [`study::RunOptions::threads`] threads;
-//! - while a study runs in-process, it installs process-wide handlers (SIGSEGV and the other
-//!   crash signals, an `atexit` check for an FMU that calls `exit()`), and an in-process run
-//!   that overruns [`study::RunOptions::timeout_per_run`] ends the process. Run untrusted FMUs
-//!   with [`study::RunOptions::isolate`] (one worker process per run) instead.
+//! - it checks the study again ([`spec::Study::check`]: its fields are public) and refuses
+//!   an empty `out_dir` and options that do not fit together, with typed errors;
+//! - process-wide behaviour is off unless the host opts in with
+//!   [`study::guard::install_process_guards`], as the command line does: signal handlers, an
+//!   `atexit` check that reports an FMU calling `exit()`, and ending the process when an
+//!   in-process run overruns [`study::RunOptions::timeout_per_run`]. Without it a host's own
+//!   `exit()` and signals are its own, and `timeout_per_run` needs
+//!   [`study::RunOptions::isolate`] (each run in a worker process, killed after the limit;
+//!   the worker is this program started as `<exe> worker`, see [`study::isolate`]): the
+//!   safe way to run an FMU that may crash, hang or call `exit()`.
 //!
 //! One simulation without a study: [`study::runner::simulate`]; the FMU itself, call by
 //! call: [`fmu::Fmu`] and [`fmu::Instance`].
@@ -107,7 +113,9 @@
 //! ```
 //!
 //! Points that failed may be left out of `rows` (and `data`) for the methods that allow it
-//! (unweighted designs).
+//! (unweighted designs); `design` checks the inputs and the settings, and `estimate`
+//! refuses `rows` and `data` that do not match the design, with typed errors
+//! ([`uq::method::MethodError`]).
 //!
 //! # Modules
 //!

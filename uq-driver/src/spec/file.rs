@@ -56,7 +56,17 @@ impl Experiment {
     /// The communication points t_0 … t_n (s), computed as start + i·step (no drift) and
     /// ending at stop: when stop − start is not a whole number of steps, the last step is
     /// shorter (as fmpy does).
+    ///
+    /// Empty when the experiment is invalid ([`Experiment::check`]: stop <= start, a step
+    /// that is 0, negative or not finite, more than `MAX_TIME_POINTS` points);
+    /// [`Experiment::try_times`] says why.
     pub fn times(&self) -> Vec<f64> {
+        self.try_times().unwrap_or_default()
+    }
+
+    /// [`Experiment::times`], or why the experiment has no valid grid.
+    pub fn try_times(&self) -> Result<Vec<f64>, InvalidExperiment> {
+        self.check()?;
         let (n, short_last) = self.grid();
         let mut t: Vec<f64> = (0..=n)
             .map(|i| {
@@ -70,7 +80,7 @@ impl Experiment {
         if short_last {
             t.push(self.stop);
         }
-        t
+        Ok(t)
     }
 
     /// Checks that start < stop and step > 0, all finite, and that the grid has at most

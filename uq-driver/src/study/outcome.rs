@@ -10,6 +10,11 @@ use crate::uq::method::MethodError;
 /// Errors of a whole study run.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyRunError {
+    /// The study is not valid (its public fields were changed after [`Study::parse`]).
+    ///
+    /// [`Study::parse`]: crate::spec::Study::parse
+    #[error(transparent)]
+    Study(#[from] crate::spec::StudyError),
     /// Running the points failed.
     #[error(transparent)]
     Run(#[from] RunError),
