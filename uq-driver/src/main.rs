@@ -28,6 +28,8 @@ fn main() -> ExitCode {
     // The CLI owns its process: signal handlers, the atexit check of an FMU calling exit(),
     // and the in-process --timeout-per-run (library hosts leave them off).
     uq_driver::study::guard::install_process_guards();
+    // The library's notes and warnings (silent by default) go to stderr.
+    uq_driver::study::progress::print_messages();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // `uq-driver inspect X | head`: the reader went away; nothing left to say.

@@ -31,7 +31,10 @@ pub enum StudyRunError {
     #[error(transparent)]
     Report(#[from] ReportError),
     /// The study stopped before every point was run (see `max_new_points`).
-    #[error("stopped after {done} of {total} points; run again with the same --out to resume")]
+    #[error(
+        "stopped after {done} of {total} points; run again with the same --out (output folder) \
+         to resume"
+    )]
     Incomplete {
         /// Points finished.
         done: usize,

@@ -140,8 +140,9 @@ pub enum RunError {
     /// Points failed and failures are not allowed.
     #[error(
         "{}; first: {first}. After fixing the cause, run again \
-         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
-         and LHS, to analyse the others)",
+         with --retry-failed (RunOptions::retry_failed) to re-run the failed points (or \
+         --allow-failures, RunOptions::allow_failures, for Monte Carlo and LHS, to analyse the \
+         others)",
         failure_count(*.failed, *.total, *.not_run)
     )]
     PointsFailed {
@@ -187,8 +188,9 @@ pub enum RunError {
         "point {point} ({values}): {message}. After fmi2Fatal, FMI 2.0 forbids any further call \
          to this FMU in this process, so the study stops here: finished points are kept in the \
          results store, point {point} is recorded as failed, and the points not finished are \
-         run by a re-run. Run again with --isolate: there a Fatal fails its point only and the \
-         study goes on (add --allow-failures, for Monte Carlo and LHS, to analyse the others)"
+         run by a re-run. Run again with --isolate (RunOptions::isolate): there a Fatal fails \
+         its point only and the study goes on (add --allow-failures, RunOptions::allow_failures, \
+         for Monte Carlo and LHS, to analyse the others)"
     )]
     Fatal {
         /// The point whose call returned fmi2Fatal.
@@ -260,15 +262,15 @@ pub fn run_points(
     prepare_out_dir(out_dir)?;
     let lock = FolderLock::acquire(out_dir)?;
     if let Some(previous) = lock.taken_over() {
-        eprintln!(
+        super::progress::message(&format!(
             "note: {} was locked by a run that is no longer running ({previous}); taking it over",
             out_dir.display()
-        );
+        ));
     }
     let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
     let records = runs.entries();
     if let Some(note) = store.recovery().summary() {
-        eprintln!("warning: {note}");
+        super::progress::message(&format!("warning: {note}"));
     }
     let wanted: Vec<usize> = match &opts.points {
         Some(p) => p.clone(),
@@ -279,13 +281,13 @@ pub fn run_points(
         .filter(|&&i| matches!(records[i], Some(Entry::Failed(_))))
         .count();
     if failed_before > 0 && !opts.retry_failed {
-        eprintln!(
+        super::progress::message(&format!(
             "note: {failed_before} point{} failed in an earlier run and {} not run again \
-             (--retry-failed runs {} again)",
+             (--retry-failed, RunOptions::retry_failed, runs {} again)",
             if failed_before == 1 { "" } else { "s" },
             if failed_before == 1 { "is" } else { "are" },
             if failed_before == 1 { "it" } else { "them" },
-        );
+        ));
     }
     let missing: Vec<usize> = wanted
         .iter()
