@@ -752,3 +752,43 @@ fn std_over_time_and_chaos_convergence_read_as_such() {
     }
     assert!(plots_are_well_formed(&out) >= 6);
 }
+
+#[test]
+fn summary_json_gives_each_inputs_own_mean_and_std() {
+    // QA round 4: the README promised a truncated normal's own mean and Std in summary.json;
+    // only the page had them. K: N(100, 10²) truncated to [95, ∞): α = −0.5, λ = φ(α)/(1 − Φ(α)),
+    // mean = 100 + 10 λ, variance = 10² (1 + α λ − λ²), with Φ(−0.5) from the normal table.
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "moments",
+        "kind = \"lhs\"\nsamples = 8",
+        "[[parameters]]\nname = \"K\"\ndistribution = \"truncated_normal\"\nmean = 100.0\nstd = 10.0\nlow = 95.0\nhigh = inf\n\
+         [[parameters]]\nname = \"C\"\ndistribution = \"lognormal\"\nmean = 20.0\nstd = 2.0",
+    );
+    let out = dir.path().join("out");
+    run_ok(&[
+        "run",
+        s.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-report",
+    ]);
+    let summary = json(&out.join("summary.json"));
+    let p = &summary["parameters"];
+    let alpha: f64 = -0.5;
+    let phi = (-alpha * alpha / 2.0).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let lambda = phi / (1.0 - 0.308_537_538_725_986_9);
+    let (mean, std) = (
+        100.0 + 10.0 * lambda,
+        10.0 * (1.0 + alpha * lambda - lambda * lambda).sqrt(),
+    );
+    let got = |k: usize, key: &str| p[k][key].as_f64().unwrap();
+    assert!((got(0, "mean") - mean).abs() < 1e-9, "{p}");
+    assert!((got(0, "std") - std).abs() < 1e-9, "{p}");
+    // The parent normal's parameters stay as written; the infinite bound is null.
+    assert_eq!(p[0]["distribution"]["mean"], 100.0);
+    assert!(p[0]["distribution"]["high"].is_null());
+    // A lognormal given by its mean and Std: those of X, not of ln X.
+    assert!((got(1, "mean") - 20.0).abs() < 1e-9 && (got(1, "std") - 2.0).abs() < 1e-9);
+}

@@ -100,8 +100,13 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
 /// of a quantity, the limit with its unit.
 fn print_exceedances(q: &ScalarStats) {
     for e in &q.exceedance_counts {
-        let limit = with_unit(&e.limit.to_string(), q.unit.as_deref());
-        println!("  P({} > {limit}): {}", q.name, e.describe_limit(&limit));
+        let value = |x: f64| with_unit(&x.to_string(), q.unit.as_deref());
+        println!(
+            "  P({} > {}): {}",
+            q.name,
+            value(e.limit),
+            e.describe_with(&value)
+        );
     }
 }
 

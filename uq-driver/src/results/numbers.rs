@@ -9,7 +9,7 @@ pub fn clean(x: f64) -> f64 {
 }
 
 /// `x` rounded to `digits` significant digits.
-fn rounded(x: f64, digits: usize) -> f64 {
+pub(crate) fn rounded(x: f64, digits: usize) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }

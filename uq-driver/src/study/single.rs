@@ -19,9 +19,9 @@ use crate::results::{
     ScalarStats, Summary, Timing, Versions,
 };
 use crate::spec::Study;
-use crate::uq::distributions::Germ;
+use crate::uq::distributions::{Distribution, Germ};
 use crate::uq::method::{
-    ChaosBasis, Design, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling,
+    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling,
 };
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
@@ -257,6 +257,7 @@ fn analyse(
             );
             warnings.extend(analysis::chaos_error_warnings(&analysed, no_estimate));
             warnings.extend(correlated_sobol_warning(study, &analysed));
+            warnings.extend(correlated_chaos_warning(study, &analysed));
             (analysed, Vec::new(), warnings)
         }
     })
@@ -279,6 +280,33 @@ fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
              a parameter first to see its whole share (its first-order index then includes what \
              it carries of the others)",
             order.join(", ")
+        )
+    })
+}
+
+/// A chaos of correlated inputs that are not all normal expands the model composed with the
+/// Gaussian copula's map (each input `F⁻¹(Φ(·))` of a mix of germs), which can be far from a
+/// polynomial although the model is smooth; its own error estimate then understates its
+/// error (QA round 4: a lognormal and a gamma input at ρ = −0.5, LARS on 400 runs: Std +7.7 %
+/// with a leave-one-out error of 0.55 %). Said where a chaos gives the statistics.
+fn correlated_chaos_warning(study: &Study, a: &Analysed) -> Option<String> {
+    let correlation = study.correlation.as_ref()?;
+    let chaos = a.outputs.iter().any(|o| o.draws == Draws::Chaos)
+        || a.quantities.iter().any(|q| q.draws == Draws::Chaos);
+    let non_normal: Vec<&str> = study
+        .parameters
+        .iter()
+        .zip(&correlation.correlated)
+        .filter(|(p, &c)| c && !matches!(p.distribution, Distribution::Normal { .. }))
+        .map(|(p, _)| p.name.as_str())
+        .collect();
+    (chaos && !non_normal.is_empty()).then(|| {
+        format!(
+            "correlated inputs that are not normal ({}): the chaos expands the model through \
+             the Gaussian copula's transform, which can be far from a polynomial; its own \
+             truncation-error estimate can then understate the error several-fold, so check \
+             the mean and Std with a sampling method (`lhs`, `qmc`)",
+            non_normal.join(", ")
         )
     })
 }

@@ -620,10 +620,10 @@ fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
         }
     }
     for e in &q.exceedance_counts {
-        let limit = with_unit(&e.limit.to_string(), unit);
+        let value = |x: f64| with_unit(&x.to_string(), unit);
         rows.push(vec![
-            format!("P({name} > {limit})"),
-            e.describe_limit(&limit),
+            format!("P({name} > {})", value(e.limit)),
+            e.describe_with(&value),
         ]);
     }
     if let Some(e) = &q.chaos_error {

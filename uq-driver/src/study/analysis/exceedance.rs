@@ -34,6 +34,7 @@ pub fn exceedance_count(draws: &[f64], limit: f64, source: Draws) -> ExceedanceC
         },
         ci_kind: "clopper_pearson",
         outer_samples: None,
+        beyond_runs: None,
     }
 }
 

@@ -354,10 +354,24 @@ pub(crate) fn scalar_stats(
             kde::gaussian_kde_binned(&density_samples, lo, hi, a.pdf_grid, bw),
         )
     };
+    let (smallest, largest) = runs
+        .valid
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
     let exceedance_counts: Vec<ExceedanceCount> = q
         .limits()
         .iter()
-        .map(|&l| exceedance_count(&density_samples, l, estimate.draws))
+        .map(|&l| {
+            let mut e = exceedance_count(&density_samples, l, estimate.draws);
+            // A chaos's draws beyond every model run: its extrapolation alone.
+            let outside = l > largest || l < smallest;
+            if estimate.draws == Draws::Chaos && outside && smallest <= largest {
+                e.beyond_runs = Some([smallest, largest]);
+            }
+            e
+        })
         .collect();
     let exceedance = exceedance_counts
         .iter()
@@ -377,8 +391,8 @@ pub(crate) fn scalar_stats(
         n_never_hunts: runs.never_hunts,
         n_never_stops: runs.never_stops,
         quantiles,
-        min: valid.iter().copied().fold(f64::INFINITY, f64::min),
-        max: valid.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        min: smallest,
+        max: largest,
         exceedance,
         exceedance_counts,
         pdf_x,
