@@ -106,6 +106,7 @@ run: build fmu
 lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc -p uq-driver --no-deps
 
 fmt:
 	$(CARGO) fmt --all

@@ -2,6 +2,123 @@
 //! uncertainty through them (Monte Carlo, Latin hypercube, stochastic collocation, the
 //! stochastic Galerkin method).
 //!
+//! The `uq-driver` command line is a thin layer over this library; everything it does is
+//! reachable from Rust.
+//!
+//! # Start here
+//!
+//! ## A study of an FMU: [`spec::Study::parse`] → [`study::run_study`] → [`study::StudyResult`]
+//!
+//! A study is described in TOML (the same file `uq-driver run` takes; see [`spec`] and the
+//! README for every key), run with [`study::run_study`] into an output folder, and its
+//! statistics come back typed:
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use uq_driver::spec::Study;
+//! use uq_driver::study::{run_study, Outcome, RunOptions};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let toml = r#"
+//! name = "wheel-sobol"
+//! fmu = "/path/to/Wheel.fmu"
+//! seed = 42
+//! [experiment]
+//! start = 0.0
+//! stop = 2.0
+//! step = 0.01                      # communication step (s)
+//! [[parameters]]
+//! name = "K"                       # stiffness (N/m)
+//! distribution = "normal"
+//! mean = 100.0
+//! std = 10.0
+//! [[parameters]]
+//! name = "C"                       # damping (N.s/m)
+//! distribution = "normal"
+//! mean = 20.0
+//! std = 2.0
+//! [outputs]
+//! variables = ["q"]                # displacement (m)
+//! [method]
+//! kind = "sobol_sampling"
+//! samples = 256
+//! "#;
+//! // `base`: the folder a relative `fmu` path starts from.
+//! let study = Study::parse(toml, "inline", None)?;
+//! let opts = RunOptions { threads: Some(2), no_report: true, ..RunOptions::default() };
+//! let Outcome::Study(result) = run_study(&study, Path::new("out/wheel-sobol"), &opts)? else {
+//!     unreachable!("a study without [[variants]] is not a suite");
+//! };
+//! let q = &result.outputs[0]; // one entry per output variable
+//! let k = q.times.iter().position(|&t| (t - 1.0).abs() < 1e-9).unwrap();
+//! println!("q(1 s): mean {} m, Std {} m", q.mean[k], q.std[k]);
+//! if let Some(sobol) = &q.sobol {
+//!     println!("first-order Sobol' indices (K, C) at 1 s: {:?}", sobol.first[k]);
+//! }
+//! # Ok(()) }
+//! ```
+//!
+//! What [`study::run_study`] does besides computing, so that a host application knows:
+//! - it writes into the output folder (the resumable results store `store/`, `summary.json`,
+//!   the CSV files and, unless [`study::RunOptions::no_report`], the plots and `index.html`),
+//!   and resumes what an earlier run there finished ([`study::RunOptions::fresh`] discards it);
+//! - it holds a lock on that folder while it runs (two studies into one folder are refused);
+//! - it runs the points on its own thread pool of [`study::RunOptions::threads`] threads;
+//! - it checks the study again ([`spec::Study::check`]: its fields are public) and refuses
+//!   an empty `out_dir` and options that do not fit together, with typed errors;
+//! - process-wide behaviour is off unless the host opts in with
+//!   [`study::guard::install_process_guards`], as the command line does: signal handlers, an
+//!   `atexit` check that reports an FMU calling `exit()`, and ending the process when an
+//!   in-process run overruns [`study::RunOptions::timeout_per_run`]. Without it a host's own
+//!   `exit()` and signals are its own, and `timeout_per_run` needs
+//!   [`study::RunOptions::isolate`] (each run in a worker process, killed after the limit;
+//!   the worker is this program started as `<exe> worker`, see [`study::isolate`]): the
+//!   safe way to run an FMU that may crash, hang or call `exit()`.
+//!
+//! One simulation without a study: [`study::runner::simulate`]; the FMU itself, call by
+//! call: [`fmu::Fmu`] and [`fmu::Instance`].
+//!
+//! ## UQ on a plain Rust function: design → simulate → estimate
+//!
+//! The methods of [`uq::method`] need no FMU: a [`uq::method::Sampling`] method builds a
+//! design for the random inputs, you evaluate your model at its points (in any order, on
+//! any threads), and the method's estimator turns the results into moments and Sobol'
+//! indices:
+//!
+//! ```
+//! use nalgebra::DMatrix;
+//! use uq_driver::uq::distributions::{Distribution, RandomParameter};
+//! use uq_driver::uq::method::{scm::Scm, ChaosBasis, Sampling};
+//! use uq_driver::uq::RandomInputs;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! // y = x1 + 2 x2 with x1, x2 ~ N(0, 1): mean 0, variance 5, S1 = (1/5, 4/5).
+//! let model = |x: &[f64]| x[0] + 2.0 * x[1];
+//! let inputs = RandomInputs::independent(vec![
+//!     RandomParameter { name: "x1".into(), distribution: Distribution::normal(0.0, 1.0)? },
+//!     RandomParameter { name: "x2".into(), distribution: Distribution::normal(0.0, 1.0)? },
+//! ]);
+//! let method = Scm { nodes: 4, order: Some(3), chaos: ChaosBasis::Askey };
+//! let design = method.design(&inputs, 42)?; // seed: same seed, same design
+//! // One row per design point (physical values in `design.values`), one column per
+//! // output value (a time step or a scalar quantity).
+//! let data = DMatrix::from_fn(design.len(), 1, |i, _| model(&design.values[i]));
+//! let rows: Vec<usize> = (0..design.len()).collect(); // the design points `data` holds
+//! let e = method.estimate(&design, &rows, &data)?;
+//! assert!(e.mean[0].abs() < 1e-12);
+//! assert!((e.std[0] * e.std[0] - 5.0).abs() < 1e-10);
+//! let s = e.sobol.expect("a chaos gives Sobol' indices");
+//! assert!((s.first[0][0] - 0.2).abs() < 1e-10 && (s.first[0][1] - 0.8).abs() < 1e-10);
+//! # Ok(()) }
+//! ```
+//!
+//! Points that failed may be left out of `rows` (and `data`) for the methods that allow it
+//! (unweighted designs); `design` checks the inputs and the settings, and `estimate`
+//! refuses `rows` and `data` that do not match the design, with typed errors
+//! ([`uq::method::MethodError`]).
+//!
+//! # Modules
+//!
 //! Modules by concept, each using only those above it in this list:
 //! - [`fmu`]: import of `.fmu` archives (safe unzip, modelDescription, dlopen, instances);
 //! - [`uq`]: distributions, random streams, sampling, quadrature, polynomial chaos, moments,

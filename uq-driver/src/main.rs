@@ -25,7 +25,11 @@ fn main() -> ExitCode {
     if matches!(cli.command, Command::Worker) {
         return ExitCode::from(u8::try_from(uq_driver::study::isolate::serve()).unwrap_or(1));
     }
-    uq_driver::study::guard::install_signal_handler();
+    // The CLI owns its process: signal handlers, the atexit check of an FMU calling exit(),
+    // and the in-process --timeout-per-run (library hosts leave them off).
+    uq_driver::study::guard::install_process_guards();
+    // The library's notes and warnings (silent by default) go to stderr.
+    uq_driver::study::progress::print_messages();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // `uq-driver inspect X | head`: the reader went away; nothing left to say.

@@ -8,7 +8,7 @@
 //! then renamed over its name: `rename` replaces a link itself, never its target. A write
 //! that fails (a full disk) leaves the previous file, or none, and no half-written one.
 //!
-//! [`write`] writes a file from memory; [`OutFile`] streams a large one (e.g. `export`'s
+//! [`write()`] writes a file from memory; [`OutFile`] streams a large one (e.g. `export`'s
 //! `runs.csv`) and is committed with [`OutFile::commit`]; dropped without it, the
 //! temporary file is removed and the target is left as it was.
 //!

@@ -9,15 +9,25 @@
 //! ```no_run
 //! # fn main() -> Result<(), uq_driver::fmu::FmuError> {
 //! use uq_driver::fmu::Fmu;
+//! // railuq's Wheel: a damped oscillator with parameters m, K, C (kg, N/m, N.s/m) and
+//! // outputs q, v, a (m, m/s, m/s2). Variable names are case-sensitive.
 //! let fmu = Fmu::open("target/fmu/Wheel.fmu".as_ref())?;
 //! let mut inst = fmu.instantiate("w0", false)?;
-//! inst.set_real_by_name("k", 2.0)?;
+//! inst.set_real_by_name("K", 150.0)?;
 //! inst.setup_experiment(None, 0.0, Some(1.0))?;
 //! inst.enter_initialization_mode()?;
 //! inst.exit_initialization_mode()?;
-//! inst.do_step(0.0, 0.01, true)?;
+//! let step = 0.01; // communication step (s)
+//! for i in 0..100 {
+//!     inst.do_step(i as f64 * step, step, true)?;
+//! }
+//! let q = inst.get_real_by_name("q")?; // displacement at t = 1 s (m)
+//! inst.terminate()?;
+//! println!("q(1 s) = {q} m");
 //! # Ok(()) }
 //! ```
+//!
+//! [`crate::study::runner::simulate`] does all of this for one parameter point and a time grid.
 //!
 //! Every `Fmu::open` extracts and loads its own copy of the binary, and
 //! [`Fmu::private_copy`] loads another copy of an opened FMU's binary, so an FMU that keeps

@@ -91,7 +91,7 @@ pub struct ConditionalTable {
     pub std_error_mean: Option<Vec<f64>>,
     /// The limits of the exceedance probabilities.
     pub limits: Vec<f64>,
-    /// `exceedance[l][row]`: P(q > limits[l] | outer).
+    /// `exceedance[l][row]`: P(q > `limits[l]` | outer).
     pub exceedance: Vec<Vec<f64>>,
     /// First-order Sobol' indices of the inner parameters per row, if the inner method has them.
     pub sobol_first: Option<Vec<Vec<f64>>>,

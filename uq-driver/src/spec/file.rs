@@ -56,7 +56,17 @@ impl Experiment {
     /// The communication points t_0 … t_n (s), computed as start + i·step (no drift) and
     /// ending at stop: when stop − start is not a whole number of steps, the last step is
     /// shorter (as fmpy does).
+    ///
+    /// Empty when the experiment is invalid ([`Experiment::check`]: stop <= start, a step
+    /// that is 0, negative or not finite, more than `MAX_TIME_POINTS` points);
+    /// [`Experiment::try_times`] says why.
     pub fn times(&self) -> Vec<f64> {
+        self.try_times().unwrap_or_default()
+    }
+
+    /// [`Experiment::times`], or why the experiment has no valid grid.
+    pub fn try_times(&self) -> Result<Vec<f64>, InvalidExperiment> {
+        self.check()?;
         let (n, short_last) = self.grid();
         let mut t: Vec<f64> = (0..=n)
             .map(|i| {
@@ -70,11 +80,11 @@ impl Experiment {
         if short_last {
             t.push(self.stop);
         }
-        t
+        Ok(t)
     }
 
     /// Checks that start < stop and step > 0, all finite, and that the grid has at most
-    /// [`MAX_TIME_POINTS`] points (before anything allocates it).
+    /// `MAX_TIME_POINTS` (1e8) points (before anything allocates it).
     pub fn check(&self) -> Result<(), InvalidExperiment> {
         if self.step == 0.0 {
             return Err(InvalidExperiment::ZeroStep);
@@ -117,7 +127,7 @@ pub enum InvalidExperiment {
         /// Step (s).
         step: f64,
     },
-    /// More communication points than [`MAX_TIME_POINTS`].
+    /// More communication points than `MAX_TIME_POINTS` (1e8).
     #[error(
         "experiment: {points:.3e} communication points (step {step:e} s), more than the limit of \
          1e8 per run (each recorded variable would take {:.1e} bytes of memory); use a \

@@ -3,12 +3,13 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use super::error::StudyError;
 use super::file::{Analysis, Experiment, PaperValue};
 use super::value::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
-use crate::uq::method::{Method, MethodSpec, Problem};
+use crate::uq::method::{Evaluation, Method, MethodSpec, Problem};
 use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// A validated study, ready to run.
@@ -85,6 +86,77 @@ impl Study {
     /// The communication points (s).
     pub fn times(&self) -> Vec<f64> {
         self.experiment.times()
+    }
+
+    /// Checks again what [`Study::parse`] validated and what a change of the public fields
+    /// can break: a valid time grid, at least one random parameter (each a valid
+    /// distribution, named once, not also fixed), something to analyse (outputs or
+    /// quantities), finite fixed values, the quantities' windows, the method's settings
+    /// against the study, and an FMU for a method that runs one; each variant of a suite
+    /// too. [`crate::study::run_study`] calls it before anything else.
+    pub fn check(&self) -> Result<(), StudyError> {
+        let invalid = |message: String| StudyError::Invalid {
+            origin: self.origin.clone(),
+            at: None,
+            message,
+        };
+        let e = &self.experiment;
+        e.check()
+            .map_err(|err| invalid(format!("[experiment]: {err}")))?;
+        if self.parameters.is_empty() {
+            return Err(invalid(
+                "no random parameters: a study needs at least one (a `nominal` study runs \
+                 the FMU at their means); to run the FMU once, use \
+                 `study::runner::simulate` (CLI: `uq-driver simulate`)"
+                    .into(),
+            ));
+        }
+        for (i, p) in self.parameters.iter().enumerate() {
+            if self.parameters[..i].iter().any(|q| q.name == p.name) {
+                return Err(invalid(format!("parameter '{}' is listed twice", p.name)));
+            }
+            if self.fixed.contains_key(&p.name) {
+                return Err(invalid(format!(
+                    "parameter '{}' is both random and fixed",
+                    p.name
+                )));
+            }
+            p.distribution
+                .validate()
+                .map_err(|err| invalid(format!("parameter '{}': {err}", p.name)))?;
+        }
+        if let Some((name, _)) = self.fixed.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(invalid(format!("fixed value of '{name}' is not finite")));
+        }
+        if self.outputs.is_empty() && self.qoi.is_empty() {
+            return Err(invalid(
+                "nothing to analyse: give output variables and/or quantities of interest".into(),
+            ));
+        }
+        for q in &self.qoi {
+            q.validate(e.stop - e.start)
+                .and_then(|()| q.check_grid(e.start, e.stop, e.step))
+                .map_err(|err| invalid(err.to_string()))?;
+        }
+        let times = self.times();
+        self.method()
+            .validate(&self.problem(&times))
+            .map_err(|err| invalid(format!("method {}: {err}", self.method().kind())))?;
+        if let Evaluation::Sampling(_) = self.method().evaluation() {
+            match &self.fmu_path {
+                None => return Err(invalid("no FMU (`fmu_path` is None) to run".into())),
+                Some(p) if p.as_os_str().is_empty() => {
+                    return Err(invalid("the FMU path is empty".into()))
+                }
+                Some(_) => {}
+            }
+        }
+        if let Some(suite) = &self.suite {
+            for v in &suite.variants {
+                v.check()?;
+            }
+        }
+        Ok(())
     }
 
     /// What the method sees of the study; `times` are [`Study::times`].

@@ -4,6 +4,12 @@
 //! inside the process, so the study stops), and SIGINT/SIGTERM/SIGHUP (temporary folders
 //! removed, the running points named). Finished points are in the store in every case (records
 //! are appended as they finish), so a re-run resumes.
+//!
+//! All of this acts on the whole process (an `atexit` handler, signal handlers, `_exit`), so
+//! it is opt-in: [`install_process_guards`], which the command line calls once at start. A
+//! library host that does not call it keeps its own process: its `exit()` is its own, no
+//! signal handler is installed, and `RunOptions::timeout_per_run` needs `RunOptions::isolate`
+//! (it is refused in-process with [`crate::study::RunError::Options`]).
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -30,6 +36,9 @@ static STATE: Mutex<State> = Mutex::new(State {
     running: BTreeMap::new(),
 });
 static ATEXIT: Once = Once::new();
+/// Set by [`install_process_guards`].
+static PROCESS_GUARDS: AtomicBool = AtomicBool::new(false);
+static SIGNALS: Once = Once::new();
 /// The FMU of a `simulate` in progress (for the `exit()` message).
 static SIMULATION: Mutex<Option<String>> = Mutex::new(None);
 
@@ -44,6 +53,28 @@ fn state() -> std::sync::MutexGuard<'static, State> {
     STATE.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Opts this process in to the process-wide guards of a study in progress, for a program that
+/// owns its process (the `uq-driver` command line calls it first thing):
+/// - SIGINT, SIGTERM and SIGHUP end the process after naming the study in progress and
+///   removing the FMUs' temporary folders ([`install_signal_handler`]);
+/// - while an in-process study or simulation runs, an `atexit` handler reports an FMU that
+///   calls `exit()` (and makes the exit status 1), and SIGSEGV, SIGBUS, SIGILL, SIGFPE and
+///   SIGABRT handlers name the running points before passing the signal on;
+/// - an in-process run longer than `RunOptions::timeout_per_run` ends the process (an FMU
+///   call cannot be interrupted inside it) after naming the point.
+///
+/// Without it (the default for a library), none of these is installed, and `timeout_per_run`
+/// without `RunOptions::isolate` is refused. Calling it again does nothing more.
+pub fn install_process_guards() {
+    PROCESS_GUARDS.store(true, Ordering::Release);
+    SIGNALS.call_once(install_signal_handler);
+}
+
+/// Whether [`install_process_guards`] was called in this process.
+pub fn process_guards() -> bool {
+    PROCESS_GUARDS.load(Ordering::Acquire)
+}
+
 /// A study in progress; dropping it ends it.
 #[derive(Debug)]
 pub struct StudyGuard {
@@ -52,9 +83,9 @@ pub struct StudyGuard {
 
 impl StudyGuard {
     /// Starts a study named `name` writing to `out_dir`; `in_process` FMUs can end the process
-    /// with `exit()`, which the guard then reports.
+    /// with `exit()`, which the guard then reports (with [`install_process_guards`] only).
     pub fn begin(name: &str, out_dir: &Path, in_process: bool) -> StudyGuard {
-        if in_process {
+        if in_process && process_guards() {
             ATEXIT.call_once(register_atexit);
             super::crash::install();
         }
@@ -181,7 +212,7 @@ pub fn exit_now(code: i32, message: &str) -> ! {
 /// Installs the handler of SIGINT, SIGTERM and SIGHUP: it names a study in progress (its
 /// finished points are kept and a re-run resumes), removes the temporary folders of opened FMUs
 /// (e.g. `inspect` stopped while it extracts) and exits with [`EXIT_INTERRUPTED`]. Call once,
-/// from the command line program.
+/// from the command line program ([`install_process_guards`] calls it).
 pub fn install_signal_handler() {
     let _ = ctrlc::set_handler(|| {
         STOPPING.store(true, Ordering::Release);
@@ -239,9 +270,12 @@ fn hold_other_exits() {
 pub struct SimulationGuard(());
 
 impl SimulationGuard {
-    /// Starts watching a simulation of `fmu` (as the user named it).
+    /// Starts watching a simulation of `fmu` (as the user named it); the `atexit` handler is
+    /// registered with [`install_process_guards`] only.
     pub fn begin(fmu: &Path) -> SimulationGuard {
-        ATEXIT.call_once(register_atexit);
+        if process_guards() {
+            ATEXIT.call_once(register_atexit);
+        }
         *SIMULATION.lock().unwrap_or_else(|e| e.into_inner()) = Some(fmu.display().to_string());
         SimulationGuard(())
     }

@@ -42,12 +42,20 @@ use crate::spec::Study;
 /// every variant into `out_dir/<variant>/` and writes the comparison into `out_dir`.
 ///
 /// Nothing is allocated, run or written (`out_dir` is not even created) before the study
-/// passes [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`.
+/// passes [`Study::check`] (the fields of a [`Study`] are public: they are checked again) and
+/// [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`. An empty
+/// `out_dir` is refused ([`RunError::NoOutDir`]), as are options that do not fit together
+/// ([`RunError::Options`]).
 pub fn run_study(
     study: &Study,
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<Outcome, StudyRunError> {
+    study.check()?;
+    if out_dir.as_os_str().is_empty() {
+        return Err(RunError::NoOutDir.into());
+    }
+    opts.check()?;
     size::check(study, out_dir, opts)?;
     runner::prepare_out_dir(out_dir)?;
     match &study.suite {

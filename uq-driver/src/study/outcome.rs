@@ -10,6 +10,11 @@ use crate::uq::method::MethodError;
 /// Errors of a whole study run.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyRunError {
+    /// The study is not valid (its public fields were changed after [`Study::parse`]).
+    ///
+    /// [`Study::parse`]: crate::spec::Study::parse
+    #[error(transparent)]
+    Study(#[from] crate::spec::StudyError),
     /// Running the points failed.
     #[error(transparent)]
     Run(#[from] RunError),
@@ -26,7 +31,10 @@ pub enum StudyRunError {
     #[error(transparent)]
     Report(#[from] ReportError),
     /// The study stopped before every point was run (see `max_new_points`).
-    #[error("stopped after {done} of {total} points; run again with the same --out to resume")]
+    #[error(
+        "stopped after {done} of {total} points; run again with the same --out (output folder) \
+         to resume"
+    )]
     Incomplete {
         /// Points finished.
         done: usize,

@@ -30,6 +30,9 @@ pub enum PointError {
     /// A design value does not fit its variable.
     #[error("{0}")]
     Value(String),
+    /// The time grid cannot be run: empty, not finite or not increasing.
+    #[error("time grid: {0}")]
+    Times(String),
     /// The FMU ended the simulation before the stop time. Statistics over time need every run
     /// on the whole grid (a mean at t over the runs that reached t would be conditioned on
     /// reaching it), so such a run is a failed point.
@@ -110,6 +113,25 @@ pub struct Trace {
     pub ended: Option<(f64, Option<Vec<f64>>)>,
 }
 
+/// A grid of at least one finite time, strictly increasing (s).
+fn check_times(times: &[f64]) -> Result<(), PointError> {
+    if times.is_empty() {
+        return Err(PointError::Times(
+            "no communication point: give at least one time (s)".into(),
+        ));
+    }
+    if let Some(t) = times.iter().find(|t| !t.is_finite()) {
+        return Err(PointError::Times(format!("time {t} is not finite")));
+    }
+    if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(PointError::Times(format!(
+            "times must increase, but {} s is followed by {} s",
+            w[0], w[1]
+        )));
+    }
+    Ok(())
+}
+
 /// Starts `slot`'s instance (fresh, or reset: [`Slot::start`]), sets the parameters (the fixed ones, the random
 /// `values`, then the Real `extra` values) and the inputs, initializes and records the signals
 /// at `times`, ending early where the FMU ends the simulation.
@@ -121,6 +143,7 @@ pub(super) fn simulate_point(
     times: &[f64],
     extra: &[(u32, f64)],
 ) -> Result<Trace, PointError> {
+    check_times(times)?;
     let nt = times.len();
     let inst = slot.start(fmu)?;
     iface.fixed.apply(inst)?;
@@ -132,7 +155,7 @@ pub(super) fn simulate_point(
         let (vr, v): (Vec<u32>, Vec<f64>) = extra.iter().copied().unzip();
         inst.set_real(&vr, &v)?;
     }
-    let stop = *times.last().expect("at least one time");
+    let stop = times[nt - 1]; // checked: at least one time
     inst.setup_experiment(None, times[0], Some(stop))?;
     inst.enter_initialization_mode()?;
     if let Some(inputs) = &iface.inputs {

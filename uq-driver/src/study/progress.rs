@@ -5,8 +5,32 @@
 
 use std::io::Write;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, RwLock};
 use std::time::{Duration, Instant};
+
+/// Where the library's messages to the user go (notes and warnings printed as a study runs:
+/// "taking over a stale lock", "N points failed in an earlier run", a variant starting, …).
+type Sink = Box<dyn Fn(&str) + Send + Sync>;
+static MESSAGES: RwLock<Option<Sink>> = RwLock::new(None);
+
+/// Sends the library's messages to `sink` (None: nowhere, the default). The command line
+/// prints them on stderr ([`print_messages`]); a host can log them, show them or drop them.
+/// Warnings that matter for the results are in `summary.warnings` as well.
+pub fn set_message_sink(sink: Option<Sink>) {
+    *MESSAGES.write().unwrap_or_else(|e| e.into_inner()) = sink;
+}
+
+/// Sends the library's messages to stderr, one line each (the command line's choice).
+pub fn print_messages() {
+    set_message_sink(Some(Box::new(|line| eprintln!("{line}"))));
+}
+
+/// One message for the user, to the sink of [`set_message_sink`] (nowhere by default).
+pub fn message(line: &str) {
+    if let Some(sink) = MESSAGES.read().unwrap_or_else(|e| e.into_inner()).as_ref() {
+        sink(line);
+    }
+}
 
 /// How progress is shown.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -175,5 +199,22 @@ mod tests {
         p.finish();
         assert!(Progress::new(ProgressMode::Lines, 0).lines.is_none());
         assert!(Progress::new(ProgressMode::Off, 10).lines.is_none());
+    }
+
+    /// QA qa4/lib M1: library code printed notes to stderr unasked; they now go to the sink a
+    /// host sets (the CLI: stderr), nowhere by default.
+    #[test]
+    fn library_messages_go_to_the_sink_that_is_set_and_nowhere_by_default() {
+        use std::sync::Arc;
+        message("dropped: no sink yet");
+        let got = Arc::new(Mutex::new(Vec::<String>::new()));
+        let g = Arc::clone(&got);
+        set_message_sink(Some(Box::new(move |l| {
+            g.lock().unwrap().push(l.to_owned())
+        })));
+        message("a note");
+        set_message_sink(None);
+        message("dropped again");
+        assert_eq!(*got.lock().unwrap(), vec!["a note".to_owned()]);
     }
 }

@@ -26,7 +26,7 @@ use crate::uq::method::{Design, MethodError};
 /// How to run a study.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Worker threads (None: all cores).
+    /// Worker threads of the model runs (None: all cores; 0 is refused).
     pub threads: Option<usize>,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
@@ -39,7 +39,8 @@ pub struct RunOptions {
     pub fresh: bool,
     /// Stop after this many newly finished points (for tests of interruption).
     pub max_new_points: Option<usize>,
-    /// Run only these points of the design (a shard); None: all.
+    /// Run only these points of the design (a shard); None: all. A point outside the design
+    /// is refused ([`RunError::Options`]).
     pub points: Option<Vec<usize>>,
     /// Write the CSV files and `summary.json` only: no plots, no `index.html`.
     pub no_report: bool,
@@ -48,8 +49,10 @@ pub struct RunOptions {
     /// `--isolate`: run each point in a worker process started from this uq-driver executable
     /// (see [`isolate`]); None: in-process.
     pub isolate: Option<PathBuf>,
-    /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point; in-process
-    /// the study stops with a message naming the point (an FMU call cannot be interrupted).
+    /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point.
+    /// In-process an FMU call cannot be interrupted, so a longer run ends the whole process
+    /// after naming the point: allowed only after [`guard::install_process_guards`] (the
+    /// command line's choice), refused with [`RunError::Options`] otherwise.
     pub timeout_per_run: Option<Duration>,
     /// Start a large study without asking (`--yes`; see [`super::size`]).
     pub yes: bool,
@@ -62,6 +65,35 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
+    /// Checks that the options fit together: `threads` at least 1, and `timeout_per_run`
+    /// either with `isolate` (a longer run is killed) or in a process that opted in to
+    /// [`guard::install_process_guards`] (in-process, a longer run ends the whole process,
+    /// which a library host must ask for).
+    pub fn check(&self) -> Result<(), RunError> {
+        if self.threads == Some(0) {
+            return Err(RunError::Options(
+                "threads = 0: give at least 1 worker thread (RunOptions::threads = None: \
+                 all cores)"
+                    .into(),
+            ));
+        }
+        if let (Some(limit), None) = (self.timeout_per_run, &self.isolate) {
+            if !guard::process_guards() {
+                return Err(RunError::Options(format!(
+                    "timeout_per_run = {} s without isolate: an FMU call cannot be interrupted \
+                     inside this process, so an overrun could only be stopped by ending the \
+                     whole process, which a library caller has not asked for. Set \
+                     RunOptions::isolate (each run in a worker process that is killed after \
+                     the limit; the --isolate of the command line), or call \
+                     uq_driver::study::guard::install_process_guards() first if this program \
+                     owns its process and may end on an overrun",
+                    limit.as_secs_f64()
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Whether failed points may be left out (the option or the study's `allow_failures`).
     pub fn allow_failures(&self, study: &Study) -> bool {
         self.allow_failures || study.analysis.allow_failures
@@ -108,8 +140,9 @@ pub enum RunError {
     /// Points failed and failures are not allowed.
     #[error(
         "{}; first: {first}. After fixing the cause, run again \
-         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
-         and LHS, to analyse the others)",
+         with --retry-failed (RunOptions::retry_failed) to re-run the failed points (or \
+         --allow-failures, RunOptions::allow_failures, for Monte Carlo and LHS, to analyse the \
+         others)",
         failure_count(*.failed, *.total, *.not_run)
     )]
     PointsFailed {
@@ -126,6 +159,13 @@ pub enum RunError {
     /// A single run failed (`simulate`).
     #[error(transparent)]
     Point(#[from] PointError),
+    /// No output folder was given (an empty path would write into the current folder).
+    #[error("no output folder: the output path is empty (give a folder for the results store and the result files)")]
+    NoOutDir,
+    /// The run options do not fit together (e.g. `timeout_per_run` in-process without the
+    /// process guards).
+    #[error("{0}")]
+    Options(String),
     /// The output path exists and is not a folder.
     #[error("{}: the output path exists and is not a folder", .0.display())]
     NotAFolder(PathBuf),
@@ -148,8 +188,9 @@ pub enum RunError {
         "point {point} ({values}): {message}. After fmi2Fatal, FMI 2.0 forbids any further call \
          to this FMU in this process, so the study stops here: finished points are kept in the \
          results store, point {point} is recorded as failed, and the points not finished are \
-         run by a re-run. Run again with --isolate: there a Fatal fails its point only and the \
-         study goes on (add --allow-failures, for Monte Carlo and LHS, to analyse the others)"
+         run by a re-run. Run again with --isolate (RunOptions::isolate): there a Fatal fails \
+         its point only and the study goes on (add --allow-failures, RunOptions::allow_failures, \
+         for Monte Carlo and LHS, to analyse the others)"
     )]
     Fatal {
         /// The point whose call returned fmi2Fatal.
@@ -204,23 +245,35 @@ pub fn run_points(
     out_dir: &Path,
     opts: &RunOptions,
 ) -> Result<RunOutcome, RunError> {
+    opts.check()?;
+    if let Some(&bad) = opts
+        .points
+        .as_ref()
+        .and_then(|p| p.iter().find(|&&i| i >= design.len()))
+    {
+        return Err(RunError::Options(format!(
+            "RunOptions::points names point {bad}, but the design has {} points (0 to {})",
+            design.len(),
+            design.len().saturating_sub(1)
+        )));
+    }
     let started = Instant::now();
     let manifest = manifest(study, fmu, design)?;
     prepare_out_dir(out_dir)?;
     let lock = FolderLock::acquire(out_dir)?;
     if let Some(previous) = lock.taken_over() {
-        eprintln!(
+        super::progress::message(&format!(
             "note: {} was locked by a run that is no longer running ({previous}); taking it over",
             out_dir.display()
-        );
+        ));
     }
     let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
     let records = runs.entries();
     if let Some(note) = store.recovery().summary() {
-        eprintln!("warning: {note}");
+        super::progress::message(&format!("warning: {note}"));
     }
     let wanted: Vec<usize> = match &opts.points {
-        Some(p) => p.iter().copied().filter(|&i| i < design.len()).collect(),
+        Some(p) => p.clone(),
         None => (0..design.len()).collect(),
     };
     let failed_before = wanted
@@ -228,13 +281,13 @@ pub fn run_points(
         .filter(|&&i| matches!(records[i], Some(Entry::Failed(_))))
         .count();
     if failed_before > 0 && !opts.retry_failed {
-        eprintln!(
+        super::progress::message(&format!(
             "note: {failed_before} point{} failed in an earlier run and {} not run again \
-             (--retry-failed runs {} again)",
+             (--retry-failed, RunOptions::retry_failed, runs {} again)",
             if failed_before == 1 { "" } else { "s" },
             if failed_before == 1 { "is" } else { "are" },
             if failed_before == 1 { "it" } else { "them" },
-        );
+        ));
     }
     let missing: Vec<usize> = wanted
         .iter()
@@ -245,10 +298,7 @@ pub fn run_points(
             Some(Entry::Ok(_)) => false,
         })
         .collect();
-    let threads = opts
-        .threads
-        .unwrap_or_else(rayon::current_num_threads)
-        .max(1);
+    let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -294,6 +344,7 @@ pub fn run_points(
     let progress = Progress::new(mode, missing.len());
     let done = AtomicBool::new(false);
     let new = std::thread::scope(|scope| {
+        // In-process, only with the process guards (checked by `opts.check()` above).
         if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
             let (guard, done) = (&guard, &done);
             scope.spawn(move || watchdog(guard, limit, done));
@@ -322,6 +373,9 @@ pub fn run_points(
 
 /// Creates the output folder, or checks that the existing path is one.
 pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.as_os_str().is_empty() {
+        return Err(RunError::NoOutDir);
+    }
     if dir.exists() && !dir.is_dir() {
         return Err(RunError::NotAFolder(dir.to_path_buf()));
     }

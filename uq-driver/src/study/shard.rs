@@ -136,7 +136,7 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     let fmu = open_fmu(&study)?;
     ranges::check_supports(&study, &fmu).map_err(RunError::from)?;
     for w in ranges::range_warnings(&study, &fmu, &design) {
-        eprintln!("uq-driver: warning: {w}");
+        super::progress::message(&format!("uq-driver: warning: {w}"));
     }
     let manifest = runner::manifest(&study, &fmu, &design)?;
     let p = Plan {

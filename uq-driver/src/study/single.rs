@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::analysis::{self, Analysed, AnalysisError};
 use super::outcome::{StudyResult, StudyRunError};
+use super::progress;
 use super::ranges;
 use super::runner::{self, RunError, RunOptions, RunOutcome};
 use super::size;
@@ -46,7 +47,7 @@ pub(crate) fn run_single(
                 // Only the design knew its size: check it before it runs.
                 size::check_runs(study, design.len(), opts)?;
             }
-            eprintln!(
+            progress::message(&format!(
                 "{}: {} with {}",
                 study.name,
                 study.method().label(study.parameters.len()),
@@ -54,10 +55,10 @@ pub(crate) fn run_single(
                     1 => "1 model run".to_owned(),
                     n => format!("{n} model runs"),
                 }
-            );
+            ));
             let early = ranges::range_warnings(study, &fmu, &design);
             for w in &early {
-                eprintln!("uq-driver: warning: {w}");
+                progress::message(&format!("uq-driver: warning: {w}"));
             }
             let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
             let noted = outcome.warnings.len();
@@ -435,11 +436,11 @@ fn with_points_csv(
     }
     let path = out_dir.join("points.csv");
     match report::study::write_points_csv(&path, &point_table(study, design, records)) {
-        Ok(()) => eprintln!(
+        Ok(()) => progress::message(&format!(
             "uq-driver: note: the status and message of every point: {}",
             path.display()
-        ),
-        Err(e) => eprintln!("uq-driver: warning: {e}"),
+        )),
+        Err(e) => progress::message(&format!("uq-driver: warning: {e}")),
     }
     error
 }

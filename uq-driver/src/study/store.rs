@@ -3,7 +3,7 @@
 //!
 //! Layout of `DIR/store/`: `manifest.json` (fingerprint of the study and the FMU, number of
 //! points and values per point) and `records.bin`, a sequence of CRC-32-framed records (see
-//! [`format`] for the bytes).
+//! [`format`](mod@format) for the bytes).
 //!
 //! Opening never panics and never gives up on good records: a damaged record is skipped and
 //! reading resumes at the next valid one. What was skipped, and which points therefore have no

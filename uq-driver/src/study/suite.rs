@@ -28,12 +28,12 @@ pub fn run(
 ) -> Result<SuiteResult, StudyRunError> {
     let mut results = Vec::new();
     for v in &suite.variants {
-        eprintln!(
+        super::progress::message(&format!(
             "{}: variant {} ({}) …",
             study.name,
             v.name,
             v.method().label(v.parameters.len())
-        );
+        ));
         let folder = out_dir.join(&v.name);
         crate::out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
             path: folder.clone(),

@@ -9,6 +9,8 @@
 //!   normal-space correlation solved by [`GaussianCopula`] so that the *physical* Pearson
 //!   correlations are the requested ones), and map `z_i` through `F_i^-1(Phi(.))`.
 //!
+//! [`Distribution::normal_score`]: crate::uq::distributions::Distribution::normal_score
+//!
 //! So every method that maps its points through [`RandomInputs::to_physical`] (all do, through
 //! [`crate::uq::method::Design::mapped`]) honours the correlation, and a chaos built on the
 //! design's coordinates is a chaos in independent germs.

@@ -1,6 +1,6 @@
 //! The files of one study's output folder: `summary.json`, `<V>.csv`, `<V>_pdf.csv`,
 //! `<V>_sobol.csv`, `points.csv`, `units.csv`, the plots and `index.html` (data files in
-//! [`files`], plots in [`plots`], the page's sections here).
+//! `files`, plots in `plots`, the page's sections here).
 
 mod files;
 mod plots;

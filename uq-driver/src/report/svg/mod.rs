@@ -616,8 +616,8 @@ fn marker_color(i: usize) -> &'static str {
     ][i % 8]
 }
 
-/// The label of a density axis for a quantity labelled `x_label`: "probability density
-/// [1/m]" for "q [m]", "[-]" for a dimensionless "W [-]", plain "probability density"
+/// The label of a density axis for a quantity labelled `x_label`: `probability density
+/// [1/m]` for `q [m]`, `[-]` for a dimensionless `W [-]`, plain `probability density`
 /// without a unit.
 pub fn density_label(x_label: &str) -> String {
     let unit = x_label

@@ -5,7 +5,7 @@
 //! its runs (read from the results store) and the per-column results are concatenated
 //! ([`merge`]); the column summaries (quantiles, range, bandwidth) are taken per block, and
 //! the densities from the draws of at most `pdf_times` columns kept on the way
-//! ([`SeriesColumns`]). A chaos's surrogate draws are taken per block of its columns too.
+//! (`SeriesColumns`). A chaos's surrogate draws are taken per block of its columns too.
 //!
 //! Block size: a block and one copy of it by the estimator stay within [`block_bytes`]
 //! (default [`BLOCK_BYTES`], 256 MiB; `RAILUQ_ANALYSIS_BLOCK_BYTES` overrides it). A block

@@ -22,9 +22,9 @@ impl Distribution {
         }
     }
 
-    /// Number of values of an integer uniform input.
-    fn count(low: i64, high: i64) -> f64 {
-        (high - low) as f64 + 1.0
+    /// Number of values of an integer uniform input (no overflow for any `low`, `high`).
+    pub(super) fn count(low: i64, high: i64) -> f64 {
+        (i128::from(high) - i128::from(low)) as f64 + 1.0
     }
 
     /// Support `(lower, upper)` (possibly infinite; for the integer uniform its smallest and
@@ -201,7 +201,7 @@ impl Distribution {
             Distribution::IntegerUniform { low, high } => {
                 // Values <= x: floor(x) - low + 1, clamped to the support.
                 let n = Self::count(low, high);
-                let below = (x.floor() - low as f64 + 1.0).clamp(0.0, n);
+                let below = clamp_to(x.floor() - low as f64 + 1.0, 0.0, n);
                 if upper {
                     (n - below) / n
                 } else {
@@ -238,7 +238,7 @@ impl Distribution {
         if let Some((s, offset, scale)) = self.shape() {
             let x = offset + scale * s.quantile(u, v, u <= 0.5);
             let (lo, hi) = self.support();
-            return x.clamp(lo, hi);
+            return clamp_to(x, lo, hi);
         }
         let z_of = |u: f64, v: f64| if u <= 0.5 { norm_ppf(u) } else { norm_isf(v) };
         match *self {
@@ -250,7 +250,7 @@ impl Distribution {
                 } else {
                     high - v * (high - low)
                 };
-                x.clamp(low, high)
+                clamp_to(x, low, high)
             }
             Distribution::TruncatedNormal {
                 mean,
@@ -259,7 +259,7 @@ impl Distribution {
                 high,
             } => {
                 let z = Trunc::new(mean, std, low, high).quantile(u, v);
-                (mean + std * z).clamp(low, high)
+                clamp_to(mean + std * z, low, high)
             }
             Distribution::IntegerUniform { low, high } => {
                 let n = Self::count(low, high);
@@ -269,7 +269,11 @@ impl Distribution {
                 } else {
                     n - 1.0 - (v * n).floor()
                 };
-                (low as f64 + k.clamp(0.0, n - 1.0)).clamp(low as f64, high as f64)
+                clamp_to(
+                    low as f64 + clamp_to(k, 0.0, n - 1.0),
+                    low as f64,
+                    high as f64,
+                )
             }
             Distribution::Beta { .. }
             | Distribution::Gamma { .. }
@@ -277,5 +281,16 @@ impl Distribution {
                 unreachable!("shapes handled above")
             }
         }
+    }
+}
+
+/// `x` limited to `[lo, hi]`, NaN kept; unlike `f64::clamp` it never panics (`lo > hi` or a
+/// NaN bound, possible for a `Distribution` built as a struct literal and not validated:
+/// the result is then meaningless, but the host is not brought down).
+pub(super) fn clamp_to(x: f64, lo: f64, hi: f64) -> f64 {
+    if x.is_nan() {
+        x
+    } else {
+        x.max(lo).min(hi)
     }
 }

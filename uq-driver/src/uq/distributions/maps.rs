@@ -2,6 +2,7 @@
 //! the isoprobabilistic map from the standard normal, the quantile from the unit interval,
 //! the affine map from the input's Askey germ, and their inverses.
 
+use super::functions::clamp_to;
 use super::{Distribution, Germ};
 use crate::uq::special::{norm_cdf, norm_isf, norm_ppf, norm_sf};
 
@@ -65,8 +66,8 @@ impl Distribution {
     /// uniform, the centre of the value's cell (`(k + 1/2) / n` on the unit interval).
     pub fn to_germ(&self, germ: Germ, value: f64) -> f64 {
         if let Distribution::IntegerUniform { low, high } = *self {
-            let n = (high - low) as f64 + 1.0;
-            let k = (value.round() - low as f64).clamp(0.0, n - 1.0);
+            let n = Distribution::count(low, high);
+            let k = clamp_to(value.round() - low as f64, 0.0, n - 1.0);
             let u = (k + 0.5) / n;
             return match germ {
                 Germ::Uniform => u,

@@ -93,8 +93,11 @@ pub enum DistributionError {
 /// Serialized with a `kind` tag, e.g. `{"kind": "normal", "mean": 1.0, "std": 0.1}`;
 /// the log-normal kind is `log_normal` (`lognormal` is accepted on input); the others are
 /// `uniform`, `truncated_normal`, `beta`, `gamma`, `weibull` and `integer_uniform`.
-/// Deserialization does not validate: call [`Distribution::validate`] on
-/// deserialized values (the constructors validate).
+/// The constructors validate; deserialization and struct literals do not: call
+/// [`Distribution::validate`] on such values. The methods' designs
+/// ([`crate::uq::method::Sampling::design`]) validate their inputs and refuse invalid ones
+/// with a typed error; the functions of an unvalidated distribution (quantile, maps, moments)
+/// never panic, but their values are then meaningless (NaN or clamped).
 /// Infinite truncation bounds are allowed but cannot be written as JSON
 /// (they become `null`); TOML (`inf`) handles them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -364,8 +367,8 @@ impl Distribution {
     pub fn nominal(&self) -> f64 {
         match *self {
             Distribution::IntegerUniform { low, high } => {
-                // floor((low + high) / 2) without overflow.
-                (low + (high - low) / 2) as f64
+                // floor((low + high) / 2) without overflow (even for an unvalidated range).
+                (i128::from(low) + i128::from(high)).div_euclid(2) as f64
             }
             _ => self.mean(),
         }

@@ -352,3 +352,62 @@ fn serde_of_the_new_families() {
         assert_eq!(serde_json::from_str::<Distribution>(text).unwrap(), d);
     }
 }
+
+/// QA qa4/lib H3: `Distribution::Uniform { low: 1, high: 0 }.inverse_cdf(0.5)` and the
+/// integer uniform with `low > high` or the full i64 range panicked (`min > max` in
+/// `f64::clamp`, an i64 overflow) instead of giving a meaningless value; `validate` is where
+/// they are refused.
+#[test]
+fn unvalidated_struct_literals_do_not_panic_in_the_mapping_functions() {
+    let bad = [
+        Distribution::Uniform {
+            low: 1.0,
+            high: 0.0,
+        },
+        Distribution::Uniform {
+            low: f64::NAN,
+            high: 0.0,
+        },
+        Distribution::IntegerUniform { low: 5, high: 1 },
+        Distribution::IntegerUniform {
+            low: i64::MIN,
+            high: i64::MAX,
+        },
+        Distribution::TruncatedNormal {
+            mean: 0.0,
+            std: 1.0,
+            low: 2.0,
+            high: -2.0,
+        },
+        Distribution::Beta {
+            alpha: 2.0,
+            beta: 3.0,
+            low: 1.0,
+            high: 0.0,
+        },
+        Distribution::Normal {
+            mean: 0.0,
+            std: -1.0,
+        },
+    ];
+    for d in bad {
+        assert!(d.validate().is_err(), "{d:?} must be refused by validate");
+        for u in [0.0, 0.1, 0.5, 0.9, 1.0] {
+            let _ = d.inverse_cdf(u);
+        }
+        for germ in [Germ::Normal, Germ::Uniform, Germ::Askey] {
+            let t = d.to_germ(germ, 0.5);
+            let _ = d.from_germ(germ, if t.is_finite() { t } else { 0.0 });
+            let _ = d.normal_score(germ, 0.25);
+        }
+        let _ = (d.from_standard_normal(0.3), d.cdf(0.5), d.pdf(0.5));
+        let _ = (d.mean(), d.std(), d.nominal(), d.support());
+    }
+    // The full i64 range keeps its centre and count without wrapping.
+    let wide = Distribution::IntegerUniform {
+        low: i64::MIN,
+        high: i64::MAX,
+    };
+    assert_eq!(wide.nominal(), -1.0);
+    assert!(wide.std() > 1e18);
+}

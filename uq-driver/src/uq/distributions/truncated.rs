@@ -3,6 +3,7 @@
 
 use std::sync::OnceLock;
 
+use super::functions::clamp_to;
 use crate::uq::quadrature::gauss_legendre;
 use crate::uq::special::{norm_cdf, norm_isf, norm_pdf, norm_ppf, norm_sf};
 
@@ -50,12 +51,12 @@ impl Trunc {
         // so that points near the bound keep their relative resolution.
         if u <= 0.5 && self.alpha.is_finite() {
             if let Some(d) = increment_for(self.alpha, u * self.mass / norm_pdf(self.alpha)) {
-                return (self.alpha + d).clamp(self.alpha, self.beta);
+                return clamp_to(self.alpha + d, self.alpha, self.beta);
             }
         }
         if v <= 0.5 && self.beta.is_finite() {
             if let Some(d) = increment_for(-self.beta, v * self.mass / norm_pdf(self.beta)) {
-                return (self.beta - d).clamp(self.alpha, self.beta);
+                return clamp_to(self.beta - d, self.alpha, self.beta);
             }
         }
         let z = if self.alpha >= 0.0 {
@@ -71,7 +72,7 @@ impl Trunc {
                 norm_isf(self.sf_beta + v * self.mass)
             }
         };
-        z.clamp(self.alpha, self.beta)
+        clamp_to(z, self.alpha, self.beta)
     }
 
     /// `P(alpha < Z <= z) / mass`.

@@ -1,6 +1,7 @@
 //! The points of a sampling method: coordinates in a standard space, physical values and,
 //! for quadrature designs, weights.
 
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::error::MethodError;
@@ -75,6 +76,37 @@ impl Design {
     /// Whether there are no points.
     pub fn is_empty(&self) -> bool {
         self.values.is_empty()
+    }
+
+    /// Checks that results fit this design: `rows` distinct points of the design, one row of
+    /// `data` per entry of `rows`.
+    pub fn check_results(&self, rows: &[usize], data: &DMatrix<f64>) -> Result<(), MethodError> {
+        if rows.len() != data.nrows() {
+            return Err(MethodError::ResultsMismatch(format!(
+                "{} rows named but data has {} rows (one row of data per entry of `rows`)",
+                rows.len(),
+                data.nrows()
+            )));
+        }
+        let mut seen = vec![false; self.len()];
+        for &r in rows {
+            match seen.get_mut(r) {
+                None => {
+                    return Err(MethodError::ResultsMismatch(format!(
+                        "row {r} is not a point of the design (it has {} points, 0 to {})",
+                        self.len(),
+                        self.len().saturating_sub(1)
+                    )))
+                }
+                Some(true) => {
+                    return Err(MethodError::ResultsMismatch(format!(
+                        "point {r} of the design is given twice in `rows`"
+                    )))
+                }
+                Some(s) => *s = true,
+            }
+        }
+        Ok(())
     }
 
     /// Whether the points carry quadrature weights (then none may be dropped).

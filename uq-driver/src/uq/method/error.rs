@@ -33,6 +33,19 @@ pub enum MethodError {
     /// Sobol' indices could not be estimated from a pick-freeze design.
     #[error(transparent)]
     Sensitivity(#[from] SensitivityError),
+    /// The results passed to an estimator do not match the design (`rows` and `data` of
+    /// different lengths, a row that is not a point of the design, a row given twice).
+    #[error("the results do not match the design: {0}")]
+    ResultsMismatch(String),
+    /// A random input is not a valid distribution (e.g. a `Distribution` struct literal
+    /// with `low > high`).
+    #[error("random input '{name}': {source}")]
+    InvalidInput {
+        /// The input's name.
+        name: String,
+        /// What is wrong with its distribution.
+        source: crate::uq::distributions::DistributionError,
+    },
     /// A weighted design lacks results at some of its points.
     #[error(
         "{missing} of {total} weighted points have no value; a weighted design cannot drop a point"

@@ -142,7 +142,7 @@ impl Sobol {
     }
 
     /// These indices with those of the columns without variance set to NaN (indices and
-    /// intervals): where `std` is zero at the rounding level of `mean` ([`no_variance`]) the
+    /// intervals): where `std` is zero at the rounding level of `mean` (`no_variance`) the
     /// indices are 0/0, undefined, whatever the estimator computed there.
     pub fn undefined_without_variance(&self, mean: &[f64], std: &[f64]) -> Sobol {
         let mut out = self.clone();

@@ -300,4 +300,181 @@ mod tests {
             }
         ));
     }
+
+    fn normal_inputs(dim: usize) -> RandomInputs {
+        RandomInputs::independent(
+            (0..dim)
+                .map(|i| RandomParameter {
+                    name: format!("x{i}"),
+                    distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+                })
+                .collect(),
+        )
+    }
+
+    fn sampling_of(text: &str) -> MethodSpec {
+        toml::from_str(text).unwrap()
+    }
+
+    /// QA qa4/lib H3/H4: `SobolSampling::estimate` with `data` three rows short of `rows`
+    /// panicked (range end index out of range); `Lhs::estimate` with three rows too many or
+    /// too few, and `Scm::estimate` with rows that are not design indices, returned `Ok`
+    /// with wrong numbers.
+    #[test]
+    fn estimators_refuse_rows_and_data_that_do_not_match() {
+        let inputs = normal_inputs(2);
+        for text in [
+            "kind = \"sobol_sampling\"\nsamples = 64\nbase = \"mc\"",
+            "kind = \"lhs\"\nsamples = 50",
+            "kind = \"mc\"\nsamples = 50",
+            "kind = \"qmc\"\nsamples = 16",
+            "kind = \"scm\"\nnodes = 3",
+            "kind = \"nominal\"",
+            "kind = \"pce_regression\"\nsamples = 40\norder = 2",
+        ] {
+            let spec = sampling_of(text);
+            let Evaluation::Sampling(m) = spec.method().evaluation() else {
+                panic!("{text}: a sampling method");
+            };
+            let design = m.design(&inputs, 7).unwrap();
+            let n = design.len();
+            let rows: Vec<usize> = (0..n).collect();
+            let ok = DMatrix::from_fn(n, 2, |i, j| design.values[i][0] + j as f64);
+            m.estimate(&design, &rows, &ok).unwrap();
+            let mismatch = |r: Result<Estimate, MethodError>, what: &str| match r {
+                Err(MethodError::ResultsMismatch(_)) => {}
+                other => panic!("{text}, {what}: {other:?}"),
+            };
+            if n > 3 {
+                let short = ok.rows(0, n - 3).into_owned();
+                mismatch(m.estimate(&design, &rows, &short), "data short");
+            }
+            let long = DMatrix::from_element(n + 3, 2, 1.0);
+            mismatch(m.estimate(&design, &rows, &long), "data long");
+            let shifted: Vec<usize> = (100..100 + n).collect();
+            mismatch(
+                m.estimate(&design, &shifted, &ok),
+                "rows outside the design",
+            );
+            if n > 1 {
+                let mut twice = rows.clone();
+                twice[1] = 0;
+                mismatch(m.estimate(&design, &twice, &ok), "a row twice");
+            }
+        }
+    }
+
+    /// QA qa4/lib H3: `SobolSampling { base: Mc, bootstrap: Some(50), confidence: 2.0 }`
+    /// panicked in `estimate` (`partition_at_index`); only `validate` refused it, which
+    /// `design` and `estimate` did not call.
+    #[test]
+    fn sobol_sampling_design_and_estimate_refuse_a_confidence_outside_0_1() {
+        let inputs = normal_inputs(2);
+        let good = sobol_sampling::SobolSampling {
+            samples: 64,
+            base: sobol_sampling::Base::Mc,
+            replicates: None,
+            bootstrap: Some(50),
+            confidence: 0.9,
+        };
+        let design = good.design(&inputs, 3).unwrap();
+        let n = design.len();
+        let rows: Vec<usize> = (0..n).collect();
+        let data = DMatrix::from_fn(n, 1, |i, _| design.values[i][0] + design.values[i][1]);
+        for confidence in [2.0, 0.0, 1.0, f64::NAN, -0.5] {
+            let bad = sobol_sampling::SobolSampling {
+                confidence,
+                ..good.clone()
+            };
+            assert!(
+                matches!(bad.design(&inputs, 3), Err(MethodError::Invalid(_))),
+                "{confidence}"
+            );
+            assert!(
+                matches!(
+                    bad.estimate(&design, &rows, &data),
+                    Err(MethodError::Invalid(_))
+                ),
+                "{confidence}"
+            );
+        }
+    }
+
+    /// QA qa4/lib H4: `Scm` on an `integer_uniform` input returned `Ok` with std 0.577 (true
+    /// 0.816): only `validate` refused a discrete input for a chaos, not `design`/`estimate`.
+    #[test]
+    fn chaos_methods_refuse_a_discrete_input_in_design_and_estimate() {
+        let discrete = RandomInputs::independent(vec![
+            RandomParameter {
+                name: "n".into(),
+                distribution: crate::uq::Distribution::integer_uniform(1, 3).unwrap(),
+            },
+            RandomParameter {
+                name: "x".into(),
+                distribution: crate::uq::Distribution::normal(0.0, 1.0).unwrap(),
+            },
+        ]);
+        for text in [
+            "kind = \"scm\"\nnodes = 4",
+            "kind = \"pce_regression\"\nsamples = 40\norder = 2",
+        ] {
+            let spec = sampling_of(text);
+            let Evaluation::Sampling(m) = spec.method().evaluation() else {
+                panic!("{text}: a sampling method");
+            };
+            match m.design(&discrete, 1) {
+                Err(MethodError::Invalid(e)) => assert!(e.0.contains("integer_uniform"), "{e}"),
+                other => panic!("{text}: {other:?}"),
+            }
+            // A design built for continuous inputs, then given a discrete one (pub fields).
+            let mut design = m.design(&normal_inputs(2), 1).unwrap();
+            design.inputs = discrete.clone();
+            let n = design.len();
+            let rows: Vec<usize> = (0..n).collect();
+            let data = DMatrix::from_element(n, 1, 1.0);
+            assert!(
+                matches!(
+                    m.estimate(&design, &rows, &data),
+                    Err(MethodError::Invalid(_))
+                ),
+                "{text}"
+            );
+        }
+        // A sampling method takes the discrete input.
+        let lhs = sampling_of("kind = \"lhs\"\nsamples = 30");
+        let Evaluation::Sampling(m) = lhs.method().evaluation() else {
+            panic!("lhs: a sampling method");
+        };
+        m.design(&discrete, 1).unwrap();
+    }
+
+    /// QA qa4/lib H3: a `Distribution` struct literal with `low > high` reached the
+    /// quantile and panicked (`min > max`); the designs now refuse it with a typed error.
+    #[test]
+    fn designs_refuse_an_invalid_distribution_literal() {
+        let inputs = RandomInputs::independent(vec![RandomParameter {
+            name: "u".into(),
+            distribution: crate::uq::Distribution::Uniform {
+                low: 1.0,
+                high: 0.0,
+            },
+        }]);
+        for text in [
+            "kind = \"lhs\"\nsamples = 10",
+            "kind = \"scm\"\nnodes = 3",
+            "kind = \"sobol_sampling\"\nsamples = 16",
+            "kind = \"nominal\"",
+        ] {
+            let spec = sampling_of(text);
+            let Evaluation::Sampling(m) = spec.method().evaluation() else {
+                panic!("{text}: a sampling method");
+            };
+            match m.design(&inputs, 1) {
+                Err(e @ MethodError::InvalidInput { .. }) => {
+                    assert!(e.to_string().contains("'u'"), "{e}")
+                }
+                other => panic!("{text}: {other:?}"),
+            }
+        }
+    }
 }

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -46,6 +46,7 @@ impl Sampling for Nominal {
     /// One point of weight 1 at the parameters' means (a discrete input at the value of
     /// its support nearest to its mean, [`crate::uq::Distribution::nominal`]).
     fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         Ok(Design {
             germ: Germ::Normal,
             points: vec![vec![0.0; inputs.len()]],
@@ -63,6 +64,7 @@ impl Sampling for Nominal {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         Ok(Estimate::from_quadrature(
             data,
             design.complete_weights(rows)?,

@@ -21,7 +21,7 @@ use super::chaos::{continuous_inputs, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
-use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{check_design, check_estimate, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::lars::PathKind;
 use crate::uq::hd::regression::LeastSquares;
@@ -262,6 +262,7 @@ impl Sampling for PceRegression {
     /// The random design mapped to the chaos germs (one uniform per coordinate through the
     /// germ law's quantile), or the points file.
     fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         if let Some(path) = &self.points {
             return self.file_design(path, inputs);
         }
@@ -303,6 +304,7 @@ impl Sampling for PceRegression {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         let families = design.families().ok_or_else(|| {
             MethodError::Invalid(InvalidSettings("regression chaos needs a chaos germ".into()))
         })?;

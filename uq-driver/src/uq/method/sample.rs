@@ -15,7 +15,9 @@ use rayon::prelude::*;
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling,
+};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -114,6 +116,7 @@ impl<T: UnitCubeSample> Method for T {
 impl<T: UnitCubeSample> Sampling for T {
     /// Replicate by replicate (point `i` in replicate `i / samples`).
     fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         let (n, d) = (self.samples(), inputs.len());
         let points = match self.replicates() {
             None => self.block(n, d, seed, None)?,
@@ -133,10 +136,11 @@ impl<T: UnitCubeSample> Sampling for T {
     /// Any subset of the points is a valid (smaller) sample: failed points may be left out.
     fn estimate(
         &self,
-        _design: &Design,
+        design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         Ok(match self.replicates() {
             None => Estimate::from_sample(data),
             Some(_) => Estimate::from_replicates(data, rows, self.samples()),

@@ -17,7 +17,7 @@ use super::chaos::{continuous_inputs, order_difference, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
@@ -104,6 +104,7 @@ impl Method for Scm {
 impl Sampling for Scm {
     /// The tensor grid, last parameter varying fastest; weights sum to one.
     fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         let families = self.chaos.families(inputs);
         if families.iter().all(|f| *f == Family::Hermite) {
             // Every input through the normal map: the Gauss–Hermite grid.
@@ -144,6 +145,7 @@ impl Sampling for Scm {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
         let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;

@@ -43,7 +43,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::qmc::{check_sobol_points, Qmc, DEFAULT_REPLICATES};
 use super::sample::UnitCubeSample;
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::random_inputs::RandomInputs;
@@ -300,6 +300,7 @@ impl Sampling for SobolSampling {
     /// In the independent uniform space (with correlated inputs the indices are those of the
     /// independent germs, one per input in study order, as for a chaos).
     fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         let d = inputs.len();
         let base = self.base_points(d, seed)?;
         let (a, b): (Vec<Vec<f64>>, Vec<Vec<f64>>) = base
@@ -324,6 +325,7 @@ impl Sampling for SobolSampling {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         let n = self.samples;
         let d = design.points.first().map_or(0, Vec::len);
         let blocks = PickFreezeRows::new(n, d, rows);

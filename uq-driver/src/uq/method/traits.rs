@@ -28,6 +28,53 @@ pub struct Problem<'a> {
     pub system: Option<&'a SystemSpec>,
 }
 
+impl<'a> Problem<'a> {
+    /// The part of a study a design depends on: these random inputs (and their
+    /// correlation), no outputs, no quantities, no times, no `[system]`. The settings checks
+    /// of [`Sampling::design`] and [`Sampling::estimate`] use it.
+    pub fn of_inputs(inputs: &'a RandomInputs) -> Problem<'a> {
+        Problem {
+            parameters: &inputs.parameters,
+            correlation: inputs.correlation.as_ref(),
+            outputs: &[],
+            quantities: 0,
+            times: &[],
+            system: None,
+        }
+    }
+}
+
+/// What every [`Sampling::design`] checks before it builds anything: each input is a valid
+/// distribution (struct literals and deserialized values are not validated on their own),
+/// and the method's settings fit these inputs ([`Method::validate`] on
+/// [`Problem::of_inputs`]: e.g. a chaos refuses a discrete input, `confidence` must be in
+/// (0, 1)).
+pub(crate) fn check_design(method: &dyn Method, inputs: &RandomInputs) -> Result<(), MethodError> {
+    for p in &inputs.parameters {
+        p.distribution
+            .validate()
+            .map_err(|source| MethodError::InvalidInput {
+                name: p.name.clone(),
+                source,
+            })?;
+    }
+    method.validate(&Problem::of_inputs(inputs))?;
+    Ok(())
+}
+
+/// What every [`Sampling::estimate`] checks before it estimates: the design's inputs and
+/// the settings as [`check_design`] does (the settings may have changed since the design
+/// was built), and that the results fit the design ([`Design::check_results`]).
+pub(crate) fn check_estimate(
+    method: &dyn Method,
+    design: &Design,
+    rows: &[usize],
+    data: &DMatrix<f64>,
+) -> Result<(), MethodError> {
+    check_design(method, &design.inputs)?;
+    design.check_results(rows, data)
+}
+
 /// The `method` entry of `summary.json`: the kind and the method's settings and diagnostics.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MethodSummary {
@@ -99,10 +146,19 @@ pub trait Sampling {
     /// The design for `inputs` (deterministic in `seed`): points in an independent standard
     /// space mapped to physical values by [`Design::mapped`], which honours the inputs'
     /// correlation.
+    ///
+    /// Checks first that every input is a valid distribution
+    /// ([`MethodError::InvalidInput`]) and that the settings fit the inputs
+    /// ([`Method::validate`] on [`Problem::of_inputs`], [`MethodError::Invalid`]); no need to
+    /// call `validate` first.
     fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError>;
 
     /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
     /// the points that gave a value; one column per time step or quantity).
+    ///
+    /// `rows` must be distinct indices of `design` with `data.nrows() == rows.len()`
+    /// ([`MethodError::ResultsMismatch`] otherwise); the settings are checked as in
+    /// [`Sampling::design`].
     fn estimate(
         &self,
         design: &Design,

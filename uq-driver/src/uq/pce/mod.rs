@@ -5,7 +5,7 @@
 //!   recurrences, their Gauss rules and the family of each input distribution;
 //! - [`basis`]: multi-index sets (total degree, hyperbolic) and the multivariate basis
 //!   `Psi_k(t) = prod_i p^(i)_{k_i}(t_i)` over them, orthonormal for the product germ law;
-//! - [`hermite`]: probabilists' Hermite polynomials `He_n` with their exact norms `n!` and
+//! - `hermite`: probabilists' Hermite polynomials `He_n` with their exact norms `n!` and
 //!   triple products (the stochastic Galerkin method assembles in that basis and hands its
 //!   chaos over through [`Pce::from_hermite_he`]).
 //!

@@ -481,6 +481,8 @@ impl Sampling for Nested {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        // The inner designs' inputs and the settings are checked by the methods they call.
+        design.check_results(rows, data)?;
         let blocks = self.blocks(design)?;
         let cond = self.conditional(&blocks, rows, data)?;
         marginal(&cond, data.ncols())
