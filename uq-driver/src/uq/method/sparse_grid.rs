@@ -23,7 +23,7 @@ use super::chaos::{continuous_inputs, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
-use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{check_design, check_estimate, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
@@ -205,6 +205,7 @@ impl Sampling for SparseGrid {
     /// The merged nodes of the sparse grid in the inputs' germs, with the (possibly
     /// negative) combined weights.
     fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
         let families = self.families(inputs);
         let grid = self.grid(&families)?;
         let germ = self.chaos.germ();
@@ -225,6 +226,7 @@ impl Sampling for SparseGrid {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
         design.complete_weights(rows)?;
         let families = design.families().ok_or_else(|| {
             MethodError::Invalid(InvalidSettings("a sparse grid needs a chaos germ".into()))
