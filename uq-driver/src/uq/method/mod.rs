@@ -331,6 +331,7 @@ mod tests {
             "kind = \"scm\"\nnodes = 3",
             "kind = \"nominal\"",
             "kind = \"pce_regression\"\nsamples = 40\norder = 2",
+            "kind = \"sparse_grid\"\nlevel = 2",
         ] {
             let spec = sampling_of(text);
             let Evaluation::Sampling(m) = spec.method().evaluation() else {
