@@ -2,7 +2,9 @@
 //! `index.html`:
 //! - `<q>_conditional.csv`: per outer sample, its outer values and the conditional mean, Std,
 //!   exceedance probabilities (and, where the inner method has them, the chaos Std, the
-//!   standard error of the mean, the first-order Sobol' indices and the chaos coefficients);
+//!   standard error of the mean, the chaos's own error estimate (`loo`, ...), the
+//!   first-order Sobol' indices and the chaos coefficients on the union of the outer
+//!   samples' bases, 0 for a term a basis does not keep: every row as long as the header);
 //! - `<q>_conditional_exceedance.svg`: the distribution over the outer samples of
 //!   P(q > limit | outer), as an empirical CDF per limit;
 //! - `<q>_conditional_mean.svg`: the conditional mean ± Std of every outer sample, sorted;
@@ -85,11 +87,23 @@ fn with_ci(x: f64, ci: [f64; 2]) -> String {
     )
 }
 
+/// What the row label says of an interval that is not the bootstrap: `ci_kind` in words.
+fn kind_note(kind: &str) -> &'static str {
+    match kind {
+        "outer_student_t" => " (interval: Student's t, wider than the bootstrap)",
+        "outer_one_sided" => " (interval: one-sided 95 % bound over the outer samples)",
+        _ => "",
+    }
+}
+
 fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> Section {
     let v = &n.variance_split;
     let t = &n.conditional;
     let mut rows = vec![
-        vec!["mean".into(), with_ci(q.mean, n.mean_ci)],
+        vec![
+            format!("mean{}", kind_note(n.mean_ci_kind)),
+            with_ci(q.mean, n.mean_ci),
+        ],
         vec!["Std".into(), with_ci(q.std, n.std_ci)],
         vec![
             format!("inner share of Var ({})", t.inner_names.join(", ")),
@@ -110,7 +124,7 @@ fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> S
     ];
     for e in &n.exceedance_ci {
         rows.push(vec![
-            format!("P({} > {})", q.name, e.limit),
+            format!("P({} > {}){}", q.name, e.limit, kind_note(e.ci_kind)),
             with_ci(e.p, e.ci),
         ]);
         rows.push(vec![
@@ -128,7 +142,8 @@ fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> S
              Var = E_outer[Var_inner] + Var_outer[E_inner]; the second term is the sample \
              variance of the conditional means less the mean squared standard error of those \
              means (the inner sampling error; none for collocation or chaos). P(q > limit) is \
-             the mean of the conditional probabilities. Intervals: {}. The plots: how \
+             the mean of the conditional probabilities (the quantity's count line gives the \
+             same number: it counts every draw of every outer sample). Intervals: {}. The plots: how \
              P(q > limit | outer) spreads over the outer samples (its empirical distribution \
              function, one step per outer sample: steps near 0 and 1 mean the outer parameters \
              decide the exceedance, steps in between that the inner ones do), and the \
@@ -165,6 +180,9 @@ fn conditional_csv(path: &Path, t: &ConditionalTable) -> Result<(), ReportError>
     if t.std_error_mean.is_some() {
         header.push("std_error_mean".into());
     }
+    if let Some((name, _)) = &t.chaos_error {
+        header.push(name.clone());
+    }
     header.extend(t.limits.iter().map(|&l| exceed_column(l)));
     if t.sobol_first.is_some() {
         header.extend(t.inner_names.iter().map(|n| format!("S_{n}")));
@@ -185,6 +203,7 @@ fn conditional_csv(path: &Path, t: &ConditionalTable) -> Result<(), ReportError>
         row.extend([t.runs[r] as f64, t.mean[r], t.std[r]]);
         row.extend(t.std_chaos.as_ref().map(|s| s[r]));
         row.extend(t.std_error_mean.as_ref().map(|s| s[r]));
+        row.extend(t.chaos_error.as_ref().map(|(_, e)| e[r]));
         row.extend(t.exceedance.iter().map(|p| p[r]));
         if let Some(s) = &t.sobol_first {
             row.extend(&s[r]);

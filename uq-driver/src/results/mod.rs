@@ -224,7 +224,11 @@ pub struct ExceedanceCount {
     /// How `ci_95` and `upper_95` were found: `clopper_pearson` (the draws counted as
     /// independent) or, in a nested study, `outer_bootstrap` (percentile bootstrap over the
     /// outer samples, the independent units; `upper_95` then is the interval's upper end, or
-    /// `1 − 0.05^(1/outer_samples)` when none exceeded).
+    /// `1 − 0.05^(1/outer_samples)` when none exceeded), `outer_student_t` (Student's t on
+    /// the mean of the conditional probabilities, wider than the bootstrap: few outer
+    /// samples) or `outer_one_sided` (none exceeded: `[0, 1 − 0.05^(1/outer_samples)]`; all
+    /// exceeded: `[0.05^(1/outer_samples), 1]`). Nested: `p` is the mean of the conditional
+    /// probabilities, `exceeded` / `of` count every draw of every outer sample.
     pub ci_kind: &'static str,
     /// Nested studies: the number of outer samples the interval rests on.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -279,10 +283,21 @@ impl ExceedanceCount {
             ),
             None => head,
         };
-        let kind = match self.outer_samples {
-            Some(_) => ", bootstrap over the outer samples",
-            None => "",
+        let kind = match (self.outer_samples, self.ci_kind) {
+            (Some(_), "outer_student_t") => ", Student's t over the outer samples",
+            (Some(_), "outer_one_sided") => ", one-sided, over the outer samples",
+            (Some(_), _) => ", bootstrap over the outer samples",
+            (None, _) => "",
         };
+        if self.ci_kind == "outer_one_sided" && self.exceeded == self.of && self.of > 0 {
+            // Nested: every outer sample exceeds; an unsampled one that does not is not ruled
+            // out (`0.05^(1/outer_samples)`, found by QA, qa5/rail H2: [1, 1] from 16 tracks).
+            return format!(
+                "{head}: P = {} (95 % lower bound of P{kind}: {})",
+                sig(self.p),
+                sig(self.ci_95[0])
+            );
+        }
         if self.exceeded == 0 {
             format!(
                 "{head} (95 % upper bound of P{kind}: {})",

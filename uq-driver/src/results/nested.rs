@@ -36,8 +36,14 @@ pub struct ExceedanceInterval {
     pub limit: f64,
     /// Marginal probability: the mean over the outer samples of P(q > limit | outer).
     pub p: f64,
-    /// Its confidence interval.
+    /// Its 95 % interval.
     pub ci: [f64; 2],
+    /// How `ci` was found: `outer_bootstrap` (percentile bootstrap over the outer samples),
+    /// `outer_student_t` (Student's t on the mean of the conditional probabilities, where it
+    /// is wider than the bootstrap: few outer samples; clipped to [0, 1]) or
+    /// `outer_one_sided` (every conditional probability 0, or every one 1: the one-sided
+    /// 95 % bound `1 − 0.05^(1/N)`, or `0.05^(1/N)`, over the `N` outer samples).
+    pub ci_kind: &'static str,
     /// Smallest conditional probability over the outer samples.
     pub conditional_min: f64,
     /// Median of the conditional probabilities.
@@ -53,6 +59,9 @@ pub struct NestedScalar {
     pub variance_split: VarianceSplit,
     /// Confidence interval of the marginal mean.
     pub mean_ci: [f64; 2],
+    /// How `mean_ci` was found: `outer_bootstrap`, or `outer_student_t` where Student's t
+    /// on the conditional means is wider (few outer samples).
+    pub mean_ci_kind: &'static str,
     /// Confidence interval of the marginal Std.
     pub std_ci: [f64; 2],
     /// Marginal exceedance probabilities with intervals, one per limit.
@@ -97,10 +106,16 @@ pub struct ConditionalTable {
     pub sobol_first: Option<Vec<Vec<f64>>>,
     /// The conditional chaos: its multi-indices and the coefficients of each row.
     pub chaos: Option<ConditionalChaos>,
+    /// The inner chaos's own truncation-error estimate per row, with its name (`loo`,
+    /// `order_difference`, `level_difference`), where the inner method has one.
+    pub chaos_error: Option<(String, Vec<f64>)>,
 }
 
-/// The conditional chaos of a quantity: its multi-indices (one per term, shared by every
-/// outer sample) and the coefficients of each outer sample.
+/// The conditional chaos of a quantity: the union of the multi-indices of every outer
+/// sample's basis (a sparse inner chaos keeps a different basis per outer sample), in graded
+/// order (total degree, then as [`crate::uq::pce::basis::MultiIndexSet::total_degree`] lists
+/// them), and per outer sample the coefficient of each (0 for a term its basis does not
+/// keep).
 pub type ConditionalChaos = (Vec<Vec<usize>>, Vec<Vec<f64>>);
 
 /// The split of an output over time.

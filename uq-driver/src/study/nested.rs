@@ -24,19 +24,22 @@ use super::analysis::{
 use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
 use crate::results::{
-    ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit, OutputStats, ScalarStats,
-    VarianceSplit,
+    ConditionalChaos, ConditionalTable, ExceedanceCount, ExceedanceInterval, NestedScalar,
+    OutputSplit, OutputStats, ScalarStats, VarianceSplit,
 };
 use crate::spec::Study;
 use crate::uq::method::nested::split::{self, Split};
 use crate::uq::method::nested::{marginal, Blocks, Conditional, Nested};
-use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling};
+use crate::uq::method::{ChaosErrorKind, Design, Draws, Estimate, MethodError, Sampling};
 use crate::uq::{moments, rng};
 
 /// Tag of the streams of the conditional chaos draws.
 const DRAWS_SEED: u64 = 0x6e65_7374_6564_0d00;
 /// Tag of the bootstrap streams.
 const BOOTSTRAP_SEED: u64 = 0x6e65_7374_6564_0b00;
+/// An inner chaos whose own truncation-error estimate exceeds this (relative to the
+/// conditional variance) in some outer samples is reported (as a stand-alone chaos is).
+const CHAOS_ERROR: f64 = 0.05;
 /// Most pooled draws of an output over time (memory: draws × times).
 pub const SERIES_DRAWS: usize = 4096;
 
@@ -86,7 +89,9 @@ pub fn analyse(
     };
     for (o, name) in study.outputs.iter().enumerate() {
         let data = runs.output(o, nt)?;
-        let (stats, split) = output(method, &blocks, name, &times, &runs.rows, &data, &settings)?;
+        let (stats, split, warning) =
+            output(method, &blocks, name, &times, &runs.rows, &data, &settings)?;
+        out.warnings.extend(warning);
         out.splits.push(split);
         out.analysed.outputs.push(stats);
     }
@@ -101,15 +106,15 @@ pub fn analyse(
             return Err(quantity_error(&name, q, &qr, None));
         }
         let scalar = Scalar { name: &name, q, qi };
-        let (stats, warning) = quantity(study, method, &blocks, scalar, qr, &settings)?;
-        out.warnings.extend(warning);
+        let (stats, warnings) = quantity(study, method, &blocks, scalar, qr, &settings)?;
+        out.warnings.extend(warnings);
         out.analysed.quantities.push(stats);
     }
     Ok(out)
 }
 
-/// The marginal statistics of output `name` (its runs `data`, design rows `rows`) and its
-/// split over time.
+/// The marginal statistics of output `name` (its runs `data`, design rows `rows`), its split
+/// over time and the note of a large inner chaos error.
 fn output(
     method: &Nested,
     blocks: &Blocks,
@@ -118,7 +123,7 @@ fn output(
     rows: &[usize],
     data: &DMatrix<f64>,
     settings: &Settings,
-) -> Result<(OutputStats, OutputSplit), AnalysisError> {
+) -> Result<(OutputStats, OutputSplit, Option<String>), AnalysisError> {
     let nt = data.ncols();
     let fail = |source| AnalysisError::Output {
         name: name.to_owned(),
@@ -139,7 +144,7 @@ fn output(
         var_outer: splits.iter().map(|s| s.var_outer).collect(),
         outer_samples: cond.present().len(),
     };
-    Ok((stats, split))
+    Ok((stats, split, inner_chaos_warning(name, &cond, Some(times))))
 }
 
 /// Where the densities of the conditional estimates come from.
@@ -200,8 +205,8 @@ struct Scalar<'a> {
     qi: usize,
 }
 
-/// The statistics of a scalar quantity and, when its corrected outer variance is negative, a
-/// note.
+/// The statistics of a scalar quantity and notes: its corrected outer variance is negative,
+/// the inner chaos's error estimate is large in some outer samples.
 fn quantity(
     study: &Study,
     method: &Nested,
@@ -209,7 +214,7 @@ fn quantity(
     scalar: Scalar,
     qr: QuantityRuns,
     settings: &Settings,
-) -> Result<(ScalarStats, Option<String>), AnalysisError> {
+) -> Result<(ScalarStats, Vec<String>), AnalysisError> {
     let Scalar { name, q, qi } = scalar;
     let fail = |source: MethodError| quantity_error(name, q, &qr, Some(source));
     let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
@@ -276,23 +281,113 @@ fn quantity(
         exceedance: &exceedance,
     };
     let nested = nested_scalar(name, parts, table);
+    let range = [stats.min, stats.max];
     for (count, e) in stats
         .exceedance_counts
         .iter_mut()
         .zip(&nested.exceedance_ci)
     {
-        nest_exceedance_count(count, e.ci, present.len(), stats.draws);
+        nested_count(count, e, &per_outer, stats.draws, range);
     }
     stats.nested = Some(nested);
-    let warning = (s.var_outer < 0.0).then(|| {
+    let mut warnings: Vec<String> = inner_chaos_warning(name, &cond, None).into_iter().collect();
+    warnings.extend((s.var_outer < 0.0).then(|| {
         format!(
             "{}: the estimated variance between outer samples, {:.3e}, is below the inner \
              sampling error it is corrected for ({:.3e}); the outer share is counted as 0 \
              (more inner runs or outer samples would resolve it)",
             name, s.var_outer_plugin, s.correction
         )
-    });
-    Ok((stats, warning))
+    }));
+    Ok((stats, warnings))
+}
+
+/// The count of P(q > `e.limit`) of a nested study: every draw of every outer sample
+/// counted (the draws the conditional probabilities come from, `per_outer`), so that with
+/// the same number from each outer sample `exceeded / of` is the marginal P of the two-level
+/// table (found by QA, qa5/rail L1: the count line said 0.613 from 1 250 draws per outer
+/// sample beside an interval of the mean of the conditional probabilities, 0.608); `p` is
+/// that mean in any case (outer samples with different numbers of successful runs weigh
+/// equally); the interval and its kind are those of `e`. `range`: the smallest and largest
+/// model run; a limit outside it, counted over chaos draws, rests on the extrapolation of the
+/// inner chaoses alone (`beyond_runs`).
+fn nested_count(
+    count: &mut ExceedanceCount,
+    e: &ExceedanceInterval,
+    per_outer: &[Vec<f64>],
+    draws: Draws,
+    range: [f64; 2],
+) {
+    count.of = per_outer.iter().map(Vec::len).sum();
+    count.exceeded = per_outer.iter().flatten().filter(|&&x| x > e.limit).count();
+    count.p = e.p;
+    nest_exceedance_count(count, e.ci, per_outer.len(), draws);
+    count.ci_kind = e.ci_kind;
+    let outside = e.limit > range[1] || e.limit < range[0];
+    if draws == Draws::Chaos && outside && range[0] <= range[1] {
+        count.beyond_runs = Some(range);
+    }
+}
+
+/// The inner chaos's own truncation-error estimate (per outer sample: its largest over the
+/// columns whose Std is above 1e-3 of the largest; `order_difference` over a series weighted
+/// by the variance) where it exceeds [`CHAOS_ERROR`] in some outer samples, summarised: how
+/// many, the largest and where. A stand-alone chaos study warns of each; the nested study
+/// dropped them (found by QA, qa5/rail M2). `times`: those of an output, `None` for a quantity.
+fn inner_chaos_warning(name: &str, cond: &Conditional, times: Option<&[f64]>) -> Option<String> {
+    let mut kind = None;
+    let mut present = 0;
+    let mut over: Vec<(usize, f64, Option<usize>)> = Vec::new();
+    for (k, e) in cond.estimates.iter().enumerate() {
+        let Some(e) = e else { continue };
+        present += 1;
+        let Some(err) = &e.chaos_error else { continue };
+        kind = Some(err.kind);
+        let worst = if err.kind == ChaosErrorKind::OrderDifference && err.values.len() > 1 {
+            let (mut shared, mut total) = (0.0, 0.0);
+            for (v, s) in err.values.iter().zip(&e.std) {
+                if v.is_finite() && s.is_finite() {
+                    shared += v * s * s;
+                    total += s * s;
+                }
+            }
+            (total > 0.0).then(|| (shared / total, None))
+        } else {
+            let largest = e
+                .std
+                .iter()
+                .filter(|s| s.is_finite())
+                .fold(0.0_f64, |m, s| m.max(s.abs()));
+            err.values
+                .iter()
+                .zip(&e.std)
+                .enumerate()
+                .filter(|(_, (v, s))| v.is_finite() && s.abs() > 1e-3 * largest)
+                .max_by(|a, b| a.1 .0.total_cmp(b.1 .0))
+                .map(|(j, (&v, _))| (v, Some(j)))
+        };
+        if let Some((v, j)) = worst.filter(|w| w.0 > CHAOS_ERROR) {
+            over.push((k, v, j));
+        }
+    }
+    let (k, v, j) = *over.iter().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let at = match (times, j) {
+        (Some(t), Some(j)) => t.get(j).map_or(String::new(), |t| format!(", t = {t} s")),
+        _ => String::new(),
+    };
+    Some(format!(
+        "{name}: the inner chaos's own truncation-error estimate ({}) exceeds {} % of the \
+         conditional variance in {} of {present} outer samples (largest {:.1} % at outer \
+         sample {k}{at}): the conditional mean, Std, P(q > limit | outer) and Sobol' indices \
+         of those samples may be far off, and the intervals over the outer samples do not \
+         cover this error; raise the inner order or number of runs (per outer sample: the \
+         `{}` column of the conditional table)",
+        kind.map_or("", |k| k.name()),
+        100.0 * CHAOS_ERROR,
+        over.len(),
+        100.0 * v,
+        kind.map_or("", |k| k.name()),
+    ))
 }
 
 /// The split of a quantity with its intervals and the conditional exceedance probabilities
@@ -315,6 +410,7 @@ fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedSca
     } = parts;
     let n = exceedance.first().map_or(0, Vec::len);
     let (fi, fo) = s.fractions();
+    let (mean_ci, mean_ci_kind) = split::mean_interval(&table.mean, ci.mean);
     NestedScalar {
         variance_split: VarianceSplit {
             inner: fi,
@@ -326,19 +422,22 @@ fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedSca
             var_outer_plugin: s.var_outer_plugin,
             correction: s.correction,
         },
-        mean_ci: ci.mean,
+        mean_ci,
+        mean_ci_kind,
         std_ci: ci.std,
         exceedance_ci: exceedance
             .iter()
             .zip(limits)
             .zip(&ci.exceedance)
-            .map(|((p, &limit), &ci)| {
+            .map(|((p, &limit), &boot)| {
                 let mut sorted = p.clone();
                 sorted.sort_by(f64::total_cmp);
+                let (ci, ci_kind) = split::exceedance_interval(p, boot);
                 ExceedanceInterval {
                     limit,
                     p: p.iter().sum::<f64>() / n as f64,
                     ci,
+                    ci_kind,
                     conditional_min: sorted[0],
                     conditional_median: moments::quantile(&sorted, 0.5),
                     conditional_max: sorted[sorted.len() - 1],
@@ -346,7 +445,10 @@ fn nested_scalar(name: &str, parts: Parts, table: ConditionalTable) -> NestedSca
             })
             .collect(),
         intervals: format!(
-            "{} % percentile bootstrap over the {} outer samples ({} resamples)",
+            "{} % percentile bootstrap over the {} outer samples ({} resamples); for the mean \
+             and P(q > limit) Student's t on the mean over the outer samples where that is \
+             wider (few outer samples), and when every conditional P is 0 (or 1) the \
+             one-sided bound 1 − 0.05^(1/{outer}) (or 0.05^(1/{outer}))",
             split::LEVEL * 100.0,
             outer,
             split::RESAMPLES
@@ -379,13 +481,14 @@ fn conditional_table(
         .iter()
         .map(|e| e.chaos.as_ref())
         .collect::<Option<Vec<_>>>()
-        .and_then(|c| {
-            let indices = c.first()?.set().indices().to_vec();
-            let coeffs = c
-                .iter()
-                .map(|p| p.coeffs.column(0).iter().copied().collect())
-                .collect();
-            Some((indices, coeffs))
+        .map(|c| union_of_bases(&c));
+    let chaos_error = est
+        .iter()
+        .map(|e| e.chaos_error.as_ref())
+        .collect::<Option<Vec<_>>>()
+        .and_then(|errs| {
+            let name = errs.first()?.kind.name().to_owned();
+            Some((name, errs.iter().map(|e| e.values[0]).collect()))
         });
     ConditionalTable {
         outer_names: names(&blocks.levels.outer),
@@ -412,5 +515,31 @@ fn conditional_table(
             })
             .collect(),
         chaos,
+        chaos_error,
     }
+}
+
+/// The coefficients of every outer sample's chaos (column 0) on the union of their
+/// multi-indices, in graded order (total degree, then as the total-degree set lists them:
+/// the first input's degree highest first); 0 where a basis does not keep a term. A sparse
+/// inner chaos keeps a different basis per outer sample: found by QA (qa5/rail M2), the
+/// first sample's labels over rows of 31 to 44 coefficients under a 41-field header.
+fn union_of_bases(chaoses: &[&crate::uq::pce::Pce]) -> ConditionalChaos {
+    let mut indices: Vec<Vec<usize>> = chaoses
+        .iter()
+        .flat_map(|p| p.set().indices().iter().cloned())
+        .collect();
+    let key = |a: &Vec<usize>| a.iter().sum::<usize>();
+    indices.sort_by(|a, b| key(a).cmp(&key(b)).then_with(|| b.cmp(a)));
+    indices.dedup();
+    let coeffs = chaoses
+        .iter()
+        .map(|p| {
+            indices
+                .iter()
+                .map(|a| p.set().position(a).map_or(0.0, |i| p.coeffs[(i, 0)]))
+                .collect()
+        })
+        .collect();
+    (indices, coeffs)
 }

@@ -174,6 +174,65 @@ pub fn bootstrap(c: &Conditionals, exceedance: &[Vec<f64>], resamples: usize, se
     }
 }
 
+/// How an interval over the outer samples was found (`ci_kind` in `summary.json`).
+pub mod kind {
+    /// The percentile bootstrap over the outer samples (at least as wide as Student's t).
+    pub const BOOTSTRAP: &str = "outer_bootstrap";
+    /// Student's t on the mean over the outer samples: wider than the bootstrap, which
+    /// cannot see outside the few values it resamples (clipped to the range of a probability
+    /// for an exceedance).
+    pub const STUDENT_T: &str = "outer_student_t";
+    /// Every outer sample's conditional probability is 0 (or every one is 1): the one-sided
+    /// 95 % bound `1 − 0.05^(1/N)` (or `0.05^(1/N)`), the rule of three over the `N`
+    /// independent outer samples; the other end is the observed 0 (or 1).
+    pub const ONE_SIDED: &str = "outer_one_sided";
+}
+
+/// The two-sided [`LEVEL`] Student-t interval of the mean of `values` (`sd / sqrt(N)`,
+/// `N − 1` degrees of freedom); `None` for fewer than two values.
+pub fn student_t(values: &[f64]) -> Option<[f64; 2]> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let n = values.len();
+    if n < 2 {
+        return None;
+    }
+    let m = values.iter().sum::<f64>() / n as f64;
+    let var = values.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+    let t = StudentsT::new(0.0, 1.0, (n - 1) as f64)
+        .ok()?
+        .inverse_cdf(1.0 - (1.0 - LEVEL) / 2.0);
+    let half = t * (var / n as f64).sqrt();
+    Some([m - half, m + half])
+}
+
+/// The interval of the mean of `values` over the outer samples from its percentile
+/// bootstrap `boot`: the Student-t interval instead where that is wider (a bootstrap over
+/// few outer samples is too narrow: QA found half the t width with 4 of them), with its
+/// [`kind`].
+pub fn mean_interval(values: &[f64], boot: [f64; 2]) -> ([f64; 2], &'static str) {
+    match student_t(values) {
+        Some(t) if t[1] - t[0] > boot[1] - boot[0] => (t, kind::STUDENT_T),
+        _ => (boot, kind::BOOTSTRAP),
+    }
+}
+
+/// The interval of a marginal exceedance probability, the mean of the conditional ones `p`
+/// (one per outer sample), from its bootstrap `boot`: when every `p` is 0 (or 1) the
+/// one-sided bound over the `N` outer samples, `[0, 1 − 0.05^(1/N)]` (or
+/// `[0.05^(1/N), 1]`) — a bootstrap gives `[0, 0]` (`[1, 1]`) there, and an unsampled outer
+/// sample on the other side cannot be ruled out; else [`mean_interval`] clipped to `[0, 1]`.
+pub fn exceedance_interval(p: &[f64], boot: [f64; 2]) -> ([f64; 2], &'static str) {
+    let n = p.len();
+    if n > 0 && p.iter().all(|&x| x == 0.0) {
+        return ([0.0, 1.0 - 0.05f64.powf(1.0 / n as f64)], kind::ONE_SIDED);
+    }
+    if n > 0 && p.iter().all(|&x| x == 1.0) {
+        return ([0.05f64.powf(1.0 / n as f64), 1.0], kind::ONE_SIDED);
+    }
+    let (ci, k) = mean_interval(p, boot);
+    ([ci[0].max(0.0), ci[1].min(1.0)], k)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,5 +311,33 @@ mod tests {
         assert!(a.mean[0] <= 2.5 && 2.5 <= a.mean[1]);
         assert!(a.exceedance[0][0] <= 0.4375 && 0.4375 <= a.exceedance[0][1]);
         assert!(a.exceedance[0][0] >= 0.0 && a.exceedance[0][1] <= 1.0);
+    }
+
+    #[test]
+    fn few_outer_samples_get_at_least_a_student_t_interval() {
+        // QA round qa5/rail H2: 4 outer samples, bootstrap half as wide as Student's t.
+        let v = [2.9, 3.0, 3.05, 3.15];
+        let t = student_t(&v).unwrap();
+        // t(0.975, 3) = 3.182446; sd = 0.104083; half = 0.165613.
+        assert!((t[1] - t[0] - 2.0 * 3.182446 * 0.104083 / 2.0).abs() < 1e-5, "{t:?}");
+        let (ci, k) = mean_interval(&v, [2.97, 3.08]);
+        assert_eq!((ci, k), (t, kind::STUDENT_T));
+        let (ci, k) = mean_interval(&v, [2.0, 4.0]);
+        assert_eq!((ci, k), ([2.0, 4.0], kind::BOOTSTRAP));
+        // Clipped to a probability.
+        let (ci, _) = exceedance_interval(&[0.9, 1.0, 1.0, 0.6], [0.8, 1.0]);
+        assert!(ci[1] == 1.0 && ci[0] < 0.8, "{ci:?}");
+    }
+
+    #[test]
+    fn every_outer_sample_exceeding_gives_a_one_sided_lower_bound_not_one() {
+        // QA round qa5/rail H2: 16 tracks all with P = 1 gave [1, 1].
+        let (ci, k) = exceedance_interval(&[1.0; 16], [1.0, 1.0]);
+        assert_eq!(k, kind::ONE_SIDED);
+        assert!((ci[0] - 0.05f64.powf(1.0 / 16.0)).abs() < 1e-15 && ci[1] == 1.0);
+        assert!((ci[0] - 0.8293).abs() < 1e-4, "{ci:?}");
+        let (ci, k) = exceedance_interval(&[0.0; 16], [0.0, 0.0]);
+        assert_eq!(k, kind::ONE_SIDED);
+        assert!(ci[0] == 0.0 && (ci[1] - (1.0 - 0.05f64.powf(1.0 / 16.0))).abs() < 1e-15);
     }
 }
