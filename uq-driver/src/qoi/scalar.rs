@@ -468,6 +468,38 @@ impl QoiSpec {
         }
     }
 
+    /// A warning when a Sperling quantity's `direction` contradicts the description of its
+    /// signal (`description` gives a variable's modelDescription description): `lateral` on
+    /// a signal described as vertical (and not lateral), or the reverse. The weighting
+    /// differs (QA5 M5: W 3.33 with the lateral weighting of a vertical acceleration, silently).
+    pub fn direction_warning(
+        &self,
+        description: &dyn Fn(&str) -> Option<String>,
+    ) -> Option<String> {
+        let QoiSpec::Sperling {
+            name,
+            signal,
+            direction,
+            ..
+        } = self
+        else {
+            return None;
+        };
+        let text = description(signal)?.to_lowercase();
+        let (chosen, other) = match direction {
+            Direction::Vertical => ("vertical", "lateral"),
+            Direction::Lateral => ("lateral", "vertical"),
+        };
+        (text.contains(other) && !text.contains(chosen)).then(|| {
+            format!(
+                "quantity '{name}': direction = \"{chosen}\" (the {chosen} Sperling weighting) on \
+                 {signal}, which the FMU describes as {other} (\"{}\"): W is then not a {chosen} \
+                 ride index; set direction = \"{other}\" or pick a {chosen} acceleration",
+                description(signal).unwrap_or_default()
+            )
+        })
+    }
+
     fn check_limits(&self) -> Result<(), InvalidQuantity> {
         match self.limits().iter().any(|l| !l.is_finite()) {
             true => Err(InvalidQuantity {
@@ -647,6 +679,34 @@ mod tests {
             "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"\ndirection = \"sideways\"",
         );
         assert!(r.unwrap_err().to_string().contains("unknown variant"));
+    }
+
+    /// QA5 M5: `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
+    /// without a word.
+    #[test]
+    fn a_lateral_sperling_on_a_vertical_signal_is_warned_about() {
+        let describe = |s: &str| match s {
+            "Zc_acc" => Some("Carbody vertical acceleration above the front bogie".to_owned()),
+            "Ydd" => Some("Lateral acceleration of the bogie frame".to_owned()),
+            _ => None,
+        };
+        let q = |signal: &str, direction: &str| -> QoiSpec {
+            toml::from_str(&format!(
+                "kind = \"sperling\"\nname = \"W\"\nsignal = \"{signal}\"\ndirection = \"{direction}\""
+            ))
+            .unwrap()
+        };
+        let w = q("Zc_acc", "lateral").direction_warning(&describe).unwrap();
+        assert!(
+            w.contains("quantity 'W'") && w.contains("describes as vertical"),
+            "{w}"
+        );
+        let w = q("Ydd", "vertical").direction_warning(&describe).unwrap();
+        assert!(w.contains("describes as lateral"), "{w}");
+        assert_eq!(q("Zc_acc", "vertical").direction_warning(&describe), None);
+        assert_eq!(q("Ydd", "lateral").direction_warning(&describe), None);
+        // No description, or one that names neither direction: nothing to say.
+        assert_eq!(q("a", "lateral").direction_warning(&describe), None);
     }
 
     #[test]
