@@ -1,7 +1,7 @@
 //! Scalar quantities of interest as the study file declares them (`[[qoi]]`): critical speed,
 //! Sperling index, peak |signal|, signed minimum and maximum, peak-to-peak, final value,
-//! evaluated on one run's time series; and the constant-speed critical speed (`hunting_speed`), which needs runs of its own
-//! ([`crate::qoi::hunting_speed`]).
+//! evaluated on one run's time series; and the constant-speed critical speed
+//! (`hunting_speed`), which needs runs of its own ([`crate::qoi::hunting_speed`]).
 
 use serde::{Deserialize, Serialize};
 
