@@ -134,11 +134,13 @@ fn dispatch(cmd: Command) -> Result<()> {
             out,
             allow_failures,
             no_report,
+            yes,
         } => {
             let out = out.unwrap_or_else(|| dir.join("result"));
             let opts = RunOptions {
                 allow_failures,
                 no_report,
+                yes,
                 ..RunOptions::default()
             };
             let r = shard::merge(&dir, &out, &opts)?;

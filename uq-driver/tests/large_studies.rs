@@ -326,3 +326,41 @@ fn a_long_study_needs_yes() {
     assert!(!err.contains("of memory, more than"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn merge_checks_the_memory_of_the_analysis_as_run_does() {
+    // QA 5 H4: `merge` analysed a study `run` refuses, and aborted (SIGABRT) on a failed
+    // allocation after reading every shard. It is now refused first, with the estimate.
+    let dir = tempfile::tempdir().unwrap();
+    let path = study(
+        dir.path(),
+        "merge_mem",
+        WHEEL_GRID,
+        "kind = \"lhs\"\nsamples = 20",
+    );
+    let plan = dir.path().join("plan");
+    let p = plan.to_str().unwrap();
+    let o = run(&["plan", path.to_str().unwrap(), "--shards", "1", "--out", p]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["run-shard", p, "--shard", "0"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let merged = dir.path().join("merged");
+    let m = merged.to_str().unwrap();
+    let o = Command::new(DRIVER)
+        .args(["merge", p, "--out", m, "--yes"])
+        .env("RAILUQ_FMU_DIR", fmu_dir())
+        .env("RAILUQ_MEMORY_LIMIT", "1000")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("20 model runs") && e.contains("refused even with --yes"),
+        "{e}"
+    );
+    assert!(!e.contains("panicked"), "{e}");
+    // Within the memory it merges, as before.
+    let o = run(&["merge", p, "--out", m, "--no-report"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(merged.join("summary.json").exists());
+}

@@ -66,6 +66,9 @@ pub(crate) enum Command {
         /// Write the CSV files and summary.json only: no plots, no index.html (as `run`).
         #[arg(long)]
         no_report: bool,
+        /// Analyse a study that needs much memory without asking (as `run --yes`).
+        #[arg(long)]
+        yes: bool,
     },
     /// Plan a study and submit it to Slurm: a job array of shards and a dependent merge job.
     Slurm(SlurmArgs),

@@ -258,6 +258,8 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     let fmu = open_fmu(&study)?;
     let design = design(&study)?;
     let n = design.len();
+    // The analysis's memory, checked as `run` checks it (refused, or large: `--yes`).
+    super::size::check_runs(&study, n, opts).map_err(StudyRunError::from)?;
     // Each shard's results, read in place: the merge holds no series in memory.
     let mut shard_runs: Vec<Option<StoredRuns>> = Vec::new();
     let mut owner: Vec<Option<usize>> = vec![None; n];
@@ -403,7 +405,8 @@ pub fn write_sbatch(
     );
     let merge = format!(
         "#!/bin/bash\n#SBATCH --job-name=uq-merge\n#SBATCH --cpus-per-task={cpus}\n#SBATCH --kill-on-invalid-dep=yes\n#SBATCH --output={log}/merge.out\n{common}\
-         exec {driver} merge {dir} --out {out}{no_report}\n",
+         # The study was checked (and confirmed, if large) when it was planned.\n\
+         exec {driver} merge {dir} --out {out} --yes{no_report}\n",
         log = dir.join("slurm").display(),
         driver = q(driver),
         dir = q(&dir),

@@ -25,16 +25,22 @@
 //!   ([`blocks::block_width`]: `w = nt` when `2 × 8 n nt ≤ B`, else the largest multiple of
 //!   32 columns within `B`, at least 32): the block, the buffer it is read through and the
 //!   estimator's copy, `3 × 8 n w`; for a method that may build a chaos, a block of surrogate
-//!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; and the
-//!   statistics of every column of every output, `8 s nt (12 + k + 6 d)`. A nested study
-//!   analyses the whole series of an output at once: `1.5 × 8 n nt` instead of the blocks.
+//!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; the column
+//!   summaries of that output, `8 nt (10 + k)`; and, kept for every output until the report,
+//!   its statistics over time, `8 s nt (8 + k + σ)` (`σ = 6d + 20` for a method with
+//!   Sobol' indices: a chaos or `sobol_sampling`, else 0), and its densities,
+//!   `1.5 × 8 s P' G` (`P' = min(P, nt)` columns of `G = pdf_grid` points, with their rows
+//!   and text). A nested study analyses the whole series of an output at once:
+//!   `2.5 × 8 n nt` instead of the blocks (its runs are the outer samples × the inner
+//!   points, counted before the design).
 //! - for `sparse_grid` and `pce_regression`, what grows with the chaos terms: the fit, the
 //!   surrogate's basis at its draws and the coefficients (`size/chaos.rs`, [`Memory::chaos`]);
 //! - the design (coordinates and values) and its copy in the report: `4 n (8 d + 24)`;
-//! - per worker thread, the signals of one run three times over: `3 × 8 T g nt`;
+//! - per worker thread, the signals of one run three times over: `3 × 8 T g nt` (freed
+//!   before the analysis: the larger of the two counts);
 //! - the time grid (a few copies): `4 × 8 nt`.
 //!
-//! The peak is the design, grid and records plus the analysis (with the worker buffers) and
+//! The peak is the design, grid and records plus the analysis (or the worker buffers) and
 //! the chaos.
 //!
 //! Time: measured, for studies of at least [`PROBE_MIN_STEPS`] communication steps in all
@@ -355,6 +361,10 @@ pub struct Shape {
     pub series_draws: usize,
     /// Columns whose densities are shown (`pdf_times + 1`).
     pub pdf_columns: usize,
+    /// Points of each density's grid (`pdf_grid`).
+    pub pdf_grid: usize,
+    /// Whether the method estimates Sobol' indices over time (a chaos, `sobol_sampling`).
+    pub sobol: bool,
     /// Quantile levels.
     pub quantile_levels: usize,
     /// The analysis's block budget (bytes; [`blocks::block_bytes`]).
@@ -370,11 +380,22 @@ impl Shape {
     /// The shape of `study` run on `threads` threads.
     pub fn of(study: &Study, threads: usize) -> Shape {
         let (runs, chaos) = match study.method().evaluation() {
-            Evaluation::Sampling(m) => {
-                (m.planned_runs_for(&study.parameters), m.draws_from_chaos())
-            }
+            Evaluation::Sampling(m) => (
+                m.planned_runs_for(&study.parameters)
+                    .or_else(|| nested_runs(study)),
+                m.draws_from_chaos(),
+            ),
             Evaluation::Intrusive(_) => (Some(0.0), true),
         };
+        // A nested study draws from its inner method's estimates.
+        let chaos = match (&study.method, chaos) {
+            (MethodSpec::Nested(n), _) => match n.inner.method().evaluation() {
+                Evaluation::Sampling(m) => m.draws_from_chaos(),
+                Evaluation::Intrusive(_) => true,
+            },
+            (_, c) => c,
+        };
+        let sobol = chaos || matches!(study.method, MethodSpec::SobolSampling(_));
         let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
         for s in study.qoi.iter().flat_map(|q| q.signals()) {
             if !signals.contains(&s) {
@@ -413,6 +434,8 @@ impl Shape {
                 0
             },
             pdf_columns: study.analysis.pdf_times + 1,
+            pdf_grid: study.analysis.pdf_grid,
+            sobol,
             quantile_levels: study.analysis.quantiles.len(),
             block_bytes: blocks::block_bytes() as f64,
             whole_series: matches!(study.method, MethodSpec::Nested(_)),
@@ -426,22 +449,37 @@ impl Shape {
         let (s, d) = (self.outputs as f64, self.dim as f64);
         let draws = self.series_draws as f64;
         let scalars = 1.5 * 8.0 * n + 8.0 * self.surrogate_samples as f64;
+        let k = self.quantile_levels as f64;
+        // The densities shown: at most `pdf_columns` columns (never more than there are).
+        let pdf_columns = (self.pdf_columns as f64).min(nt);
+        // Kept for every output until the report: its statistics over time (times, mean,
+        // Std, the 3σ band, the standard error or the chaos's Std, the chaos error, the
+        // quantiles; the Sobol' indices and their intervals, a few small vectors per
+        // column), and its densities (with their rows and the text of one being written:
+        // QA 5 H1 measured about 1.4 × 8 P G per output).
+        let sobol = if self.sobol { 6.0 * d + 20.0 } else { 0.0 };
+        let kept_per_output =
+            8.0 * nt * (8.0 + k + sobol) + 1.5 * 8.0 * pdf_columns * self.pdf_grid as f64;
+        // The output being analysed: its column summaries (a small struct and the
+        // quantiles' vector per column) and the draws kept for its densities.
+        let current = 8.0 * nt * (10.0 + k) + 8.0 * pdf_columns * n.max(draws);
         let series = if self.outputs == 0 {
             0.0
         } else if self.whole_series {
-            1.5 * 8.0 * n * nt + 8.0 * draws * nt
+            // The pooled series of an output and the estimator's copies of it (QA 5 H2:
+            // 2.0 × 8 n nt measured at 20 000 × 10⁴ and 1000 × 10⁵).
+            2.5 * 8.0 * n * nt + 8.0 * draws * nt + current + s * kept_per_output
         } else {
             let w = block_columns(nt, n, self.block_bytes);
             let w_draws = block_columns(nt, draws, self.block_bytes);
-            3.0 * 8.0 * n * w
-                + 2.0 * 8.0 * draws * w_draws
-                + 8.0 * self.pdf_columns as f64 * n.max(draws)
-                + 8.0 * s * nt * (12.0 + self.quantile_levels as f64 + 6.0 * d)
+            3.0 * 8.0 * n * w + 2.0 * 8.0 * draws * w_draws + current + s * kept_per_output
         };
+        // The workers' buffers are freed when the runs end, before the analysis starts.
+        let workers = 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt;
         Memory {
             records: n * (96.0 + 16.0 * self.quantities as f64),
             store: 0.0,
-            analysis: series.max(scalars) + 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt,
+            analysis: series.max(scalars).max(workers),
             design: 4.0 * n * (8.0 * d + 24.0),
             grid: 4.0 * 8.0 * nt,
             chaos: self.chaos.map_or(0.0, |c| {
@@ -449,6 +487,26 @@ impl Shape {
             }),
         }
     }
+}
+
+/// The runs of a nested design: outer samples × inner points, each level's count from its
+/// own method over its own parameters (`None` where either level only knows at the design).
+fn nested_runs(study: &Study) -> Option<f64> {
+    let MethodSpec::Nested(nested) = &study.method else {
+        return None;
+    };
+    let (outer, inner): (Vec<_>, Vec<_>) = study
+        .parameters
+        .iter()
+        .cloned()
+        .partition(|p| nested.outer_parameters.contains(&p.name));
+    let count =
+        |spec: &MethodSpec, params: &[crate::uq::RandomParameter]| match spec.method().evaluation()
+        {
+            Evaluation::Sampling(m) => m.planned_runs_for(params),
+            Evaluation::Intrusive(_) => None,
+        };
+    Some(count(&nested.outer, &outer)? * count(&nested.inner, &inner)?)
 }
 
 /// The columns of a block of `rows` rows out of `nt` within `budget` bytes: as
@@ -708,6 +766,8 @@ mod tests {
             cost_factor: 1.0,
             series_draws: 4_000,
             pdf_columns: 151,
+            pdf_grid: 200,
+            sobol: false,
             quantile_levels: 3,
             block_bytes: 256.0 * 1024.0 * 1024.0,
             whole_series: false,
@@ -743,9 +803,10 @@ mod tests {
         // One block of all 501 columns, the draws likewise, the kept draws, the statistics.
         let blocks = 3.0 * 8.0 * 1000.0 * 501.0 + 2.0 * 8.0 * 4000.0 * 501.0;
         let kept = 8.0 * 151.0 * 4000.0;
-        let stats = 8.0 * 501.0 * (12.0 + 3.0 + 12.0);
-        let workers = 3.0 * 8.0 * 2.0 * 501.0;
-        assert_eq!(m.analysis, blocks + kept + stats + workers);
+        let columns = 8.0 * 501.0 * (10.0 + 3.0);
+        let stats = 8.0 * 501.0 * (8.0 + 3.0) + 1.5 * 8.0 * 151.0 * 200.0;
+        let workers: f64 = 3.0 * 8.0 * 2.0 * 501.0;
+        assert_eq!(m.analysis, workers.max(blocks + kept + columns + stats));
         assert_eq!(m.design, 4.0 * 1000.0 * (16.0 + 24.0));
         assert_eq!(m.total(), m.design + m.grid + m.records + m.analysis);
         // Quantities only (no output): no surrogate draws over time.
@@ -755,6 +816,84 @@ mod tests {
             ..wheel_shape(10.0)
         };
         assert!(q.memory(10.0).analysis < 1e7);
+    }
+
+    /// The QA 5 many-output studies (`Many<N>.fmu`, 2 fixed-parameter inputs, lhs) of `s`
+    /// outputs, `nt` times and `n` runs.
+    fn many_outputs(s: usize, nt: f64, n: f64) -> Shape {
+        Shape {
+            outputs: s,
+            signals: s,
+            time_points: nt,
+            surrogate_samples: 0,
+            series_draws: 0,
+            ..wheel_shape(n)
+        }
+    }
+
+    #[test]
+    fn many_outputs_count_the_densities_and_statistics_kept_per_output() {
+        // QA 5 H1: peak RSS 224 MB (1000 outputs × 101 times × 200 runs) and 429 MB
+        // (2000 × 101 × 100), estimated 26 and 51 MiB: the densities of every output
+        // (101 columns × 200 grid points) were not counted.
+        for (s, n, peak) in [(1000, 200.0, 224e6), (2000, 100.0, 429e6)] {
+            let total = many_outputs(s, 101.0, n).memory(n).total();
+            assert!(
+                total >= peak && total <= 2.0 * peak,
+                "{s}: {}",
+                bytes(total)
+            );
+        }
+        // Few outputs keep their estimates (QA: 28 MB and 87 MB measured).
+        for (s, peak) in [(20, 28e6), (200, 87e6)] {
+            let total = many_outputs(s, 1001.0, 500.0).memory(500.0).total();
+            assert!(total <= 2.0 * peak, "{s}: {}", bytes(total));
+        }
+    }
+
+    #[test]
+    fn many_outputs_with_long_series_are_estimated_by_what_the_analysis_holds() {
+        // QA 5 H5: 100 and 200 outputs × 100 001 times × 10 runs peaked at 791 MB and
+        // 1.55 GB, estimated 2.5 and 4.9 GiB (refused under a 2 GiB cap).
+        for (s, peak) in [(100, 791e6), (200, 1.55e9)] {
+            let total = many_outputs(s, 100_001.0, 10.0).memory(10.0).total();
+            assert!(
+                total >= peak && total <= 1.5 * peak,
+                "{s}: {}",
+                bytes(total)
+            );
+        }
+        let f = footprint(&many_outputs(100, 100_001.0, 10.0), 1.8 * GIB);
+        assert!(judge(&f, true).is_ok(), "{f}");
+    }
+
+    fn nested_study(outer: usize, inner: usize, step: f64) -> Study {
+        let text = format!(
+            "name = \"n\"\nfmu = \"Functions.fmu\"\n[experiment]\nstart = 0.0\nstop = 1.0\n\
+             step = {step}\n[[parameters]]\nname = \"a\"\ndistribution = \"uniform\"\n\
+             low = 0.0\nhigh = 1.0\nlevel = \"outer\"\n[[parameters]]\nname = \"b\"\n\
+             distribution = \"normal\"\nmean = 0.0\nstd = 1.0\n[outputs]\n\
+             variables = [\"y_t\"]\n[method]\nkind = \"nested\"\n\
+             outer = {{ kind = \"mc\", samples = {outer} }}\n\
+             inner = {{ kind = \"lhs\", samples = {inner} }}\n"
+        );
+        Study::parse(&text, "test", None).unwrap()
+    }
+
+    #[test]
+    fn nested_studies_count_their_runs_before_the_design_and_the_pooled_series() {
+        // QA 5 H3: "model runs not known before the design" and a fixed 3.0 GiB for any
+        // outer × inner; H2: 20 000 runs × 10 001 times estimated 2.5 GiB, peak 3.23 GB,
+        // and 1000 × 100 001 peaked at 1.65 GB.
+        for (outer, inner, step, peak) in [(100, 200, 1e-4, 3.23e9), (20, 50, 1e-5, 1.65e9)] {
+            let shape = Shape::of(&nested_study(outer, inner, step), 2);
+            let n = (outer * inner) as f64;
+            assert_eq!(shape.runs, Some(n));
+            let f = estimate(&shape, shape.runs);
+            assert_eq!(f.runs, Some(n));
+            let total = f.memory.total();
+            assert!(total >= peak && total <= 2.0 * peak, "{f} {shape:?}");
+        }
     }
 
     #[test]
