@@ -82,6 +82,11 @@ fn interface_text(info: &ModelInfo) -> String {
             "{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
             v.name, v.vr, v.start, v.causality, v.variability, v.initial, v.unit, v.min
         );
+        // Only where declared, so that the GUIDs of models without a maximum stay as they were.
+        if let Some(max) = v.max {
+            s.pop();
+            let _ = writeln!(s, "|max {max:?}");
+        }
     }
     s
 }
@@ -126,6 +131,9 @@ fn type_element(v: &Variable) -> String {
             }
             if let Some(m) = v.min {
                 let _ = write!(attrs, " min=\"{}\"", fmt_f64(m));
+            }
+            if let Some(m) = v.max {
+                let _ = write!(attrs, " max=\"{}\"", fmt_f64(m));
             }
             if let Some(s) = start {
                 let _ = write!(attrs, " start=\"{}\"", fmt_f64(s));

@@ -97,6 +97,8 @@ pub struct Variable {
     pub unit: Option<&'static str>,
     /// Lower bound, if any (Real only).
     pub min: Option<f64>,
+    /// Upper bound, if any (Real only).
+    pub max: Option<f64>,
     /// One-line description.
     pub description: &'static str,
 }
@@ -120,6 +122,7 @@ impl Variable {
             initial: Some(Initial::Exact),
             unit,
             min: None,
+            max: None,
             description,
         }
     }
@@ -166,6 +169,7 @@ impl Variable {
             initial: None,
             unit,
             min: None,
+            max: None,
             description,
         }
     }
@@ -188,6 +192,11 @@ impl Variable {
     /// The same variable with a lower bound.
     pub const fn with_min(self, min: Option<f64>) -> Variable {
         Variable { min, ..self }
+    }
+
+    /// The same variable with an upper bound.
+    pub const fn with_max(self, max: Option<f64>) -> Variable {
+        Variable { max, ..self }
     }
 
     /// The type of the variable.

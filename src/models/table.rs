@@ -213,7 +213,8 @@ pub fn any_string(_name: &'static str, _value: &str) -> SetResult {
 ///
 /// A parameter line names the place its value is stored (read by the getter, assigned by
 /// the setter after the check `check(name, value)`); `real_parameter` takes an optional
-/// trailing `min = x` (the XML `min` attribute). Outputs and calculated parameters give an
+/// trailing `min = x` and then `max = y` (the XML `min` and `max` attributes; the check
+/// must refuse values outside them). Outputs and calculated parameters give an
 /// expression of the model `m`. The macro defines the `VR_…` constants, `TABLE` (a
 /// [`Table`]) and `VARIABLES` (the [`Variable`] list).
 macro_rules! variables {
@@ -239,11 +240,11 @@ macro_rules! variables {
     };
     (@bind $model:ty, $m:ident, real_parameter ($name:literal, $vr_name:ident = $vr:literal,
         $unit:expr, $place:expr, $start:expr, $variability:ident, $check:expr, $desc:literal
-        $(, min = $min:expr)?)) => {
+        $(, min = $min:expr)? $(, max = $max:expr)?)) => {
         $crate::models::table::Binding {
             var: $crate::models::Variable::real_parameter(
                 $name, $vr, $start, $crate::models::Variability::$variability, $unit, $desc,
-            )$(.with_min(Some($min)))?,
+            )$(.with_min(Some($min)))?$(.with_max(Some($max)))?,
             access: $crate::models::table::Access::Real(
                 |$m: &$model| $place,
                 Some(|$m: &mut $model, value: f64| {

@@ -469,3 +469,95 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices(
     );
     assert_eq!(summary(&out)["model_runs"], 4096 * 10);
 }
+
+/// P(X ≥ k) for X ~ Binomial(n, p), summed term by term.
+fn binomial_upper_tail(k: usize, n: usize, p: f64) -> f64 {
+    let mut term = (1.0 - p).powi(n as i32); // P(X = 0)
+    let mut tail = if k == 0 { term } else { 0.0 };
+    for j in 1..=n {
+        term *= (n - j + 1) as f64 / j as f64 * p / (1.0 - p);
+        if j >= k {
+            tail += term;
+        }
+    }
+    tail
+}
+
+/// The Clopper–Pearson 95 % interval by bisection on the binomial tails (written here, apart
+/// from the driver's inverse incomplete beta function).
+fn clopper_pearson_by_bisection(k: usize, n: usize) -> (f64, f64) {
+    let solve = |f: &dyn Fn(f64) -> f64| {
+        // f increases in p from below 0 to above 0.
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if f(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let lower = if k == 0 {
+        0.0
+    } else {
+        solve(&|p| binomial_upper_tail(k, n, p) - 0.025)
+    };
+    let upper = if k == n {
+        1.0
+    } else {
+        solve(&|p| 0.025 - (1.0 - binomial_upper_tail(k + 1, n, p)))
+    };
+    (lower, upper)
+}
+
+/// QA5 M6: the exceedance of a pick-freeze design used to count all N·(d + 2) runs as
+/// independent draws (768 of 768 → 0.995–1.00, where the 128 independent runs of A and B give
+/// 0.977). It is counted over the 2N runs of A and B alone.
+#[test]
+fn sobol_sampling_counts_its_exceedance_over_the_independent_a_and_b_runs() {
+    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let n = 64;
+    let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, n);
+    // The limit belongs to the [[qoi]] table: right after its signal.
+    let text = std::fs::read_to_string(&study)
+        .unwrap()
+        .replace("signal = \"y\"\n", "signal = \"y\"\nlimits = [5.0]\n");
+    std::fs::write(&study, text).unwrap();
+    let out = dir.path().join("exceed");
+    run_ok(&[
+        "run",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let e = &summary(&out)["quantities"]["y_end"]["exceedance_counts"][0];
+    assert_eq!(e["of"].as_u64().unwrap() as usize, 2 * n, "{e}");
+    // The runs of A and B are design points 0..2N (blocks A, B, AB_1, ...).
+    let samples = std::fs::read_to_string(out.join("y_end_samples.csv")).unwrap();
+    let values: Vec<(usize, f64)> = samples
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (r, v) = l.split_once(',').unwrap();
+            (r.parse().unwrap(), v.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(values.len(), n * 5, "every run's value is still written");
+    let k = values
+        .iter()
+        .filter(|&&(r, v)| r < 2 * n && v > 5.0)
+        .count();
+    assert!(k > 0 && k < 2 * n, "{k} of {}", 2 * n);
+    assert_eq!(e["exceeded"].as_u64().unwrap() as usize, k);
+    assert!((e["p"].as_f64().unwrap() - k as f64 / (2 * n) as f64).abs() < 1e-15);
+    let (lo, hi) = clopper_pearson_by_bisection(k, 2 * n);
+    let ci = &e["ci_95"];
+    assert!((ci[0].as_f64().unwrap() - lo).abs() < 1e-9, "{ci} vs {lo}");
+    assert!((ci[1].as_f64().unwrap() - hi).abs() < 1e-9, "{ci} vs {hi}");
+    assert!(e["of_what"].as_str().unwrap().contains("A and B"), "{e}");
+}

@@ -616,3 +616,21 @@ fn a_dt_beyond_the_stability_limit_is_refused_at_initialization() {
         m.initialize(&InitContext::default()).unwrap();
     }
 }
+
+/// QA5 M5: `v = 300` (meant as km/h) ran at 1080 km/h without a word. The speed declares the
+/// range [0, 160] m/s (576 km/h, above the 574.8 km/h record) and refuses a value outside it.
+#[test]
+fn a_speed_in_km_per_hour_is_refused() {
+    let mut m = VehicleTrack::default();
+    let e = m.set_real(VR_V, 300.0).unwrap_err().to_string();
+    assert!(e.contains('v') && e.contains("at most 160 m/s"), "{e}");
+    assert!(e.contains("not km/h") && e.contains("83.33 m/s"), "{e}");
+    assert!(m.set_real(VR_V, 160.000_001).is_err());
+    assert!(m.set_real(VR_V, -1.0).is_err());
+    assert!(m.set_real(VR_V, 160.0).is_ok());
+    assert!(m.set_real(VR_V, 0.0).is_ok());
+    let v = INFO.variable(VR_V).unwrap();
+    assert_eq!((v.min, v.max), (Some(0.0), Some(160.0)));
+    // 574.8 km/h, the record, lies inside the range.
+    assert!(574.8 / 3.6 < v.max.unwrap());
+}

@@ -72,6 +72,28 @@ fn irregularity_code(name: &'static str, value: i32) -> SetResult {
     Ok(None)
 }
 
+/// Highest running speed accepted (m/s): 576 km/h, just above the rail speed record of
+/// 574.8 km/h (TGV, 2007). It catches a speed given in km/h (`v = 300` would be 1080 km/h).
+pub const MAX_SPEED: f64 = 160.0;
+
+/// A running speed in `[0, MAX_SPEED]` m/s.
+fn speed_in_range(name: &'static str, value: f64) -> SetResult {
+    non_negative(name, value)?;
+    if value > MAX_SPEED {
+        return Err(ModelError::InvalidValue {
+            name,
+            value: value.to_string(),
+            reason: format!(
+                "must be at most {MAX_SPEED} m/s ({} km/h, above the 574.8 km/h rail speed \
+                 record): the speed is in m/s, not km/h ({value} km/h = {:.2} m/s)",
+                MAX_SPEED * 3.6,
+                value / 3.6
+            ),
+        });
+    }
+    Ok(None)
+}
+
 fn flag(name: &'static str, value: i32) -> SetResult {
     if !(value == 0 || value == 1) {
         return invalid(name, value, "must be 0 or 1");
@@ -94,7 +116,7 @@ variables! {
     real_parameter("Csz", VR_CSZ = 8, Some("N.s/m"), m.p.reals[8], 120e3, Tunable, non_negative, "Secondary vertical damping per bogie side [paper]"),
     real_parameter("Lc", VR_LC = 9, Some("m"), m.p.reals[9], 8.6875, Fixed, positive, "Half distance between bogie centres [paper]"),
     real_parameter("Lt", VR_LT = 10, Some("m"), m.p.reals[10], 1.25, Fixed, positive, "Half wheelbase of a bogie [paper]"),
-    real_parameter("v", VR_V = 11, Some("m/s"), m.p.reals[11], DEFAULT_SPEED, Fixed, non_negative, "Running speed (300 km/h) [paper]"),
+    real_parameter("v", VR_V = 11, Some("m/s"), m.p.reals[11], DEFAULT_SPEED, Fixed, speed_in_range, "Running speed in m/s, not km/h (83.33 = 300 km/h) [paper]; range [0, 160] m/s: 160 m/s = 576 km/h, just above the 574.8 km/h rail speed record", min = 0.0, max = MAX_SPEED),
     real_parameter("g", VR_G = 12, Some("m/s2"), m.p.reals[12], 9.8, Fixed, non_negative, "Gravity [paper]"),
     real_parameter("R", VR_R = 13, Some("m"), m.p.reals[13], 0.43, Fixed, positive, "Wheel rolling radius, sets the Hertz constant G [assumed]"),
     real_parameter("mr", VR_MR = 14, Some("kg/m"), m.p.reals[14], 60.64, Fixed, positive, "Rail mass per metre [paper]"),

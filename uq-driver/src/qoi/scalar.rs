@@ -1,7 +1,7 @@
 //! Scalar quantities of interest as the study file declares them (`[[qoi]]`): critical speed,
-//! Sperling index, peak |signal|, final value, evaluated on one run's time series; and the
-//! constant-speed critical speed (`hunting_speed`), which needs runs of its own
-//! ([`crate::qoi::hunting_speed`]).
+//! Sperling index, peak |signal|, signed minimum and maximum, peak-to-peak, final value,
+//! evaluated on one run's time series; and the constant-speed critical speed
+//! (`hunting_speed`), which needs runs of its own ([`crate::qoi::hunting_speed`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -69,6 +69,39 @@ pub enum QoiSpec {
     },
     /// Largest |signal| over [from, to] (s).
     MaxAbs {
+        /// Name in reports.
+        name: String,
+        /// Signal.
+        signal: String,
+        /// Start of the interval (s).
+        #[serde(default)]
+        from: f64,
+        /// End of the interval (s; default the stop time).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<f64>,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+    /// Smallest value of the signal (signed) over [from, to] (s): e.g. the least wheel–rail
+    /// force, 0 when the wheel leaves the rail.
+    Min {
+        /// Name in reports.
+        name: String,
+        /// Signal.
+        signal: String,
+        /// Start of the interval (s).
+        #[serde(default)]
+        from: f64,
+        /// End of the interval (s; default the stop time).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<f64>,
+        /// Exceedance limits.
+        #[serde(default)]
+        limits: Vec<f64>,
+    },
+    /// Largest value of the signal (signed) over [from, to] (s).
+    Max {
         /// Name in reports.
         name: String,
         /// Signal.
@@ -219,6 +252,8 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { name, .. }
             | QoiSpec::Sperling { name, .. }
             | QoiSpec::MaxAbs { name, .. }
+            | QoiSpec::Min { name, .. }
+            | QoiSpec::Max { name, .. }
             | QoiSpec::Range { name, .. }
             | QoiSpec::Final { name, .. } => name,
             QoiSpec::HuntingSpeed(h) => &h.name,
@@ -241,6 +276,8 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
             QoiSpec::Sperling { signal, .. }
             | QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Min { signal, .. }
+            | QoiSpec::Max { signal, .. }
             | QoiSpec::Range { signal, .. }
             | QoiSpec::Final { signal, .. } => vec![signal],
             QoiSpec::HuntingSpeed(_) => Vec::new(),
@@ -253,6 +290,8 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { limits, .. }
             | QoiSpec::Sperling { limits, .. }
             | QoiSpec::MaxAbs { limits, .. }
+            | QoiSpec::Min { limits, .. }
+            | QoiSpec::Max { limits, .. }
             | QoiSpec::Range { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
             QoiSpec::HuntingSpeed(h) => &h.limits,
@@ -265,6 +304,8 @@ impl QoiSpec {
             QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
             QoiSpec::Sperling { .. } => None,
             QoiSpec::MaxAbs { signal, .. }
+            | QoiSpec::Min { signal, .. }
+            | QoiSpec::Max { signal, .. }
             | QoiSpec::Range { signal, .. }
             | QoiSpec::Final { signal, .. } => Some(signal),
             QoiSpec::HuntingSpeed(h) => Some(&h.speed_parameter),
@@ -346,6 +387,22 @@ impl QoiSpec {
                     None => format!("largest |{signal}| from {from} s to the end"),
                 }
             }
+            QoiSpec::Min {
+                signal, from, to, ..
+            }
+            | QoiSpec::Max {
+                signal, from, to, ..
+            } => {
+                let which = match self {
+                    QoiSpec::Min { .. } => "smallest",
+                    _ => "largest",
+                };
+                let signal = words.signal(signal);
+                match to {
+                    Some(to) => format!("{which} value of {signal} (signed) over {from}–{to} s"),
+                    None => format!("{which} value of {signal} (signed) from {from} s to the end"),
+                }
+            }
             QoiSpec::Range {
                 signal, from, to, ..
             } => {
@@ -407,7 +464,10 @@ impl QoiSpec {
                     None
                 }
             }
-            QoiSpec::MaxAbs { from, to, .. } | QoiSpec::Range { from, to, .. } => to
+            QoiSpec::MaxAbs { from, to, .. }
+            | QoiSpec::Min { from, to, .. }
+            | QoiSpec::Max { from, to, .. }
+            | QoiSpec::Range { from, to, .. } => to
                 .is_some_and(|t| t <= *from)
                 .then_some("`to` must be after `from`"),
             QoiSpec::Final { .. } => None,
@@ -449,7 +509,10 @@ impl QoiSpec {
                     0.5 / step
                 ))
             }
-            QoiSpec::MaxAbs { from, to, .. } | QoiSpec::Range { from, to, .. } => {
+            QoiSpec::MaxAbs { from, to, .. }
+            | QoiSpec::Min { from, to, .. }
+            | QoiSpec::Max { from, to, .. }
+            | QoiSpec::Range { from, to, .. } => {
                 let tol = 1e-9 * step;
                 let to_t = to.unwrap_or(stop).min(stop);
                 // The first communication point at or after `from`.
@@ -466,6 +529,38 @@ impl QoiSpec {
             }
             _ => Ok(()),
         }
+    }
+
+    /// A warning when a Sperling quantity's `direction` contradicts the description of its
+    /// signal (`description` gives a variable's modelDescription description): `lateral` on
+    /// a signal described as vertical (and not lateral), or the reverse. The weighting
+    /// differs (QA5 M5: W 3.33 with the lateral weighting of a vertical acceleration, silently).
+    pub fn direction_warning(
+        &self,
+        description: &dyn Fn(&str) -> Option<String>,
+    ) -> Option<String> {
+        let QoiSpec::Sperling {
+            name,
+            signal,
+            direction,
+            ..
+        } = self
+        else {
+            return None;
+        };
+        let text = description(signal)?.to_lowercase();
+        let (chosen, other) = match direction {
+            Direction::Vertical => ("vertical", "lateral"),
+            Direction::Lateral => ("lateral", "vertical"),
+        };
+        (text.contains(other) && !text.contains(chosen)).then(|| {
+            format!(
+                "quantity '{name}': direction = \"{chosen}\" (the {chosen} Sperling weighting) on \
+                 {signal}, which the FMU describes as {other} (\"{}\"): W is then not a {chosen} \
+                 ride index; set direction = \"{other}\" or pick a {chosen} acceleration",
+                description(signal).unwrap_or_default()
+            )
+        })
     }
 
     fn check_limits(&self) -> Result<(), InvalidQuantity> {
@@ -569,6 +664,29 @@ pub fn evaluate<'a>(
             }
             Ok((m, Code::Ok))
         }
+        QoiSpec::Min {
+            signal: s,
+            from,
+            to,
+            ..
+        }
+        | QoiSpec::Max {
+            signal: s,
+            from,
+            to,
+            ..
+        } => {
+            let values = in_window(times, signal(s), *from, *to);
+            // NaN-skipping folds, as max_abs: a window of NaN only has no value.
+            let m = match q {
+                QoiSpec::Min { .. } => values.fold(f64::NAN, f64::min),
+                _ => values.fold(f64::NAN, f64::max),
+            };
+            if m.is_nan() {
+                return Err(empty_window(s, *from, *to));
+            }
+            Ok((m, Code::Ok))
+        }
         QoiSpec::Range {
             signal: s,
             from,
@@ -647,6 +765,34 @@ mod tests {
             "kind = \"sperling\"\nname = \"W\"\nsignal = \"a\"\ndirection = \"sideways\"",
         );
         assert!(r.unwrap_err().to_string().contains("unknown variant"));
+    }
+
+    /// QA5 M5: `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
+    /// without a word.
+    #[test]
+    fn a_lateral_sperling_on_a_vertical_signal_is_warned_about() {
+        let describe = |s: &str| match s {
+            "Zc_acc" => Some("Carbody vertical acceleration above the front bogie".to_owned()),
+            "Ydd" => Some("Lateral acceleration of the bogie frame".to_owned()),
+            _ => None,
+        };
+        let q = |signal: &str, direction: &str| -> QoiSpec {
+            toml::from_str(&format!(
+                "kind = \"sperling\"\nname = \"W\"\nsignal = \"{signal}\"\ndirection = \"{direction}\""
+            ))
+            .unwrap()
+        };
+        let w = q("Zc_acc", "lateral").direction_warning(&describe).unwrap();
+        assert!(
+            w.contains("quantity 'W'") && w.contains("describes as vertical"),
+            "{w}"
+        );
+        let w = q("Ydd", "vertical").direction_warning(&describe).unwrap();
+        assert!(w.contains("describes as lateral"), "{w}");
+        assert_eq!(q("Zc_acc", "vertical").direction_warning(&describe), None);
+        assert_eq!(q("Ydd", "lateral").direction_warning(&describe), None);
+        // No description, or one that names neither direction: nothing to say.
+        assert_eq!(q("a", "lateral").direction_warning(&describe), None);
     }
 
     #[test]

@@ -12,7 +12,9 @@ use super::{
     Series, Table,
 };
 use crate::results::numbers::to_spread;
-use crate::results::{self, group_digits, sig, OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::results::{
+    self, group_digits, sig, ExceedanceCount, OutputStats, ScalarStats, SuiteSummary, Summary,
+};
 use crate::spec::PaperValue;
 
 /// One variant's results.
@@ -76,6 +78,17 @@ fn quantity_names(variants: &[VariantResults], r: usize) -> Vec<String> {
 /// The quantity `name` of a variant, if it computes it.
 fn find<'a>(quantities: &'a [ScalarStats], name: &str) -> Option<&'a ScalarStats> {
     quantities.iter().find(|q| q.name == name)
+}
+
+/// A probability in the table of variants: `0.3125`, or, when no draw exceeded, the 95 %
+/// upper bound with the count, `< 0.221 (0 of 12)`, as the variant's page gives it (QA5 L2:
+/// "0.0000" from 12 runs read as certainty).
+fn probability_cell(e: &ExceedanceCount) -> String {
+    if e.exceeded == 0 && e.of > 0 {
+        format!("< {} (0 of {})", sig(e.upper_95), group_digits(e.of))
+    } else {
+        format!("{:.4}", e.p)
+    }
 }
 
 /// The table of variants: method, runs, wall time, differences against the reference, and
@@ -149,7 +162,12 @@ fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usiz
                     Some(q) => {
                         row.push(to_spread(q.mean, q.std));
                         row.push(to_spread(q.std, q.std));
-                        row.extend(q.exceedance.iter().map(|(_, p, _)| format!("{p:.4}")));
+                        row.extend(q.exceedance.iter().enumerate().map(|(k, (_, p, _))| {
+                            match q.exceedance_counts.get(k) {
+                                Some(e) => probability_cell(e),
+                                None => format!("{p:.4}"),
+                            }
+                        }));
                     }
                     None => row.extend(std::iter::repeat_n(String::new(), 2 + ls.len())),
                 }
@@ -504,5 +522,27 @@ fn paper_section(summary: &SuiteSummary) -> Section {
             .collect(),
             rows,
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::analysis::exceedance_count;
+    use crate::uq::method::Draws;
+
+    #[test]
+    fn the_suite_table_shows_the_upper_bound_when_no_run_exceeded() {
+        let none = exceedance_count(&[1.0; 12], 2.0, Draws::Runs);
+        // 1 - 0.05^(1/12) = 0.2209.
+        let bound = 1.0 - 0.05f64.powf(1.0 / 12.0);
+        assert!((bound - 0.2209).abs() < 1e-4);
+        assert_eq!(
+            probability_cell(&none),
+            format!("< {} (0 of 12)", sig(bound))
+        );
+        assert_eq!(probability_cell(&none), "< 0.221 (0 of 12)");
+        let some = exceedance_count(&[1.0, 3.0, 1.0, 1.0], 2.0, Draws::Runs);
+        assert_eq!(probability_cell(&some), "0.2500");
     }
 }

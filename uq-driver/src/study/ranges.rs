@@ -81,7 +81,24 @@ pub fn range_warnings(study: &Study, fmu: &Fmu, design: &Design) -> Vec<String> 
             p.name,
         ));
     }
+    warnings.extend(declaration_warnings(study, fmu));
     warnings
+}
+
+/// What the modelDescription says against the study's settings: a `[fixed]` Real outside its
+/// declared range (as `simulate --set` warns; the FMU may refuse it too), a Sperling
+/// `direction` that contradicts its signal's description.
+fn declaration_warnings(study: &Study, fmu: &Fmu) -> Vec<String> {
+    let fixed = study
+        .fixed
+        .iter()
+        .filter_map(|(name, value)| value_warning(fmu, name, value));
+    let describe = |s: &str| fmu.description().variable(s)?.description.clone();
+    let directions = study
+        .qoi
+        .iter()
+        .filter_map(|q| q.direction_warning(&describe));
+    fixed.chain(directions).collect()
 }
 
 /// A warning when the value `value` given for variable `name` (e.g. `simulate --set`) is a

@@ -329,6 +329,21 @@ pub(crate) fn scalar_stats(
     settings: &Settings,
     density: Option<Vec<f64>>,
 ) -> Result<ScalarStats, AnalysisError> {
+    scalar_stats_counted(name, q, estimate, runs, settings, density, None)
+}
+
+/// [`scalar_stats`] with the exceedance counted over `independent` where given: the run
+/// values that are independent draws of the input law (e.g. the runs of `A` and `B` of a
+/// pick-freeze design, whose other blocks reuse their columns), named by `of_what`.
+fn scalar_stats_counted(
+    name: &str,
+    q: &QoiSpec,
+    estimate: &Estimate,
+    runs: QuantityRuns,
+    settings: &Settings,
+    density: Option<Vec<f64>>,
+    independent: Option<(&[f64], &str)>,
+) -> Result<ScalarStats, AnalysisError> {
     let a = settings.analysis;
     let data = DMatrix::from_column_slice(runs.valid.len(), 1, &runs.valid);
     let density_samples: Vec<f64> = match density {
@@ -364,7 +379,14 @@ pub(crate) fn scalar_stats(
         .limits()
         .iter()
         .map(|&l| {
-            let mut e = exceedance_count(&density_samples, l, estimate.draws);
+            let mut e = match independent {
+                Some((values, of_what)) if estimate.draws == Draws::Runs => {
+                    let mut e = exceedance_count(values, l, Draws::Runs);
+                    e.of_what = of_what.to_owned();
+                    e
+                }
+                _ => exceedance_count(&density_samples, l, estimate.draws),
+            };
             // A chaos's draws beyond every model run: its extrapolation alone.
             let outside = l > largest || l < smallest;
             if estimate.draws == Draws::Chaos && outside && smallest <= largest {
@@ -486,6 +508,10 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
     })
 }
 
+/// What an exceedance counted over the runs a method names as its independent draws
+/// ([`Sampling::moment_rows`], e.g. `A` and `B` of `sobol_sampling`) counts.
+const INDEPENDENT_RUNS: &str = "independent runs (A and B)";
+
 /// What [`analyse_runs`] finds.
 #[derive(Clone, Debug)]
 pub struct Analysed {
@@ -556,7 +582,10 @@ pub fn analyse_runs(
                 .filter_map(|&r| qr.valid.get(r).copied())
                 .collect::<Vec<_>>()
         });
-        let mut stats = scalar_stats(&name, q, &estimate, qr, &settings, None)?;
+        // A pick-freeze design's exceedance is counted over its independent runs only.
+        let independent = moment_values.as_deref().map(|v| (v, INDEPENDENT_RUNS));
+        let mut stats =
+            scalar_stats_counted(&name, q, &estimate, qr, &settings, None, independent)?;
         if let Some(values) = moment_values {
             stats.convergence = convergence(&estimate, 0, &values).filter(|_| !stats.deterministic);
         }

@@ -31,7 +31,9 @@
 //!
 //! Mean, Std and the standard error of the mean come from the runs of `A` and `B`
 //! (Monte Carlo formula); quantiles and densities from every run (each block follows the
-//! input law).
+//! input law). Exceedance counts and their Clopper–Pearson intervals come from the `2N`
+//! independent runs of `A` and `B` ([`Sampling::moment_rows`]; the analysis counts over them):
+//! the `AB_i` blocks reuse their columns, so all the runs are not independent draws.
 
 use nalgebra::DMatrix;
 use rayon::prelude::*;
