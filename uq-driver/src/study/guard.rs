@@ -146,16 +146,25 @@ impl Drop for RunningPoint {
 }
 
 /// What is running now, for a message: "study S (output folder D): point 3 (K = 1, C = 2), …".
-/// `None` when no study is in progress; never blocks (a process on its way out must not wait
-/// for a thread that holds the registry).
+/// `None` when no study is in progress; never blocks for long (a process on its way out must
+/// not wait for a thread that holds the registry): another thread holds it only while it
+/// registers or ends a point, so a few tries over up to 50 ms find it free, unless that thread
+/// is stuck (then the points are said to be unknown). One try alone lost the points about
+/// once in six when two threads' FMUs called exit() together.
 fn describe_running() -> Option<String> {
     if ACTIVE.load(Ordering::Acquire) == 0 {
         return None;
     }
-    let Ok(s) = STATE.try_lock() else {
-        return Some("a study (its running points are unknown)".to_owned());
-    };
-    Some(describe(&s))
+    for _ in 0..50 {
+        match STATE.try_lock() {
+            Ok(s) => return Some(describe(&s)),
+            Err(std::sync::TryLockError::Poisoned(e)) => return Some(describe(&e.into_inner())),
+            Err(std::sync::TryLockError::WouldBlock) => {
+                std::thread::sleep(std::time::Duration::from_millis(1))
+            }
+        }
+    }
+    Some("a study (its running points are unknown)".to_owned())
 }
 
 /// Prepares the message of a crash in-process for what runs now (called with the registry
@@ -345,11 +354,17 @@ extern "C" fn on_exit() {
         return;
     }
     let simulation = SIMULATION.try_lock().ok().and_then(|s| s.clone());
+    if ACTIVE.load(Ordering::Acquire) == 0 && simulation.is_none() {
+        return;
+    }
+    // Hold another thread's exit() before anything that may wait (describe_running): that
+    // exit finds the handler list already taken and would otherwise end the process with the
+    // FMU's status (0) while this one still writes its message.
+    hold_other_exits();
     let what = describe_running();
     if what.is_none() && simulation.is_none() {
         return;
     }
-    hold_other_exits();
     let _ = std::panic::catch_unwind(|| match (what, simulation) {
         (Some(what), _) => eprintln!(
             "uq-driver: error: the process was ended by a call to exit() during {what}: an FMU \
