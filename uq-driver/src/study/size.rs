@@ -13,7 +13,7 @@
 //! quantities, `g` signals read per step, `d` random parameters, `T` threads, `P` columns
 //! whose densities are shown (`pdf_times + 1`), `k` quantile levels, `S` surrogate draws of
 //! a series (`min(series_samples, surrogate_samples)`, for a method that may build a chaos;
-//! else 0), `B` the analysis's block budget ([`blocks::block_bytes`], 256 MiB unless
+//! else 0), `B` the analysis's block budget ([`blocks::block_bytes`](crate::study::analysis::blocks::block_bytes), 256 MiB unless
 //! `RAILUQ_ANALYSIS_BLOCK_BYTES` says otherwise):
 //! - the records: the series of the runs are written to the results store as each run
 //!   finishes and are not held; per run, where its values are and its place in the analysis,
@@ -22,7 +22,7 @@
 //!   cache, not the process's memory), so nothing is counted for it ([`Memory::store`] is 0);
 //!   only repairing a damaged store copies its valid records into memory;
 //! - the analysis of one output, a block of `w` time columns at a time
-//!   ([`blocks::block_width`]: `w = nt` when `2 × 8 n nt ≤ B`, else the largest multiple of
+//!   ([`blocks::block_width`](crate::study::analysis::blocks::block_width): `w = nt` when `2 × 8 n nt ≤ B`, else the largest multiple of
 //!   32 columns within `B`, at least 32): the block, the buffer it is read through and the
 //!   estimator's copy, `3 × 8 n w`; for a method that may build a chaos, a block of surrogate
 //!   draws, `2 × 8 S w_S`; the draws kept for the densities, `8 P max(n, S)`; the column
@@ -62,18 +62,19 @@
 mod available;
 mod chaos;
 mod disk;
+mod shape;
+
+pub use shape::Shape;
 
 use std::fmt;
 use std::path::Path;
 use std::time::Instant;
 
-use super::analysis::blocks;
 use super::guard::StudyGuard;
 use super::interface::Interface;
 use super::runner::{self, RunOptions};
-use crate::qoi::QoiSpec;
 use crate::spec::Study;
-use crate::uq::method::{Evaluation, MethodSpec};
+use crate::uq::method::Evaluation;
 
 /// More model runs than this need `--yes`.
 pub const MAX_RUNS: f64 = 100_000.0;
@@ -333,193 +334,6 @@ pub fn duration(s: f64) -> String {
     }
 }
 
-/// What the estimate needs to know of a study.
-#[derive(Clone, Copy, Debug)]
-pub struct Shape {
-    /// Model runs, if known.
-    pub runs: Option<f64>,
-    /// Communication points per run.
-    pub time_points: f64,
-    /// Stored outputs.
-    pub outputs: usize,
-    /// Scalar quantities.
-    pub quantities: usize,
-    /// Signals read at every step (outputs and the quantities' signals).
-    pub signals: usize,
-    /// Random parameters.
-    pub dim: usize,
-    /// Worker threads.
-    pub threads: usize,
-    /// Draws of a chaos surrogate per output (`[analysis] surrogate_samples`; 0 for a method
-    /// that draws from its runs).
-    pub surrogate_samples: usize,
-    /// Simulated time of a point over that of its run: 1, plus the runs of its own of each
-    /// `hunting_speed` quantity.
-    pub cost_factor: f64,
-    /// Surrogate draws of a time series (`min(series_samples, surrogate_samples)`; 0 for a
-    /// method that draws from its runs).
-    pub series_draws: usize,
-    /// Columns whose densities are shown (`pdf_times + 1`).
-    pub pdf_columns: usize,
-    /// Points of each density's grid (`pdf_grid`).
-    pub pdf_grid: usize,
-    /// Whether the method estimates Sobol' indices over time (a chaos, `sobol_sampling`).
-    pub sobol: bool,
-    /// Quantile levels.
-    pub quantile_levels: usize,
-    /// The analysis's block budget (bytes; [`blocks::block_bytes`]).
-    pub block_bytes: f64,
-    /// Whether the whole series of an output is analysed at once (nested studies).
-    pub whole_series: bool,
-    /// The chaos of a method whose arrays grow with its terms (`sparse_grid`,
-    /// `pce_regression`).
-    pub chaos: Option<ChaosShape>,
-}
-
-impl Shape {
-    /// The shape of `study` run on `threads` threads.
-    pub fn of(study: &Study, threads: usize) -> Shape {
-        let (runs, chaos) = match study.method().evaluation() {
-            Evaluation::Sampling(m) => (
-                m.planned_runs_for(&study.parameters)
-                    .or_else(|| nested_runs(study)),
-                m.draws_from_chaos(),
-            ),
-            Evaluation::Intrusive(_) => (Some(0.0), true),
-        };
-        // A nested study draws from its inner method's estimates.
-        let chaos = match (&study.method, chaos) {
-            (MethodSpec::Nested(n), _) => match n.inner.method().evaluation() {
-                Evaluation::Sampling(m) => m.draws_from_chaos(),
-                Evaluation::Intrusive(_) => true,
-            },
-            (_, c) => c,
-        };
-        let sobol = chaos || matches!(study.method, MethodSpec::SobolSampling(_));
-        let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
-        for s in study.qoi.iter().flat_map(|q| q.signals()) {
-            if !signals.contains(&s) {
-                signals.push(s);
-            }
-        }
-        let e = &study.experiment;
-        let own_runs: f64 = study
-            .qoi
-            .iter()
-            .filter_map(|q| match q {
-                QoiSpec::HuntingSpeed(h) => Some(h.runs_when_found() as f64 * h.duration),
-                _ => None,
-            })
-            .sum();
-        Shape {
-            runs,
-            time_points: ((e.stop - e.start) / e.step).round() + 1.0,
-            outputs: study.outputs.len(),
-            quantities: study.qoi.iter().map(|q| q.quantity_names().len()).sum(),
-            signals: signals.len(),
-            dim: study.parameters.len(),
-            threads: threads.max(1),
-            surrogate_samples: if chaos {
-                study.analysis.surrogate_samples
-            } else {
-                0
-            },
-            cost_factor: 1.0 + own_runs / (e.stop - e.start),
-            series_draws: if chaos {
-                study
-                    .analysis
-                    .series_samples
-                    .min(study.analysis.surrogate_samples)
-            } else {
-                0
-            },
-            pdf_columns: study.analysis.pdf_times + 1,
-            pdf_grid: study.analysis.pdf_grid,
-            sobol,
-            quantile_levels: study.analysis.quantiles.len(),
-            block_bytes: blocks::block_bytes() as f64,
-            whole_series: matches!(study.method, MethodSpec::Nested(_)),
-            chaos: ChaosShape::of(study),
-        }
-    }
-
-    /// The memory estimate for `runs` runs (see the module documentation).
-    pub fn memory(&self, runs: f64) -> Memory {
-        let (n, nt) = (runs, self.time_points);
-        let (s, d) = (self.outputs as f64, self.dim as f64);
-        let draws = self.series_draws as f64;
-        let scalars = 1.5 * 8.0 * n + 8.0 * self.surrogate_samples as f64;
-        let k = self.quantile_levels as f64;
-        // The densities shown: at most `pdf_columns` columns (never more than there are).
-        let pdf_columns = (self.pdf_columns as f64).min(nt);
-        // Kept for every output until the report: its statistics over time (times, mean,
-        // Std, the 3σ band, the standard error or the chaos's Std, the chaos error, the
-        // quantiles; the Sobol' indices and their intervals, a few small vectors per
-        // column), and its densities (with their rows and the text of one being written:
-        // QA 5 H1 measured about 1.4 × 8 P G per output).
-        let sobol = if self.sobol { 6.0 * d + 20.0 } else { 0.0 };
-        let kept_per_output =
-            8.0 * nt * (8.0 + k + sobol) + 1.5 * 8.0 * pdf_columns * self.pdf_grid as f64;
-        // The output being analysed: its column summaries (a small struct and the
-        // quantiles' vector per column) and the draws kept for its densities.
-        let current = 8.0 * nt * (10.0 + k) + 8.0 * pdf_columns * n.max(draws);
-        let series = if self.outputs == 0 {
-            0.0
-        } else if self.whole_series {
-            // The pooled series of an output and the estimator's copies of it (QA 5 H2:
-            // 2.0 × 8 n nt measured at 20 000 × 10⁴ and 1000 × 10⁵).
-            2.5 * 8.0 * n * nt + 8.0 * draws * nt + current + s * kept_per_output
-        } else {
-            let w = block_columns(nt, n, self.block_bytes);
-            let w_draws = block_columns(nt, draws, self.block_bytes);
-            3.0 * 8.0 * n * w + 2.0 * 8.0 * draws * w_draws + current + s * kept_per_output
-        };
-        // The workers' buffers are freed when the runs end, before the analysis starts.
-        let workers = 3.0 * 8.0 * (self.threads * self.signals) as f64 * nt;
-        Memory {
-            records: n * (96.0 + 16.0 * self.quantities as f64),
-            store: 0.0,
-            analysis: series.max(scalars).max(workers),
-            design: 4.0 * n * (8.0 * d + 24.0),
-            grid: 4.0 * 8.0 * nt,
-            chaos: self.chaos.map_or(0.0, |c| {
-                c.memory(n, nt, block_columns(nt, n, self.block_bytes))
-            }),
-        }
-    }
-}
-
-/// The runs of a nested design: outer samples × inner points, each level's count from its
-/// own method over its own parameters (`None` where either level only knows at the design).
-fn nested_runs(study: &Study) -> Option<f64> {
-    let MethodSpec::Nested(nested) = &study.method else {
-        return None;
-    };
-    let (outer, inner): (Vec<_>, Vec<_>) = study
-        .parameters
-        .iter()
-        .cloned()
-        .partition(|p| nested.outer_parameters.contains(&p.name));
-    let count =
-        |spec: &MethodSpec, params: &[crate::uq::RandomParameter]| match spec.method().evaluation()
-        {
-            Evaluation::Sampling(m) => m.planned_runs_for(params),
-            Evaluation::Intrusive(_) => None,
-        };
-    Some(count(&nested.outer, &outer)? * count(&nested.inner, &inner)?)
-}
-
-/// The columns of a block of `rows` rows out of `nt` within `budget` bytes: as
-/// [`blocks::block_width`], in floating point (the counts may be beyond any integer type).
-fn block_columns(nt: f64, rows: f64, budget: f64) -> f64 {
-    let align = blocks::BLOCK_ALIGN as f64;
-    let w = (budget / (2.0 * 8.0 * rows.max(1.0))).floor();
-    if w >= nt {
-        return nt.max(1.0);
-    }
-    ((w / align).floor() * align).max(align)
-}
-
 /// Checks `study` (to be written to `out_dir`) before anything is allocated or run (a suite:
 /// each variant). Opens the FMU to time a short run, unless the points are to run isolated
 /// or under a time limit (`--isolate`, `--timeout-per-run`: the timing run would run the FMU
@@ -751,7 +565,10 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::shape::block_columns;
     use super::*;
+    use crate::study::analysis::blocks;
+    use crate::uq::method::MethodSpec;
 
     fn wheel_shape(runs: f64) -> Shape {
         Shape {
