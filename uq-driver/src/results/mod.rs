@@ -253,6 +253,15 @@ impl ExceedanceCount {
         self.describe_with(&|x: f64| x.to_string())
     }
 
+    /// Sets [`Self::beyond_runs`] when the count is over the `draws` of a chaos and the limit
+    /// lies outside `[smallest, largest]`, the range of the model runs.
+    pub fn note_range(&mut self, draws: Draws, [smallest, largest]: [f64; 2]) {
+        let outside = self.limit > largest || self.limit < smallest;
+        if draws == Draws::Chaos && outside && smallest <= largest {
+            self.beyond_runs = Some([smallest, largest]);
+        }
+    }
+
     /// [`Self::describe`] with the limit (and the range of the runs) written by `value`,
     /// e.g. with its unit: `0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)`.
     pub fn describe_with(&self, value: &dyn Fn(f64) -> String) -> String {

@@ -18,8 +18,8 @@ use rand::RngCore;
 use rayon::prelude::*;
 
 use super::analysis::{
-    nest_exceedance_count, output_stats, quantity_error, scalar_stats, surrogates_of, Analysed,
-    AnalysisError, QuantityRuns, Runs, Settings,
+    nest_exceedance_count, output_stats, quantity_error, scalar_stats, series_error, surrogates_of,
+    Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
 };
 use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
@@ -30,16 +30,13 @@ use crate::results::{
 use crate::spec::Study;
 use crate::uq::method::nested::split::{self, Split};
 use crate::uq::method::nested::{marginal, Blocks, Conditional, Nested};
-use crate::uq::method::{ChaosErrorKind, Design, Draws, Estimate, MethodError, Sampling};
+use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling};
 use crate::uq::{moments, rng};
 
 /// Tag of the streams of the conditional chaos draws.
 const DRAWS_SEED: u64 = 0x6e65_7374_6564_0d00;
 /// Tag of the bootstrap streams.
 const BOOTSTRAP_SEED: u64 = 0x6e65_7374_6564_0b00;
-/// An inner chaos whose own truncation-error estimate exceeds this (relative to the
-/// conditional variance) in some outer samples is reported (as a stand-alone chaos is).
-const CHAOS_ERROR: f64 = 0.05;
 /// Most pooled draws of an output over time (memory: draws × times).
 pub const SERIES_DRAWS: usize = 4096;
 
@@ -323,10 +320,7 @@ fn nested_count(
     count.p = e.p;
     nest_exceedance_count(count, e.ci, per_outer.len(), draws);
     count.ci_kind = e.ci_kind;
-    let outside = e.limit > range[1] || e.limit < range[0];
-    if draws == Draws::Chaos && outside && range[0] <= range[1] {
-        count.beyond_runs = Some(range);
-    }
+    count.note_range(draws, range);
 }
 
 /// The inner chaos's own truncation-error estimate (per outer sample: its largest over the
@@ -343,29 +337,7 @@ fn inner_chaos_warning(name: &str, cond: &Conditional, times: Option<&[f64]>) ->
         present += 1;
         let Some(err) = &e.chaos_error else { continue };
         kind = Some(err.kind);
-        let worst = if err.kind == ChaosErrorKind::OrderDifference && err.values.len() > 1 {
-            let (mut shared, mut total) = (0.0, 0.0);
-            for (v, s) in err.values.iter().zip(&e.std) {
-                if v.is_finite() && s.is_finite() {
-                    shared += v * s * s;
-                    total += s * s;
-                }
-            }
-            (total > 0.0).then(|| (shared / total, None))
-        } else {
-            let largest = e
-                .std
-                .iter()
-                .filter(|s| s.is_finite())
-                .fold(0.0_f64, |m, s| m.max(s.abs()));
-            err.values
-                .iter()
-                .zip(&e.std)
-                .enumerate()
-                .filter(|(_, (v, s))| v.is_finite() && s.abs() > 1e-3 * largest)
-                .max_by(|a, b| a.1 .0.total_cmp(b.1 .0))
-                .map(|(j, (&v, _))| (v, Some(j)))
-        };
+        let worst = series_error(err, &e.std);
         if let Some((v, j)) = worst.filter(|w| w.0 > CHAOS_ERROR) {
             over.push((k, v, j));
         }

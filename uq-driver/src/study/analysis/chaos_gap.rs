@@ -6,11 +6,12 @@ use std::collections::BTreeMap;
 use super::Analysed;
 use crate::report::units::with_unit;
 use crate::results::numbers::computed;
-use crate::uq::method::ChaosErrorKind;
+use crate::uq::method::{ChaosError, ChaosErrorKind};
 
 /// A chaos whose own truncation-error estimate (relative to the variance) exceeds this at some
-/// time, or for a quantity, is reported ([`chaos_error_warnings`]).
-const CHAOS_ERROR: f64 = 0.05;
+/// time, or for a quantity, is reported ([`chaos_error_warnings`]; a nested study's inner
+/// chaoses likewise).
+pub(crate) const CHAOS_ERROR: f64 = 0.05;
 
 /// A chaos whose variance differs from the method's own by more than this fraction of it
 /// (at some time) is reported ([`chaos_gap_warnings`]).
@@ -82,42 +83,18 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
     let mut missing = false;
     for o in &a.outputs {
         match &o.chaos_error {
-            // SCM's mean and Std are the quadrature's; its order difference (the variance
-            // share of the top degree) says whether the chaos itself has converged, over the
-            // whole series (weighted by the variance, as the Sobol' indices of a series are).
-            Some(e) if e.kind == ChaosErrorKind::OrderDifference => {
-                let (mut shared, mut total) = (0.0, 0.0);
-                for (v, s) in e.values.iter().zip(&o.std) {
-                    if v.is_finite() && s.is_finite() {
-                        shared += v * s * s;
-                        total += s * s;
-                    }
-                }
-                if total > 0.0 && shared / total > CHAOS_ERROR {
-                    out.push(top_order_warning(
-                        &o.name,
-                        " over its series",
-                        shared / total,
-                    ));
-                }
-            }
             Some(e) => {
-                let resolved = resolved(&o.std);
-                let worst = e
-                    .values
-                    .iter()
-                    .zip(&o.std)
-                    .enumerate()
-                    .filter(|(_, (v, s))| v.is_finite() && resolved(**s))
-                    .max_by(|a, b| a.1 .0.total_cmp(b.1 .0));
-                if let Some((k, (&v, _))) = worst {
-                    if v > CHAOS_ERROR {
-                        let at = o
-                            .times
-                            .get(k)
-                            .map_or(String::new(), |t| format!(" at t = {t} s"));
-                        out.push(error_warning(&o.name, &at, e.kind.name(), v));
-                    }
+                if let Some((v, k)) = series_error(e, &o.std).filter(|w| w.0 > CHAOS_ERROR) {
+                    out.push(match k {
+                        None => top_order_warning(&o.name, " over its series", v),
+                        Some(k) => {
+                            let at = o
+                                .times
+                                .get(k)
+                                .map_or(String::new(), |t| format!(" at t = {t} s"));
+                            error_warning(&o.name, &at, e.kind.name(), v)
+                        }
+                    });
                 }
             }
             None => missing |= o.std.iter().any(|s| *s > 0.0),
@@ -144,6 +121,33 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
         ));
     }
     out
+}
+
+/// The truncation error of a chaos over a series whose Std is `std`, as the warnings judge it:
+/// SCM's `order_difference` (the variance share of the top degree; its mean and Std are the
+/// quadrature's, so it says whether the chaos itself has converged) over the whole series,
+/// weighted by the variance as the Sobol' indices of a series are (no column); any other
+/// estimate at its largest over the columns whose Std is resolved (above 1e-3 of the
+/// largest), with that column.
+pub(crate) fn series_error(e: &ChaosError, std: &[f64]) -> Option<(f64, Option<usize>)> {
+    if e.kind == ChaosErrorKind::OrderDifference {
+        let (mut shared, mut total) = (0.0, 0.0);
+        for (v, s) in e.values.iter().zip(std) {
+            if v.is_finite() && s.is_finite() {
+                shared += v * s * s;
+                total += s * s;
+            }
+        }
+        return (total > 0.0).then(|| (shared / total, None));
+    }
+    let resolved = resolved(std);
+    e.values
+        .iter()
+        .zip(std)
+        .enumerate()
+        .filter(|(_, (v, s))| v.is_finite() && resolved(**s))
+        .max_by(|a, b| a.1 .0.total_cmp(b.1 .0))
+        .map(|(k, (&v, _))| (v, Some(k)))
 }
 
 fn error_warning(name: &str, at: &str, kind: &str, value: f64) -> String {

@@ -16,7 +16,7 @@ mod exceedance;
 mod runs;
 mod surrogate;
 
-pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings};
+pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
 pub use exceedance::{clopper_pearson, exceedance_count, nest_exceedance_count};
@@ -388,10 +388,7 @@ fn scalar_stats_counted(
                 _ => exceedance_count(&density_samples, l, estimate.draws),
             };
             // A chaos's draws beyond every model run: its extrapolation alone.
-            let outside = l > largest || l < smallest;
-            if estimate.draws == Draws::Chaos && outside && smallest <= largest {
-                e.beyond_runs = Some([smallest, largest]);
-            }
+            e.note_range(estimate.draws, [smallest, largest]);
             e
         })
         .collect();
