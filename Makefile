@@ -122,7 +122,7 @@ test-rust:
 	$(CARGO) build -p railuq --lib --features test-panic
 	$(CARGO) test -p railuq --features test-panic
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
-	  $(CARGO) test --release -p uq-driver
+	  $(CARGO) test --release -p uq-driver -p out-file
 
 test-python: venv
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python

@@ -133,7 +133,9 @@
 //! - [`suggest`]: "did you mean" for misspelt names.
 
 pub mod fmu;
-pub mod out_file;
+/// Writing output files safely (links replaced, devices and pipes written into): the
+/// `out-file` crate of this workspace.
+pub use ::out_file;
 pub mod qoi;
 pub mod report;
 pub mod results;

@@ -1,6 +1,7 @@
-//! File-system safety of the output folder (QA findings 1 and 3): links planted in the
+//! File-system safety of output files and folders: links planted in the
 //! folder are never written through, and names of outputs and quantities never become
-//! paths outside it nor overwrite the folder's own files.
+//! paths outside it nor overwrite the folder's own files; a device or pipe named as output
+//! is written into, never replaced.
 
 #[path = "support/wheel.rs"]
 mod wheel;
@@ -260,4 +261,91 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
         );
         assert!(points.contains("fails on purpose"), "{name}: {points}");
     }
+}
+
+/// `simulate` of the wheel for 0.5 s at 0.05 s: the CSV it writes (header and 11 rows).
+fn simulate_to(out: &str) -> Output {
+    let fmu = wheel::wheel_fmu();
+    run(&[
+        "simulate",
+        fmu.to_str().unwrap(),
+        "--stop",
+        "0.5",
+        "--step",
+        "0.05",
+        "--out",
+        out,
+    ])
+}
+
+fn file_type(p: &Path) -> std::fs::FileType {
+    std::fs::symlink_metadata(p).unwrap().file_type()
+}
+
+#[test]
+fn simulate_out_a_named_pipe_writes_into_it_and_leaves_it_a_pipe() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let pipe = dir.path().join("p");
+    assert!(Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .unwrap()
+        .success());
+    let reader = {
+        let pipe = pipe.clone();
+        std::thread::spawn(move || std::fs::read_to_string(pipe).unwrap())
+    };
+    let o = simulate_to(pipe.to_str().unwrap());
+    assert!(o.status.success(), "{}", text(&o));
+    let got = reader.join().unwrap();
+    assert!(got.starts_with("time,"), "{got}");
+    assert_eq!(got.lines().count(), 12, "{got}");
+    assert!(file_type(&pipe).is_fifo());
+    // What a regular file gets is the same text.
+    let file = dir.path().join("q.csv");
+    let o = simulate_to(file.to_str().unwrap());
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), got);
+}
+
+#[test]
+fn simulate_out_dash_writes_to_standard_output() {
+    let o = simulate_to("-");
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.starts_with("time,"), "{out}");
+    assert_eq!(out.lines().count(), 12, "{out}");
+    assert!(!Path::new("-").exists());
+}
+
+#[test]
+fn simulate_out_a_character_device_leaves_it_that_device() {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    // The null device's numbers (1, 3) under a temporary name: needs root (as CI is).
+    let dir = tempfile::tempdir().unwrap();
+    let dev = dir.path().join("null");
+    let made = Command::new("mknod")
+        .arg(&dev)
+        .args(["c", "1", "3"])
+        .stderr(std::process::Stdio::null())
+        .status()
+        .unwrap();
+    if !made.success() {
+        eprintln!("skipped: mknod needs root");
+        return;
+    }
+    let o = simulate_to(dev.to_str().unwrap());
+    assert!(o.status.success(), "{}", text(&o));
+    let m = std::fs::symlink_metadata(&dev).unwrap();
+    assert!(m.file_type().is_char_device());
+    assert_eq!(m.rdev(), libc::makedev(1, 3));
+}
+
+#[test]
+fn simulate_out_a_folder_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = simulate_to(dir.path().to_str().unwrap());
+    assert!(!o.status.success());
+    assert!(text(&o).contains("is a folder"), "{}", text(&o));
 }

@@ -87,7 +87,7 @@ fn update_readme(path: &Path) -> Result<(), PackageError> {
     let infos: Vec<_> = registry().iter().map(|e| e.info).collect();
     let (new, found) = railuq::fmi2::xml::update_readme_tables(&text, &infos);
     if new != text {
-        std::fs::write(path, new).map_err(io)?;
+        out_file::write(path, new.as_bytes()).map_err(io)?;
     }
     println!("{}: {found} variable tables up to date", path.display());
     Ok(())

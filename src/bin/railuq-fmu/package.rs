@@ -122,7 +122,7 @@ pub fn write_descriptions(dir: &Path) -> Result<Vec<PathBuf>, PackageError> {
     let mut written = Vec::new();
     for e in registry() {
         let path = dir.join(format!("{}.xml", e.info.name));
-        fs::write(&path, model_description(e.info)?).map_err(io(&path))?;
+        out_file::write(&path, model_description(e.info)?.as_bytes()).map_err(io(&path))?;
         written.push(path);
     }
     Ok(written)
@@ -215,8 +215,8 @@ pub fn package(
     let entries = entries(info, libraries)?;
     fs::create_dir_all(out_dir).map_err(io(out_dir))?;
     let path = out_dir.join(format!("{}.fmu", info.name));
-    let tmp = out_dir.join(format!(".{}.fmu.tmp", info.name));
-    let file = fs::File::create(&tmp).map_err(io(&tmp))?;
+    // Through a temporary file renamed over the name (a device or pipe is written into).
+    let file = out_file::OutFile::create(&path, 1 << 16).map_err(io(&path))?;
     let zerr = |source| PackageError::Zip {
         path: path.clone(),
         source,
@@ -238,8 +238,7 @@ pub fn package(
         zip.start_file(name, opts).map_err(zerr)?;
         zip.write_all(&data).map_err(io(&path))?;
     }
-    zip.finish().map_err(zerr)?;
-    fs::rename(&tmp, &path).map_err(io(&path))?;
+    zip.finish().map_err(zerr)?.commit().map_err(io(&path))?;
     Ok(path)
 }
 

@@ -126,7 +126,8 @@ pub(crate) enum SurrogateCommand {
         /// Input value, NAME=VALUE (repeatable).
         #[arg(long = "at", value_parser = parse_number_assignment)]
         at: Vec<(String, f64)>,
-        /// CSV file to write (default: standard output).
+        /// CSV file to write (default, or `-`: standard output; a device or a named pipe is
+        /// written into, never replaced).
         #[arg(long, short)]
         out: Option<PathBuf>,
     },
@@ -146,7 +147,8 @@ pub(crate) enum SurrogateCommand {
         /// the last).
         #[arg(long = "time")]
         times: Vec<f64>,
-        /// CSV file to write (default: standard output).
+        /// CSV file to write (default, or `-`: standard output; a device or a named pipe is
+        /// written into, never replaced).
         #[arg(long, short)]
         out: Option<PathBuf>,
     },
@@ -312,7 +314,8 @@ pub(crate) struct SimulateArgs {
     /// Communication step (s; default: the FMU's default experiment).
     #[arg(long)]
     pub(crate) step: Option<f64>,
-    /// CSV file to write (default: standard output).
+    /// CSV file to write (default, or `-`: standard output; a device or a named pipe is
+    /// written into, never replaced).
     #[arg(long, short)]
     pub(crate) out: Option<PathBuf>,
     /// Instantiate the FMU with loggingOn = true (many FMUs log only then) and print its

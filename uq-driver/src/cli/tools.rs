@@ -12,9 +12,14 @@ use uq_driver::spec::{Experiment, FixedValue, InvalidExperiment};
 use uq_driver::study::{guard, runner, size};
 use uq_driver::uq::surrogate::Surrogate;
 
-/// Writes `text` to `out`, or to standard output.
+/// The file named by `--out`, or `None` for standard output (no `--out`, or `--out -`).
+fn out_path(out: Option<&Path>) -> Option<&Path> {
+    out.filter(|p| !uq_driver::out_file::is_stdout(p))
+}
+
+/// Writes `text` to `out` (by the rules of [`uq_driver::out_file`]), or to standard output.
 pub(crate) fn emit(text: &str, out: Option<&Path>) -> Result<()> {
-    match out {
+    match out_path(out) {
         Some(p) => uq_driver::out_file::write(p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display())),
         None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
@@ -38,7 +43,7 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
         } => {
             let s = Surrogate::load(&dir)?;
             // Written as drawn: the memory does not grow with -n.
-            match out.as_deref() {
+            match out_path(out.as_deref()) {
                 Some(p) => {
                     let mut f = uq_driver::out_file::OutFile::create(p, 1 << 16)
                         .with_context(|| format!("writing {}", p.display()))?;
@@ -97,7 +102,9 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     let sim = {
         // An FMU that calls exit() is reported; what it prints stays out of a CSV on stdout.
         let _exit = guard::SimulationGuard::begin(&a.fmu);
-        let _stdout = a.out.is_none().then(guard::StdoutToStderr::begin);
+        let _stdout = out_path(a.out.as_deref())
+            .is_none()
+            .then(guard::StdoutToStderr::begin);
         runner::simulate_with(
             &fmu,
             &params,
@@ -136,12 +143,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         }
         text.push('\n');
     }
-    match a.out.as_deref() {
-        Some(p) => uq_driver::out_file::write(p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display()))?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
-    Ok(())
+    emit(&text, a.out.as_deref())
 }
 
 pub(crate) fn inspect(path: &Path) -> Result<()> {
