@@ -264,32 +264,122 @@ pub fn default_table() -> Result<ContactTable, ContactError> {
 }
 
 #[cfg(test)]
-mod explore {
+mod tests {
     use super::*;
+    use crate::contact::conicity::DeltaR;
+
     #[test]
-    #[ignore]
-    fn explore() {
-        let t = std::time::Instant::now();
-        let st = ContactSettings::default();
-        let g = Geometry::new(&st.wheel, &st.rail, &st).unwrap();
-        eprintln!("setup {:?}", t.elapsed());
-        let ys = st.displacements().unwrap();
-        let t1 = std::time::Instant::now();
-        let _ = g.sweep(&ys).unwrap();
-        eprintln!("sweep {:?}", t1.elapsed());
-        let t = std::time::Instant::now();
+    fn symmetric_profiles_give_a_symmetric_table() {
         let s = compute(&ContactSettings::default()).unwrap();
-        eprintln!("time {:?} conformal {}", t.elapsed(), s.conformal_rows);
-        for (g, r) in s.geometry.iter().zip(s.table.rows()) {
-            let ymm = g.y * 1e3;
-            if (ymm * 100.0).round() as i64 % 50 == 0 {
-                eprintln!(
-                    "y {:6.2} roll {:9.6} h {:.6} | L s {:7.2} r {:.6} d {:7.4} kw {:8.2} kr {:8.2} u {:6.2} zc {:8.4} | R s {:7.2} r {:.6} d {:7.4} | a {:.3} b {:.3} q0 {:.4} c11 {:.3}",
-                    ymm, g.roll, g.height, g.left.s * 1e3, g.left.r, g.left.delta, g.left.wheel_curvature, g.left.rail_curvature, g.left.rail_u * 1e3, g.left.zc * 1e3,
-                    g.right.s * 1e3, g.right.r, g.right.delta, r.a * 1e3, r.b * 1e3, r.q0 * 1e3, r.c11
-                );
+        let g = &s.geometry;
+        assert_eq!(g.len(), 3401);
+        for (a, b) in g.iter().zip(g.iter().rev()) {
+            assert!((a.y + b.y).abs() < 1e-12);
+            assert!((a.roll + b.roll).abs() < 1e-12, "roll at {}", a.y);
+            for (x, y) in [
+                (a.left.r, b.right.r),
+                (a.left.aw, b.right.aw),
+                (a.left.delta, b.right.delta),
+                (a.left.zc, b.right.zc),
+            ] {
+                assert!((x - y).abs() < 1e-10, "at y = {}: {x} vs {y}", a.y);
             }
         }
-        eprintln!("flange {:?}", s.flange_contact());
+    }
+
+    #[test]
+    fn s1002_on_uic60_at_1_to_40_has_a_plausible_flange_contact_and_conicity() {
+        let s = compute(&ContactSettings::default()).unwrap();
+        let flange = s.flange_contact().unwrap();
+        assert!(
+            (0.006..=0.010).contains(&flange),
+            "flange contact at {flange} m"
+        );
+        let (y, dr): (Vec<f64>, Vec<f64>) = s.delta_r().into_iter().unzip();
+        let lambda = DeltaR::new(&y, &dr).unwrap().conicity(3e-3).unwrap();
+        assert!((0.1..=0.25).contains(&lambda), "λ_eq(3 mm) = {lambda}");
+        // Tread contact at the centre, r close to r0, static penetration of a tenth of a mm.
+        let t = s.table.rows();
+        let mid = &t[1700];
+        assert!(mid.y.abs() < 1e-12 && (mid.r - 0.425).abs() < 2e-4 && mid.delta < 0.05);
+        assert!(t
+            .iter()
+            .all(|r| r.q0 > 3e-5 && r.q0 < 2e-4 && r.n0 == s.table.rows()[0].n0));
+        assert_eq!(s.conformal_rows, 0);
+    }
+
+    #[test]
+    fn the_default_table_is_the_default_settings_table() {
+        let a = default_table().unwrap();
+        assert_eq!(a, compute_table(&ContactSettings::default()).unwrap());
+        assert_eq!(a.range(), (-0.017, 0.017));
+        assert!((a.rows()[0].n0 - 66_602.297).abs() < 1e-3);
+    }
+
+    #[test]
+    fn sampled_profiles_read_as_csv_give_nearly_the_built_in_table() {
+        let mm = |p: &Profile, n: usize, shift: f64| -> String {
+            p.sample(n)
+                .iter()
+                .map(|(u, z)| format!("{},{}\n", (u + shift) * 1e3, z * 1e3))
+                .collect()
+        };
+        let d = ContactSettings::default();
+        let settings = ContactSettings {
+            wheel: Profile::wheel_from_csv(&mm(&d.wheel, 1228, 0.07), 0.07).unwrap(),
+            rail: Profile::rail_from_csv(&mm(&d.rail, 731, 0.0)).unwrap(),
+            y_step: 1e-4,
+            ..d.clone()
+        };
+        let built_in = compute(&ContactSettings { y_step: 1e-4, ..d }).unwrap();
+        let sampled = compute(&settings).unwrap();
+        let fb = |s: &ContactSolution| s.flange_contact().unwrap();
+        assert!((fb(&built_in) - fb(&sampled)).abs() < 2e-4);
+        for (a, b) in built_in.geometry.iter().zip(&sampled.geometry) {
+            // The same contact (away from the jumps of the contact point and from the nearly
+            // conformal flange root), to the splines' accuracy: r within 2 µm on the tread,
+            // 0.1 mm on the flange (where r changes by 2.7 mm per mm across the profile).
+            let conformity = a.left.wheel_curvature + a.left.rail_curvature;
+            if (a.left.s - b.left.s).abs() < 1e-4 && (a.left.delta < 0.2 || conformity > 30.0) {
+                assert!((a.left.r - b.left.r).abs() < 1e-4, "at {}", a.y);
+                assert!((a.left.delta - b.left.delta).abs() < 5e-3, "at {}", a.y);
+                if a.left.delta < 0.2 {
+                    assert!((a.left.r - b.left.r).abs() < 2e-6, "at {}", a.y);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn settings_out_of_range_are_refused() {
+        let d = ContactSettings::default();
+        for bad in [
+            ContactSettings {
+                y_step: 3e-5 * 0.7,
+                ..d.clone()
+            },
+            ContactSettings {
+                gauge: 1.3,
+                ..d.clone()
+            },
+            ContactSettings {
+                poisson: 0.5,
+                ..d.clone()
+            },
+            ContactSettings {
+                n0: -1.0,
+                ..d.clone()
+            },
+            ContactSettings {
+                inclination: 0.5,
+                ..d.clone()
+            },
+            ContactSettings {
+                gauge_depth: 0.05,
+                ..d.clone()
+            },
+        ] {
+            assert!(compute(&bad).is_err(), "{bad:?}");
+        }
     }
 }

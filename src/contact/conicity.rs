@@ -207,6 +207,87 @@ mod tests {
         }
     }
 
+    /// One EN 15302 reference case: Δr (m) on y (m), and (ŷ, tan γe, upper, lower, upper
+    /// wider, lower wider).
+    struct Case {
+        name: String,
+        y: Vec<f64>,
+        dr: Vec<f64>,
+        refs: Vec<[f64; 6]>,
+    }
+
+    fn en15302_cases() -> Vec<Case> {
+        let mut cases: Vec<Case> = Vec::new();
+        for line in include_str!("testdata/en15302.txt").lines() {
+            let line = line.split('#').next().unwrap_or("");
+            let mut f = line.split_whitespace();
+            let num = |s: &str| s.parse::<f64>().unwrap();
+            match f.next() {
+                Some("case") => {
+                    let name = f.next().unwrap().to_owned();
+                    let (a, b, h) = (
+                        num(f.next().unwrap()),
+                        num(f.next().unwrap()),
+                        num(f.next().unwrap()),
+                    );
+                    let n = ((b - a) / h).round() as usize + 1;
+                    let y = (0..n).map(|i| (a + h * i as f64) * 1e-3).collect();
+                    cases.push(Case {
+                        name,
+                        y,
+                        dr: Vec::new(),
+                        refs: Vec::new(),
+                    });
+                }
+                Some("dr") => {
+                    let c = cases.last_mut().unwrap();
+                    c.dr.extend(f.map(|v| num(v) * 1e-3));
+                }
+                Some("ref") => {
+                    let v: Vec<f64> = f.map(num).collect();
+                    cases
+                        .last_mut()
+                        .unwrap()
+                        .refs
+                        .push([v[0], v[1], v[2], v[3], v[4], v[5]]);
+                }
+                _ => {}
+            }
+        }
+        cases
+    }
+
+    #[test]
+    fn en15302_reference_cases_lie_within_their_tolerances() {
+        let cases = en15302_cases();
+        assert_eq!(cases.len(), 9);
+        let mut checked = 0;
+        for c in &cases {
+            assert_eq!(c.y.len(), c.dr.len(), "{}", c.name);
+            let d = DeltaR::new(&c.y, &c.dr).unwrap();
+            for r in &c.refs {
+                let Ok(got) = d.conicity(r[0] * 1e-3) else {
+                    continue; // beyond the tabulated Δr
+                };
+                // Annex F's band, and (tighter) within 0.01 of the reference value itself.
+                let (name, amp) = (&c.name, r[0]);
+                assert!(
+                    got >= r[3] && got <= r[2],
+                    "{name} ŷ = {amp} mm: {got} not in [{}, {}]",
+                    r[3],
+                    r[2]
+                );
+                assert!(
+                    (got - r[1]).abs() < 0.01,
+                    "{name} ŷ = {amp} mm: {got} vs {}",
+                    r[1]
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 400, "{checked}");
+    }
+
     #[test]
     fn a_dead_zone_gives_zero_and_too_large_amplitudes_are_refused() {
         let y = grid(-0.005, 0.005, 101);

@@ -140,6 +140,9 @@ pub struct WheelContact {
     pub zc: f64,
     /// Lateral curvature of the rail profile at the contact, positive convex (1/m).
     pub rail_curvature: f64,
+    /// Contact angle in the track frame from the rail's slope at the contact (rad): δ + φ on
+    /// the left wheel, δ − φ on the right when the surfaces are tangent.
+    pub rail_angle: f64,
 }
 
 /// The rigid contact of a wheelset at one lateral displacement.
@@ -542,6 +545,7 @@ impl Geometry {
             rail_u: (1.0 - f) * self.rail_u[i] + f * self.rail_u[i + 1],
             zc: zr,
             rail_curvature: -d2zr / (1.0 + dzr * dzr).powf(1.5),
+            rail_angle: dzr.atan(),
         }
     }
 
@@ -621,5 +625,88 @@ impl Geometry {
             }
         }
         Ok(rows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Conical wheels (cone angle γ, radius r0 on the rolling circle at d from the centre) on
+    /// rails whose heads are circles of radius ρ centred at (±e, −ρ): the contact of a cone
+    /// with a circle is that of the cone offset by ρ (radius r0 + ρ√(1 + γ²) at d) with a knife
+    /// edge at the circle's centre, so Δr = 2e sin φ and y = (e/γ) sin φ cos φ − (r0 + ρ√(1+γ²)
+    /// − γ(e cos φ − d)) sin φ exactly. To first order in φ, Δr = 2γy / (1 − γ(r0 + ρ)/e): the
+    /// textbook Δr = 2γy, which neglects the roll.
+    #[test]
+    fn conical_wheels_on_round_and_knife_edge_rails_follow_the_closed_form() {
+        for (gamma, rho) in [(0.05, 5e-4), (0.025, 2e-3), (0.2, 5e-4)] {
+            let csv: String = (0..=16)
+                .map(|i| {
+                    let y = 30.0 + 5.0 * i as f64;
+                    format!("{y},{}\n", -gamma * (y - 70.0))
+                })
+                .collect();
+            let wheel = Profile::wheel_from_csv(&csv, 0.07).unwrap();
+            let rail = Profile::crown(rho, rho * 60f64.to_radians().sin()).unwrap();
+            let (fb, r0) = (1.36, 0.425);
+            let d = 0.5 * fb + 0.07;
+            let settings = ContactSettings {
+                wheel: wheel.clone(),
+                rail: rail.clone(),
+                inclination: 0.0,
+                gauge: 2.0 * d - rho,
+                gauge_depth: rho * (1.0 - 30f64.to_radians().cos()),
+                flange_back: fb,
+                rolling_circle: 0.07,
+                r0,
+                y_min: -0.01,
+                y_max: 0.01,
+                y_step: 5e-4,
+                ..ContactSettings::default()
+            };
+            let e = 0.5 * settings.gauge + 0.5 * rho;
+            let r_off = r0 + rho * (1.0 + gamma * gamma).sqrt();
+            let g = Geometry::new(&wheel, &rail, &settings).unwrap();
+            let rows = g.sweep(&settings.displacements().unwrap()).unwrap();
+            for row in &rows {
+                let (sn, c) = row.roll.sin_cos();
+                let dr = row.left.r - row.right.r;
+                let y = e / gamma * sn * c - (r_off - gamma * (e * c - d)) * sn;
+                assert!(
+                    (dr - 2.0 * e * sn).abs() < 2e-9,
+                    "γ {gamma}: Δr {dr} at {}",
+                    row.y
+                );
+                assert!((row.y - y).abs() < 2e-9, "γ {gamma}: y {} vs {y}", row.y);
+                if row.y.abs() > 1e-6 {
+                    let first = 1.0 / (1.0 - gamma * (r0 + rho) / e);
+                    let ratio = dr / (2.0 * gamma * row.y);
+                    assert!((ratio / first - 1.0).abs() < 2e-3, "{ratio} vs {first}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn contact_points_are_points_of_common_tangency() {
+        let settings = ContactSettings {
+            y_step: 1e-4,
+            ..ContactSettings::default()
+        };
+        let g = Geometry::new(&settings.wheel, &settings.rail, &settings).unwrap();
+        for row in g.sweep(&settings.displacements().unwrap()).unwrap() {
+            let (l, r) = (&row.left, &row.right);
+            assert!(
+                (l.rail_angle - (l.delta + row.roll)).abs() < 1e-6,
+                "{row:?}"
+            );
+            assert!(
+                (r.rail_angle - (r.delta - row.roll)).abs() < 1e-6,
+                "{row:?}"
+            );
+            // Both wheels on their rails: the same height of the axle over each.
+            assert!(l.zc <= 0.0 && r.zc <= 0.0);
+        }
     }
 }
