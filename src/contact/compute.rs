@@ -4,8 +4,10 @@
 //! coefficients ([`super::kalker`]).
 //!
 //! Hertz's curvatures at the left wheel's contact: along the rolling direction the wheel's
-//! cos δ / r (a body of revolution, δ the contact angle relative to the axle) and 0 for the
-//! straight rail; across it the lateral curvatures of the two profiles (convex positive). Where
+//! cos δ / r (the principal curvature of a body of revolution across its meridian, δ the contact
+//! angle relative to the axle; [`RollingCurvature::Radius`] takes 1/r instead, as RSGEO does)
+//! and 0 for the straight rail; across it the lateral curvatures of the two profiles (convex
+//! positive). The two differ on the flange only (cos 70° = 0.34). Where
 //! the profiles are close to conformal (the sum of the lateral curvatures below a twentieth of
 //! the longitudinal one), the sum is held at that floor, so that b ≤ about 7 a; the number of
 //! such rows is reported.
@@ -66,6 +68,16 @@ pub enum ContactError {
     Table(#[from] TableError),
 }
 
+/// The wheel's curvature along the rolling direction used for the Hertz ellipse.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RollingCurvature {
+    /// cos δ / r: the principal curvature of the wheel's surface of revolution (exact).
+    #[default]
+    Meridian,
+    /// 1/r: the rolling circle's curvature (the usual simplification; RSGEO's tables use it).
+    Radius,
+}
+
 /// What to compute: profiles, track and wheelset layout, loads, material and the grid of
 /// displacements. All lengths in m, angles in rad, forces in N, moduli in Pa.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +104,8 @@ pub struct ContactSettings {
     pub young: f64,
     /// Poisson ratio of wheel and rail (1).
     pub poisson: f64,
+    /// The wheel's curvature along the rolling direction for Hertz.
+    pub rolling_curvature: RollingCurvature,
     /// First wheelset displacement of the table (m).
     pub y_min: f64,
     /// Last wheelset displacement of the table (m).
@@ -118,6 +132,7 @@ impl Default for ContactSettings {
             n0: cooperrider_wheel_load(),
             young: 2.1e11,
             poisson: 0.27,
+            rolling_curvature: RollingCurvature::Meridian,
             y_min: -0.017,
             y_max: 0.017,
             y_step: 1e-5,
@@ -218,7 +233,11 @@ pub fn compute(settings: &ContactSettings) -> Result<ContactSolution, ContactErr
         .iter()
         .map(|g| {
             let c = &g.left;
-            let ax = 0.5 * c.delta.cos() / c.r;
+            let ax = 0.5 / c.r
+                * match settings.rolling_curvature {
+                    RollingCurvature::Meridian => c.delta.cos(),
+                    RollingCurvature::Radius => 1.0,
+                };
             let mut by = 0.5 * (c.wheel_curvature + c.rail_curvature);
             if by < CONFORMAL_FLOOR * ax {
                 by = CONFORMAL_FLOOR * ax;

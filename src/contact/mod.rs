@@ -24,7 +24,7 @@ pub mod uic60;
 
 pub use compute::{
     compute, compute_table, cooperrider_wheel_load, default_table, ContactError, ContactSettings,
-    ContactSolution,
+    ContactSolution, RollingCurvature,
 };
 pub use profile::{Profile, ProfileError};
 pub use table::{ContactTable, TableError, TableRow};
