@@ -6,7 +6,7 @@
 //! - [`geometry`]: the rigid contact of a wheelset on a track (roll, contact points, radii,
 //!   contact angles);
 //! - [`hertz`], [`kalker`]: the contact ellipse, penetration and creep coefficients;
-//! - [`compute`]: all of it as a [`ContactTable`] ([`compute_table`], [`default_table`]);
+//! - [`compute`](mod@compute): all of it as a [`ContactTable`] ([`compute_table`], [`default_table`]);
 //! - [`conicity`]: equivalent conicity from Δr(y) (EN 15302).
 //!
 //! Pure Rust, no FMI types.

@@ -17,7 +17,7 @@
 /// The shape of one piece of a profile.
 #[derive(Clone, Debug, PartialEq)]
 enum Shape {
-    /// z = Σₖ coef[k]·(u − origin)ᵏ.
+    /// z = Σₖ coef\[k\]·(u − origin)ᵏ.
     Poly { origin: f64, coef: Vec<f64> },
     /// A circular arc of centre (cu, cz) and radius `radius`: its upper half (z ≥ cz) or its
     /// lower half.
@@ -163,7 +163,7 @@ impl Profile {
         Ok(Profile { pieces })
     }
 
-    /// A polynomial piece on [u0, u1]: z = Σₖ coef[k]·(u − origin)ᵏ (m).
+    /// A polynomial piece on [u0, u1]: z = Σₖ coef\[k\]·(u − origin)ᵏ (m).
     pub(crate) fn poly(u0: f64, u1: f64, origin: f64, coef: Vec<f64>) -> (f64, f64, ShapeSpec) {
         (u0, u1, ShapeSpec(Shape::Poly { origin, coef }))
     }
