@@ -2,9 +2,29 @@
 //! lateral displacement, the format of a table file, interpolation), and its computation from
 //! wheel and rail profiles.
 //!
+//! - [`profile`]: profiles as curves (built-in [`s1002`] wheel and [`uic60`] rail, or CSV);
+//! - [`geometry`]: the rigid contact of a wheelset on a track (roll, contact points, radii,
+//!   contact angles);
+//! - [`hertz`], [`kalker`]: the contact ellipse, penetration and creep coefficients;
+//! - [`compute`](mod@compute): all of it as a [`ContactTable`] ([`compute_table`], [`default_table`]);
+//! - [`conicity`]: equivalent conicity from Δr(y) (EN 15302).
+//!
 //! Pure Rust, no FMI types.
 #![forbid(unsafe_code)]
 
+pub mod compute;
+pub mod conicity;
+pub mod geometry;
+pub mod hertz;
+pub mod kalker;
+pub mod profile;
+pub mod s1002;
 pub mod table;
+pub mod uic60;
 
+pub use compute::{
+    compute, compute_table, cooperrider_wheel_load, default_table, ContactError, ContactSettings,
+    ContactSolution, RollingCurvature,
+};
+pub use profile::{Profile, ProfileError};
 pub use table::{ContactTable, TableError, TableRow};

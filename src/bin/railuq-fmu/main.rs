@@ -1,12 +1,15 @@
 //! Build helper: `railuq-fmu xml DIR` writes the model descriptions; `railuq-fmu readme FILE`
 //! rewrites the marked variable tables of README.md; `railuq-fmu package
 //! [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]` writes one `.fmu` per model
-//! carrying every library given, each under the platform folder its header names.
+//! carrying every library given, each under the platform folder its header names;
+//! `railuq-fmu contact --out FILE [...]` writes a wheel–rail contact table and its plot.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod contact;
 mod package;
+mod svg;
 
 use package::{model_info, package, write_descriptions, Library, PackageError};
 use railuq::models::registry;
@@ -14,13 +17,19 @@ use railuq::models::registry;
 const USAGE: &str = "usage: railuq-fmu xml DIR
        railuq-fmu readme FILE
        railuq-fmu package [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]
+       ";
 
-package writes OUT_DIR/<Model>.fmu for each MODEL (default: every model) with the shared
+const PACKAGE_HELP: &str =
+    "package writes OUT_DIR/<Model>.fmu for each MODEL (default: every model) with the shared
 library LIB and each --library LIB (e.g. a Windows DLL beside the Linux .so), one per platform,
 stripped of symbols and debug info with binutils' strip ($STRIP if set) unless --keep-debug.";
 
 fn usage() -> ExitCode {
-    eprintln!("{USAGE}");
+    eprintln!(
+        "{USAGE}{}\n\n{PACKAGE_HELP}\n\n{}",
+        contact::USAGE,
+        contact::HELP
+    );
     ExitCode::from(2)
 }
 
@@ -95,16 +104,25 @@ fn update_readme(path: &Path) -> Result<(), PackageError> {
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let result = match args.first().map(String::as_str) {
-        Some("xml") if args.len() == 2 => write_descriptions(Path::new(&args[1])).map(|paths| {
-            for p in paths {
-                println!("wrote {}", p.display());
-            }
-        }),
-        Some("readme") if args.len() == 2 => update_readme(Path::new(&args[1])),
+    let result: Result<(), Box<dyn std::error::Error>> = match args.first().map(String::as_str) {
+        Some("xml") if args.len() == 2 => write_descriptions(Path::new(&args[1]))
+            .map(|paths| {
+                for p in paths {
+                    println!("wrote {}", p.display());
+                }
+            })
+            .map_err(Into::into),
+        Some("readme") if args.len() == 2 => update_readme(Path::new(&args[1])).map_err(Into::into),
         Some("package") => match parse_package(&args[1..]) {
-            Some(a) => run_package(&a),
+            Some(a) => run_package(&a).map_err(Into::into),
             None => return usage(),
+        },
+        Some("contact") => match contact::parse(&args[1..]) {
+            Ok(a) => contact::run(&a).map_err(Into::into),
+            Err(e) => {
+                eprintln!("railuq-fmu contact: {e}");
+                return usage();
+            }
         },
         _ => return usage(),
     };
