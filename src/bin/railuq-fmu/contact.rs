@@ -3,7 +3,6 @@
 //! conicity).
 
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -173,58 +172,14 @@ pub fn settings(a: &ContactArgs) -> Result<ContactSettings, ContactCliError> {
     Ok(s)
 }
 
-/// Writes `bytes` to `path` under the project's rule: into a device, FIFO or socket directly
-/// (never replaced or removed); a regular file (or a new one) through a temporary file in the
-/// same folder renamed over it. A symbolic link is followed to its target.
+/// Writes `bytes` to `path` by the rules of the `out-file` crate (uq-driver's): a new name, a
+/// regular file or a link through a temporary file renamed over it (a link is replaced, never
+/// written through); a device or FIFO written into, never replaced; `-` standard output.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), ContactCliError> {
-    let io = |source| ContactCliError::Io {
+    out_file::write(path, bytes).map_err(|source| ContactCliError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let target = match fs::symlink_metadata(path) {
-        Ok(m) if m.file_type().is_symlink() => fs::canonicalize(path).map_err(io)?,
-        _ => path.to_path_buf(),
-    };
-    if let Ok(m) = fs::metadata(&target) {
-        if m.is_dir() {
-            return Err(io(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "is a directory",
-            )));
-        }
-        if !m.is_file() {
-            return write_special(&target, bytes).map_err(io);
-        }
-    }
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = target.file_name().unwrap_or_default().to_string_lossy();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let written = fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
-    if let Err(e) = written.and_then(|()| fs::rename(&tmp, &target)) {
-        let _ = fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    Ok(())
-}
-
-/// Writes into an existing device, FIFO or socket.
-fn write_special(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if fs::metadata(path)?.file_type().is_socket() {
-            let mut s = std::os::unix::net::UnixStream::connect(path)?;
-            return s.write_all(bytes);
-        }
-    }
-    let mut f = fs::OpenOptions::new().write(true).open(path)?;
-    f.write_all(bytes)
+    })
 }
 
 /// The plot of a solution: Δr(y), contact angles, roll, and λ_eq over the amplitudes.
@@ -369,29 +324,18 @@ mod tests {
     }
 
     #[test]
-    fn outputs_replace_regular_files_and_write_into_fifos() {
+    fn outputs_go_through_the_shared_output_rules() {
+        // The rules themselves are tested in the out-file crate; here: this command uses them
+        // (a link planted as the output is replaced, not written through).
         let dir = std::env::temp_dir().join(format!("railuq-contact-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
-        let f = dir.join("t.csv");
-        fs::write(&f, "old").unwrap();
-        write_output(&f, b"new").unwrap();
-        assert_eq!(fs::read_to_string(&f).unwrap(), "new");
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 1, "no temporary left");
-        #[cfg(unix)]
-        {
-            let fifo = dir.join("fifo");
-            let ok = std::process::Command::new("mkfifo").arg(&fifo).status();
-            if ok.map(|s| s.success()).unwrap_or(false) {
-                let reader = {
-                    let fifo = fifo.clone();
-                    std::thread::spawn(move || fs::read_to_string(fifo).unwrap())
-                };
-                write_output(&fifo, b"table").unwrap();
-                assert_eq!(reader.join().unwrap(), "table");
-                use std::os::unix::fs::FileTypeExt;
-                assert!(fs::metadata(&fifo).unwrap().file_type().is_fifo());
-            }
-        }
+        let victim = dir.join("victim");
+        fs::write(&victim, "keep").unwrap();
+        let out = dir.join("t.csv");
+        std::os::unix::fs::symlink(&victim, &out).unwrap();
+        write_output(&out, b"new").unwrap();
+        assert_eq!(fs::read_to_string(&victim).unwrap(), "keep");
+        assert_eq!(fs::read_to_string(&out).unwrap(), "new");
         assert!(write_output(&dir, b"x").is_err());
         fs::remove_dir_all(&dir).unwrap();
     }
