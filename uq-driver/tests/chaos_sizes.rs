@@ -1,4 +1,4 @@
-//! The up-front size checks of the chaos methods (QA findings F2 and F5).
+//! The up-front size checks of the chaos methods.
 //!
 //! - F2: a 300-run sparse regression chaos (LARS) in 30 inputs of order 5 was estimated at
 //!   5 MiB and peaked at 1.5 GB (its candidates at the runs), a 41 601-run sparse grid at

@@ -1,4 +1,4 @@
-//! Command-line consistency pinned after the QA campaign: exact quantile column names
+//! Command-line consistency pinned: exact quantile column names
 //! through a whole study (F6), and `merge` / `slurm` taking `--no-report` as `run` does (F9).
 
 #[path = "support/wheel.rs"]

@@ -1,4 +1,4 @@
-//! QA5 M5: the VehicleTrack speed `v` declares its range [0, 160] m/s, so a speed given in
+//! The VehicleTrack speed `v` declares its range [0, 160] m/s, so a speed given in
 //! km/h (`v = 300`, 1080 km/h) is warned about by the driver and refused by the FMU, and a
 //! lateral Sperling weighting on the vertical carbody acceleration is warned about.
 

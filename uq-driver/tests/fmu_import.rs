@@ -745,7 +745,7 @@ fn symlink_entry_is_refused() {
 
 #[test]
 fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
-    // QA round 3, L-1: an FMU declaring canHandleVariableCommunicationStepSize="false" was sent
+    // An FMU declaring canHandleVariableCommunicationStepSize="false" was sent
     // a shorter last step (stop - start not a whole number of steps) without a word; fmpy ends
     // such a run at the last whole step instead. Now `simulate` and `run` refuse, naming the
     // stop times that fit; a whole number of steps runs as before.

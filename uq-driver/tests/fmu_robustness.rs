@@ -1,5 +1,4 @@
-//! Robustness of the importer and the runner against FMUs that are legal but awkward (the QA
-//! campaign of 2026-11-30): FMUs with global state, each expectation computed here from the
+//! Robustness of the importer and the runner against FMUs that are legal but awkward: FMUs with global state, each expectation computed here from the
 //! test FMU's documented behaviour (`tests/fmus/README.md`).
 
 #[path = "support/test_fmus.rs"]

@@ -405,7 +405,7 @@ fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
     let cells: Vec<&str> = row_b.split("<td").skip(1).collect();
     // variant, method, runs, wall time, mean/Std end, mean/Std peak (blank).
     assert_eq!(cells.len(), 8, "{row_b}");
-    // The mean to the resolution of its Std, as the page writes statistics (QA round 3, M8).
+    // The mean to the resolution of its Std, as the page writes statistics (M8).
     let std_b = summary["variants"][1]["quantities"][0]["std"]
         .as_f64()
         .unwrap();

@@ -1,4 +1,4 @@
-//! QA round 3, the instance lifecycle of a study, against the Features test FMU's `reset_bug`
+//! The instance lifecycle of a study, against the Features test FMU's `reset_bug`
 //! (a broken `fmi2Reset`), `name_dir` (working files keyed on the instance name) and `quiet`
 //! (messages only with logging on): H-2 (instances reused through a broken `fmi2Reset` gave
 //! failures or silently wrong numbers), M-3 (every instance was named `uq-driver`), M-2 (FMUs

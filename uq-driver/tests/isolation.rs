@@ -163,7 +163,7 @@ fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
 
 #[test]
 fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnable() {
-    // QA round 3, H-1: after one point's fmi2Fatal in-process, every later point was refused by
+    // After one point's fmi2Fatal in-process, every later point was refused by
     // the FMU layer and stored as *failed*; with --allow-failures the study then analysed the
     // points that happened to finish first (a thread-count-dependent subset), exit 0. Now the
     // study stops at the Fatal, naming the point and --isolate; only that point is stored as
@@ -553,7 +553,7 @@ impl Case {
 
 #[test]
 fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers() {
-    // QA finding 6: fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
+    // Fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
     // forever, --timeout-per-run or not. The pipes now sit at high descriptors.
     let Some(c) = case(9) else { return };
     let o = c
@@ -580,7 +580,7 @@ fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers(
 
 #[test]
 fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_its_pipes() {
-    // QA finding 7: the driver noticed a crashed worker only when its pipes closed, i.e. when
+    // The driver noticed a crashed worker only when its pipes closed, i.e. when
     // a helper process the FMU had started (here one that lives 20 s) ended.
     let Some(c) = case(10) else { return };
     let t0 = Instant::now();
@@ -596,7 +596,7 @@ fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_
 
 #[test]
 fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finishes() {
-    // QA finding L11: a worker dead of SIGTERM was taken for a driver being stopped from
+    // A worker dead of SIGTERM was taken for a driver being stopped from
     // outside, so the study stopped at that point on every re-run and could never finish.
     let Some(c) = case(11) else { return };
     let o = c
@@ -609,7 +609,7 @@ fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finis
 
 #[test]
 fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status() {
-    // QA finding 12: an FMU crashing in-process killed the driver printing only the plan line.
+    // An FMU crashing in-process killed the driver printing only the plan line.
     use std::os::unix::process::ExitStatusExt;
     for (mode, sig, name) in [(2, 11, "SIGSEGV"), (3, 6, "SIGABRT")] {
         let Some(c) = case(mode) else { return };
@@ -633,7 +633,7 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
 
 #[test]
 fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
-    // QA finding 5: `simulate` exited 0 with no CSV and no message.
+    // `simulate` exited 0 with no CSV and no message.
     let Some(fmu) = test_fmus::test_fmu("Features") else {
         return;
     };
@@ -660,7 +660,7 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
 
 #[test]
 fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
-    // QA finding 9: the FMU's printf output was interleaved with the CSV rows on stdout.
+    // The FMU's printf output was interleaved with the CSV rows on stdout.
     let Some(fmu) = test_fmus::test_fmu("Features") else {
         return;
     };

@@ -1,4 +1,4 @@
-//! Oversized designs (issue 12 item 3, issue 11 item 7): `samples = 1000000000000`,
+//! Oversized designs: `samples = 1000000000000`,
 //! `step = 1e-12` and `stop = 1e15` with `step = 1` used to end in an out-of-memory abort
 //! (exit 134) and an empty output folder. They must end in a clear refusal with the estimate
 //! and the limit, whatever `--yes` says, before anything is allocated, with the output folder
@@ -329,7 +329,7 @@ fn a_long_study_needs_yes() {
 
 #[test]
 fn merge_checks_the_memory_of_the_analysis_as_run_does() {
-    // QA 5 H4: `merge` analysed a study `run` refuses, and aborted (SIGABRT) on a failed
+    // `merge` analysed a study `run` refuses, and aborted (SIGABRT) on a failed
     // allocation after reading every shard. It is now refused first, with the estimate.
     let dir = tempfile::tempdir().unwrap();
     let path = study(

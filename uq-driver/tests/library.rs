@@ -1,4 +1,4 @@
-//! uq-driver used as a library (QA qa4/lib): bad studies and options give typed errors
+//! uq-driver used as a library: bad studies and options give typed errors
 //! instead of panics, wrong results or files in the current folder, and a study leaves the
 //! host's process alone (no `atexit` handler, no signal handlers, no `_exit`) unless the host
 //! opts in with `install_process_guards`.
@@ -60,7 +60,7 @@ fn invalid_message(r: Result<Outcome, StudyRunError>) -> String {
     }
 }
 
-/// QA qa4/lib H4: `run_study` did not validate a `Study` whose public fields were changed
+/// `run_study` did not validate a `Study` whose public fields were changed
 /// after `Study::parse`: stop < start returned `Ok` with the initial state as the result, no
 /// parameters ran 50 identical runs, no outputs analysed nothing, and step 0 or NaN gave a
 /// misleading "inf B of memory" size error.
@@ -111,7 +111,7 @@ fn run_study_refuses_a_study_changed_into_an_invalid_one() {
     assert_eq!(r.outputs[0].times.len(), 101);
 }
 
-/// QA qa4/lib H5: `run_study(&study, Path::new(""), …)` wrote `store/`, `points.csv`, `q.csv`
+/// `run_study(&study, Path::new(""), …)` wrote `store/`, `points.csv`, `q.csv`
 /// … into the host's current folder.
 #[test]
 fn an_empty_output_folder_is_refused() {
@@ -123,7 +123,7 @@ fn an_empty_output_folder_is_refused() {
     }
 }
 
-/// QA qa4/lib H1: `timeout_per_run` without `isolate` ended the host process with
+/// `timeout_per_run` without `isolate` ended the host process with
 /// `_exit(1)` when a run overran; a library caller now gets a typed error before anything
 /// runs, saying why and what to use instead.
 #[test]
@@ -144,7 +144,7 @@ fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
         Err(e) => panic!("{e}"),
         Ok(_) => panic!("timeout_per_run in-process was accepted"),
     }
-    // threads = 0 was silently made 1 (QA L5); points outside the design were dropped.
+    // threads = 0 was silently made 1 ; points outside the design were dropped.
     let o = RunOptions {
         threads: Some(0),
         ..opts()
@@ -164,7 +164,7 @@ fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
     }
 }
 
-/// QA qa4/lib H3: `simulate` with an empty time grid panicked ("at least one time"), and
+/// `simulate` with an empty time grid panicked ("at least one time"), and
 /// `Experiment::times()` of a 1e21-point grid panicked with "capacity overflow".
 #[test]
 fn an_empty_or_invalid_time_grid_is_a_typed_error() {
@@ -207,7 +207,7 @@ fn handler_of(sig: i32) -> usize {
     }
 }
 
-/// QA qa4/lib H2: an in-process study installed SIGSEGV, SIGBUS, SIGILL, SIGFPE and SIGABRT
+/// An in-process study installed SIGSEGV, SIGBUS, SIGILL, SIGFPE and SIGABRT
 /// handlers for the rest of the host's process.
 #[test]
 fn an_in_process_study_leaves_the_signal_handlers_alone() {
@@ -235,7 +235,7 @@ fn an_in_process_study_leaves_the_signal_handlers_alone() {
 /// Set in the child process of the next test.
 const HOST_EXIT_CHILD: &str = "UQ_DRIVER_TEST_HOST_EXIT_CHILD";
 
-/// QA qa4/lib H2: while a study ran in a background thread, the host's own
+/// While a study ran in a background thread, the host's own
 /// `std::process::exit(0)` became exit status 1 with a message blaming an FMU (an `atexit`
 /// handler registered by the study). The host (this test binary, run again as a child)
 /// exits with its own status and no such message.

@@ -210,7 +210,7 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
 
 #[test]
 fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
-    // QA round 3, L-2: a study that stopped at its first failure, or had too few successful
+    // A study that stopped at its first failure, or had too few successful
     // runs to analyse, left only store/: the per-point messages could not be read. Now
     // points.csv is written with every point's status (the Features FMU fails its step at
     // t = misbehave_at with mode 1, an fmi2Error).

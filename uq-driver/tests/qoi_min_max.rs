@@ -1,4 +1,4 @@
-//! QA5 M3: the `min` and `max` quantity kinds (signed smallest and largest value of a signal
+//! The `min` and `max` quantity kinds (signed smallest and largest value of a signal
 //! over a window) on the Wheel FMU, against its closed form q(t) of m q'' + C q' + K q = 0
 //! (`support/wheel.rs`) at each run's K and C.
 

@@ -1,4 +1,4 @@
-//! Honest reports (issue 15): degenerate studies (one run, zero spread, no exceedance) get no
+//! Honest reports: degenerate studies (one run, zero spread, no exceedance) get no
 //! density and the right words; units from the modelDescription appear on the axes, in
 //! summary.json and in units.csv; every plot file is well-formed SVG (parsed with quick-xml)
 //! or PNG (decoded); `--no-report` writes the data files only; `export --runs` and `compare`
@@ -153,7 +153,7 @@ fn a_single_run_has_no_density_and_says_so() {
         assert!(!out.join(f).exists(), "{f} drawn for a single run");
     }
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
-    // QA round 3, M3: a nominal run is a value against each limit, not a probability
+    // A nominal run is a value against each limit, not a probability
     // ("0 of 1 runs exceeded 1 (95 % upper bound of P: 0.950)"), and its inputs were held at
     // their means, not sampled.
     assert!(
@@ -475,7 +475,7 @@ fn a_missing_fmu_lists_every_place_searched() {
 
 #[test]
 fn a_one_letter_signal_is_described_after_its_name() {
-    // QA round 3, H3: with `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
+    // With `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
     // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
     // description went after the first "a" of the sentence, inside "peak".
     let dir = tempfile::tempdir().unwrap();
@@ -516,7 +516,7 @@ fn a_one_letter_signal_is_described_after_its_name() {
 
 #[test]
 fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
-    // QA round 3, L10 and M8: a variant's page was headed "railuq study scm" with no word of
+    // A variant's page was headed "railuq study scm" with no word of
     // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("s.toml");
@@ -548,7 +548,7 @@ fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_diff
 
 #[test]
 fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
-    // QA round 3, M2: the SGM page said "1 model runs … on 1 threads" and "Units are those the
+    // The SGM page said "1 model runs … on 1 threads" and "Units are those the
     // FMU declares" (there is no FMU), and its description promised a system "given below"
     // that the page did not show.
     let dir = tempfile::tempdir().unwrap();
@@ -601,7 +601,7 @@ fn csv_column(path: &Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// QA3 H1: the wheel-rail impact of `vehicle-track-defect` lasts about 2 ms, between two
+/// The wheel-rail impact of `vehicle-track-defect` lasts about 2 ms, between two
 /// evenly spaced heat-map columns; the columns must include the times of the extremes of
 /// the quantiles and of the mean, and the grid must span the band over every time (the old
 /// heat map took its range from the sampled columns and cut the peak off).
@@ -675,7 +675,7 @@ fn sobol_sampling_study(dir: &Path) -> PathBuf {
     out
 }
 
-/// QA3 H2 and M9: the Sobol' bars of `sobol_sampling` carry the intervals the method
+/// The Sobol' bars of `sobol_sampling` carry the intervals the method
 /// computes (a whisker per bar, labelled in the words of the method's summary), and the
 /// running mean and Std of the convergence plot end at the reported mean and Std (they were
 /// taken over every pick-freeze row, the statistics over A and B only).
@@ -718,13 +718,13 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
     assert_eq!(*runs.last().unwrap(), 512.0, "A and B of 256 base rows");
     let band = std::fs::read_to_string(out.join("q_peak_convergence.svg")).unwrap();
     assert!(band.contains("iid standard errors"), "{band}");
-    // Scalar densities are per unit of the quantity (QA3 M10).
+    // Scalar densities are per unit of the quantity .
     let pdf = std::fs::read_to_string(out.join("q_peak_pdf.svg")).unwrap();
     assert!(pdf.contains("probability density [1/m]"), "{pdf}");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
-/// QA3 H4, M6, M7: every single-study page shows Std(t) (`<V>_std.svg`, with the chaos's
+/// Every single-study page shows Std(t) (`<V>_std.svg`, with the chaos's
 /// Std and its truncation-error estimate where there are), and the convergence against the
 /// chaos order has whole-number ticks and a dot at every order.
 #[test]
@@ -889,7 +889,7 @@ fn nominal_studies_write_no_header_only_density_files() {
 
 #[test]
 fn summary_json_gives_each_inputs_own_mean_and_std() {
-    // QA round 4: the README promised a truncated normal's own mean and Std in summary.json;
+    // The README promised a truncated normal's own mean and Std in summary.json;
     // only the page had them. K: N(100, 10²) truncated to [95, ∞): α = −0.5, λ = φ(α)/(1 − Φ(α)),
     // mean = 100 + 10 λ, variance = 10² (1 + α λ − λ²), with Φ(−0.5) from the normal table.
     let dir = tempfile::tempdir().unwrap();

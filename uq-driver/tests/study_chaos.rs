@@ -610,7 +610,7 @@ fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not(
     if test_fmus::built().is_none() {
         return;
     }
-    // QA: a 30-input G function at level 2 gave a mean of 0.013 (true 1) with a level
+    // A 30-input G function at level 2 gave a mean of 0.013 (true 1) with a level
     // difference of 1.45 written only to a CSV column, and no warning. Here: the g-function
     // (|4x - 2| kinks) of 8 uniform inputs at level 1, and by LARS on 20 runs.
     let dir = tempfile::tempdir().unwrap();
@@ -675,7 +675,7 @@ fn correlated_inputs_say_their_sobol_indices_depend_on_the_parameter_order() {
     if test_fmus::built().is_none() {
         return;
     }
-    // QA: with [[correlation]] the indices are those of the Cholesky-ordered germs; S of one
+    // With [[correlation]] the indices are those of the Cholesky-ordered germs; S of one
     // input was 0.0006 in file order and 0.116 listed first, while the report called it "the
     // share of the variance it causes alone". y = x1 + x2² (function 4), rho = 0.8.
     let p = |n: &str, m: f64| format!("[[parameters]]\nname = \"{n}\"\nmean = {m}\nstd = 1.0\n");
@@ -731,7 +731,7 @@ fn a_chaos_of_correlated_non_normal_inputs_says_its_error_estimate_may_be_optimi
     if test_fmus::built().is_none() {
         return;
     }
-    // QA round 4: a lognormal and a gamma input at rho = -0.5 by LARS gave a Std 7.7 % off
+    // A lognormal and a gamma input at rho = -0.5 by LARS gave a Std 7.7 % off
     // with a leave-one-out error of 0.55 %, and no warning: the copula's transform makes the
     // model far from a polynomial in the germs. Normal inputs keep it linear: no warning.
     let dir = tempfile::tempdir().unwrap();
@@ -766,7 +766,7 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     if test_fmus::built().is_none() {
         return;
     }
-    // QA round 4: exp(x) by SCM on 4 nodes kept 7 % of its variance in the top order, gave
+    // Exp(x) by SCM on 4 nodes kept 7 % of its variance in the top order, gave
     // P(q > limit) = 3.7e-4 for a true 1e-3 (a limit beyond every model run) and a negative
     // 0.1 % quantile of a positive quantity, and warned of nothing. Here Ishigami on 4 nodes
     // per input (the quadrature's Std is off by more than 5 % of the closed form's) against

@@ -1,6 +1,6 @@
 //! Two-level (nested) studies through uq-driver on the C test FMU `Functions` with
 //! `function = 4`: y = x1 + x2² + h(seed), h a standard normal hashed from the Integer `seed`
-//! (issue 14). The references are computed here, independently of the driver: the hash is
+//!. The references are computed here, independently of the driver: the hash is
 //! written again below (SplitMix64 + Box–Muller, as in `tests/fmus/README.md`), the inner
 //! moments are those of x1 + x2² with x1, x2 ~ N(0, 1) (mean 1, variance 1 + 2 = 3), and the
 //! exceedance probability is a one-dimensional quadrature over x2 of the normal tail of x1.
@@ -225,7 +225,7 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     assert!((p - p_exact).abs() < 0.02, "P {p} vs {p_exact}");
     assert!(p_ci[0] <= p_exact && p_exact <= p_ci[1], "{p_ci:?}");
     // The count's interval (printed by `run`) is that same bootstrap over the outer samples,
-    // not a Clopper–Pearson interval of the pooled draws as if they were independent (QA: that
+    // not a Clopper–Pearson interval of the pooled draws as if they were independent (that
     // held the true P in 3 of 30 seeds), and the pooled values are named as chaos draws.
     let c = &q["exceedance_counts"][0];
     assert_eq!(pair(&c["ci_95"]), p_ci);
@@ -435,7 +435,7 @@ fn strict_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 
 #[test]
 fn a_sparse_inner_chaos_writes_a_rectangular_conditional_table_on_the_union_of_its_bases() {
-    // QA round qa5/rail M2: LARS keeps a different basis per outer sample; the conditional CSV
+    // LARS keeps a different basis per outer sample; the conditional CSV
     // had rows of 31 to 44 fields under the first sample's 41 labels, no `loo` column, and
     // the inner chaos's error warnings were dropped. Ishigami (function 1) with its `a` and
     // `b` outer: the terms LARS keeps depend on them.
@@ -589,7 +589,7 @@ limits = [4.0]
 
 #[test]
 fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
-    // QA round qa5/rail H2: a percentile bootstrap over 4 outer samples is about half as wide
+    // A percentile bootstrap over 4 outer samples is about half as wide
     // as Student's t, and covers far less than 95 %. Here 40 studies of 4 outer samples
     // (seeds 1..=40), each with an exact inner chaos; the true P(y > 1) and P(y > 3) from the
     // whole population of seeds. A simulation of the same (numpy, 2 000 repetitions) gives
@@ -647,7 +647,7 @@ fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
 
 #[test]
 fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extrapolation() {
-    // QA round qa5/rail H2: every track exceeding gave the interval [1, 1]; M2: a limit
+    // Every track exceeding gave the interval [1, 1]; M2: a limit
     // beyond every model run, counted over the inner chaoses' draws, said nothing of it; L1:
     // the count line printed the pooled-draw P beside the interval of the mean of the
     // conditional P. y = x1 + x2² + h ≥ −4.3 or so in every run: −30 is below all of them,

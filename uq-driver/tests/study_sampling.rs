@@ -1,5 +1,5 @@
 //! Quasi-Monte Carlo, replicated Latin hypercubes and Sobol' indices, run through uq-driver on
-//! FMUs (issue 11 items 3, 4 and 8), against references computed here: the wheel's closed form
+//! FMUs, against references computed here: the wheel's closed form
 //! on a Gauss–Hermite grid (`support/wheel.rs`), the closed-form indices of the Ishigami and
 //! g-functions on the C test FMU `Functions` (`support/test_fmus.rs`).
 
@@ -275,7 +275,7 @@ fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
         "{covered} of 20 intervals cover the reference"
     );
     // At t = 0 every run starts at q0: no variance, so the indices (0/0) and their
-    // intervals are undefined: NaN, not 0 with a [0, 0] interval (QA F5).
+    // intervals are undefined: NaN, not 0 with a [0, 0] interval .
     for col in ["S_K", "ST_C", "S_K_lo", "S_K_hi", "ST_C_lo", "ST_C_hi"] {
         assert!(
             csv.at(0.0, col).is_nan(),
@@ -512,7 +512,7 @@ fn clopper_pearson_by_bisection(k: usize, n: usize) -> (f64, f64) {
     (lower, upper)
 }
 
-/// QA5 M6: the exceedance of a pick-freeze design used to count all N·(d + 2) runs as
+/// The exceedance of a pick-freeze design used to count all N·(d + 2) runs as
 /// independent draws (768 of 768 → 0.995–1.00, where the 128 independent runs of A and B give
 /// 0.977). It is counted over the 2N runs of A and B alone.
 #[test]

@@ -1,4 +1,4 @@
-//! Numbers a method cannot know are not written as exact ones (QA findings F2–F5, through the
+//! Numbers a method cannot know are not written as exact ones (through the
 //! `uq-driver` binary and the Functions / Features test FMUs, `tests/fmus`):
 //! - F2: a chaos method has no sampling standard error of the mean: `null`, not 0;
 //! - F3: only a positive-mean normal input warns of points at x <= 0;

@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn an_fmu_needing_the_python_runtime_gets_a_hint_to_preload_it() {
-        // QA round 3, I-1: a pythonfmu 0.7.0 FMU's library does not link libpython.
+        // A pythonfmu 0.7.0 FMU's library does not link libpython.
         let reason = "/tmp/x/Osc.so: undefined symbol: _Py_NoneStruct".to_owned();
         let hinted = with_load_hint(reason.clone());
         assert!(

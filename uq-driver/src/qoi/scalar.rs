@@ -534,7 +534,7 @@ impl QoiSpec {
     /// A warning when a Sperling quantity's `direction` contradicts the description of its
     /// signal (`description` gives a variable's modelDescription description): `lateral` on
     /// a signal described as vertical (and not lateral), or the reverse. The weighting
-    /// differs (QA5 M5: W 3.33 with the lateral weighting of a vertical acceleration, silently).
+    /// differs (W 3.33 with the lateral weighting of a vertical acceleration, silently).
     pub fn direction_warning(
         &self,
         description: &dyn Fn(&str) -> Option<String>,
@@ -606,7 +606,7 @@ mod tests {
         assert!(r.unwrap_err().to_string().contains("unknown variant"));
     }
 
-    /// QA5 M5: `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
+    /// `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
     /// without a word.
     #[test]
     fn a_lateral_sperling_on_a_vertical_signal_is_warned_about() {
@@ -739,7 +739,7 @@ mod tests {
 
     #[test]
     fn a_one_letter_signal_is_described_after_its_name_not_inside_a_word() {
-        // QA round 3, H3: the description was put after the first "a" of the sentence, the
+        // The description was put after the first "a" of the sentence, the
         // one inside "peak": "pea (Acceleration q'')k-to-peak (max − min) of a over 0.5–2 s".
         let q: QoiSpec = toml::from_str(
             "kind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\nto = 2.0",

@@ -235,8 +235,8 @@ pub struct ExceedanceCount {
     pub outer_samples: Option<usize>,
     /// Counted over the draws of a chaos surrogate with the limit outside the range
     /// `[smallest, largest]` of the model runs: the probability rests on the chaos's
-    /// extrapolation alone, which its truncation-error estimate does not cover (QA round 4:
-    /// P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
+    /// extrapolation alone, which its truncation-error estimate does not cover
+    /// (P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub beyond_runs: Option<[f64; 2]>,
 }
@@ -248,7 +248,7 @@ impl ExceedanceCount {
     /// over the outer samples: 0.2–0.42)`.
     ///
     /// Nested studies used to print the Clopper–Pearson interval of the pooled runs, as if
-    /// they were independent: it held the true P in 3 of 30 seeds (found by QA).
+    /// they were independent: it held the true P in 3 of 30 seeds.
     pub fn describe(&self) -> String {
         self.describe_with(&|x: f64| x.to_string())
     }
@@ -300,7 +300,7 @@ impl ExceedanceCount {
         };
         if self.ci_kind == "outer_one_sided" && self.exceeded == self.of && self.of > 0 {
             // Nested: every outer sample exceeds; an unsampled one that does not is not ruled
-            // out (`0.05^(1/outer_samples)`, found by QA, qa5/rail H2: [1, 1] from 16 tracks).
+            // out (`0.05^(1/outer_samples)`, [1, 1] from 16 tracks).
             return format!(
                 "{head}: P = {} (95 % lower bound of P{kind}: {})",
                 sig(self.p),
@@ -479,7 +479,7 @@ impl OutputSummary {
     }
 }
 
-/// The random parameters with the mean and Std of each (QA round 4: a truncated normal's own
+/// The random parameters with the mean and Std of each (a truncated normal's own
 /// moments, which the README promised in `summary.json`, were only on the page).
 fn parameters_with_moments<S: serde::Serializer>(
     parameters: &[RandomParameter],

@@ -302,7 +302,7 @@ fn quantity(
 /// The count of P(q > `e.limit`) of a nested study: every draw of every outer sample
 /// counted (the draws the conditional probabilities come from, `per_outer`), so that with
 /// the same number from each outer sample `exceeded / of` is the marginal P of the two-level
-/// table (found by QA, qa5/rail L1: the count line said 0.613 from 1 250 draws per outer
+/// table (the count line said 0.613 from 1 250 draws per outer
 /// sample beside an interval of the mean of the conditional probabilities, 0.608); `p` is
 /// that mean in any case (outer samples with different numbers of successful runs weigh
 /// equally); the interval and its kind are those of `e`. `range`: the smallest and largest
@@ -327,7 +327,7 @@ fn nested_count(
 /// columns whose Std is above 1e-3 of the largest; `order_difference` over a series weighted
 /// by the variance) where it exceeds [`CHAOS_ERROR`] in some outer samples, summarised: how
 /// many, the largest and where. A stand-alone chaos study warns of each; the nested study
-/// dropped them (found by QA, qa5/rail M2). `times`: those of an output, `None` for a quantity.
+/// dropped them. `times`: those of an output, `None` for a quantity.
 fn inner_chaos_warning(name: &str, cond: &Conditional, times: Option<&[f64]>) -> Option<String> {
     let mut kind = None;
     let mut present = 0;
@@ -494,7 +494,7 @@ fn conditional_table(
 /// The coefficients of every outer sample's chaos (column 0) on the union of their
 /// multi-indices, in graded order (total degree, then as the total-degree set lists them:
 /// the first input's degree highest first); 0 where a basis does not keep a term. A sparse
-/// inner chaos keeps a different basis per outer sample: found by QA (qa5/rail M2), the
+/// inner chaos keeps a different basis per outer sample: the
 /// first sample's labels over rows of 31 to 44 coefficients under a 41-field header.
 fn union_of_bases(chaoses: &[&crate::uq::pce::Pce]) -> ConditionalChaos {
     let mut indices: Vec<Vec<usize>> = chaoses

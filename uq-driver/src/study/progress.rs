@@ -201,7 +201,7 @@ mod tests {
         assert!(Progress::new(ProgressMode::Off, 10).lines.is_none());
     }
 
-    /// QA qa4/lib M1: library code printed notes to stderr unasked; they now go to the sink a
+    /// Library code printed notes to stderr unasked; they now go to the sink a
     /// host sets (the CLI: stderr), nowhere by default.
     #[test]
     fn library_messages_go_to_the_sink_that_is_set_and_nowhere_by_default() {

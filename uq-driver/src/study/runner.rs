@@ -494,7 +494,7 @@ pub fn check_failures(
 mod tests {
     use super::*;
 
-    /// QA F4: a study stopped at its first failures said "2 of 200 points failed" although
+    /// A study stopped at its first failures said "2 of 200 points failed" although
     /// 103 of them fail; the points not started are not counted as successes.
     #[test]
     fn failure_message_says_the_study_stopped_and_how_many_points_were_not_started() {

@@ -425,7 +425,7 @@ mod tests {
 
     #[test]
     fn the_array_job_runs_its_shards_with_the_options_given_to_slurm() {
-        // QA round 3: `slurm --isolate` (or --fresh-instances, --fmu-logging) planned shards
+        // `slurm --isolate` (or --fresh-instances, --fmu-logging) planned shards
         // that ran without them.
         let d = tempfile::tempdir().unwrap();
         let o = SlurmOptions {

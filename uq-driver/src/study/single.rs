@@ -266,7 +266,7 @@ fn analyse(
 
 /// With correlated inputs the Sobol' indices are those of the independent germs in study
 /// order (the Cholesky factor of the copula): the index of a parameter counts only its part
-/// independent of the parameters listed before it, so it changes with their order (QA: S of
+/// independent of the parameters listed before it, so it changes with their order (S of
 /// one input was 0.0006 in file order and 0.116 listed first). Said where indices are given.
 fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
     let correlated = study.correlation.is_some();
@@ -288,7 +288,7 @@ fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
 /// A chaos of correlated inputs that are not all normal expands the model composed with the
 /// Gaussian copula's map (each input `F⁻¹(Φ(·))` of a mix of germs), which can be far from a
 /// polynomial although the model is smooth; its own error estimate then understates its
-/// error (QA round 4: a lognormal and a gamma input at ρ = −0.5, LARS on 400 runs: Std +7.7 %
+/// error (a lognormal and a gamma input at ρ = −0.5, LARS on 400 runs: Std +7.7 %
 /// with a leave-one-out error of 0.55 %). Said where a chaos gives the statistics.
 fn correlated_chaos_warning(study: &Study, a: &Analysed) -> Option<String> {
     let correlation = study.correlation.as_ref()?;
@@ -423,7 +423,7 @@ fn write_surrogate(
 /// The design with the status of each point.
 /// `error`, after writing `points.csv` (every point's status and message) when points failed:
 /// a study that stops on its failures, or has too few successful runs to analyse, still says
-/// what happened to each point (QA round 3, L-2: before, only the store held the messages).
+/// what happened to each point (before, only the store held the messages).
 fn with_points_csv(
     study: &Study,
     design: &Design,

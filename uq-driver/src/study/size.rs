@@ -635,7 +635,7 @@ mod tests {
         assert!(q.memory(10.0).analysis < 1e7);
     }
 
-    /// The QA 5 many-output studies (`Many<N>.fmu`, 2 fixed-parameter inputs, lhs) of `s`
+    /// The many-output studies (`Many<N>.fmu`, 2 fixed-parameter inputs, lhs) of `s`
     /// outputs, `nt` times and `n` runs.
     fn many_outputs(s: usize, nt: f64, n: f64) -> Shape {
         Shape {
@@ -650,7 +650,7 @@ mod tests {
 
     #[test]
     fn many_outputs_count_the_densities_and_statistics_kept_per_output() {
-        // QA 5 H1: peak RSS 224 MB (1000 outputs × 101 times × 200 runs) and 429 MB
+        // Peak RSS 224 MB (1000 outputs × 101 times × 200 runs) and 429 MB
         // (2000 × 101 × 100), estimated 26 and 51 MiB: the densities of every output
         // (101 columns × 200 grid points) were not counted.
         for (s, n, peak) in [(1000, 200.0, 224e6), (2000, 100.0, 429e6)] {
@@ -661,7 +661,7 @@ mod tests {
                 bytes(total)
             );
         }
-        // Few outputs keep their estimates (QA: 28 MB and 87 MB measured).
+        // Few outputs keep their estimates (28 MB and 87 MB measured).
         for (s, peak) in [(20, 28e6), (200, 87e6)] {
             let total = many_outputs(s, 1001.0, 500.0).memory(500.0).total();
             assert!(total <= 2.0 * peak, "{s}: {}", bytes(total));
@@ -670,7 +670,7 @@ mod tests {
 
     #[test]
     fn many_outputs_with_long_series_are_estimated_by_what_the_analysis_holds() {
-        // QA 5 H5: 100 and 200 outputs × 100 001 times × 10 runs peaked at 791 MB and
+        // 100 and 200 outputs × 100 001 times × 10 runs peaked at 791 MB and
         // 1.55 GB, estimated 2.5 and 4.9 GiB (refused under a 2 GiB cap).
         for (s, peak) in [(100, 791e6), (200, 1.55e9)] {
             let total = many_outputs(s, 100_001.0, 10.0).memory(10.0).total();
@@ -699,7 +699,7 @@ mod tests {
 
     #[test]
     fn nested_studies_count_their_runs_before_the_design_and_the_pooled_series() {
-        // QA 5 H3: "model runs not known before the design" and a fixed 3.0 GiB for any
+        // "model runs not known before the design" and a fixed 3.0 GiB for any
         // outer × inner; H2: 20 000 runs × 10 001 times estimated 2.5 GiB, peak 3.23 GB,
         // and 1000 × 100 001 peaked at 1.65 GB.
         for (outer, inner, step, peak) in [(100, 200, 1e-4, 3.23e9), (20, 50, 1e-5, 1.65e9)] {
@@ -847,7 +847,7 @@ mod tests {
 
     #[test]
     fn the_qa_chaos_studies_are_estimated_above_their_largest_allocations() {
-        // QA F2: 300 LHS runs, 30 inputs, order 5: the candidates of degree 5 at the runs,
+        // 300 LHS runs, 30 inputs, order 5: the candidates of degree 5 at the runs,
         // 300 × C(35, 5) × 8 B = 779 MB, was the allocation that failed (estimate: 5.1 MiB).
         let s = chaos_study(
             30,
@@ -868,7 +868,7 @@ mod tests {
         let s = chaos_study(30, "kind = \"pce_regression\"\nsamples = 400000\norder = 5");
         let ls = Shape::of(&s, 2).memory(400_000.0);
         assert!(ls.chaos >= 4.0 * 8.0 * 400_000.0 * binomial(35, 5));
-        // A level-3 sparse grid in 30 uniform inputs (Gauss–Patterson): 41 601 runs (QA's
+        // A level-3 sparse grid in 30 uniform inputs (Gauss–Patterson): 41 601 runs (an earlier
         // count), and the basis of the 4 000 draws of the series twice (once while built):
         // the chaos terms from the degrees 0, 2, 5, 11 projected at levels 0..=3 (new degrees
         // 1, 2, 3, 6 per level), summed over the levels with |l| <= 3.
@@ -887,7 +887,7 @@ mod tests {
         let m = shape.memory(41_601.0);
         let basis = 4000.0 * terms(30, 3) * 8.0;
         assert!(m.chaos >= 2.0 * basis, "{} {}", m.chaos, basis);
-        // The QA's study (3 time points) peaked at 2.59 GB and was estimated at 97 MiB.
+        // The study (3 time points) peaked at 2.59 GB and was estimated at 97 MiB.
         assert!(m.total() > 2.5e9, "{}", bytes(m.total()));
         let f = Footprint {
             available: (1.5e9, true),

@@ -11,7 +11,7 @@
 //! kill during a write) is cut off; damage before the last valid record makes the store
 //! rewrite `records.bin` with its valid records only, keeping the damaged file beside it as
 //! `records.damaged-<unix seconds>.bin`. A store of the previous format (format 1, before
-//! issue 12) is read and converted, the old file kept as `records.v1.bin`.
+//! format 1) is read and converted, the old file kept as `records.v1.bin`.
 
 pub mod format;
 mod runs;
@@ -118,7 +118,7 @@ impl fmt::Display for Recovery {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "results store {}: ", self.path.display())?;
         if self.converted_from_v1 {
-            write!(f, "converted from the format before issue 12; ")?;
+            write!(f, "converted from the format before format 2; ")?;
         }
         if !self.skipped.is_empty() {
             let n = self.skipped.len();

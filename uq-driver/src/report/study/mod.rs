@@ -665,7 +665,7 @@ mod tests {
 
     #[test]
     fn warnings_on_the_page_have_no_markdown_backticks() {
-        // QA round 3, L5: "raise `order` (below `nodes`)" was shown with its backticks.
+        // "raise `order` (below `nodes`)" was shown with its backticks.
         assert_eq!(
             plain_quotes("raise `order` (below `nodes`) or `nodes`"),
             "raise ‘order’ (below ‘nodes’) or ‘nodes’"

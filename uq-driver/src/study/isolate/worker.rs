@@ -450,7 +450,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn a_malformed_answer_fails_the_point_and_a_torn_one_is_stopped_by_the_watchdog() {
-        // QA finding 6: stray bytes on the answer pipe hung the driver forever.
+        // Stray bytes on the answer pipe hung the driver forever.
         let dir = tempfile::tempdir().unwrap();
         // A length far beyond any frame: refused at once.
         let opts = fake_worker(dir.path(), "printf 'garbage12345'; sleep 30");
@@ -476,7 +476,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn a_dead_worker_is_noticed_though_a_process_it_started_keeps_its_pipes_open() {
-        // QA finding 7: only the end of the pipes was noticed.
+        // Only the end of the pipes was noticed.
         let dir = tempfile::tempdir().unwrap();
         let mut opts = fake_worker(dir.path(), "sleep 20 & kill -SEGV $$");
         opts.timeout = None;

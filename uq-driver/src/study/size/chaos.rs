@@ -174,7 +174,7 @@ mod tests {
                 "d = {d}, order {p}, q = {q}"
             );
         }
-        // C(35, 5), the QA's LARS candidates in 30 inputs.
+        // C(35, 5), the LARS candidates in 30 inputs.
         assert_eq!(hyperbolic_terms(30, 5, 1.0), 324_632.0);
     }
 }

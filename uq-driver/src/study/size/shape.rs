@@ -130,7 +130,7 @@ impl Shape {
         // Std, the 3σ band, the standard error or the chaos's Std, the chaos error, the
         // quantiles; the Sobol' indices and their intervals, a few small vectors per
         // column), and its densities (with their rows and the text of one being written:
-        // QA 5 H1 measured about 1.4 × 8 P G per output).
+        // Measured: about 1.4 × 8 P G per output).
         let sobol = if self.sobol { 6.0 * d + 20.0 } else { 0.0 };
         let kept_per_output =
             8.0 * nt * (8.0 + k + sobol) + 1.5 * 8.0 * pdf_columns * self.pdf_grid as f64;
@@ -140,8 +140,8 @@ impl Shape {
         let series = if self.outputs == 0 {
             0.0
         } else if self.whole_series {
-            // The pooled series of an output and the estimator's copies of it (QA 5 H2:
-            // 2.0 × 8 n nt measured at 20 000 × 10⁴ and 1000 × 10⁵).
+            // The pooled series of an output and the estimator's copies of it
+            // (2.0 × 8 n nt measured at 20 000 × 10⁴ and 1000 × 10⁵).
             2.5 * 8.0 * n * nt + 8.0 * draws * nt + current + s * kept_per_output
         } else {
             let w = block_columns(nt, n, self.block_bytes);

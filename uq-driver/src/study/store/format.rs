@@ -1,7 +1,7 @@
 //! The byte format of `records.bin`: framing, checksums, and a reader that resynchronises
 //! after damage. Every function here accepts any input without panicking.
 //!
-//! Format 2 (written since issue 12), all integers little endian:
+//! Format 2 (written since format 2), all integers little endian:
 //!
 //! ```text
 //! magic F5 52 51 32 | index u64 | kind u8 | length u64 | header crc32 | payload | record crc32
@@ -15,7 +15,7 @@
 //! 0xF5 never occurs in UTF-8, so a failure message cannot contain a record start; f64 data
 //! can, by chance, but a false start also needs two matching CRC-32s.
 //!
-//! Format 1 (before issue 12): `"REC1" | index u64 | kind u8 | length u64 | payload | FNV-1a
+//! Format 1 (the first): `"REC1" | index u64 | kind u8 | length u64 | payload | FNV-1a
 //! u64` over index, kind and payload. It is only read, to convert an old store.
 
 use std::ops::Range;

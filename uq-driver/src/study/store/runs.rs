@@ -1,5 +1,5 @@
 //! The finished points of a study, their values left in the store file: only the position
-//! of each point's values is held, so the runs of a study need not fit in memory (issue 12).
+//! of each point's values is held, so the runs of a study need not fit in memory.
 //! The analysis reads the values it needs, a block of time columns at a time
 //! ([`Values::read_into`], positioned reads of the file: they go through the page cache and
 //! count in no process's memory).

@@ -1,4 +1,4 @@
-//! High-dimensional UQ building blocks (issue 11): pure numerics, no FMU.
+//! High-dimensional UQ building blocks: pure numerics, no FMU.
 //!
 //! One concept per module (the Askey families and the orthonormal bases over multi-index
 //! sets are in [`crate::uq::pce`]; the input families in [`crate::uq::distributions`]):

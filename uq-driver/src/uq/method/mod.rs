@@ -316,7 +316,7 @@ mod tests {
         toml::from_str(text).unwrap()
     }
 
-    /// QA qa4/lib H3/H4: `SobolSampling::estimate` with `data` three rows short of `rows`
+    /// `SobolSampling::estimate` with `data` three rows short of `rows`
     /// panicked (range end index out of range); `Lhs::estimate` with three rows too many or
     /// too few, and `Scm::estimate` with rows that are not design indices, returned `Ok`
     /// with wrong numbers.
@@ -365,7 +365,7 @@ mod tests {
         }
     }
 
-    /// QA qa4/lib H3: `SobolSampling { base: Mc, bootstrap: Some(50), confidence: 2.0 }`
+    /// `SobolSampling { base: Mc, bootstrap: Some(50), confidence: 2.0 }`
     /// panicked in `estimate` (`partition_at_index`); only `validate` refused it, which
     /// `design` and `estimate` did not call.
     #[test]
@@ -401,7 +401,7 @@ mod tests {
         }
     }
 
-    /// QA qa4/lib H4: `Scm` on an `integer_uniform` input returned `Ok` with std 0.577 (true
+    /// `Scm` on an `integer_uniform` input returned `Ok` with std 0.577 (true
     /// 0.816): only `validate` refused a discrete input for a chaos, not `design`/`estimate`.
     #[test]
     fn chaos_methods_refuse_a_discrete_input_in_design_and_estimate() {
@@ -449,7 +449,7 @@ mod tests {
         m.design(&discrete, 1).unwrap();
     }
 
-    /// QA qa4/lib H3: a `Distribution` struct literal with `low > high` reached the
+    /// A `Distribution` struct literal with `low > high` reached the
     /// quantile and panicked (`min > max`); the designs now refuse it with a typed error.
     #[test]
     fn designs_refuse_an_invalid_distribution_literal() {

@@ -19,7 +19,7 @@
 //! - base `qmc`: from the spread of the R replicate estimates (each replicate's rows alone),
 //!   `estimate ± t_{R-1, (1 + confidence)/2} sd_R / sqrt(R)`. The rows of one scrambled net
 //!   are not independent: a bootstrap over them missed the indices of the Morris function in
-//!   every seed (QA2 F1), since the error of one net depends on its scrambling;
+//!   every seed, since the error of one net depends on its scrambling;
 //! - bases `mc` and `lhs`: percentile bootstrap from `bootstrap` resamples of the rows (the
 //!   same resampled rows for every column; resample `k` from the ChaCha20 stream
 //!   `(0x5eed_b007, k)`, so the intervals are reproducible).

@@ -102,8 +102,8 @@ impl Conditional {
     /// of the mean): since `E[Σ (y − ȳ)²] = n σ² − n Var(ȳ)` for any design whose points each
     /// follow the inputs' law, this is unbiased whenever `se²` is. For Monte Carlo
     /// (`se² = s²/n`) it is `s²` itself; for a replicated quasi-Monte Carlo design, whose
-    /// mean varies far less than `σ²/n`, it drops the `n/(n − 1)` excess of `s²` (found by QA:
-    /// inner designs of 16 runs gave 2.48 ± 0.05 for a true 2.33). A Latin hypercube's `se²`
+    /// mean varies far less than `σ²/n`, it drops the `n/(n − 1)` excess of `s²`
+    /// (inner designs of 16 runs gave 2.48 ± 0.05 for a true 2.33). A Latin hypercube's `se²`
     /// is the Monte Carlo one, an upper bound, so its `v` stays `s²`, at most `n/(n − 1)`
     /// high. Quadrature and chaos estimates (no `se²`) keep their own variance.
     pub fn column(&self, col: usize) -> Conditionals {

@@ -207,7 +207,7 @@ pub fn student_t(values: &[f64]) -> Option<[f64; 2]> {
 
 /// The interval of the mean of `values` over the outer samples from its percentile
 /// bootstrap `boot`: the Student-t interval instead where that is wider (a bootstrap over
-/// few outer samples is too narrow: QA found half the t width with 4 of them), with its
+/// few outer samples is too narrow: it was found half the t width with 4 of them), with its
 /// [`kind`].
 pub fn mean_interval(values: &[f64], boot: [f64; 2]) -> ([f64; 2], &'static str) {
     match student_t(values) {
@@ -315,7 +315,7 @@ mod tests {
 
     #[test]
     fn few_outer_samples_get_at_least_a_student_t_interval() {
-        // QA round qa5/rail H2: 4 outer samples, bootstrap half as wide as Student's t.
+        // 4 outer samples, bootstrap half as wide as Student's t.
         let v = [2.9, 3.0, 3.05, 3.15];
         let t = student_t(&v).unwrap();
         // t(0.975, 3) = 3.182446; sd = 0.104083; half = 0.165613.
@@ -331,7 +331,7 @@ mod tests {
 
     #[test]
     fn every_outer_sample_exceeding_gives_a_one_sided_lower_bound_not_one() {
-        // QA round qa5/rail H2: 16 tracks all with P = 1 gave [1, 1].
+        // 16 tracks all with P = 1 gave [1, 1].
         let (ci, k) = exceedance_interval(&[1.0; 16], [1.0, 1.0]);
         assert_eq!(k, kind::ONE_SIDED);
         assert!((ci[0] - 0.05f64.powf(1.0 / 16.0)).abs() < 1e-15 && ci[1] == 1.0);

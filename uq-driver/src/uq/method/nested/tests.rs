@@ -308,7 +308,7 @@ fn integer_uniform_covers_its_range_uniformly_in_every_sampling_design() {
 
 #[test]
 fn small_quasi_monte_carlo_inner_designs_give_unbiased_conditional_variances() {
-    // QA round 4: the conditional variance of an inner design of 16 scrambled Sobol' points
+    // The conditional variance of an inner design of 16 scrambled Sobol' points
     // was its sample variance, whose divisor n − 1 overstates σ² by n/(n − 1) when the
     // design's mean hardly varies (2.48 ± 0.05 for a true 2.33). The inner variance of
     // y = x1 + x2² + u is 1 + 2 = 3 at every u.
