@@ -142,4 +142,5 @@ pub mod results;
 pub mod spec;
 pub mod study;
 pub mod suggest;
+pub mod text;
 pub mod uq;

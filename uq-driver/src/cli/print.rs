@@ -40,7 +40,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
             format!("report: {}", out.join("index.html").display())
         }
     );
-    let nominal = s.method.kind == "nominal";
+    let nominal = uq_driver::uq::method::notes_of_kind(&s.method.kind).deterministic;
     for q in &r.quantities {
         let u = q.unit.as_deref();
         let v = |x: f64| with_unit(&six_digits(x), u);

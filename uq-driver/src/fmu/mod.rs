@@ -42,6 +42,7 @@ mod error;
 mod ffi;
 mod instance;
 mod logger;
+mod value;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -56,6 +57,7 @@ pub use description::{
 };
 pub use error::{FmuError, LogMessage, Status};
 pub use instance::{FmuState, Instance, InstanceState, StatusKind};
+pub use value::FixedValue;
 
 /// An opened FMU: extracted, described and loaded, ready to instantiate.
 ///

@@ -7,7 +7,7 @@
 //! - [`kde`]: Gaussian kernel density estimates.
 
 pub mod critical_speed;
-mod evaluate;
+pub mod evaluate;
 pub mod hunting_speed;
 pub mod kde;
 pub mod scalar;

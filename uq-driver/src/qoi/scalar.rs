@@ -8,9 +8,6 @@ use serde::{Deserialize, Serialize};
 use crate::qoi::critical_speed::CriticalSpeedError;
 use crate::qoi::hunting_speed::HuntingSpeedSpec;
 use crate::qoi::sperling::{Direction, SperlingError, Statistic, Window};
-use crate::results::QuantityDefinition;
-
-pub use super::evaluate::{evaluate, Code};
 
 /// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
 /// `kind`).
@@ -574,9 +571,24 @@ impl QoiSpec {
     }
 }
 
+/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct QuantityDefinition {
+    /// `kind` of the `[[qoi]]` entry.
+    pub kind: String,
+    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
+    /// `window`, `statistic`).
+    pub settings: serde_json::Map<String, serde_json::Value>,
+    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
+    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
+    /// 1 s left out`.
+    pub text: String,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::qoi::evaluate::{evaluate, Code};
 
     #[test]
     fn direction_is_typed_with_vertical_default() {

@@ -18,7 +18,7 @@
 
 pub mod compare;
 pub mod csv;
-pub mod file_name;
+pub use crate::text::file_name;
 pub mod heatmap;
 pub mod html;
 pub mod inputs;

@@ -7,7 +7,8 @@
 mod nested;
 pub mod numbers;
 
-use crate::report::file_name::stem;
+pub use crate::qoi::scalar::QuantityDefinition;
+use crate::text::file_name::stem;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
@@ -348,20 +349,6 @@ pub fn sig(x: f64) -> String {
     } else {
         format!("{x:.2e}")
     }
-}
-
-/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct QuantityDefinition {
-    /// `kind` of the `[[qoi]]` entry.
-    pub kind: String,
-    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
-    /// `window`, `statistic`).
-    pub settings: serde_json::Map<String, serde_json::Value>,
-    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
-    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
-    /// 1 s left out`.
-    pub text: String,
 }
 
 /// Mean and Std of an estimate against the work spent.

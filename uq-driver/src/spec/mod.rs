@@ -38,8 +38,8 @@ mod file;
 mod load;
 mod parameter;
 mod study;
-mod value;
 
+pub use crate::fmu::FixedValue;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{
@@ -49,7 +49,6 @@ pub use file::{
 pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};
 pub use study::{Study, Suite};
-pub use value::FixedValue;
 
 #[cfg(test)]
 mod tests;

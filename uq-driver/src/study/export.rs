@@ -21,10 +21,10 @@ use super::lock::{FolderLock, LockError};
 use super::store::format::{self, Slot};
 use super::store::Manifest;
 use crate::out_file::OutFile;
-use crate::report::csv::{push_header, split_line};
-use crate::report::file_name::stem;
 use crate::report::ReportError;
 use crate::spec::Experiment;
+use crate::text::csv::{push_header, split_line};
+use crate::text::file_name::stem;
 
 /// Why the runs cannot be exported.
 #[derive(Debug, thiserror::Error)]
@@ -106,10 +106,9 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
     if summary["fmu"].is_null() && summary["method"]["kind"].is_string() {
         // An intrusive method (SGM) solves its own system once: no runs, no store.
         let kind = summary["method"]["kind"].as_str().unwrap_or_default();
-        let what = if kind == "sgm" {
-            "an SGM study".to_string()
-        } else {
-            format!("a {kind} study")
+        let what = match crate::uq::method::notes_of_kind(kind).name {
+            Some(name) => name.to_string(),
+            None => format!("a {kind} study"),
         };
         return Err(invalid(
             dir,

@@ -11,7 +11,7 @@ use super::runner::RunError;
 use super::store::Manifest;
 use crate::fmu::{Fmu, FmuError};
 use crate::spec::Study;
-use crate::uq::method::{ChaosBasis, Design, MethodSpec};
+use crate::uq::method::Design;
 
 /// SHA-256 of an FMU, hex: of the file, or, for an extracted FMU folder, of every file's
 /// relative path and content in sorted order.
@@ -72,23 +72,10 @@ pub fn study_hash(study: &Study) -> String {
     if let Some(c) = &study.correlation {
         key["correlation"] = serde_json::json!(c.pairs);
     }
-    // SCM follows each input's Askey family since `chaos` became one of its keys: where that
-    // changes the design (an input with a non-Hermite germ) the hash says so, so that a store
-    // of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
-    if scm_askey(&study.method) && ChaosBasis::some_own_family(&study.parameters) {
-        key["scm_germ"] = serde_json::json!("askey");
+    if let Some((name, value)) = study.method().hash_entry(&study.parameters) {
+        key[name] = value;
     }
     format!("{:x}", Sha256::digest(key.to_string().as_bytes()))
-}
-
-/// Whether `method` (or a nested study's inner method) is an SCM on the inputs' Askey
-/// families.
-fn scm_askey(method: &MethodSpec) -> bool {
-    match method {
-        MethodSpec::Scm(s) => s.chaos == ChaosBasis::Askey,
-        MethodSpec::Nested(n) => scm_askey(&n.inner),
-        _ => false,
-    }
 }
 
 /// The store manifest of `study` on `fmu` with `design`.

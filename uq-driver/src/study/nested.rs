@@ -12,7 +12,7 @@
 //! - Outputs over time: the marginal mean and Std and the split at every time; quantiles and
 //!   the PDF evolution from at most [`SERIES_DRAWS`] pooled draws.
 
-use crate::report::file_name::stem;
+use crate::text::file_name::stem;
 use nalgebra::DMatrix;
 use rand::RngCore;
 use rayon::prelude::*;

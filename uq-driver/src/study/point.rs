@@ -9,7 +9,8 @@ use super::instances::{first_difference, same_record, InstancePolicy, ResetCheck
 use super::interface::{Interface, RandomValueError};
 use super::runner::RunError;
 use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
-use crate::qoi::scalar::{self, QoiError};
+use crate::qoi::evaluate::evaluate;
+use crate::qoi::QoiError;
 use crate::qoi::QoiSpec;
 use crate::spec::FixedValue;
 
@@ -281,11 +282,10 @@ pub fn run_point(
             out.extend(runs.evaluate(h, fmu, slot, values)?);
             continue;
         }
-        let (v, code) =
-            scalar::evaluate(q, times, signal).map_err(|error| PointError::Quantity {
-                name: q.name().to_owned(),
-                error,
-            })?;
+        let (v, code) = evaluate(q, times, signal).map_err(|error| PointError::Quantity {
+            name: q.name().to_owned(),
+            error,
+        })?;
         out.push(v);
         out.push(code as u8 as f64);
     }

@@ -171,14 +171,14 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     let mut csv = String::from("index,shard");
     for par in &study.parameters {
         csv.push(',');
-        crate::report::csv::push_field(&mut csv, &par.name);
+        crate::text::csv::push_field(&mut csv, &par.name);
     }
     csv.push('\n');
     for (i, vals) in design.values.iter().enumerate() {
         csv.push_str(&format!("{i},{}", i % shards));
         for v in vals {
             csv.push(',');
-            crate::report::csv::push_shortest(&mut csv, *v);
+            crate::text::csv::push_shortest(&mut csv, *v);
         }
         csv.push('\n');
     }

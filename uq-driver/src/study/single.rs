@@ -22,7 +22,7 @@ use crate::results::{
 use crate::spec::Study;
 use crate::uq::distributions::{Distribution, Germ};
 use crate::uq::method::{
-    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling,
+    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSummary, Sampling,
 };
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
@@ -241,22 +241,21 @@ fn analyse(
     records: &StoredRuns,
     units: &BTreeMap<String, String>,
 ) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
-    Ok(match &study.method {
-        MethodSpec::Nested(nested) => {
+    Ok(match study.method.nested() {
+        Some(nested) => {
             let n = super::nested::analyse(study, nested, design, records)?;
             (n.analysed, n.splits, n.warnings)
         }
-        _ => {
+        None => {
             let analysed = analysis::analyse_runs(study, method, design, records)?;
             // Inputs with an Askey family of their own that the design maps through the normal.
             let askey_hint =
                 design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);
             let mut warnings = analysis::chaos_gap_warnings(&analysed, askey_hint, units);
-            let no_estimate = matches!(study.method, MethodSpec::SparseGrid(_)).then_some(
-                "a sparse grid has one only at a level above 0 with nested rules; Beta and \
-                 Gamma inputs, and the gauss_* rules, are not nested",
-            );
-            warnings.extend(analysis::chaos_error_warnings(&analysed, no_estimate));
+            warnings.extend(analysis::chaos_error_warnings(
+                &analysed,
+                method.no_error_estimate(),
+            ));
             warnings.extend(correlated_sobol_warning(study, &analysed));
             warnings.extend(correlated_chaos_warning(study, &analysed));
             (analysed, Vec::new(), warnings)

@@ -96,7 +96,7 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 pub use available::available_memory;
-pub use chaos::{hyperbolic_terms, ChaosFit, ChaosShape};
+pub use chaos::ChaosShape;
 pub use disk::Disk;
 
 /// Why a study does not start.

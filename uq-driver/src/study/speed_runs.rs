@@ -10,8 +10,8 @@ use super::instances::Slot;
 use super::interface::{Interface, InterfaceError, Settings, VariableProblem, Variables};
 use super::point::{simulate_point, PointError};
 use crate::fmu::{Fmu, VariableKind};
+use crate::qoi::evaluate::Code;
 use crate::qoi::hunting_speed::{bisect, keeps_hunting, HuntingSpeed, HuntingSpeedSpec};
-use crate::qoi::scalar::Code;
 use crate::qoi::QoiSpec;
 use crate::spec::{Experiment, Study};
 

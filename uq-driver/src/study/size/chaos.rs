@@ -27,28 +27,7 @@
 //! - **the coefficients** of every output's chaos, and a merged copy: `8 T nt (s + 1)`.
 
 use crate::spec::Study;
-use crate::uq::hd::smolyak::GridSize;
-use crate::uq::method::MethodSpec;
-
-/// What the estimate needs of a chaos method.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ChaosFit {
-    /// `pce_regression` with `sparse = true`: the candidates of all the degrees tried
-    /// (`sum_p m_p`) and of the highest (`m_order`).
-    Lars {
-        /// `sum_p m_p`, `p = 1..=order`.
-        candidates: f64,
-        /// `m_order`.
-        largest: f64,
-    },
-    /// `pce_regression` with `sparse = false`: the terms of the basis.
-    LeastSquares {
-        /// Terms.
-        terms: f64,
-    },
-    /// `sparse_grid`: the grid's counted sizes.
-    Projection(GridSize),
-}
+use crate::uq::method::{ChaosFit, Evaluation};
 
 /// The shape of a study's chaos for the memory estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,18 +50,9 @@ impl ChaosShape {
     /// then refuse the study).
     pub fn of(study: &Study) -> Option<ChaosShape> {
         let dim = study.parameters.len();
-        let fit = match &study.method {
-            MethodSpec::SparseGrid(m) => ChaosFit::Projection(m.size(&study.parameters).ok()?),
-            MethodSpec::PceRegression(m) if m.sparse => ChaosFit::Lars {
-                candidates: (1..=m.order)
-                    .map(|p| hyperbolic_terms(dim, p, m.q_norm))
-                    .sum(),
-                largest: hyperbolic_terms(dim, m.order, m.q_norm),
-            },
-            MethodSpec::PceRegression(m) => ChaosFit::LeastSquares {
-                terms: hyperbolic_terms(dim, m.order, m.q_norm),
-            },
-            _ => return None,
+        let fit = match study.method().evaluation() {
+            Evaluation::Sampling(m) => m.chaos_fit(&study.parameters)?,
+            Evaluation::Intrusive(_) => return None,
         };
         let a = &study.analysis;
         let series = if study.outputs.is_empty() {
@@ -142,18 +112,9 @@ impl ChaosShape {
     }
 }
 
-/// Terms of the hyperbolic (q-norm) truncation `{k : sum_i k_i^q <= order^q}` in `dim`
-/// dimensions (the set of `MultiIndexSet::hyperbolic`), counted without building it: over
-/// the non-increasing lists of non-zero degrees within the bound, the ways of placing them
-/// among the dimensions. `q = 1` gives `C(dim + order, order)`.
-pub fn hyperbolic_terms(dim: usize, order: usize, q: f64) -> f64 {
-    // Beyond 1e10 terms any estimate is refused: counting further would only take time.
-    crate::uq::pce::MultiIndexSet::hyperbolic_count_upto(dim, order, q, 1e10)
-}
-
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::uq::method::hyperbolic_terms;
     use crate::uq::pce::MultiIndexSet;
 
     #[test]

@@ -5,7 +5,7 @@ use super::Memory;
 use crate::qoi::QoiSpec;
 use crate::spec::Study;
 use crate::study::analysis::blocks;
-use crate::uq::method::{Evaluation, MethodSpec};
+use crate::uq::method::Evaluation;
 
 /// What the estimate needs to know of a study.
 #[derive(Clone, Copy, Debug)]
@@ -53,23 +53,15 @@ pub struct Shape {
 impl Shape {
     /// The shape of `study` run on `threads` threads.
     pub fn of(study: &Study, threads: usize) -> Shape {
-        let (runs, chaos) = match study.method().evaluation() {
+        let (runs, chaos, sobol, whole_series) = match study.method().evaluation() {
             Evaluation::Sampling(m) => (
-                m.planned_runs_for(&study.parameters)
-                    .or_else(|| nested_runs(study)),
+                m.planned_runs_for(&study.parameters),
                 m.draws_from_chaos(),
+                m.estimates_sobol(),
+                m.whole_series(),
             ),
-            Evaluation::Intrusive(_) => (Some(0.0), true),
+            Evaluation::Intrusive(_) => (Some(0.0), true, true, false),
         };
-        // A nested study draws from its inner method's estimates.
-        let chaos = match (&study.method, chaos) {
-            (MethodSpec::Nested(n), _) => match n.inner.method().evaluation() {
-                Evaluation::Sampling(m) => m.draws_from_chaos(),
-                Evaluation::Intrusive(_) => true,
-            },
-            (_, c) => c,
-        };
-        let sobol = chaos || matches!(study.method, MethodSpec::SobolSampling(_));
         let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
         for s in study.qoi.iter().flat_map(|q| q.signals()) {
             if !signals.contains(&s) {
@@ -112,7 +104,7 @@ impl Shape {
             sobol,
             quantile_levels: study.analysis.quantiles.len(),
             block_bytes: blocks::block_bytes() as f64,
-            whole_series: matches!(study.method, MethodSpec::Nested(_)),
+            whole_series,
             chaos: ChaosShape::of(study),
         }
     }
@@ -161,26 +153,6 @@ impl Shape {
             }),
         }
     }
-}
-
-/// The runs of a nested design: outer samples × inner points, each level's count from its
-/// own method over its own parameters (`None` where either level only knows at the design).
-fn nested_runs(study: &Study) -> Option<f64> {
-    let MethodSpec::Nested(nested) = &study.method else {
-        return None;
-    };
-    let (outer, inner): (Vec<_>, Vec<_>) = study
-        .parameters
-        .iter()
-        .cloned()
-        .partition(|p| nested.outer_parameters.contains(&p.name));
-    let count =
-        |spec: &MethodSpec, params: &[crate::uq::RandomParameter]| match spec.method().evaluation()
-        {
-            Evaluation::Sampling(m) => m.planned_runs_for(params),
-            Evaluation::Intrusive(_) => None,
-        };
-    Some(count(&nested.outer, &outer)? * count(&nested.inner, &inner)?)
 }
 
 /// The columns of a block of `rows` rows out of `nt` within `budget` bytes: as

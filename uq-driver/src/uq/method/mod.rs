@@ -45,14 +45,26 @@ pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
 pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
-    details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
+    details, hyperbolic_terms, ChaosFit, Evaluation, Intrusive, KindNotes, Method, MethodSummary,
+    Problem, Sampling, Solution,
 };
 
-/// Declares the method modules and the `[method]` table: one line per method.
+// The method modules: declared here, not by the macro below, so that rustfmt reaches them.
+pub mod lhs;
+pub mod mc;
+pub mod nested;
+pub mod nominal;
+pub mod pce_regression;
+pub mod qmc;
+pub mod scm;
+pub mod sgm;
+pub mod sobol_sampling;
+pub mod sparse_grid;
+
+/// Builds the `[method]` table from the list of methods: one line per method, `module::Type`,
+/// the module's name being the `kind` of study files.
 macro_rules! methods {
     ($($module:ident :: $Type:ident),* $(,)?) => {
-        $(pub mod $module;)*
-
         /// The `[method]` table of a study: `kind` names the method (the type's name in
         /// snake_case), the other keys are its settings.
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -70,6 +82,22 @@ macro_rules! methods {
                 match self {
                     $(MethodSpec::$Type(m) => m,)*
                 }
+            }
+
+            /// The method these settings select, to be completed (files, levels).
+            pub fn method_mut(&mut self) -> &mut dyn Method {
+                match self {
+                    $(MethodSpec::$Type(m) => m,)*
+                }
+            }
+        }
+
+        /// What the report and the terminal say of the results of the method `kind` (as a
+        /// `summary.json` names it); nothing in particular for a kind this build does not know.
+        pub fn notes_of_kind(kind: &str) -> KindNotes {
+            match kind {
+                $(stringify!($module) => <$module::$Type as Method>::notes(),)*
+                _ => KindNotes::default(),
             }
         }
     };
@@ -92,32 +120,21 @@ impl MethodSpec {
     /// Resolves the files a method's settings name (e.g. a points file) against `base`,
     /// the study file's folder, and records what must enter the study's hash.
     pub fn resolve_files(&mut self, base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
+        self.method_mut().resolve_files(base)
+    }
+
+    /// The two-level settings of a nested study, whose analysis is its own.
+    pub fn nested(&self) -> Option<&nested::Nested> {
         match self {
-            MethodSpec::PceRegression(m) => m.resolve_points(base),
-            MethodSpec::Nested(m) => {
-                m.outer.resolve_files(base)?;
-                m.inner.resolve_files(base)
-            }
-            _ => Ok(()),
+            MethodSpec::Nested(n) => Some(n),
+            _ => None,
         }
     }
 
     /// Takes the parameters marked `level = "outer"` (names, study order): a nested study
     /// draws them in its outer design; any other method refuses them.
     pub fn set_levels(&mut self, outer: &[String]) -> Result<(), InvalidSettings> {
-        match self {
-            MethodSpec::Nested(m) => {
-                m.outer_parameters = outer.to_vec();
-                Ok(())
-            }
-            _ if outer.is_empty() => Ok(()),
-            other => Err(InvalidSettings(format!(
-                "parameter '{}' has level = \"outer\", which only a nested study \
-                 ([method] kind = \"nested\") has; {} draws every parameter in one design",
-                outer[0],
-                other.method().kind()
-            ))),
-        }
+        self.method_mut().set_outer_parameters(outer)
     }
 }
 

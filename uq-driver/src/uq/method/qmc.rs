@@ -76,7 +76,8 @@ impl UnitCubeSample for Qmc {
         replicate: Option<usize>,
     ) -> Result<Vec<Vec<f64>>, MethodError> {
         let r = replicate.unwrap_or(0) as u64;
-        let invalid = |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
+        let invalid =
+            |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
         Sobol::scrambled(d, seed, r)
             .map_err(invalid)?
             .points(0, n)

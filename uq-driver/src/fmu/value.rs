@@ -1,6 +1,6 @@
 //! A deterministic value as a study's `[fixed]` table or `simulate --set` gives it: a number,
 //! a Boolean or a text. Which FMI type it becomes is decided by the variable it is set on
-//! ([`crate::study::interface`]): a Real takes a number, an Integer or Enumeration a whole
+//! (by the study's interface to the FMU): a Real takes a number, an Integer or Enumeration a whole
 //! number, a Boolean `true`/`false` (or 1/0), a String a text; a text given for a Real,
 //! Integer, Enumeration or Boolean variable is parsed as such (that is how `--set NAME=VALUE`
 //! arrives).
