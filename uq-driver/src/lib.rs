@@ -142,5 +142,6 @@ pub mod results;
 pub mod spec;
 pub mod study;
 pub mod suggest;
+pub mod sys;
 pub mod text;
 pub mod uq;

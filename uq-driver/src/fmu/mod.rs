@@ -39,7 +39,6 @@ mod binary;
 pub mod cleanup;
 pub mod description;
 mod error;
-mod ffi;
 mod instance;
 mod logger;
 mod value;

@@ -6,6 +6,8 @@
 //! - [`sperling`]: the Sperling ride index of an acceleration record;
 //! - [`kde`]: Gaussian kernel density estimates.
 
+#![forbid(unsafe_code)]
+
 pub mod critical_speed;
 pub mod evaluate;
 pub mod hunting_speed;

@@ -16,6 +16,8 @@
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
 //! file. Only I/O (and, for CSV, inconsistent column lengths) produce a [`ReportError`].
 
+#![forbid(unsafe_code)]
+
 pub mod compare;
 pub mod csv;
 pub use crate::text::file_name;

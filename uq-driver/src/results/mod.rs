@@ -4,6 +4,8 @@
 //! The field names of [`Summary`] and [`SuiteSummary`] are a public interface (they are the
 //! keys of `summary.json`): add fields, rename none.
 
+#![forbid(unsafe_code)]
+
 mod nested;
 pub mod numbers;
 

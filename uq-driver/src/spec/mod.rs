@@ -32,6 +32,8 @@
 //! in one place (`load.rs`) into a [`Study`]. Errors carry the origin and, where the
 //! file has them, the line and column.
 
+#![forbid(unsafe_code)]
+
 mod builtins;
 mod error;
 mod file;

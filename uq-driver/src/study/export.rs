@@ -167,10 +167,10 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
     let map = if len == 0 {
         None
     } else {
-        // SAFETY: a read-only map of the store while this process holds the folder's lock,
-        // under which alone `run` appends to, repairs or truncates the file.
+        // This process holds the folder's lock, under which alone `run` appends to, repairs
+        // or truncates the file.
         Some(
-            unsafe { memmap2::Mmap::map(&file) }.map_err(|source| ExportError::Read {
+            crate::sys::map_read_only(&file).map_err(|source| ExportError::Read {
                 path: rp.clone(),
                 source,
             })?,

@@ -87,7 +87,7 @@ impl StudyGuard {
     pub fn begin(name: &str, out_dir: &Path, in_process: bool) -> StudyGuard {
         if in_process && process_guards() {
             ATEXIT.call_once(register_atexit);
-            super::crash::install();
+            crate::sys::crash::install();
         }
         let token = NEXT_TOKEN.fetch_add(1, Ordering::Relaxed);
         let mut s = state();
@@ -171,7 +171,7 @@ fn describe_running() -> Option<String> {
 /// held, as it changes).
 fn changed(s: &State) {
     let in_process = s.studies.values().any(|(_, _, p)| *p);
-    super::crash::prepare(in_process.then(|| describe(s)).as_deref());
+    crate::sys::crash::prepare(in_process.then(|| describe(s)).as_deref());
 }
 
 /// "study S (output folder D): running point 3 (K = 1, C = 2), …" for every study.
@@ -209,13 +209,11 @@ pub fn exit_now(code: i32, message: &str) -> ! {
     DELIBERATE.store(true, Ordering::Release);
     eprintln!("{message}");
     crate::fmu::cleanup::remove_all();
-    // SAFETY: fflush(NULL) flushes every C stream (what FMU code printed); `_exit` then ends
-    // the process with `code` without running exit handlers or destructors, which is the point.
-    // Rust's stdout is line-buffered: whole lines were written already.
-    unsafe {
-        libc::fflush(std::ptr::null_mut());
-        libc::_exit(code)
-    }
+    // Every C stream flushed (what FMU code printed), then `_exit`: no exit handlers or
+    // destructors, which is the point. Rust's stdout is line-buffered: whole lines were
+    // written already.
+    crate::sys::flush_c_streams();
+    crate::sys::exit_immediately(code)
 }
 
 /// Installs the handler of SIGINT, SIGTERM and SIGHUP: it names a study in progress (its
@@ -254,25 +252,6 @@ pub fn stop_requested_within(wait: Duration) -> bool {
     }
 }
 
-/// Keeps another thread that calls `exit()` meanwhile (a second FMU instance misbehaving at
-/// the same moment) from ending the process with its status first: after the exit handlers,
-/// glibc's `exit()` flushes the C streams under the lock of the list of streams
-/// (`_IO_cleanup`), so holding that lock parks such a thread until this one calls `_exit`.
-/// (Without it, the other thread's `exit(0)` wins the race whenever two instances exit
-/// together.) Rust's `eprintln!` writes to file descriptor 2 directly and needs no such lock.
-fn hold_other_exits() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    {
-        extern "C" {
-            /// glibc: takes the (recursive) lock of the list of all `FILE` streams.
-            fn _IO_list_lock();
-        }
-        // SAFETY: `_IO_list_lock` takes no arguments; the lock is never released because the
-        // process ends with `_exit` right after.
-        unsafe { _IO_list_lock() };
-    }
-}
-
 /// A `simulate` run of an FMU in progress: an FMU that calls `exit()` meanwhile is reported
 /// (exit status 1) instead of ending the process quietly with its own status.
 #[derive(Debug)]
@@ -307,17 +286,12 @@ pub struct StdoutToStderr {
 impl StdoutToStderr {
     /// Points fd 1 at stderr (when that fails, stdout stays as it is).
     pub fn begin() -> StdoutToStderr {
-        use std::os::fd::FromRawFd;
         let _ = std::io::stdout().flush();
-        // SAFETY: fcntl(F_DUPFD_CLOEXEC) of the process's own stdout; the result is checked.
-        let fd = unsafe { libc::fcntl(1, libc::F_DUPFD_CLOEXEC, 3) };
-        if fd < 0 {
+        let Ok(saved) = crate::sys::dup_cloexec(1, 3) else {
             return StdoutToStderr { saved: None };
-        }
-        // SAFETY: `fd` is a fresh descriptor owned by nothing else.
-        let saved = unsafe { std::os::fd::OwnedFd::from_raw_fd(fd) };
-        // SAFETY: 2 and 1 are the process's own stderr and stdout; Rust's stdout was flushed.
-        if unsafe { libc::dup2(2, 1) } < 0 {
+        };
+        // Rust's stdout was flushed: nothing of it is waiting for the old fd 1.
+        if crate::sys::dup2(2, 1).is_err() {
             return StdoutToStderr { saved: None };
         }
         StdoutToStderr { saved: Some(saved) }
@@ -328,23 +302,16 @@ impl Drop for StdoutToStderr {
     fn drop(&mut self) {
         use std::os::fd::AsRawFd;
         if let Some(saved) = self.saved.take() {
-            // SAFETY: fflush(NULL) flushes every C stream (what the FMU printed goes where fd 1
-            // points now, stderr); dup2 puts the saved stdout back on fd 1.
-            unsafe {
-                libc::fflush(std::ptr::null_mut());
-                libc::dup2(saved.as_raw_fd(), 1);
-            }
+            // What the FMU printed goes where fd 1 points now (stderr), then stdout is back.
+            crate::sys::flush_c_streams();
+            let _ = crate::sys::dup2(saved.as_raw_fd(), 1);
         }
     }
 }
 
 /// Registers [`on_exit`] with the C library.
 fn register_atexit() {
-    // SAFETY: `on_exit` is an `extern "C" fn()` that lives as long as the program; `atexit`
-    // only stores the pointer.
-    unsafe {
-        libc::atexit(on_exit);
-    }
+    crate::sys::at_exit(on_exit);
 }
 
 /// Runs when the process calls `exit()`. A study in progress that did not end on purpose means
@@ -360,7 +327,7 @@ extern "C" fn on_exit() {
     // Hold another thread's exit() before anything that may wait (describe_running): that
     // exit finds the handler list already taken and would otherwise end the process with the
     // FMU's status (0) while this one still writes its message.
-    hold_other_exits();
+    crate::sys::hold_other_exits();
     let what = describe_running();
     if what.is_none() && simulation.is_none() {
         return;
@@ -378,7 +345,7 @@ extern "C" fn on_exit() {
         (None, None) => {}
     });
     crate::fmu::cleanup::remove_all();
-    // SAFETY: `_exit` ends the process at once with this status, which is what is wanted here
-    // (an exit() already in progress would otherwise report the FMU's status).
-    unsafe { libc::_exit(EXIT_FAILURE) }
+    // At once with this status (an exit() already in progress would otherwise report the
+    // FMU's status).
+    crate::sys::exit_immediately(EXIT_FAILURE)
 }

@@ -6,9 +6,10 @@
 //! own system instead of running an FMU. A suite (a study with `[[variants]]`) runs each
 //! variant into a sub-folder and then writes a comparison ([`suite`]).
 
+#![forbid(unsafe_code)]
+
 pub mod analysis;
 mod batch;
-mod crash;
 pub mod export;
 mod fingerprint;
 pub mod guard;

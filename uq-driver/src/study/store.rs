@@ -253,9 +253,9 @@ impl Store {
         let map = if len == 0 {
             None
         } else {
-            // SAFETY: read-only map of a file that no other run writes meanwhile (the caller
-            // holds the folder's lock); it is dropped before this function writes the file.
-            Some(unsafe { memmap2::Mmap::map(&file) }.map_err(io_err(&path))?)
+            // No other run writes the file meanwhile (the caller holds the folder's lock); the
+            // map is dropped before this function writes the file.
+            Some(crate::sys::map_read_only(&file).map_err(io_err(&path))?)
         };
         let bytes: &[u8] = map.as_deref().unwrap_or_default();
 
@@ -284,9 +284,9 @@ impl Store {
             let new_map = if new_len == 0 {
                 None
             } else {
-                // SAFETY: as above, a read-only map of the file this run just wrote under the
-                // folder's lock; dropped before anything appends to it.
-                Some(unsafe { memmap2::Mmap::map(&file) }.map_err(io_err(&path))?)
+                // As above: the file this run just wrote under the folder's lock; the map is
+                // dropped before anything appends to it.
+                Some(crate::sys::map_read_only(&file).map_err(io_err(&path))?)
             };
             let written: &[u8] = new_map.as_deref().unwrap_or_default();
             done = read_records(written, Format::V2, manifest).0;

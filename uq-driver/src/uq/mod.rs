@@ -15,6 +15,8 @@
 //! - [`surrogate`]: the exported chaos surrogate (`surrogate.json`), evaluated and sampled;
 //! - [`hd`]: high-dimensional building blocks (sparse grids, Askey chaos, QMC, LARS, copula).
 
+#![forbid(unsafe_code)]
+
 pub mod distributions;
 pub mod galerkin;
 pub mod hd;

@@ -21,57 +21,29 @@ pub const PROTOCOL_FD_MIN: i32 = 100;
 /// starts does not inherit them. Returns (input, output).
 #[cfg(unix)]
 fn protocol_fds() -> std::io::Result<(std::fs::File, std::fs::File)> {
-    use std::os::fd::FromRawFd;
-    let last = std::io::Error::last_os_error;
-    // SAFETY: fcntl(F_DUPFD_CLOEXEC) on the process's own stdout/stdin; results are checked.
-    let out = unsafe { libc::fcntl(1, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
-    if out < 0 {
-        return Err(last());
-    }
-    // SAFETY: `out` is a fresh descriptor owned by nothing else.
-    let out = unsafe { std::fs::File::from_raw_fd(out) };
-    // SAFETY: as above, for stdin.
-    let input = unsafe { libc::fcntl(0, libc::F_DUPFD_CLOEXEC, PROTOCOL_FD_MIN) };
-    if input < 0 {
-        return Err(last());
-    }
-    // SAFETY: `input` is a fresh descriptor owned by nothing else.
-    let input = unsafe { std::fs::File::from_raw_fd(input) };
-    // SAFETY: 2 and 1 are the process's own stderr and stdout; nothing in this process holds a
-    // Rust handle that relies on fd 1 staying the pipe (only `out` is used for the protocol).
-    if unsafe { libc::dup2(2, 1) } < 0 {
-        return Err(last());
-    }
+    use crate::sys::{dup2, dup_cloexec};
+    let out = std::fs::File::from(dup_cloexec(1, PROTOCOL_FD_MIN)?);
+    let input = std::fs::File::from(dup_cloexec(0, PROTOCOL_FD_MIN)?);
+    // Nothing in this process relies on fd 1 staying the pipe (only `out` carries the
+    // protocol), nor reads fd 0 any more (the protocol reads `input`).
+    dup2(2, 1)?;
     let null = std::fs::File::open("/dev/null")?;
-    // SAFETY: `null` is an open descriptor; fd 0 is the process's stdin, which nothing reads
-    // any more (the protocol reads `input`).
-    if unsafe { libc::dup2(std::os::fd::AsRawFd::as_raw_fd(&null), 0) } < 0 {
-        return Err(last());
-    }
+    dup2(std::os::fd::AsRawFd::as_raw_fd(&null), 0)?;
     Ok((input, out))
 }
 
 /// Ignores SIGINT and, on Linux, asks to be killed when the parent dies.
 #[cfg(unix)]
 fn detach_from_terminal_signals() {
-    // SAFETY: setting SIGINT's disposition to ignore is async-signal-safe and affects only this
-    // process.
-    unsafe {
-        libc::signal(libc::SIGINT, libc::SIG_IGN);
-    }
+    crate::sys::ignore_sigint();
     #[cfg(target_os = "linux")]
     {
-        // SAFETY: PR_SET_PDEATHSIG with a valid signal number; no pointers involved.
-        unsafe {
-            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
-        }
-        // The parent may have died before the prctl: then nobody reads our answers.
+        crate::sys::die_with_parent();
+        // The parent may have died before that: then nobody reads our answers.
         let expected = std::env::var("UQ_DRIVER_PARENT_PID")
             .ok()
             .and_then(|p| p.parse::<i32>().ok());
-        // SAFETY: getppid has no preconditions.
-        let parent = unsafe { libc::getppid() };
-        if expected.is_some_and(|p| p != parent) {
+        if expected.is_some_and(|p| p != crate::sys::parent_pid()) {
             std::process::exit(0);
         }
     }

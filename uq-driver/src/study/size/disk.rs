@@ -1,8 +1,6 @@
 //! The results store against the free disk space: the series of the runs go to the store as
 //! they finish (not to memory), so the disk is what a study with long series can run out of.
 
-use std::ffi::CString;
-use std::os::unix::ffi::OsStrExt;
 use std::path::Path;
 
 /// The store's size and the room for it (bytes).
@@ -39,12 +37,7 @@ pub fn free_bytes(dir: &Path) -> Option<f64> {
             break;
         }
     }
-    let c = CString::new(p.as_os_str().as_bytes()).ok()?;
-    // SAFETY: an all-zero statvfs is a valid value of this plain C struct.
-    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
-    // SAFETY: a NUL-terminated path and a pointer to a local statvfs, as statvfs(3) requires.
-    let rc = unsafe { libc::statvfs(c.as_ptr(), &mut s) };
-    (rc == 0).then_some(s.f_bavail as f64 * s.f_frsize as f64 + existing as f64)
+    crate::sys::available_bytes(p).map(|free| free + existing as f64)
 }
 
 #[cfg(test)]

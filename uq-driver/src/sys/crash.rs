@@ -37,7 +37,7 @@ static PREVIOUS: OnceLock<Vec<(i32, libc::sigaction)>> = OnceLock::new();
 
 /// Prepares the text the handler prints: `what` is running (a study, its points); `None`:
 /// nothing is. Callers serialize (the study registry's lock).
-pub(super) fn prepare(what: Option<&str>) {
+pub fn prepare(what: Option<&str>) {
     let text = what.map_or_else(String::new, |what| {
         format!(
             " during {what}: an FMU running in-process crashed and took the process with it. \
@@ -59,7 +59,7 @@ pub(super) fn prepare(what: Option<&str>) {
 }
 
 /// Installs the handler (once per process).
-pub(super) fn install() {
+pub fn install() {
     #[cfg(unix)]
     INSTALL.call_once(|| {
         let mut previous = Vec::new();
