@@ -132,6 +132,8 @@
 //!   statistics, shards for a cluster, suites;
 //! - [`suggest`]: "did you mean" for misspelt names.
 
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod fmu;
 /// Writing output files safely (links replaced, devices and pipes written into): the
 /// `out-file` crate of this workspace.

@@ -12,7 +12,7 @@ use std::process::{Command, Output};
 
 use uq_driver::fmu::Fmu;
 use uq_driver::spec::FixedValue;
-use uq_driver::study::runner::simulate;
+use uq_driver::study::run::simulate;
 
 const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 

@@ -11,7 +11,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use uq_driver::spec::Study;
-use uq_driver::study::runner::{self, RunOptions};
+use uq_driver::study::run::{self as runner, RunOptions};
 use uq_driver::uq::distributions::Germ;
 use uq_driver::uq::method::Design;
 

@@ -13,7 +13,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use uq_driver::spec::{Experiment, Study, StudyError};
-use uq_driver::study::runner::{simulate, PointError};
+use uq_driver::study::run::{simulate, PointError};
 use uq_driver::study::{run_study, Outcome, RunError, RunOptions, StudyRunError};
 
 fn study(method: &str) -> Study {

@@ -369,7 +369,7 @@ fn no_report_export_and_compare() {
     let again = std::fs::read_to_string(a.join("runs/runs.csv")).unwrap();
     assert_eq!(again, csv);
     // While a run holds the folder, export refuses instead of reading a store being written.
-    let held = uq_driver::study::lock::FolderLock::acquire(&a).unwrap();
+    let held = uq_driver::study::store::lock::FolderLock::acquire(&a).unwrap();
     let o = run(&["export", a.to_str().unwrap(), "--runs"]);
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);

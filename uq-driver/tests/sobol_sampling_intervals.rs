@@ -329,7 +329,7 @@ fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
 fn sobol_sampling_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
     use sha2::{Digest, Sha256};
     use uq_driver::spec::{builtin, Study};
-    use uq_driver::study::runner::study_hash;
+    use uq_driver::study::plan::fingerprint::study_hash;
     let text = builtin("wheel-sobol-sampling").unwrap();
     let study = |base: &str, extra: &str| {
         let t = text

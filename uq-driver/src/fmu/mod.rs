@@ -27,7 +27,7 @@
 //! # Ok(()) }
 //! ```
 //!
-//! [`crate::study::runner::simulate`] does all of this for one parameter point and a time grid.
+//! [`crate::study::run::simulate`] does all of this for one parameter point and a time grid.
 //!
 //! Every `Fmu::open` extracts and loads its own copy of the binary, and
 //! [`Fmu::private_copy`] loads another copy of an opened FMU's binary, so an FMU that keeps

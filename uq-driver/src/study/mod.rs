@@ -9,33 +9,19 @@
 #![forbid(unsafe_code)]
 
 pub mod analysis;
-mod batch;
-pub mod export;
-mod fingerprint;
-pub mod guard;
-pub mod inputs;
-pub mod instances;
-pub mod interface;
-pub mod isolate;
-pub mod lock;
-pub mod nested;
 mod outcome;
-mod point;
+pub mod plan;
 pub mod progress;
-pub mod ranges;
-pub mod runner;
+pub mod run;
 pub mod shard;
 mod single;
-pub mod size;
-pub mod speed_runs;
 pub mod store;
 pub mod suite;
-mod worker_fmu;
 
 use std::path::Path;
 
 pub use outcome::{Outcome, StudyResult, StudyRunError, SuiteResult};
-pub use runner::{RunError, RunOptions, RunOutcome};
+pub use run::{RunError, RunOptions, RunOutcome};
 
 use crate::spec::Study;
 
@@ -57,8 +43,8 @@ pub fn run_study(
         return Err(RunError::NoOutDir.into());
     }
     opts.check()?;
-    size::check(study, out_dir, opts)?;
-    runner::prepare_out_dir(out_dir)?;
+    plan::size::check(study, out_dir, opts)?;
+    run::prepare_out_dir(out_dir)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),
         None => single::run_single(study, out_dir, opts).map(|r| Outcome::Study(Box::new(r))),

@@ -1,10 +1,10 @@
 //! What running a study returns, and how it fails.
 
-use super::analysis::AnalysisError;
-use super::runner::RunError;
-use super::size::SizeError;
 use crate::report::ReportError;
 use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::study::analysis::AnalysisError;
+use crate::study::plan::size::SizeError;
+use crate::study::run::RunError;
 use crate::uq::method::MethodError;
 
 /// Errors of a whole study run.

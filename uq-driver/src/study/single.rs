@@ -5,13 +5,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use super::analysis::{self, Analysed, AnalysisError};
-use super::outcome::{StudyResult, StudyRunError};
-use super::progress;
-use super::ranges;
-use super::runner::{self, RunError, RunOptions, RunOutcome};
-use super::size;
-use super::store::{Entry, StoredRuns};
 use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
@@ -20,6 +13,13 @@ use crate::results::{
     ScalarStats, Summary, Timing, Versions,
 };
 use crate::spec::Study;
+use crate::study::analysis::{self, Analysed, AnalysisError};
+use crate::study::outcome::{StudyResult, StudyRunError};
+use crate::study::plan::ranges;
+use crate::study::plan::size;
+use crate::study::progress;
+use crate::study::run::{self, RunError, RunOptions, RunOutcome};
+use crate::study::store::{Entry, StoredRuns};
 use crate::uq::distributions::{Distribution, Germ};
 use crate::uq::method::{
     ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSummary, Sampling,
@@ -40,7 +40,7 @@ pub(crate) fn run_single(
     match study.method().evaluation() {
         Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
-            let fmu = open_fmu(study)?;
+            let fmu = run::open_fmu(study)?;
             ranges::check_supports(study, &fmu).map_err(RunError::from)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
             if method.planned_runs_for(&study.parameters).is_none() {
@@ -60,7 +60,7 @@ pub(crate) fn run_single(
             for w in &early {
                 progress::message(&format!("uq-driver: warning: {w}"));
             }
-            let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
+            let outcome = run::run_points(study, &fmu, &design, out_dir, opts)?;
             let noted = outcome.warnings.len();
             let mut result = finish(study, method, &fmu, &design, outcome, out_dir, opts)?;
             // finish puts the same range warnings first in the summary's list, then those the
@@ -69,12 +69,6 @@ pub(crate) fn run_single(
             Ok(result)
         }
     }
-}
-
-/// Opens the study's FMU.
-pub(crate) fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
-    let path = study.fmu_path.as_deref().unwrap_or(Path::new(""));
-    Ok(Fmu::open(path)?)
 }
 
 /// Facts of a run for the summary.
@@ -149,7 +143,7 @@ pub(crate) fn finish(
 ) -> Result<StudyResult, StudyRunError> {
     let entries = outcome.runs.entries();
     let done = entries.iter().filter(|r| r.is_some()).count();
-    let failed = runner::check_failures(
+    let failed = run::check_failures(
         study,
         design,
         entries,
@@ -243,7 +237,7 @@ fn analyse(
 ) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
     Ok(match study.method.nested() {
         Some(nested) => {
-            let n = super::nested::analyse(study, nested, design, records)?;
+            let n = crate::study::analysis::nested::analyse(study, nested, design, records)?;
             (n.analysed, n.splits, n.warnings)
         }
         None => {

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use super::outcome::{StudyResult, StudyRunError, SuiteResult};
-use super::runner::RunOptions;
-use super::single::run_single;
 use crate::report::{self, suite::VariantResults};
 use crate::results::{SuiteSummary, VariantOutput, VariantSummary};
 use crate::spec::{Study, Suite};
+use crate::study::outcome::{StudyResult, StudyRunError, SuiteResult};
+use crate::study::run::RunOptions;
+use crate::study::single::run_single;
 
 /// Largest |a − b| over paired entries.
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
@@ -28,7 +28,7 @@ pub fn run(
 ) -> Result<SuiteResult, StudyRunError> {
     let mut results = Vec::new();
     for v in &suite.variants {
-        super::progress::message(&format!(
+        crate::study::progress::message(&format!(
             "{}: variant {} ({}) …",
             study.name,
             v.name,

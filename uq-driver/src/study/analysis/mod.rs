@@ -13,6 +13,7 @@ mod chaos_gap;
 mod columns;
 mod error;
 mod exceedance;
+pub mod nested;
 mod runs;
 mod surrogate;
 

@@ -17,12 +17,12 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use super::lock::{FolderLock, LockError};
-use super::store::format::{self, Slot};
-use super::store::Manifest;
 use crate::out_file::OutFile;
 use crate::report::ReportError;
 use crate::spec::Experiment;
+use crate::study::store::format::{self, Slot};
+use crate::study::store::lock::{FolderLock, LockError};
+use crate::study::store::Manifest;
 use crate::text::csv::{push_header, split_line};
 use crate::text::file_name::stem;
 

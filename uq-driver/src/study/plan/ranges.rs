@@ -2,9 +2,9 @@
 //! distribution whose whole support lies outside the declared range is refused; design points
 //! outside it are run (never dropped) and reported with their probability weight.
 
-use super::interface::{InterfaceError, VariableProblem};
 use crate::fmu::{Fmu, VariableKind};
 use crate::spec::{FixedValue, Study};
+use crate::study::plan::interface::{InterfaceError, VariableProblem};
 use crate::uq::method::Design;
 
 /// The declared range of variable `name` (either end may be open), if it declares one.

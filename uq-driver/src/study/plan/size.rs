@@ -70,10 +70,11 @@ use std::fmt;
 use std::path::Path;
 use std::time::Instant;
 
-use super::guard::StudyGuard;
-use super::interface::Interface;
-use super::runner::{self, RunOptions};
 use crate::spec::Study;
+use crate::study::plan::interface::Interface;
+use crate::study::run;
+use crate::study::run::guard::StudyGuard;
+use crate::study::run::options::RunOptions;
 use crate::uq::method::Evaluation;
 
 /// More model runs than this need `--yes`.
@@ -513,10 +514,10 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
         0,
         "a short timing run at the parameters' means, before the study".to_owned(),
     );
-    let fmu = super::single::open_fmu(study).ok()?;
+    let fmu = run::open_fmu(study).ok()?;
     let iface = Interface {
         qois: Vec::new(),
-        ..Interface::resolve(study, &fmu).ok()?
+        ..crate::study::plan::resolve::interface(study, &fmu).ok()?
     };
     let values: Vec<f64> = study
         .parameters
@@ -528,18 +529,18 @@ fn probe(study: &Study, out_dir: &Path) -> Option<f64> {
     let grid = |m: usize| -> Vec<f64> { (0..=m).map(|i| e.start + i as f64 * e.step).collect() };
     // Reused through fmi2Reset (a failed reset gets a fresh instance): the timing of a run,
     // not of an instantiation.
-    let policy = super::instances::InstancePolicy {
+    let policy = crate::study::run::instances::InstancePolicy {
         reuse: true,
         logging_on: false,
     };
-    let mut slot = super::instances::Slot::new(policy, false);
+    let mut slot = crate::study::run::instances::Slot::new(policy, false);
     // The best of a few repeats: other work on the machine only ever adds time.
     let mut time = |m: usize, repeats: usize| -> Option<f64> {
         let times = grid(m);
         let mut best = f64::INFINITY;
         for _ in 0..repeats {
             let started = Instant::now();
-            runner::run_point(&fmu, &mut slot, &iface, &values, &times).ok()?;
+            run::point::run_point(&fmu, &mut slot, &iface, &values, &times).ok()?;
             best = best.min(started.elapsed().as_secs_f64());
         }
         Some(best)

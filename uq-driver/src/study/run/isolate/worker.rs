@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use super::protocol::{bytes_to_f64s, f64s_to_bytes, read_frame, write_frame, Frame};
 use super::{IsolateOptions, WorkerFailure};
-use crate::study::instances::ResetCheck;
+use crate::study::run::instances::ResetCheck;
 
 /// How many of a worker's last stderr lines a failure message quotes.
 const TAIL_LINES: usize = 12;
@@ -101,7 +101,7 @@ fn describe_exit(status: ExitStatus) -> (String, bool) {
         use std::os::unix::process::ExitStatusExt;
         if let Some(sig) = status.signal() {
             let outside = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP].contains(&sig)
-                && crate::study::guard::stop_requested_within(GRACE);
+                && crate::study::run::guard::stop_requested_within(GRACE);
             return (
                 format!(
                     "the worker process running the FMU was killed by {}",

@@ -17,17 +17,17 @@ use nalgebra::DMatrix;
 use rand::RngCore;
 use rayon::prelude::*;
 
-use super::analysis::{
-    nest_exceedance_count, output_stats, quantity_error, scalar_stats, series_error, surrogates_of,
-    Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
-};
-use super::store::StoredRuns;
 use crate::qoi::QoiSpec;
 use crate::results::{
     ConditionalChaos, ConditionalTable, ExceedanceCount, ExceedanceInterval, NestedScalar,
     OutputSplit, OutputStats, ScalarStats, VarianceSplit,
 };
 use crate::spec::Study;
+use crate::study::analysis::{
+    nest_exceedance_count, output_stats, quantity_error, scalar_stats, series_error, surrogates_of,
+    Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
+};
+use crate::study::store::StoredRuns;
 use crate::uq::method::nested::split::{self, Split};
 use crate::uq::method::nested::{marginal, Blocks, Conditional, Nested};
 use crate::uq::method::{Design, Draws, Estimate, MethodError, Sampling};

@@ -4,100 +4,15 @@
 
 use std::path::Path;
 
-use super::inputs::isclose;
+use super::error::{PointError, RunError};
 use super::instances::{first_difference, same_record, InstancePolicy, ResetCheck, Slot};
-use super::interface::{Interface, RandomValueError};
-use super::runner::RunError;
 use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
-use crate::qoi::evaluate::evaluate;
-use crate::qoi::QoiError;
+use crate::qoi::evaluate::{evaluate, Code};
+use crate::qoi::hunting_speed::{bisect, keeps_hunting, HuntingSpeed, HuntingSpeedSpec};
 use crate::qoi::QoiSpec;
 use crate::spec::FixedValue;
-
-/// Why one model run failed. Its text is stored with the point, so it is complete on its own.
-#[derive(Debug, thiserror::Error)]
-pub enum PointError {
-    /// An FMI call failed (the message lists what the FMU logged).
-    #[error(transparent)]
-    Fmu(#[from] FmuError),
-    /// An output became NaN or infinite.
-    #[error("non-finite value of {signal} at t = {time} s")]
-    NonFinite {
-        /// The variable.
-        signal: String,
-        /// When (s).
-        time: f64,
-    },
-    /// A design value does not fit its variable.
-    #[error("{0}")]
-    Value(String),
-    /// The time grid cannot be run: empty, not finite or not increasing.
-    #[error("time grid: {0}")]
-    Times(String),
-    /// The FMU ended the simulation before the stop time. Statistics over time need every run
-    /// on the whole grid (a mean at t over the runs that reached t would be conditioned on
-    /// reaching it), so such a run is a failed point.
-    #[error(
-        "the FMU ended the simulation at t = {time} s, before the stop time {stop} s \
-         (fmi2DoStep returned fmi2Discard and fmi2Terminated is true); statistics over time \
-         need every run on the whole grid, so the point counts as failed (a stop time of at \
-         most {time} s keeps such runs)"
-    )]
-    EndedEarly {
-        /// When the FMU ended it (s).
-        time: f64,
-        /// The study's stop time (s).
-        stop: f64,
-    },
-    /// A quantity of interest could not be evaluated on the run.
-    #[error("quantity '{name}': {error}")]
-    Quantity {
-        /// The quantity.
-        name: String,
-        /// Why.
-        error: QoiError,
-    },
-    /// A constant-speed run of a `hunting_speed` quantity failed.
-    #[error("quantity '{name}': the constant-speed run at {parameter} = {speed}: {source}")]
-    SpeedRun {
-        /// The quantity.
-        name: String,
-        /// The speed parameter.
-        parameter: String,
-        /// Its value in the failed run.
-        speed: f64,
-        /// Why the run failed.
-        source: Box<PointError>,
-    },
-}
-
-impl PointError {
-    /// The FMI error behind this failure, if any.
-    fn fmu_error(&self) -> Option<&FmuError> {
-        match self {
-            PointError::Fmu(e) => Some(e),
-            PointError::SpeedRun { source, .. } => source.fmu_error(),
-            _ => None,
-        }
-    }
-
-    /// Whether a call of this run was refused because a call (of this run or of another
-    /// instance of the same library) had returned fmi2Fatal: the point itself is not at fault.
-    pub fn refused_after_fatal(&self) -> bool {
-        matches!(self.fmu_error(), Some(FmuError::Unusable { .. }))
-    }
-
-    /// Whether a call of this run returned fmi2Fatal.
-    pub fn returned_fatal(&self) -> bool {
-        matches!(
-            self.fmu_error(),
-            Some(FmuError::Call {
-                status: Status::Fatal,
-                ..
-            })
-        )
-    }
-}
+use crate::study::plan::inputs::isclose;
+use crate::study::plan::interface::{Interface, RandomValueError, SpeedRuns};
 
 /// What one run recorded.
 #[derive(Clone, Debug, PartialEq)]
@@ -292,7 +207,7 @@ pub fn run_point(
     Ok(out)
 }
 
-/// The second half of the reset self-check ([`super::instances`]): point `values`, whose run
+/// The second half of the reset self-check ([`crate::study::run::instances`]): point `values`, whose run
 /// on a fresh instance gave `first`, run again on the same instance (held by `slot`) after
 /// `fmi2Reset`. Afterwards `slot` reuses instances if the check passed, else not (and holds
 /// none). Also returns the error of the second run when it returned fmi2Fatal (the FMU is then
@@ -342,7 +257,7 @@ pub struct Simulation {
 }
 
 /// One deterministic run of `fmu` with `params` set before initialization, `inputs` (a CSV
-/// file, see [`super::inputs`]) applied during the run, recording `outputs` (names; every
+/// file, see [`crate::study::plan::inputs`]) applied during the run, recording `outputs` (names; every
 /// output that can be recorded when empty) at `times`. Where the FMU ends the simulation
 /// early, the run ends there (its last row at the FMU's last successful time), as in fmpy.
 pub fn simulate(
@@ -401,4 +316,89 @@ pub fn simulate_with(
         skipped: iface.skipped,
         ended_at,
     })
+}
+
+impl SpeedRuns {
+    /// The bisection at one design point (`values` of the random parameters) on `slot`'s
+    /// instance (reset, or a fresh one, between runs, by its policy): the record's (value, code) pairs of both quantities, `name` then
+    /// `name_decay`.
+    pub fn evaluate(
+        &self,
+        h: &HuntingSpeedSpec,
+        fmu: &Fmu,
+        slot: &mut Slot,
+        values: &[f64],
+    ) -> Result<[f64; 4], PointError> {
+        let outcome = bisect(h.low, h.high, h.tolerance, |v| {
+            self.hunts(h, fmu, slot, values, v)
+                .map_err(|source| PointError::SpeedRun {
+                    name: h.name.clone(),
+                    parameter: h.speed_parameter.clone(),
+                    speed: v,
+                    source: Box::new(source),
+                })
+        })?;
+        Ok(match outcome {
+            HuntingSpeed::Found { hunts, decays, .. } => {
+                let ok = Code::Ok as u8 as f64;
+                [hunts, ok, decays, ok]
+            }
+            HuntingSpeed::NeverHunts => {
+                let c = Code::NeverHunts as u8 as f64;
+                [f64::NAN, c, f64::NAN, c]
+            }
+            HuntingSpeed::AlwaysHunts => {
+                let c = Code::NeverStops as u8 as f64;
+                [f64::NAN, c, f64::NAN, c]
+            }
+        })
+    }
+
+    /// One run at `speed`: whether the disturbance keeps hunting.
+    fn hunts(
+        &self,
+        h: &HuntingSpeedSpec,
+        fmu: &Fmu,
+        slot: &mut Slot,
+        values: &[f64],
+        speed: f64,
+    ) -> Result<bool, PointError> {
+        let nt = self.times.len();
+        let trace = simulate_point(
+            fmu,
+            slot,
+            &self.run,
+            values,
+            &self.times,
+            &[(self.speed, speed)],
+        )
+        .inspect_err(|_| slot.discard())?;
+        if let Some((time, _)) = trace.ended {
+            slot.discard();
+            return Err(PointError::EndedEarly {
+                time,
+                stop: self.times[nt - 1],
+            });
+        }
+        let series = &trace.values[..nt];
+        if let Some(k) = series.iter().position(|v| !v.is_finite()) {
+            slot.discard();
+            return Err(PointError::NonFinite {
+                signal: h.signal.clone(),
+                time: self.times[k],
+            });
+        }
+        Ok(keeps_hunting(&self.times, series, h.window, h.threshold))
+    }
+}
+
+/// "K = 1.2, C = 3" for messages.
+pub(crate) fn describe_values(study: &crate::spec::Study, values: &[f64]) -> String {
+    study
+        .parameters
+        .iter()
+        .zip(values)
+        .map(|(p, v)| format!("{} = {v}", p.name))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

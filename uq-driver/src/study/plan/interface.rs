@@ -13,11 +13,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::inputs::{InputError, InputTable};
-use super::speed_runs::SpeedRuns;
 use crate::fmu::{Fmu, FmuError, Instance, ScalarVariable, VariableKind};
 use crate::qoi::QoiSpec;
 use crate::spec::{FixedValue, Study};
+use crate::study::plan::inputs::{InputError, InputTable};
 
 /// Why a fixed value does not fit an Integer: a fraction, or a whole number beyond 32 bits.
 fn not_whole_why(value: f64) -> &'static str {
@@ -308,6 +307,20 @@ impl Signals {
     }
 }
 
+/// A `hunting_speed` quantity's runs, resolved against the FMU.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedRuns {
+    /// Index of the quantity among the study's `[[qoi]]`.
+    pub qoi: usize,
+    /// Value reference of the speed parameter (a Real).
+    pub speed: u32,
+    /// What each run sets and reads: the random parameters, `[fixed]` merged with `set`, the
+    /// inputs; the signal as the only output.
+    pub run: Box<Interface>,
+    /// The runs' communication points (s): the study's start time to start + duration.
+    pub times: Vec<f64>,
+}
+
 /// Value references resolved against the FMU.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Interface {
@@ -341,8 +354,9 @@ impl Interface {
     }
 
     /// Checks the study's variables against the FMU and resolves their value references
-    /// (reading the input file, if any).
-    pub fn resolve(study: &Study, fmu: &Fmu) -> Result<Interface, InterfaceError> {
+    /// (reading the input file, if any); not yet the runs of the `hunting_speed` quantities
+    /// ([`super::resolve::interface`] adds them).
+    pub(crate) fn resolve_variables(study: &Study, fmu: &Fmu) -> Result<Interface, InterfaceError> {
         let vars = Variables { fmu };
         let random = study
             .parameters
@@ -356,7 +370,7 @@ impl Interface {
                 signal_names.push(s.to_owned());
             }
         }
-        let mut iface = Interface {
+        Ok(Interface {
             random,
             fixed,
             signals: vars.signals(&signal_names)?,
@@ -366,9 +380,7 @@ impl Interface {
             inputs: vars.inputs(study.inputs.as_deref())?,
             skipped: Vec::new(),
             speed_runs: Vec::new(),
-        };
-        iface.speed_runs = SpeedRuns::resolve_all(study, &iface, &vars)?;
-        Ok(iface)
+        })
     }
 
     /// The interface of one deterministic run: `params` set before initialization, `outputs`

@@ -6,9 +6,9 @@ use std::io::BufReader;
 use super::protocol::{bytes_to_f64s, f64s_to_bytes, read_frame, write_frame};
 use super::Setup;
 use crate::fmu::Fmu;
-use crate::study::instances::{ResetCheck, Slot};
-use crate::study::point::check_reset;
-use crate::study::runner::run_point;
+use crate::study::run::instances::{ResetCheck, Slot};
+use crate::study::run::point::check_reset;
+use crate::study::run::point::run_point;
 
 /// The worker's protocol descriptors are moved to this number or above, out of the way of an
 /// FMU that writes to (or closes) low descriptors.

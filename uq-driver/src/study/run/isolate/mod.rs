@@ -4,7 +4,7 @@
 //! A worker is the uq-driver executable started with the hidden subcommand `worker`
 //! ([`serve`], `serve.rs`). It opens the FMU from the folder the parent already extracted,
 //! creates one instance at a time, and runs points one after the other exactly as the
-//! in-process runner does ([`run_point`](crate::study::runner::run_point); fresh or reset
+//! in-process runner does ([`run_point`](crate::study::run::point::run_point); fresh or reset
 //! instances by the setup's [`InstancePolicy`], and the reset self-check of
 //! [`super::instances`] when the parent asks), so results are bit-identical. The parent's
 //! side of one worker is [`Worker`] (`worker.rs`), shared by the runner's threads through
@@ -49,8 +49,8 @@ use std::time::Duration;
 use serde::{Deserialize, Serialize};
 
 use super::instances::{InstancePolicy, ResetCheck};
-use super::interface::Interface;
 use crate::fmu::Fmu;
+use crate::study::plan::interface::Interface;
 
 pub use protocol::{read_frame, write_frame};
 pub use serve::{serve, PROTOCOL_FD_MIN};

@@ -13,7 +13,9 @@
 //! `records.damaged-<unix seconds>.bin`. A store of the previous format (format 1, before
 //! format 1) is read and converted, the old file kept as `records.v1.bin`.
 
+pub mod export;
 pub mod format;
+pub mod lock;
 mod runs;
 
 use std::fmt;

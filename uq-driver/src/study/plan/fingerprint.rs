@@ -6,11 +6,10 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::interface::Interface;
-use super::runner::RunError;
-use super::store::Manifest;
 use crate::fmu::{Fmu, FmuError};
 use crate::spec::Study;
+use crate::study::run::error::RunError;
+use crate::study::store::Manifest;
 use crate::uq::method::Design;
 
 /// SHA-256 of an FMU, hex: of the file, or, for an extracted FMU folder, of every file's
@@ -80,7 +79,7 @@ pub fn study_hash(study: &Study) -> String {
 
 /// The store manifest of `study` on `fmu` with `design`.
 pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, RunError> {
-    let iface = Interface::resolve(study, fmu)?;
+    let iface = crate::study::plan::resolve::interface(study, fmu)?;
     let fmu_sha256 = sha256_file(fmu.path()).map_err(|source| FmuError::Io {
         path: fmu.path().to_path_buf(),
         source,

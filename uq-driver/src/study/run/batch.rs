@@ -6,15 +6,16 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use super::guard::StudyGuard;
-use super::instances::{self, InstancePolicy, ResetCheck, Slot};
-use super::interface::Interface;
-use super::isolate::{WorkerFailure, WorkerPool};
-use super::progress::Progress;
-use super::runner::{describe_values, run_point, PointError, RunError};
-use super::store::{Entry, Record, Store};
-use super::worker_fmu::WorkerFmus;
+use super::error::{PointError, RunError};
+use super::point::{describe_values, run_point};
 use crate::spec::Study;
+use crate::study::plan::interface::Interface;
+use crate::study::progress::Progress;
+use crate::study::run::guard::StudyGuard;
+use crate::study::run::instances::{self, InstancePolicy, ResetCheck, Slot};
+use crate::study::run::isolate::{WorkerFailure, WorkerPool};
+use crate::study::run::worker_fmu::WorkerFmus;
+use crate::study::store::{Entry, Record, Store};
 use crate::uq::method::Design;
 
 /// Points to run in parallel, each appended to the store as it finishes.
@@ -176,7 +177,14 @@ impl Batch<'_> {
             };
             let (check, fatal) = {
                 let _running = running();
-                super::point::check_reset(&fmu, &mut slot, &self.iface, values, &self.times, record)
+                crate::study::run::point::check_reset(
+                    &fmu,
+                    &mut slot,
+                    &self.iface,
+                    values,
+                    &self.times,
+                    record,
+                )
             };
             // Freed before the other points start (an FMU instantiable once per process).
             drop(slot);

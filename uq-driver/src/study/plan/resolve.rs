@@ -1,32 +1,24 @@
-//! The runs of its own of a `hunting_speed` quantity ([`crate::qoi::hunting_speed`]): at each
-//! design point, runs at constant speeds with the point's random values, the study's `[fixed]`
-//! values, the quantity's `set` values and the speed parameter, bisected on the same FMU
-//! instance as the point's run. They are part of the point's evaluation, so their results are
+//! A study resolved against its FMU: the [`Interface`] of its runs, including the runs of its
+//! own of each `hunting_speed` quantity ([`crate::qoi::hunting_speed`]): at each design point,
+//! runs at constant speeds with the point's random values, the study's `[fixed]` values, the
+//! quantity's `set` values and the speed parameter, bisected on the same FMU instance as the
+//! point's run (`run::point`). They are part of the point's evaluation, so their results are
 //! stored in the point's record (resumable, shardable, and the same in a `--isolate` worker).
 
-use serde::{Deserialize, Serialize};
-
-use super::instances::Slot;
-use super::interface::{Interface, InterfaceError, Settings, VariableProblem, Variables};
-use super::point::{simulate_point, PointError};
 use crate::fmu::{Fmu, VariableKind};
-use crate::qoi::evaluate::Code;
-use crate::qoi::hunting_speed::{bisect, keeps_hunting, HuntingSpeed, HuntingSpeedSpec};
+use crate::qoi::hunting_speed::HuntingSpeedSpec;
 use crate::qoi::QoiSpec;
 use crate::spec::{Experiment, Study};
+use crate::study::plan::interface::{
+    Interface, InterfaceError, Settings, SpeedRuns, VariableProblem, Variables,
+};
 
-/// A `hunting_speed` quantity's runs, resolved against the FMU.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpeedRuns {
-    /// Index of the quantity among the study's `[[qoi]]`.
-    pub qoi: usize,
-    /// Value reference of the speed parameter (a Real).
-    pub speed: u32,
-    /// What each run sets and reads: the random parameters, `[fixed]` merged with `set`, the
-    /// inputs; the signal as the only output.
-    pub run: Box<Interface>,
-    /// The runs' communication points (s): the study's start time to start + duration.
-    pub times: Vec<f64>,
+/// Checks the study's variables against the FMU and resolves their value references (reading
+/// the input file, if any), with the runs of each `hunting_speed` quantity.
+pub fn interface(study: &Study, fmu: &Fmu) -> Result<Interface, InterfaceError> {
+    let mut iface = Interface::resolve_variables(study, fmu)?;
+    iface.speed_runs = SpeedRuns::resolve_all(study, &iface, &Variables { fmu })?;
+    Ok(iface)
 }
 
 impl SpeedRuns {
@@ -108,78 +100,6 @@ impl SpeedRuns {
             run: Box::new(run),
             times,
         })
-    }
-
-    /// The bisection at one design point (`values` of the random parameters) on `slot`'s
-    /// instance (reset, or a fresh one, between runs, by its policy): the record's (value, code) pairs of both quantities, `name` then
-    /// `name_decay`.
-    pub fn evaluate(
-        &self,
-        h: &HuntingSpeedSpec,
-        fmu: &Fmu,
-        slot: &mut Slot,
-        values: &[f64],
-    ) -> Result<[f64; 4], PointError> {
-        let outcome = bisect(h.low, h.high, h.tolerance, |v| {
-            self.hunts(h, fmu, slot, values, v)
-                .map_err(|source| PointError::SpeedRun {
-                    name: h.name.clone(),
-                    parameter: h.speed_parameter.clone(),
-                    speed: v,
-                    source: Box::new(source),
-                })
-        })?;
-        Ok(match outcome {
-            HuntingSpeed::Found { hunts, decays, .. } => {
-                let ok = Code::Ok as u8 as f64;
-                [hunts, ok, decays, ok]
-            }
-            HuntingSpeed::NeverHunts => {
-                let c = Code::NeverHunts as u8 as f64;
-                [f64::NAN, c, f64::NAN, c]
-            }
-            HuntingSpeed::AlwaysHunts => {
-                let c = Code::NeverStops as u8 as f64;
-                [f64::NAN, c, f64::NAN, c]
-            }
-        })
-    }
-
-    /// One run at `speed`: whether the disturbance keeps hunting.
-    fn hunts(
-        &self,
-        h: &HuntingSpeedSpec,
-        fmu: &Fmu,
-        slot: &mut Slot,
-        values: &[f64],
-        speed: f64,
-    ) -> Result<bool, PointError> {
-        let nt = self.times.len();
-        let trace = simulate_point(
-            fmu,
-            slot,
-            &self.run,
-            values,
-            &self.times,
-            &[(self.speed, speed)],
-        )
-        .inspect_err(|_| slot.discard())?;
-        if let Some((time, _)) = trace.ended {
-            slot.discard();
-            return Err(PointError::EndedEarly {
-                time,
-                stop: self.times[nt - 1],
-            });
-        }
-        let series = &trace.values[..nt];
-        if let Some(k) = series.iter().position(|v| !v.is_finite()) {
-            slot.discard();
-            return Err(PointError::NonFinite {
-                signal: h.signal.clone(),
-                time: self.times[k],
-            });
-        }
-        Ok(keeps_hunting(&self.times, series, h.window, h.threshold))
     }
 }
 
