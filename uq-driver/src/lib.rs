@@ -119,7 +119,12 @@
 //!
 //! # Modules
 //!
-//! Modules by concept, each using only those above it in this list:
+//! Modules by concept, bottom first, each using only those before it in this list (a test,
+//! `layers`, reads every file's imports and fails on one against this order, and on two files
+//! that import each other):
+//! - `text` (crate-internal): CSV fields, numbers as text, file names;
+//! - `suggest` (crate-internal): "did you mean" for misspelt names;
+//! - `sys` (crate-internal): process-level system calls behind safe functions;
 //! - [`fmu`]: import of `.fmu` archives (safe unzip, modelDescription, dlopen, instances);
 //! - [`uq`]: distributions, random streams, sampling, quadrature, polynomial chaos, moments,
 //!   and the UQ methods ([`uq::method`], one module per method: design + estimator);
@@ -127,23 +132,29 @@
 //!   kernel densities;
 //! - [`spec`]: the study file, typed and validated;
 //! - [`results`]: typed results and the summaries written to `summary.json`;
-//! - [`report`]: CSV/JSON writers, plots, the HTML pages of a study and of a suite;
-//! - [`study`]: running a study: the parallel runner, the resumable results store, the
-//!   statistics, shards for a cluster, suites;
-//! - [`suggest`]: "did you mean" for misspelt names.
+//! - `report` (crate-internal): CSV/JSON writers, plots, the HTML pages of a study and of a
+//!   suite;
+//! - [`study`]: running a study: planning it (`plan`), running its points (`run`, the one
+//!   place that runs them), the resumable results store (`store`), the statistics
+//!   (`analysis`), shards for a cluster, suites;
+//! - [`prelude`]: the types most programs need;
+//! - `cli` (feature `cli`, on by default): the `uq-driver` command line.
+//!
+//! `unsafe` code is confined to the FMI import layer ([`fmu`]) and `sys`; every other module
+//! is `#![forbid(unsafe_code)]`.
 
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod fmu;
-/// Writing output files safely (links replaced, devices and pipes written into): the
-/// `out-file` crate of this workspace.
-pub use ::out_file;
+#[cfg(test)]
+mod layers;
+pub mod prelude;
 pub mod qoi;
-pub mod report;
+pub(crate) mod report;
 pub mod results;
 pub mod spec;
 pub mod study;
-pub mod suggest;
-pub mod sys;
-pub mod text;
+pub(crate) mod suggest;
+pub(crate) mod sys;
+pub(crate) mod text;
 pub mod uq;

@@ -15,14 +15,15 @@ use crate::uq::surrogate::Surrogate;
 
 /// The file named by `--out`, or `None` for standard output (no `--out`, or `--out -`).
 fn out_path(out: Option<&Path>) -> Option<&Path> {
-    out.filter(|p| !crate::out_file::is_stdout(p))
+    out.filter(|p| !out_file::is_stdout(p))
 }
 
-/// Writes `text` to `out` (by the rules of [`crate::out_file`]), or to standard output.
+/// Writes `text` to `out` (by the rules of the `out-file` crate), or to standard output.
 pub(crate) fn emit(text: &str, out: Option<&Path>) -> Result<()> {
     match out_path(out) {
-        Some(p) => crate::out_file::write(p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display())),
+        Some(p) => {
+            out_file::write(p, text.as_bytes()).with_context(|| format!("writing {}", p.display()))
+        }
         None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
     }
 }
@@ -46,7 +47,7 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             // Written as drawn: the memory does not grow with -n.
             match out_path(out.as_deref()) {
                 Some(p) => {
-                    let mut f = crate::out_file::OutFile::create(p, 1 << 16)
+                    let mut f = out_file::OutFile::create(p, 1 << 16)
                         .with_context(|| format!("writing {}", p.display()))?;
                     s.write_sample_csv(n, seed, &times, &mut f, &p.display().to_string())?;
                     f.commit()

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use super::{write_bytes, ReportError};
-pub use crate::text::csv::{push_field, push_header, push_shortest, shortest, split_line};
+pub use crate::text::csv::{push_field, push_header, push_shortest, shortest};
 
 /// Writes a CSV file with one header line and one row per index of the columns.
 ///

@@ -36,9 +36,7 @@ pub use csv::{write_columns, write_grid};
 pub use heatmap::Heatmap;
 pub use html::{ReportPage, Section, Table};
 pub use study::StudyReport;
-pub use svg::{
-    histogram_density, nice_ticks, palette, Band, BarChart, BarGroup, DensityPlot, LinePlot, Series,
-};
+pub use svg::{histogram_density, palette, Band, DensityPlot, LinePlot, Series};
 
 /// Errors of the report writers.
 #[derive(Debug, thiserror::Error)]
@@ -76,9 +74,9 @@ pub enum ReportError {
 }
 
 /// Writes `bytes` to `path`, attaching the path to any I/O error; never through a symbolic
-/// link, never half-written ([`crate::out_file`]).
+/// link, never half-written (the `out-file` crate).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    crate::out_file::write(path, bytes).map_err(|source| ReportError::Io {
+    out_file::write(path, bytes).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })

@@ -4,24 +4,31 @@
 //! [`run_study`] is the whole pipeline: study → the method's design → runs (parallel,
 //! resumable) → the method's estimates → statistics → report. An intrusive method solves its
 //! own system instead of running an FMU. A suite (a study with `[[variants]]`) runs each
-//! variant into a sub-folder and then writes a comparison ([`suite`]).
+//! variant into a sub-folder and then writes a comparison.
 
 #![forbid(unsafe_code)]
 
-pub mod analysis;
+pub(crate) mod analysis;
 mod outcome;
-pub mod plan;
-pub mod progress;
-pub mod run;
-pub mod shard;
+pub(crate) mod plan;
+pub(crate) mod progress;
+pub(crate) mod run;
+pub(crate) mod shard;
 mod single;
-pub mod store;
-pub mod suite;
+pub(crate) mod store;
+pub(crate) mod suite;
 
 use std::path::Path;
 
+pub use analysis::AnalysisError;
 pub use outcome::{Outcome, StudyResult, StudyRunError, SuiteResult};
-pub use run::{RunError, RunOptions, RunOutcome};
+pub use plan::interface::{InterfaceError, VariableProblem};
+pub use plan::size::SizeError;
+pub use progress::{set_message_sink, Sink};
+pub use run::guard::install_process_guards;
+pub use run::{simulate, simulate_with, FailedPoint, PointError, RunError, RunOptions, Simulation};
+pub use store::lock::LockError;
+pub use store::StoreError;
 
 use crate::spec::Study;
 
@@ -30,7 +37,7 @@ use crate::spec::Study;
 ///
 /// Nothing is allocated, run or written (`out_dir` is not even created) before the study
 /// passes [`Study::check`] (the fields of a [`Study`] are public: they are checked again) and
-/// [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`. An empty
+/// the size check: too large to run, it is refused; large, it needs `opts.yes`. An empty
 /// `out_dir` is refused ([`RunError::NoOutDir`]), as are options that do not fit together
 /// ([`RunError::Options`]).
 pub fn run_study(

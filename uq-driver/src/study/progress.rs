@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 /// Where the library's messages to the user go (notes and warnings printed as a study runs:
 /// "taking over a stale lock", "N points failed in an earlier run", a variant starting, …).
-type Sink = Box<dyn Fn(&str) + Send + Sync>;
+pub type Sink = Box<dyn Fn(&str) + Send + Sync>;
 static MESSAGES: RwLock<Option<Sink>> = RwLock::new(None);
 
 /// Sends the library's messages to `sink` (None: nowhere, the default). The command line
@@ -42,18 +42,6 @@ pub enum ProgressMode {
     Bar,
     /// A line now and then (a log file).
     Lines,
-}
-
-impl ProgressMode {
-    /// A bar when standard error is a terminal, else lines.
-    pub fn auto() -> ProgressMode {
-        use std::io::IsTerminal;
-        if std::io::stderr().is_terminal() {
-            ProgressMode::Bar
-        } else {
-            ProgressMode::Lines
-        }
-    }
 }
 
 /// Progress over `total` points.

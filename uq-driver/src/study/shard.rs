@@ -165,7 +165,7 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
             )));
         }
     }
-    crate::out_file::write(
+    out_file::write(
         &path,
         serde_json::to_string_pretty(&p).expect("json").as_bytes(),
     )
@@ -185,7 +185,7 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
         csv.push('\n');
     }
     let dpath = dir.join("design.csv");
-    crate::out_file::write(&dpath, csv.as_bytes()).map_err(io(&dpath))?;
+    out_file::write(&dpath, csv.as_bytes()).map_err(io(&dpath))?;
     Ok(p)
 }
 
@@ -337,7 +337,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     drop(shard_runs);
     let outcome = RunOutcome {
         runs,
-        lock: Some(lock),
+        _lock: Some(lock),
         n_new: 0,
         n_resumed: n,
         wall_time: 0.0,
@@ -374,7 +374,7 @@ pub fn write_sbatch(
     o: &SlurmOptions,
 ) -> Result<(PathBuf, PathBuf), ShardError> {
     let sdir = dir.join("slurm");
-    crate::out_file::sub_folder(&sdir).map_err(io(&sdir))?;
+    out_file::sub_folder(&sdir).map_err(io(&sdir))?;
     let dir = std::fs::canonicalize(dir).map_err(io(dir))?;
     if dir.to_string_lossy().contains(char::is_whitespace) {
         // #SBATCH lines are not parsed by a shell: a path with blanks cannot be written there.
@@ -416,8 +416,8 @@ pub fn write_sbatch(
         no_report = if o.no_report { " --no-report" } else { "" },
     );
     let (a, b) = (sdir.join("shard.sbatch"), sdir.join("merge.sbatch"));
-    crate::out_file::write(&a, shard.as_bytes()).map_err(io(&a))?;
-    crate::out_file::write(&b, merge.as_bytes()).map_err(io(&b))?;
+    out_file::write(&a, shard.as_bytes()).map_err(io(&a))?;
+    out_file::write(&b, merge.as_bytes()).map_err(io(&b))?;
     Ok((a, b))
 }
 

@@ -35,7 +35,7 @@ pub fn run(
             v.method().label(v.parameters.len())
         ));
         let folder = out_dir.join(&v.name);
-        crate::out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
+        out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
             path: folder.clone(),
             source,
         })?;

@@ -97,7 +97,6 @@ pub const ASSUMED_MEMORY: f64 = 4.0 * GIB;
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 pub use available::available_memory;
-pub use chaos::ChaosShape;
 pub use disk::Disk;
 
 /// Why a study does not start.
@@ -421,20 +420,6 @@ pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, Si
     };
     judge(&footprint, true)?;
     Ok(footprint)
-}
-
-/// Refuses `what` when its `need` (bytes) exceeds the memory available to this process
-/// ([`available_memory`], or an assumed amount where the system does not say).
-pub fn check_memory(what: &str, need: f64) -> Result<(), SizeError> {
-    let available = available_memory().unwrap_or(ASSUMED_MEMORY);
-    if need.is_nan() || need > available {
-        return Err(SizeError::NoMemory {
-            what: what.to_owned(),
-            need: bytes(need),
-            limit: bytes(available),
-        });
-    }
-    Ok(())
 }
 
 /// The footprint of `shape` with `runs` runs (none known: the grid and one run's buffers).

@@ -23,7 +23,7 @@ use crate::spec::Study;
 use crate::study::plan::fingerprint;
 use crate::study::progress::{Progress, ProgressMode};
 use crate::study::store::lock::FolderLock;
-use crate::study::store::{Entry, Record, Store, StoreError, StoredRuns};
+use crate::study::store::{Entry, Store, StoreError, StoredRuns};
 use crate::uq::method::Design;
 use batch::{Batch, Notes};
 pub use error::{FailedPoint, PointError, RunError};
@@ -31,7 +31,7 @@ use guard::StudyGuard;
 use instances::InstancePolicy;
 use isolate::{IsolateOptions, WorkerPool};
 pub use options::RunOptions;
-pub use point::{simulate, simulate_with, Simulation, Trace};
+pub use point::{simulate, simulate_with, Simulation};
 use worker_fmu::WorkerFmus;
 
 /// What a run produced: every point's record, in design order, read in place from the
@@ -41,7 +41,7 @@ pub struct RunOutcome {
     /// Records by point index (all present unless stopped early).
     pub runs: StoredRuns,
     /// The output folder's lock, held while the records are read (None: not locked).
-    pub lock: Option<FolderLock>,
+    pub _lock: Option<FolderLock>,
     /// Points run in this invocation.
     pub n_new: usize,
     /// Points found finished in the store.
@@ -55,13 +55,6 @@ pub struct RunOutcome {
     /// Warnings of the runs (printed when they arose): a failed reset self-check or
     /// `fmi2Reset`, for `summary.json`.
     pub warnings: Vec<String>,
-}
-
-impl RunOutcome {
-    /// Every record read into memory (small studies and tests: this holds every series).
-    pub fn records(&self) -> Result<Vec<Option<Record>>, StoreError> {
-        self.runs.records()
-    }
 }
 
 /// Runs every point of `design` not yet in the store of `out_dir` (with
@@ -190,7 +183,7 @@ pub fn run_points(
     }
     Ok(RunOutcome {
         runs,
-        lock: Some(lock),
+        _lock: Some(lock),
         n_new,
         n_resumed: wanted.len() - missing.len(),
         wall_time: started.elapsed().as_secs_f64(),

@@ -17,7 +17,6 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::out_file::OutFile;
 use crate::report::ReportError;
 use crate::spec::Experiment;
 use crate::study::store::format::{self, Slot};
@@ -25,6 +24,7 @@ use crate::study::store::lock::{FolderLock, LockError};
 use crate::study::store::Manifest;
 use crate::text::csv::{push_header, split_line};
 use crate::text::file_name::stem;
+use out_file::OutFile;
 
 /// Why the runs cannot be exported.
 #[derive(Debug, thiserror::Error)]

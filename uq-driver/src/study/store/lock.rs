@@ -220,7 +220,7 @@ impl FolderLock {
         file.sync_data().map_err(io)?;
         // Only this process writes in the folder now: temporary files there are a killed
         // run's leftovers.
-        crate::out_file::remove_leftovers(dir);
+        out_file::remove_leftovers(dir);
         Ok(FolderLock {
             path,
             file,

@@ -27,7 +27,7 @@ use std::sync::Mutex;
 
 use serde::{Deserialize, Serialize};
 
-pub use format::{decode, encode, Decoded, Format, Skipped, Slot};
+pub use format::{encode, Format, Skipped, Slot};
 pub use runs::{Entry, StoredRuns, Values};
 
 /// What the store is for; a store written for another study is refused.
@@ -241,7 +241,7 @@ impl Store {
             fs::remove_dir_all(&sdir).map_err(io_err(&sdir))?;
         }
         // A planted link (the folder may be shared, the run root's) is never written through.
-        crate::out_file::sub_folder(&sdir).map_err(io_err(&sdir))?;
+        out_file::sub_folder(&sdir).map_err(io_err(&sdir))?;
         check_manifest(dir, &sdir.join("manifest.json"), manifest)?;
         let path = sdir.join("records.bin");
         let mut file = OpenOptions::new()
@@ -432,7 +432,7 @@ fn write_kept(
 fn check_manifest(dir: &Path, mpath: &Path, manifest: &Manifest) -> Result<(), StoreError> {
     if !mpath.exists() {
         let text = serde_json::to_string_pretty(manifest).expect("serializable");
-        return crate::out_file::write(mpath, text.as_bytes()).map_err(io_err(mpath));
+        return out_file::write(mpath, text.as_bytes()).map_err(io_err(mpath));
     }
     let text = fs::read_to_string(mpath).map_err(io_err(mpath))?;
     let old: Manifest = serde_json::from_str(&text).map_err(|e| StoreError::Corrupt {

@@ -52,8 +52,7 @@ use super::instances::{InstancePolicy, ResetCheck};
 use crate::fmu::Fmu;
 use crate::study::plan::interface::Interface;
 
-pub use protocol::{read_frame, write_frame};
-pub use serve::{serve, PROTOCOL_FD_MIN};
+pub use serve::serve;
 pub use worker::Worker;
 
 /// What a worker needs to run points.
