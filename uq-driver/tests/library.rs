@@ -3,11 +3,9 @@
 //! host's process alone (no `atexit` handler, no signal handlers, no `_exit`) unless the host
 //! opts in with `install_process_guards`.
 //!
-//! This test binary never calls `install_process_guards` (it would change every test of the
-//! binary): the opted-in behaviour is the command line's, tested in `isolation.rs`.
-
-#[path = "support/wheel.rs"]
-mod wheel;
+//! No test of this test binary calls `install_process_guards` (it would change every test of
+//! the process, see `main.rs`): the opted-in behaviour is the command line's, tested in
+//! `isolation.rs`.
 
 use std::path::Path;
 use std::time::Duration;
@@ -16,30 +14,11 @@ use uq_driver::spec::{Experiment, Study, StudyError};
 use uq_driver::study::run::{simulate, PointError};
 use uq_driver::study::{run_study, Outcome, RunError, RunOptions, StudyRunError};
 
+use crate::support::wheel;
+
 fn study(method: &str) -> Study {
-    let text = format!(
-        r#"name = "lib"
-fmu = "{}"
-seed = 1
-[experiment]
-start = 0.0
-stop = 1.0
-step = 0.01
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-std = 2.0
-[outputs]
-variables = ["q"]
-[method]
-{method}
-"#,
-        wheel::wheel_fmu().display()
-    );
+    let experiment = "start = 0.0\nstop = 1.0\nstep = 0.01";
+    let text = wheel::study_text("lib", 1, experiment, method, "");
     Study::parse(&text, "inline", None).unwrap()
 }
 
@@ -235,6 +214,13 @@ fn an_in_process_study_leaves_the_signal_handlers_alone() {
 /// Set in the child process of the next test.
 const HOST_EXIT_CHILD: &str = "UQ_DRIVER_TEST_HOST_EXIT_CHILD";
 
+/// The name the test harness knows the test function `name` of this module by
+/// (`library::name`), to run it alone in a child process.
+fn test_name(name: &str) -> String {
+    let module = module_path!().split_once("::").map_or("", |m| m.1);
+    format!("{module}::{name}")
+}
+
 /// While a study ran in a background thread, the host's own
 /// `std::process::exit(0)` became exit status 1 with a message blaming an FMU (an `atexit`
 /// handler registered by the study). The host (this test binary, run again as a child)
@@ -266,7 +252,7 @@ fn the_hosts_own_exit_during_a_study_keeps_its_status() {
     let child = std::process::Command::new(std::env::current_exe().unwrap())
         .args([
             "--exact",
-            "the_hosts_own_exit_during_a_study_keeps_its_status",
+            &test_name("the_hosts_own_exit_during_a_study_keeps_its_status"),
             "--nocapture",
         ])
         .env(HOST_EXIT_CHILD, dir.path().join("out"))
