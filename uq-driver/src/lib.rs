@@ -45,7 +45,7 @@
 //! "#;
 //! // `base`: the folder a relative `fmu` path starts from.
 //! let study = Study::parse(toml, "inline", None)?;
-//! let opts = RunOptions { threads: Some(2), no_report: true, ..RunOptions::default() };
+//! let opts = RunOptions::default().with_threads(2).with_no_report(true);
 //! let Outcome::Study(result) = run_study(&study, Path::new("out/wheel-sobol"), &opts)? else {
 //!     unreachable!("a study without [[variants]] is not a suite");
 //! };

@@ -23,12 +23,10 @@ fn study(method: &str) -> Study {
 }
 
 fn opts() -> RunOptions {
-    RunOptions {
-        threads: Some(2),
-        no_report: true,
-        fresh: true,
-        ..RunOptions::default()
-    }
+    RunOptions::default()
+        .with_threads(2)
+        .with_no_report(true)
+        .with_fresh(true)
 }
 
 fn invalid_message(r: Result<Outcome, StudyRunError>) -> String {
@@ -109,10 +107,7 @@ fn an_empty_output_folder_is_refused() {
 fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
     let dir = tempfile::tempdir().unwrap();
     let s = study("kind = \"lhs\"\nsamples = 50");
-    let o = RunOptions {
-        timeout_per_run: Some(Duration::from_millis(1)),
-        ..opts()
-    };
+    let o = opts().with_timeout_per_run(Duration::from_millis(1));
     match run_study(&s, &dir.path().join("out"), &o) {
         Err(StudyRunError::Run(RunError::Options(m))) => {
             assert!(
@@ -124,18 +119,12 @@ fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
         Ok(_) => panic!("timeout_per_run in-process was accepted"),
     }
     // threads = 0 was silently made 1 ; points outside the design were dropped.
-    let o = RunOptions {
-        threads: Some(0),
-        ..opts()
-    };
+    let o = opts().with_threads(0);
     assert!(matches!(
         run_study(&s, &dir.path().join("out0"), &o),
         Err(StudyRunError::Run(RunError::Options(_)))
     ));
-    let o = RunOptions {
-        points: Some(vec![1_000_000]),
-        ..opts()
-    };
+    let o = opts().with_points(vec![1_000_000]);
     match run_study(&s, &dir.path().join("out1"), &o) {
         Err(StudyRunError::Run(RunError::Options(m))) => assert!(m.contains("1000000"), "{m}"),
         Err(e) => panic!("{e}"),

@@ -27,6 +27,7 @@ use crate::uq::random_inputs::Correlation;
 
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct OutputStats {
     /// Variable name.
     pub name: String,
@@ -81,6 +82,7 @@ impl OutputStats {
 
 /// Statistics of one scalar quantity of interest.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct ScalarStats {
     /// Quantity name.
     pub name: String,
@@ -491,6 +493,7 @@ fn parameters_with_moments<S: serde::Serializer>(
 
 /// `summary.json` of a study.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Summary {
     /// Study name.
     pub study: String,
@@ -602,6 +605,7 @@ pub struct VariantSummary {
 
 /// `summary.json` of a suite.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct SuiteSummary {
     /// Suite name.
     pub suite: String,

@@ -101,6 +101,7 @@ pub use disk::Disk;
 
 /// Why a study does not start.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SizeError {
     /// The study's results store needs more disk space than there is.
     #[error(

@@ -11,6 +11,7 @@ use crate::uq::method::MethodError;
 
 /// A point that failed: where and why.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct FailedPoint {
     /// Index in the design.
     pub index: usize,
@@ -33,6 +34,7 @@ impl std::fmt::Display for FailedPoint {
 
 /// Runner failures.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum RunError {
     /// The FMU could not be opened.
     #[error(transparent)]
@@ -116,6 +118,7 @@ pub enum RunError {
 
 /// Why one model run failed. Its text is stored with the point, so it is complete on its own.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PointError {
     /// An FMI call failed (the message lists what the FMU logged).
     #[error(transparent)]

@@ -7,8 +7,16 @@ use super::error::RunError;
 use super::guard;
 use crate::spec::Study;
 
-/// How to run a study.
+/// How to run a study. Built from [`RunOptions::default`] (all cores, resume, a report) with
+/// the `with_*` methods, or by setting fields on a default value:
+///
+/// ```
+/// use uq_driver::study::RunOptions;
+/// let opts = RunOptions::default().with_threads(2).with_no_report(true).with_fresh(true);
+/// assert_eq!(opts.threads, Some(2));
+/// ```
 #[derive(Clone, Debug, Default)]
+#[non_exhaustive]
 pub struct RunOptions {
     /// Worker threads of the model runs (None: all cores; 0 is refused).
     pub threads: Option<usize>,
@@ -49,6 +57,90 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
+    /// Worker threads of the model runs (at least 1; the default is all cores).
+    pub fn with_threads(mut self, v: usize) -> Self {
+        self.threads = Some(v);
+        self
+    }
+
+    /// Shows a progress bar (on a terminal).
+    pub fn with_progress(mut self, v: bool) -> Self {
+        self.progress = v;
+        self
+    }
+
+    /// Prints progress lines (for a log file).
+    pub fn with_progress_lines(mut self, v: bool) -> Self {
+        self.progress_lines = v;
+        self
+    }
+
+    /// Unweighted designs: continues past failed points.
+    pub fn with_allow_failures(mut self, v: bool) -> Self {
+        self.allow_failures = v;
+        self
+    }
+
+    /// Discards earlier results in the output folder.
+    pub fn with_fresh(mut self, v: bool) -> Self {
+        self.fresh = v;
+        self
+    }
+
+    /// Stops after this many newly finished points (the study resumes later).
+    pub fn with_max_new_points(mut self, v: usize) -> Self {
+        self.max_new_points = Some(v);
+        self
+    }
+
+    /// Runs only these points of the design (a shard).
+    pub fn with_points(mut self, v: Vec<usize>) -> Self {
+        self.points = Some(v);
+        self
+    }
+
+    /// Writes the CSV files and `summary.json` only.
+    pub fn with_no_report(mut self, v: bool) -> Self {
+        self.no_report = v;
+        self
+    }
+
+    /// Runs the points that failed in an earlier run again.
+    pub fn with_retry_failed(mut self, v: bool) -> Self {
+        self.retry_failed = v;
+        self
+    }
+
+    /// Runs each point in a worker process started from this executable (see the field).
+    pub fn with_isolate(mut self, v: PathBuf) -> Self {
+        self.isolate = Some(v);
+        self
+    }
+
+    /// The time limit of one run (see the field).
+    pub fn with_timeout_per_run(mut self, v: Duration) -> Self {
+        self.timeout_per_run = Some(v);
+        self
+    }
+
+    /// Starts a large study without asking.
+    pub fn with_yes(mut self, v: bool) -> Self {
+        self.yes = v;
+        self
+    }
+
+    /// Runs every point on a fresh FMU instance.
+    pub fn with_fresh_instances(mut self, v: bool) -> Self {
+        self.fresh_instances = v;
+        self
+    }
+
+    /// Instantiates the FMU with `loggingOn = true`.
+    pub fn with_fmu_logging(mut self, v: bool) -> Self {
+        self.fmu_logging = v;
+        self
+    }
+
     /// Checks that the options fit together: `threads` at least 1, and `timeout_per_run`
     /// either with `isolate` (a longer run is killed) or in a process that opted in to
     /// [`guard::install_process_guards`] (in-process, a longer run ends the whole process,

@@ -243,6 +243,7 @@ pub fn check_reset(
 
 /// One deterministic run: its times and, per recorded variable, the series.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct Simulation {
     /// The variables recorded.
     pub names: Vec<String>,
