@@ -12,6 +12,8 @@
 //! - [`galerkin`]: the stochastic Galerkin system of a linear second-order model;
 //! - [`moments`]: sample and quadrature moments, quantiles, exceedance probabilities;
 //! - [`method`]: the UQ methods, one module each (design + estimator);
+//! - [`reliability`]: small failure probabilities (FORM, SORM, importance sampling, subset
+//!   simulation) and Morris screening, on a batch-evaluated limit state in standard space;
 //! - [`surrogate`]: the exported chaos surrogate (`surrogate.json`), evaluated and sampled;
 //! - [`hd`]: high-dimensional building blocks (sparse grids, Askey chaos, QMC, LARS, copula).
 
@@ -23,6 +25,7 @@ pub mod moments;
 pub mod pce;
 pub mod quadrature;
 pub mod random_inputs;
+pub mod reliability;
 pub mod rng;
 pub mod sampling;
 pub mod special;
