@@ -346,6 +346,7 @@ mod tests {
             let mut m = lin.model();
             let r = form(&mut m, &Form::default(), 0).unwrap();
             let err = (r.probability - p).abs() / p;
+            println!("linear P = {p}: FORM error {err:.1e}, {} runs", r.runs);
             assert!(r.converged, "{r:?}");
             assert!(err < 0.01, "P = {p}: FORM {} ({err:.2e})", r.probability);
             assert!(r.runs <= 20 * 8, "{} runs", r.runs);
@@ -376,6 +377,10 @@ mod tests {
                 let mut m = lognormal_model(&inputs, limit);
                 let r = form(&mut m, &settings, 0).unwrap();
                 let err = (r.probability - p).abs() / p;
+                println!(
+                    "lognormal P = {p}, {scheme:?}: FORM error {err:.1e}, {} runs",
+                    r.runs
+                );
                 assert!(r.converged && err < 0.01, "{p} {scheme:?}: {r:?}");
                 assert!(r.runs <= 20 * 8, "{} runs", r.runs);
                 let x = r.x_star.unwrap();

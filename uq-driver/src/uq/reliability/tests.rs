@@ -159,6 +159,20 @@ fn correlated_lognormal_inputs_through_the_nataf_transformation() {
     let [a, b] = is.interval.unwrap();
     assert!(a <= exact && exact <= b, "IS {is:?} vs {exact:.4e}");
     let ss = subset_simulation(&mut m, &Subset::default(), 2, is.next_run).unwrap();
+    println!(
+        "correlated log-normals, exact {exact:.4e}: FORM {:.4e} ({} runs), SORM {:.4e} ({} \
+         runs), IS {:.4e} CoV {:.3} ({} runs), subset {:.4e} CoV {:.3} ({} runs)",
+        f.probability,
+        f.runs,
+        so.probability,
+        so.runs,
+        is.probability,
+        is.cov.unwrap(),
+        is.runs,
+        ss.probability,
+        ss.cov.unwrap(),
+        ss.runs
+    );
     let [a, b] = ss.interval.unwrap();
     assert!(a <= exact && exact <= b, "subset {ss:?} vs {exact:.4e}");
 }
