@@ -21,7 +21,7 @@
 //!
 //! Runs go in batches of `batch` samples until the CoV reaches `target_cov` (with at least
 //! [`MIN_FAILURES`] failing samples) or `max_runs` are spent. Sample `i` draws from its own
-//! stream ([`super::Purpose::ImportanceSample`]): the same seed gives the same samples,
+//! stream (index `1 << 56 | i`): the same seed gives the same samples,
 //! whatever the batch size.
 
 use serde::{Deserialize, Serialize};

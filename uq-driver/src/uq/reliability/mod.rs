@@ -22,7 +22,7 @@
 //! Every point a method requests is a *run* with an index (`0, 1, 2, ...` in the order of
 //! the requests, [`Point::run`]). The points requested are a deterministic function of the
 //! settings, the seed and the values returned for the earlier runs: random numbers come from
-//! [`rng::stream`](crate::uq::rng::stream)`(seed, index)` streams (fixed per sample, chain or
+//! [`crate::uq::rng::stream`]`(seed, index)` streams (fixed per sample, chain or
 //! start, never per thread), and nothing depends on timing or on the thread count. So a
 //! runner
 //! 1. stores each finished run as `(run index, u, outcome)` ([`StoredRun`]) as it finishes;
@@ -36,9 +36,9 @@
 //! [`LimitState::evaluate`]; the method returns [`ReliabilityError::Aborted`].
 //!
 //! # Methods (one file each)
-//! - [`form`]: the design point by iHLRF (Zhang & Der Kiureghian 1997), `P = Phi(-beta)`;
+//! - [`form`](mod@form): the design point by iHLRF (Zhang & Der Kiureghian 1997), `P = Phi(-beta)`;
 //!   [`multistart`]: several starting points, distinct design points flagged;
-//! - [`sorm`]: principal curvatures at the design point; Breitung (1984),
+//! - [`sorm`](mod@sorm): principal curvatures at the design point; Breitung (1984),
 //!   Hohenbichler & Rackwitz (1988), Tvedt (1990);
 //! - [`importance`]: importance sampling around the design point;
 //! - [`subset`]: subset simulation (Au & Beck 2001) with adaptive conditional sampling

@@ -23,7 +23,7 @@
 //! until `r` remain (the greedy variant of Ruano et al. 2012). Cost `O(M^2 d^3)`.
 //!
 //! Run `t (d + 1) + j` is point `j` of trajectory `t`; candidate `m` draws from its own
-//! stream ([`super::Purpose::Morris`]).
+//! stream (index `4 << 56 | m`).
 
 use serde::{Deserialize, Serialize};
 

@@ -11,7 +11,7 @@
 //! first-order union bound (Boole) of the series system they span.
 //!
 //! The starts run one after the other (each with its own batches of `d + 1` runs); random
-//! starts draw from the stream of their index ([`super::Purpose::Start`]).
+//! starts draw from the stream of their index (`3 << 56 | k`).
 
 use serde::{Deserialize, Serialize};
 

@@ -42,8 +42,8 @@
 //! `cov_upper`, on the log scale: conservative (it held the exact value in 197 to 200 of 200
 //! seeds), about twice as wide in `ln P` as the one on `cov`.
 //!
-//! Streams: sample `i` of level 0 draws from index `i`, chain `c` of level `l >= 1` from
-//! index `l << 32 | c` ([`super::Purpose::Subset`]), `d` normals per step.
+//! Streams: sample `i` of level 0 draws from index `2 << 56 | i`, chain `c` of level
+//! `l >= 1` from index `2 << 56 | l << 32 | c`, `d` normals per step.
 
 use serde::{Deserialize, Serialize};
 
