@@ -14,6 +14,8 @@
 //! - `galerkin`: the stochastic Galerkin system of a linear second-order model;
 //! - `moments`: sample and quadrature moments, quantiles, exceedance probabilities;
 //! - [`method`]: the UQ methods, one module each (design + estimator);
+//! - `reliability`: small failure probabilities (FORM, SORM, importance sampling, subset
+//!   simulation) and Morris screening, on a batch-evaluated limit state in standard space;
 //! - [`surrogate`]: the exported chaos surrogate (`surrogate.json`), evaluated and sampled;
 //! - `hd`: high-dimensional building blocks (sparse grids, Askey chaos, QMC, LARS, copula).
 
@@ -27,6 +29,7 @@ pub(crate) mod moments;
 pub(crate) mod pce;
 pub(crate) mod quadrature;
 pub(crate) mod random_inputs;
+pub(crate) mod reliability;
 pub(crate) mod rng;
 pub(crate) mod sampling;
 pub(crate) mod special;
