@@ -158,3 +158,23 @@ pub(crate) mod suggest;
 pub(crate) mod sys;
 pub(crate) mod text;
 pub mod uq;
+
+/// Not part of the API: the fuzz targets' and the integration tests' access to internals; may
+/// change at any release.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::study::plan::fingerprint::study_hash;
+    pub use crate::study::run::run_points;
+    pub use crate::uq::hd::lars::PathKind;
+    pub use crate::uq::hd::sensitivity::pick_freeze_bootstrap;
+    pub use crate::uq::hd::sobol_seq::Sobol;
+    pub use crate::uq::hd::sparse_chaos::{fit_chaos, FitKind};
+    pub use crate::uq::pce::askey::Family;
+
+    /// The results store: its reader and writer, the record format, the folder lock.
+    pub mod store {
+        pub use crate::study::store::format::{decode, MAGIC};
+        pub use crate::study::store::lock::FolderLock;
+        pub use crate::study::store::{encode, Format, Manifest, Record, Store};
+    }
+}

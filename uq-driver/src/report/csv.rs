@@ -116,6 +116,7 @@ fn push_number(out: &mut String, v: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::text::csv::split_line;
 
     fn parse(text: &str) -> Vec<Vec<f64>> {
         text.lines()

@@ -217,18 +217,19 @@ mod tests {
             ],
             log_scale: false,
         };
-        map.write_png(&dir.join("q_pdf.png")).unwrap();
-        map.write_svg(&dir.join("q_pdf.svg"), "q_pdf.png").unwrap();
-        map.write_svg_embedded(&dir.join("q_pdf_embedded.svg"))
-            .unwrap();
+        let png = map.to_png().unwrap();
+        write_bytes(&dir.join("q_pdf.png"), &png).unwrap();
+        write_bytes(&dir.join("q_pdf.svg"), map.to_svg("q_pdf.png").as_bytes()).unwrap();
+        let embedded = map.to_svg(&Heatmap::data_uri(&png));
+        write_bytes(&dir.join("q_pdf_embedded.svg"), embedded.as_bytes()).unwrap();
         let log_map = Heatmap {
             log_scale: true,
             title: "PDF of q over time (log colour)".into(),
             ..map.clone()
         };
-        log_map
-            .write_svg_embedded(&dir.join("q_pdf_log.svg"))
-            .unwrap();
+        let log_png = log_map.to_png().unwrap();
+        let log_svg = log_map.to_svg(&Heatmap::data_uri(&log_png));
+        write_bytes(&dir.join("q_pdf_log.svg"), log_svg.as_bytes()).unwrap();
 
         csv::write_columns(
             &dir.join("q_stats.csv"),

@@ -62,11 +62,6 @@ impl Slot {
         }
     }
 
-    /// How the next run gets its instance.
-    pub fn policy(&self) -> InstancePolicy {
-        self.policy
-    }
-
     /// Reuse instances from now on, or not.
     pub fn set_reuse(&mut self, reuse: bool) {
         self.policy.reuse = reuse;

@@ -66,8 +66,9 @@ pub struct Decoded {
 }
 
 impl Decoded {
-    /// End of the last valid record (0 if there is none).
-    pub fn valid_end(&self) -> usize {
+    /// End of the last valid record (0 if there is none). Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn valid_end(&self) -> usize {
         self.records.last().map_or(0, |(_, _, r)| r.end)
     }
 }
@@ -347,7 +348,7 @@ pub fn detect_format(bytes: &[u8]) -> Format {
     Format::V2
 }
 
-/// Decodes a store file of either format (see [`detect_format`]).
+/// Decodes a store file of either format (see `detect_format`).
 pub fn decode(bytes: &[u8], n_values: usize) -> (Format, Decoded) {
     let format = detect_format(bytes);
     (format, decode_format(bytes, n_values, format))

@@ -233,11 +233,6 @@ impl FolderLock {
     pub fn taken_over(&self) -> Option<&str> {
         self.taken_over.as_deref()
     }
-
-    /// The lock file.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
 }
 
 impl Drop for FolderLock {
@@ -277,7 +272,7 @@ mod tests {
         std::fs::write(dir.path().join(LOCK_FILE), format!("{stale}\n")).unwrap();
         let lock = FolderLock::acquire(dir.path()).unwrap();
         assert_eq!(lock.taken_over(), Some(stale));
-        let text = std::fs::read_to_string(lock.path()).unwrap();
+        let text = std::fs::read_to_string(&lock.path).unwrap();
         assert!(
             text.starts_with(&format!("pid {} ", std::process::id())),
             "{text}"

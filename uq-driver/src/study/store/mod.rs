@@ -205,8 +205,9 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> StoreError + '_ {
 }
 
 /// Decodes format-2 records from `bytes`, skipping damaged stretches; returns the records and
-/// the end of the last valid one.
-pub fn decode_all(bytes: &[u8], n_values: usize) -> (Vec<(usize, Record)>, usize) {
+/// the end of the last valid one. Serves the tests.
+#[cfg(test)]
+pub(crate) fn decode_all(bytes: &[u8], n_values: usize) -> (Vec<(usize, Record)>, usize) {
     let d = format::decode_format(bytes, n_values, Format::V2);
     let end = d.valid_end();
     (d.records.into_iter().map(|(i, r, _)| (i, r)).collect(), end)
