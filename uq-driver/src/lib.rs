@@ -67,15 +67,15 @@
 //! - it checks the study again ([`spec::Study::check`]: its fields are public) and refuses
 //!   an empty `out_dir` and options that do not fit together, with typed errors;
 //! - process-wide behaviour is off unless the host opts in with
-//!   [`study::guard::install_process_guards`], as the command line does: signal handlers, an
+//!   [`study::install_process_guards`], as the command line does: signal handlers, an
 //!   `atexit` check that reports an FMU calling `exit()`, and ending the process when an
 //!   in-process run overruns [`study::RunOptions::timeout_per_run`]. Without it a host's own
 //!   `exit()` and signals are its own, and `timeout_per_run` needs
 //!   [`study::RunOptions::isolate`] (each run in a worker process, killed after the limit;
-//!   the worker is this program started as `<exe> worker`, see [`study::isolate`]): the
+//!   the worker is this program started as `<exe> worker`, see `uq-driver worker`): the
 //!   safe way to run an FMU that may crash, hang or call `exit()`.
 //!
-//! One simulation without a study: [`study::runner::simulate`]; the FMU itself, call by
+//! One simulation without a study: [`study::simulate`]; the FMU itself, call by
 //! call: [`fmu::Fmu`] and [`fmu::Instance`].
 //!
 //! ## UQ on a plain Rust function: design → simulate → estimate

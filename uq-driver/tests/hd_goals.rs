@@ -6,11 +6,8 @@
 
 use std::f64::consts::PI;
 
-use uq_driver::uq::hd::lars::PathKind;
-use uq_driver::uq::hd::sobol_seq::Sobol;
-use uq_driver::uq::hd::sparse_chaos::{fit_chaos, FitKind};
-use uq_driver::uq::pce::askey::Family;
-use uq_driver::uq::special::norm_ppf;
+use uq_driver::internals::{fit_chaos, Family, FitKind, PathKind, Sobol};
+use uq_driver::uq::norm_ppf;
 
 use crate::support::benchmarks;
 

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use uq_driver::fmu::Fmu;
 use uq_driver::spec::FixedValue;
-use uq_driver::study::run::simulate;
+use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
 use crate::support::{built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8};

@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
 
+use uq_driver::internals as runner;
 use uq_driver::spec::Study;
-use uq_driver::study::run::{self as runner, RunOptions};
-use uq_driver::uq::distributions::Germ;
+use uq_driver::study::RunOptions;
 use uq_driver::uq::method::Design;
+use uq_driver::uq::Germ;
 
 use crate::support::{
     built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head, test_fmus, utf8,
@@ -282,7 +283,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
 
 #[test]
 fn a_retried_point_that_now_succeeds_replaces_its_failure_in_the_store() {
-    use uq_driver::study::store::{Manifest, Record, Store};
+    use uq_driver::internals::store::{Manifest, Record, Store};
     let dir = tempfile::tempdir().unwrap();
     let m = Manifest {
         study_hash: "s".into(),
@@ -426,11 +427,12 @@ fn integral_design_values_set_an_integer_random_parameter() {
     let outcome =
         runner::run_points(&study, &fmu, &design, dir.path(), &RunOptions::default()).unwrap();
     let got: Vec<Vec<f64>> = outcome
+        .runs
         .records()
         .unwrap()
         .iter()
         .map(|r| match r {
-            Some(uq_driver::study::store::Record::Ok(v)) => v.clone(),
+            Some(uq_driver::internals::store::Record::Ok(v)) => v.clone(),
             other => panic!("{other:?}"),
         })
         .collect();

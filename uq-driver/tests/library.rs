@@ -11,8 +11,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use uq_driver::spec::{Experiment, Study, StudyError};
-use uq_driver::study::run::{simulate, PointError};
 use uq_driver::study::{run_study, Outcome, RunError, RunOptions, StudyRunError};
+use uq_driver::study::{simulate, PointError};
 
 use crate::support::wheel;
 

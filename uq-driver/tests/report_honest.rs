@@ -306,9 +306,9 @@ fn no_report_export_and_compare() {
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("store/manifest.json")).unwrap()).unwrap();
     let n_values = manifest["n_values"].as_u64().unwrap() as usize;
-    let extra = uq_driver::study::store::encode(
+    let extra = uq_driver::internals::store::encode(
         0,
-        &uq_driver::study::store::Record::Ok(vec![42.0; n_values]),
+        &uq_driver::internals::store::Record::Ok(vec![42.0; n_values]),
     );
     let mut f = std::fs::OpenOptions::new()
         .append(true)
@@ -320,7 +320,7 @@ fn no_report_export_and_compare() {
     let again = read(&a.join("runs/runs.csv"));
     assert_eq!(again, csv);
     // While a run holds the folder, export refuses instead of reading a store being written.
-    let held = uq_driver::study::store::lock::FolderLock::acquire(&a).unwrap();
+    let held = uq_driver::internals::store::FolderLock::acquire(&a).unwrap();
     let o = run(&["export", utf8(&a), "--runs"]);
     assert!(!o.status.success());
     let err = stderr(&o);

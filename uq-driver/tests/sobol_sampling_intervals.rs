@@ -7,10 +7,11 @@
 use std::collections::BTreeMap;
 
 use nalgebra::DMatrix;
-use uq_driver::uq::hd::sensitivity;
+use uq_driver::internals::pick_freeze_bootstrap;
 use uq_driver::uq::method::sobol_sampling::SobolSampling;
+use uq_driver::uq::method::Estimate;
 use uq_driver::uq::method::{Method, Sampling};
-use uq_driver::uq::{Distribution, Estimate, RandomInputs, RandomParameter};
+use uq_driver::uq::{Distribution, RandomInputs, RandomParameter};
 
 fn unit_inputs(d: usize, low: f64, high: f64) -> RandomInputs {
     RandomInputs::independent(
@@ -301,7 +302,7 @@ fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
         let (m, values, e) = run(text, &inputs, 4, ishigami);
         let n = m.samples;
         // The bootstrap of before: resample k of the rows from the stream (0x5eed_b007, k).
-        let want = sensitivity::pick_freeze_bootstrap(
+        let want = pick_freeze_bootstrap(
             &centred(&values, n),
             n,
             3,
@@ -328,8 +329,8 @@ fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
 #[test]
 fn sobol_sampling_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
     use sha2::{Digest, Sha256};
+    use uq_driver::internals::study_hash;
     use uq_driver::spec::{builtin, Study};
-    use uq_driver::study::plan::fingerprint::study_hash;
     let text = builtin("wheel-sobol-sampling").unwrap();
     let study = |base: &str, extra: &str| {
         let t = text

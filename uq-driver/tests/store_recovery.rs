@@ -9,7 +9,7 @@ use std::path::Path;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use uq_driver::study::store::{self, format, Manifest, Record, Store};
+use uq_driver::internals::store::{self, Manifest, Record, Store};
 
 fn manifest(n_points: usize, n_values: usize) -> Manifest {
     Manifest {
@@ -307,7 +307,7 @@ fn torn_tail_is_cut_and_its_point_reported() {
 #[test]
 fn random_garbage_never_panics() {
     let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let magic2 = format::MAGIC;
+    let magic2 = store::MAGIC;
     for round in 0..3000 {
         let len = rng.gen_range(0..400);
         let mut bytes: Vec<u8> = (0..len).map(|_| rng.gen()).collect();

@@ -104,7 +104,6 @@ fn log_lines(messages: &[LogMessage], logging_on: bool) -> String {
 /// user-facing message.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-#[non_exhaustive]
 pub enum FmuError {
     /// The file is not a zip archive.
     #[error("{}: not a zip archive ({reason})", .path.display())]

@@ -14,7 +14,7 @@ pub type Sink = Box<dyn Fn(&str) + Send + Sync>;
 static MESSAGES: RwLock<Option<Sink>> = RwLock::new(None);
 
 /// Sends the library's messages to `sink` (None: nowhere, the default). The command line
-/// prints them on stderr ([`print_messages`]); a host can log them, show them or drop them.
+/// prints them on stderr (`print_messages`); a host can log them, show them or drop them.
 /// Warnings that matter for the results are in `summary.warnings` as well.
 pub fn set_message_sink(sink: Option<Sink>) {
     *MESSAGES.write().unwrap_or_else(|e| e.into_inner()) = sink;

@@ -277,7 +277,7 @@ fn ppf_lower(q: f64) -> f64 {
 /// `-inf`, `p = 1` gives `+inf`, `p` outside `[0, 1]` or NaN gives NaN.
 /// For `p > 1/2` the computation uses `1 - p` (exact in floating point), so
 /// upper-tail quantiles are as accurate as the input allows; prefer
-/// [`norm_isf`] when the upper-tail probability itself is known.
+/// `norm_isf` when the upper-tail probability itself is known.
 pub fn norm_ppf(p: f64) -> f64 {
     if p.is_nan() || !(0.0..=1.0).contains(&p) {
         return f64::NAN;

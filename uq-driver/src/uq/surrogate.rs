@@ -485,7 +485,7 @@ impl Surrogate {
 
     /// `eval` as CSV: `name,time,value`, one row per output and time, then one per quantity
     /// (empty time). Numbers as every CSV of the driver writes them
-    /// ([`crate::text::csv::push_shortest`]).
+    /// (the shortest round-trip form of every CSV of the driver).
     pub fn eval_csv(&self, x: &[f64]) -> String {
         let v = self.eval(x);
         let mut text = String::from("name,time,value\n");
@@ -629,7 +629,7 @@ impl Surrogate {
     }
 
     /// `n` random points of the inputs' joint law with the surrogate's values there: point
-    /// `i` comes from the stream `(seed, i)` only ([`germ_draws`]).
+    /// `i` comes from the stream `(seed, i)` only (`germ_draws`).
     pub fn sample(&self, n: usize, seed: u64) -> Vec<(Vec<f64>, SurrogateValues)> {
         let families: Vec<Family> = self.file.inputs.iter().map(|i| i.family).collect();
         germ_draws(&families, n, seed)

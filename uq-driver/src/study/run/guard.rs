@@ -56,7 +56,7 @@ fn state() -> std::sync::MutexGuard<'static, State> {
 /// Opts this process in to the process-wide guards of a study in progress, for a program that
 /// owns its process (the `uq-driver` command line calls it first thing):
 /// - SIGINT, SIGTERM and SIGHUP end the process after naming the study in progress and
-///   removing the FMUs' temporary folders ([`install_signal_handler`]);
+///   removing the FMUs' temporary folders (`install_signal_handler`);
 /// - while an in-process study or simulation runs, an `atexit` handler reports an FMU that
 ///   calls `exit()` (and makes the exit status 1), and SIGSEGV, SIGBUS, SIGILL, SIGFPE and
 ///   SIGABRT handlers name the running points before passing the signal on;

@@ -39,14 +39,14 @@ pub struct RunOptions {
     /// Run the points that failed in an earlier run again (`--retry-failed`).
     pub retry_failed: bool,
     /// `--isolate`: run each point in a worker process started from this uq-driver executable
-    /// (see [`isolate`]); None: in-process.
+    /// (the `uq-driver worker` protocol); None: in-process.
     pub isolate: Option<PathBuf>,
     /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point.
     /// In-process an FMU call cannot be interrupted, so a longer run ends the whole process
     /// after naming the point: allowed only after [`guard::install_process_guards`] (the
     /// command line's choice), refused with [`RunError::Options`] otherwise.
     pub timeout_per_run: Option<Duration>,
-    /// Start a large study without asking (`--yes`; see [`super::size`]).
+    /// Start a large study without asking (`--yes`; see the size checks of a study).
     pub yes: bool,
     /// `--fresh-instances`: every run on a fresh FMU instance, never reused through
     /// `fmi2Reset` (and no reset self-check).

@@ -258,7 +258,7 @@ pub struct Simulation {
 }
 
 /// One deterministic run of `fmu` with `params` set before initialization, `inputs` (a CSV
-/// file, see [`crate::study::plan::inputs`]) applied during the run, recording `outputs` (names; every
+/// file, as `[inputs]` reads it) applied during the run, recording `outputs` (names; every
 /// output that can be recorded when empty) at `times`. Where the FMU ends the simulation
 /// early, the run ends there (its last row at the FMU's last successful time), as in fmpy.
 pub fn simulate(

@@ -1,5 +1,5 @@
 //! Quasi-Monte Carlo: `replicates` independent Owen-scrambled Sobol' sequences (Joe–Kuo
-//! direction numbers, [`crate::uq::hd::sobol_seq`]) of `samples` points each, mapped through
+//! direction numbers, `uq::hd::sobol_seq`) of `samples` points each, mapped through
 //! each input's quantile function.
 //!
 //! Replicate `r` is the scrambling keyed by `(seed, r)`: its dimension `j` takes the `j`-th

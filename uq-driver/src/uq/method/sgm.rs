@@ -1,7 +1,7 @@
 //! The stochastic Galerkin method on a linear second-order system given in the study file
 //! (`[system]`): `M q'' + C q' + K q = f`, each matrix (and q0, v0) affine in the Gaussian
 //! parameters, `A = A_given + Σ_j p_j · D_j`. The Galerkin system itself is in
-//! [`crate::uq::galerkin`]; this module reads the `[system]` table, checks it against the
+//! `uq::galerkin`; this module reads the `[system]` table, checks it against the
 //! study, solves, and returns the chaos of every output over time.
 
 use serde::{Deserialize, Serialize};

@@ -11,7 +11,7 @@
 //!   `k / (samples / R)`;
 //! - `"mc"`: Monte Carlo; `"lhs"`: a Latin hypercube (one design of `samples` points).
 //!
-//! Estimators ([`crate::uq::hd::sensitivity`]): first order by Saltelli (2010), total by
+//! Estimators (`uq::hd::sensitivity`): first order by Saltelli (2010), total by
 //! Jansen (1999), normalised by the variance of the `2 × samples` values of `A` and `B`, on
 //! the values less their mean over `A` and `B` (same expectation; centring cuts the variance
 //! of the first-order estimator when the mean is large against the spread), always on all
