@@ -107,6 +107,7 @@ lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc -p uq-driver --no-deps
+	$(PYTHON) uq-driver/api_items.py target/doc/uq_driver/all.html 250
 
 fmt:
 	$(CARGO) fmt --all

@@ -1,4 +1,4 @@
-"""`make bench`, issue 15: analysis at the speed of the runs.
+"""`make bench`, analysis at the speed of the runs.
 
 - For every built-in study (`--all-builtins`; by default every one whose runs take less than
   a few minutes on 2 cores), the wall time of the whole `uq-driver run` command beside the
@@ -177,7 +177,7 @@ def peers(h, work, driver, repeats, checks):
 
 
 def bench(h, work, driver, repeats, checks, all_builtins=False):
-    """The two sections of issue 15 (see the module's doc)."""
+    """The two sections: analysis at the speed of the runs (see the module's doc)."""
     try:
         import chaospy  # noqa: F401
         import openturns  # noqa: F401

@@ -1,4 +1,4 @@
-"""`make bench`, issue 11: the high-dimensional goals, runs counted, side by side with
+"""`make bench`, the high-dimensional goals, runs counted, side by side with
 OpenTURNS and chaospy.
 
 - Ishigami (x_i ~ U(-π, π), a = 7, b = 0.1): every first-order and total Sobol' index within
@@ -441,7 +441,7 @@ def versus(s):
 
 
 def summary_section(h, summaries, sections):
-    sec = h.Section("High-dimensional goals (issue 11): runs needed, uq-driver vs OpenTURNS vs "
+    sec = h.Section("High-dimensional goals: runs needed, uq-driver vs OpenTURNS vs "
                     "chaospy",
                     ["benchmark", "goal", "uq-driver", "OpenTURNS", "chaospy",
                      "uq-driver goal"])

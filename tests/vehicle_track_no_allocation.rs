@@ -1,6 +1,11 @@
 //! The VehicleTrack step allocates nothing: a counting global allocator (this test binary's
 //! own) sees no allocation during `do_step`, on every kernel path, at N = NM and NM = 2N + 1,
 //! window shifts included.
+//!
+//! This file stays a test binary of its own, apart from `fmi_abi.rs`: a `#[global_allocator]`
+//! is the allocator of the whole binary, and the count must see this one test's allocations
+//! only (tests of the same binary run on other threads at the same time and would allocate
+//! between the two readings of the counter).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};

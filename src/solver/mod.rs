@@ -90,7 +90,7 @@ mod tests {
 
     #[test]
     fn a_tiny_substep_is_written_in_exponent_form_not_with_300_zeros() {
-        // QA: h = 1e-300 gave a 452-character message.
+        // H = 1e-300 gave a 452-character message.
         let e = substeps(0.01, 1e-300).unwrap_err().to_string();
         assert!(e.len() < 200, "{e}");
         assert!(e.contains("of at most 1e-300 s"), "{e}");

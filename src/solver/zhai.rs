@@ -22,7 +22,7 @@
 //! (`r > 2`, e.g. after a short last substep) is it a start step again. Restarting at every
 //! change of length instead (as this module did before) is the one-step formula, which
 //! gains energy: an importer that varies its communication step by 1 % from step to step made
-//! the vehicle–track model blow up within 0.03 s (found by QA).
+//! the vehicle–track model blow up within 0.03 s.
 //! The caller supplies the accelerations `M⁻¹F` as a closure writing into a slice, so the
 //! integrator is generic over the state dimension and never allocates while stepping.
 #![forbid(unsafe_code)]
@@ -243,7 +243,7 @@ mod tests {
 
     #[test]
     fn steps_that_change_length_every_step_stay_stable() {
-        // QA: the vehicle–track model (stiffest mode at ωh ≈ 0.5) blew up when an importer
+        // The vehicle–track model (stiffest mode at ωh ≈ 0.5) blew up when an importer
         // alternated communication steps of 1e-4 and 0.99e-4 s: each change restarted the
         // method with the one-step formula, which gains energy.
         for q in [0.99, 0.9, 0.5] {

@@ -45,7 +45,7 @@
 //! "#;
 //! // `base`: the folder a relative `fmu` path starts from.
 //! let study = Study::parse(toml, "inline", None)?;
-//! let opts = RunOptions { threads: Some(2), no_report: true, ..RunOptions::default() };
+//! let opts = RunOptions::default().with_threads(2).with_no_report(true);
 //! let Outcome::Study(result) = run_study(&study, Path::new("out/wheel-sobol"), &opts)? else {
 //!     unreachable!("a study without [[variants]] is not a suite");
 //! };
@@ -67,15 +67,15 @@
 //! - it checks the study again ([`spec::Study::check`]: its fields are public) and refuses
 //!   an empty `out_dir` and options that do not fit together, with typed errors;
 //! - process-wide behaviour is off unless the host opts in with
-//!   [`study::guard::install_process_guards`], as the command line does: signal handlers, an
+//!   [`study::install_process_guards`], as the command line does: signal handlers, an
 //!   `atexit` check that reports an FMU calling `exit()`, and ending the process when an
 //!   in-process run overruns [`study::RunOptions::timeout_per_run`]. Without it a host's own
 //!   `exit()` and signals are its own, and `timeout_per_run` needs
 //!   [`study::RunOptions::isolate`] (each run in a worker process, killed after the limit;
-//!   the worker is this program started as `<exe> worker`, see [`study::isolate`]): the
+//!   the worker is this program started as `<exe> worker`, see `uq-driver worker`): the
 //!   safe way to run an FMU that may crash, hang or call `exit()`.
 //!
-//! One simulation without a study: [`study::runner::simulate`]; the FMU itself, call by
+//! One simulation without a study: [`study::simulate`]; the FMU itself, call by
 //! call: [`fmu::Fmu`] and [`fmu::Instance`].
 //!
 //! ## UQ on a plain Rust function: design → simulate → estimate
@@ -119,7 +119,12 @@
 //!
 //! # Modules
 //!
-//! Modules by concept, each using only those above it in this list:
+//! Modules by concept, bottom first, each using only those before it in this list (a test,
+//! `layers`, reads every file's imports and fails on one against this order, and on two files
+//! that import each other):
+//! - `text` (crate-internal): CSV fields, numbers as text, file names;
+//! - `suggest` (crate-internal): "did you mean" for misspelt names;
+//! - `sys` (crate-internal): process-level system calls behind safe functions;
 //! - [`fmu`]: import of `.fmu` archives (safe unzip, modelDescription, dlopen, instances);
 //! - [`uq`]: distributions, random streams, sampling, quadrature, polynomial chaos, moments,
 //!   and the UQ methods ([`uq::method`], one module per method: design + estimator);
@@ -127,19 +132,49 @@
 //!   kernel densities;
 //! - [`spec`]: the study file, typed and validated;
 //! - [`results`]: typed results and the summaries written to `summary.json`;
-//! - [`report`]: CSV/JSON writers, plots, the HTML pages of a study and of a suite;
-//! - [`study`]: running a study: the parallel runner, the resumable results store, the
-//!   statistics, shards for a cluster, suites;
-//! - [`suggest`]: "did you mean" for misspelt names.
+//! - `report` (crate-internal): CSV/JSON writers, plots, the HTML pages of a study and of a
+//!   suite;
+//! - [`study`]: running a study: planning it (`plan`), running its points (`run`, the one
+//!   place that runs them), the resumable results store (`store`), the statistics
+//!   (`analysis`), shards for a cluster, suites;
+//! - [`prelude`]: the types most programs need;
+//! - `cli` (feature `cli`, on by default): the `uq-driver` command line.
+//!
+//! `unsafe` code is confined to the FMI import layer ([`fmu`]) and `sys`; every other module
+//! is `#![forbid(unsafe_code)]`.
 
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod fmu;
-/// Writing output files safely (links replaced, devices and pipes written into): the
-/// `out-file` crate of this workspace.
-pub use ::out_file;
+#[cfg(test)]
+mod layers;
+pub mod prelude;
 pub mod qoi;
-pub mod report;
+pub(crate) mod report;
 pub mod results;
 pub mod spec;
 pub mod study;
-pub mod suggest;
+pub(crate) mod suggest;
+pub(crate) mod sys;
+pub(crate) mod text;
 pub mod uq;
+
+/// Not part of the API: the fuzz targets' and the integration tests' access to internals; may
+/// change at any release.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::study::plan::fingerprint::study_hash;
+    pub use crate::study::run::run_points;
+    pub use crate::uq::hd::lars::PathKind;
+    pub use crate::uq::hd::sensitivity::pick_freeze_bootstrap;
+    pub use crate::uq::hd::sobol_seq::Sobol;
+    pub use crate::uq::hd::sparse_chaos::{fit_chaos, FitKind};
+    pub use crate::uq::pce::askey::Family;
+
+    /// The results store: its reader and writer, the record format, the folder lock.
+    pub mod store {
+        pub use crate::study::store::format::{decode, MAGIC};
+        pub use crate::study::store::lock::FolderLock;
+        pub use crate::study::store::{encode, Format, Manifest, Record, Store};
+    }
+}

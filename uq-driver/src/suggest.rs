@@ -2,6 +2,8 @@
 //! keys, FMU variables), by Jaro–Winkler similarity (the `strsim` crate), and the
 //! suggestions the command line adds to the messages of the TOML parser.
 
+#![forbid(unsafe_code)]
+
 /// The name of `candidates` closest to `wrong`, if one is close enough to be a likely typo:
 /// Jaro–Winkler similarity at least 0.8, or one edit away (insertion, deletion, substitution
 /// or swap of neighbours: `Kzp` for `Kpz`), or the same name in another case; `None` when

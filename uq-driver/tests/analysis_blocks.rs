@@ -1,50 +1,34 @@
-//! Issue 12 item 3: the series of the runs are written to the results store as they finish and
-//! not held; the analysis reads them back a block of time columns at a time. Pinned here on
+//! The series of the runs are written to the results store as they finish and not held; the
+//! analysis reads them back a block of time columns at a time. Pinned here on
 //! the wheel FMU: the files do not depend on the block size (`RAILUQ_ANALYSIS_BLOCK_BYTES`),
 //! also after a kill and a resume; a study whose series exceed the memory limit
 //! (`RAILUQ_MEMORY_LIMIT`) is accepted and runs in far less memory than its series, with a
 //! mean that matches the wheel's closed form (`support/wheel.rs`).
 
-#[path = "support/wheel.rs"]
-mod wheel;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::wheel::{self, read_csv};
+use crate::support::{driver, run_args, run_killed, stderr, summary};
 
 /// `uq-driver args` with the environment `env`.
 fn run(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(DRIVER);
-    c.args(args).env("RAILUQ_FMU_DIR", wheel::fmu_dir());
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("uq-driver runs")
+    driver()
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .expect("uq-driver runs")
 }
 
-fn run_ok(args: &[&str], env: &[(&str, &str)]) {
-    let out = run(args, env);
-    assert!(
-        out.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-/// `uq-driver run STUDY --out OUT --no-report`.
-fn run_args<'a>(study: &'a Path, out: &'a Path) -> [&'a str; 5] {
-    [
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--no-report",
-    ]
-}
-
+/// `uq-driver run STUDY --out OUT --no-report` with the environment `env`; must succeed.
 fn run_study(study: &Path, out: &Path, env: &[(&str, &str)]) {
-    run_ok(&run_args(study, out), env);
+    let args = run_args(study, out, &["--no-report"]);
+    let o = run(&args, env);
+    assert!(
+        o.status.success(),
+        "uq-driver {args:?} failed:\n{}",
+        stderr(&o)
+    );
 }
 
 /// Every file of an output folder but the store and the lock, with `summary.json` stripped of
@@ -140,23 +124,13 @@ fn a_killed_study_resumed_with_tiny_blocks_gives_the_uninterrupted_files() {
     let full = dir.path().join("full");
     run_study(&study, &full, &[]);
     let part = dir.path().join("part");
-    let mut child = Command::new(DRIVER)
-        .args(["run", study.to_str().unwrap(), "--out"])
-        .arg(&part)
-        .args(["--threads", "1", "--no-report"])
-        .env("RAILUQ_FMU_DIR", wheel::fmu_dir())
-        .spawn()
-        .unwrap();
-    let records = part.join("store/records.bin");
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
     // Kill it once a quarter of the records (of 4 037 bytes each) are written.
-    while std::fs::metadata(&records).map_or(0, |m| m.len()) < 5_000 * 4_037 {
-        assert!(child.try_wait().unwrap().is_none(), "finished too early");
-        assert!(std::time::Instant::now() < deadline, "no progress");
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    run_killed(
+        &study,
+        &part,
+        &["--threads", "1", "--no-report"],
+        5_000 * 4_037,
+    );
     assert!(!part.join("q.csv").exists(), "killed before the end");
     run_study(&study, &part, &[TINY]);
     assert_same_files(&full, &part);
@@ -164,13 +138,12 @@ fn a_killed_study_resumed_with_tiny_blocks_gives_the_uninterrupted_files() {
 
 /// Runs `args` and returns the child's peak resident memory (bytes, `ru_maxrss`).
 fn peak_memory(args: &[&str], env: &[(&str, &str)]) -> u64 {
-    let mut c = Command::new(DRIVER);
-    c.args(args).env("RAILUQ_FMU_DIR", wheel::fmu_dir());
-    for (k, v) in env {
-        c.env(k, v);
-    }
     #[allow(clippy::zombie_processes)] // reaped by wait4 below
-    let child = c.spawn().unwrap();
+    let child = driver()
+        .args(args)
+        .envs(env.iter().copied())
+        .spawn()
+        .unwrap();
     let mut status = 0;
     // SAFETY: an all-zero rusage is a valid value of this plain C struct.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
@@ -194,7 +167,7 @@ fn series_larger_than_the_memory_limit_are_run_and_analysed_in_blocks() {
     let method = format!("kind = \"lhs\"\nsamples = {n}");
     let study = wheel::write_study(dir.path(), "big", "big", 5, experiment, &method, "");
     let out = dir.path().join("out");
-    let args = run_args(&study, &out);
+    let args = run_args(&study, &out, &["--no-report"]);
     let limit = ("RAILUQ_MEMORY_LIMIT", "268435456");
     let budget = ("RAILUQ_ANALYSIS_BLOCK_BYTES", "8388608");
     let peak = peak_memory(&args, &[limit, budget]);
@@ -203,12 +176,10 @@ fn series_larger_than_the_memory_limit_are_run_and_analysed_in_blocks() {
         peak < series / 4,
         "peak {peak} bytes for {series} bytes of series"
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(summary["model_runs"], n);
+    assert_eq!(summary(&out)["model_runs"], n);
     // The statistics are those of the runs: the mean within 4 standard errors of the
     // closed form at a few times, the columns of the CSV all there.
-    let csv = wheel::read_csv(&out.join("q.csv"));
+    let csv = read_csv(&out.join("q.csv"));
     for t in [0.5, 1.0, 2.0, 5.0] {
         let (mean, se) = (csv.at(t, "mean"), csv.at(t, "std_error_mean"));
         let reference = wheel::reference(t).0;
@@ -218,12 +189,12 @@ fn series_larger_than_the_memory_limit_are_run_and_analysed_in_blocks() {
         );
     }
     // Without the blocks the same study is refused under the limit: its series alone exceed
-    // it (the estimate the issue asks for, with the limit).
+    // it (the refusal gives the estimate and the limit).
     let unblocked = run(
         &args,
         &[limit, ("RAILUQ_ANALYSIS_BLOCK_BYTES", "1000000000000")],
     );
     assert!(!unblocked.status.success());
-    let err = String::from_utf8_lossy(&unblocked.stderr);
+    let err = stderr(&unblocked);
     assert!(err.contains("refused"), "{err}");
 }

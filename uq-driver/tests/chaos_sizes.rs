@@ -1,4 +1,4 @@
-//! The up-front size checks of the chaos methods (QA findings F2 and F5).
+//! The up-front size checks of the chaos methods.
 //!
 //! - F2: a 300-run sparse regression chaos (LARS) in 30 inputs of order 5 was estimated at
 //!   5 MiB and peaked at 1.5 GB (its candidates at the runs), a 41 601-run sparse grid at
@@ -11,17 +11,13 @@
 //! Studies on the Functions test FMU (the g-function, `function = 3`), whose parameters
 //! `x1..x8`, `a1..a8`, `a`, `b`, `sigma_h`, `rw` are made random here; nothing is run.
 
-#[path = "support/refusal.rs"]
-mod refusal;
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use refusal::assert_refused;
-
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::refusal::assert_refused;
+use crate::support::{
+    driver, run_args, stderr, study_head, test_fmus, uniform, utf8, write_toml, DRIVER,
+};
 
 /// Random parameters the Functions FMU has (the g-function uses the first eight).
 const NAMES: [&str; 20] = [
@@ -37,20 +33,11 @@ fn study(dir: &Path, name: &str, dim: usize, method: &str, tail: &str) -> PathBu
         .iter()
         .map(|n| {
             let (low, high) = if *n == "rw" { (0.05, 0.15) } else { (0.0, 1.0) };
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = {low}\nhigh = {high}\n"
-            )
+            uniform(&[n], low, high)
         })
         .collect();
     let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = 11
-[experiment]
-start = 0.0
-stop = 0.1
-step = 0.1
-[fixed]
+        r#"{head}[fixed]
 function = 3
 {parameters}
 [outputs]
@@ -59,15 +46,14 @@ variables = ["y"]
 {method}
 {tail}
 "#,
-        fmu = fmu.display()
+        head = study_head(name, &fmu, 11, "start = 0.0\nstop = 0.1\nstep = 0.1")
     );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    write_toml(dir, name, &text)
 }
 
-fn driver(args: &[&str], memory_limit: Option<&str>) -> Output {
-    let mut c = Command::new(DRIVER);
+/// `uq-driver args`, under the memory limit `memory_limit` (bytes) if given.
+fn run(args: &[&str], memory_limit: Option<&str>) -> Output {
+    let mut c = driver();
     c.args(args);
     if let Some(m) = memory_limit {
         c.env("RAILUQ_MEMORY_LIMIT", m);
@@ -86,14 +72,14 @@ fn plan_study(
     let shards = shards.to_string();
     let mut args = vec![
         "plan",
-        study.to_str().unwrap(),
+        utf8(study),
         "--shards",
         &shards,
         "--out",
-        plan.to_str().unwrap(),
+        utf8(plan),
     ];
     args.extend_from_slice(extra);
-    driver(&args, memory_limit)
+    run(&args, memory_limit)
 }
 
 /// The memory estimate (bytes) in a refusal's text: "about X UNIT of memory".
@@ -129,11 +115,10 @@ fn a_lars_study_whose_design_matrix_does_not_fit_is_refused_before_any_run() {
     );
     let out = dir.path().join("out");
     for extra in [&[][..], &["--yes"][..]] {
-        let mut args = vec!["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
+        let mut args = run_args(&p, &out, extra);
         // Were it to start, one point and the study stops (no analysis).
         args.extend_from_slice(&["--max-points", "1"]);
-        let o = driver(&args, Some("200000000"));
+        let o = run(&args, Some("200000000"));
         let err = assert_refused(
             &o,
             &[
@@ -179,16 +164,8 @@ fn a_sparse_grid_whose_surrogate_basis_does_not_fit_is_refused_before_any_run() 
         "",
     );
     let out = dir.path().join("out");
-    let o = driver(
-        &[
-            "run",
-            p.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--yes",
-            "--max-points",
-            "1",
-        ],
+    let o = run(
+        &run_args(&p, &out, &["--yes", "--max-points", "1"]),
         Some("300000000"),
     );
     let err = assert_refused(
@@ -209,18 +186,11 @@ fn a_sparse_grid_whose_surrogate_basis_does_not_fit_is_refused_before_any_run() 
         "kind = \"sparse_grid\"\nlevel = 3",
         "[analysis]\nseries_samples = 100\nsurrogate_samples = 100",
     );
-    let o = driver(
-        &[
-            "run",
-            p.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--max-points",
-            "1",
-        ],
+    let o = run(
+        &run_args(&p, &out, &["--max-points", "1"]),
         Some("300000000"),
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(err.contains("stopped after 1 of 9841 points"), "{err}");
 }
 
@@ -260,14 +230,14 @@ fn plan_of_a_large_sparse_grid_needs_yes() {
     assert_refused(&o, &needles);
     assert!(!plan.exists(), "no plan is written");
     let slurm = dir.path().join("slurm");
-    let o = driver(
+    let o = run(
         &[
             "slurm",
-            p.to_str().unwrap(),
+            utf8(&p),
             "--shards",
             "4",
             "--out",
-            slurm.to_str().unwrap(),
+            utf8(&slurm),
             "--dry-run",
         ],
         None,
@@ -275,15 +245,12 @@ fn plan_of_a_large_sparse_grid_needs_yes() {
     assert_refused(&o, &needles);
     assert!(!slurm.exists());
     let out = dir.path().join("out");
-    let o = driver(
-        &["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()],
-        None,
-    );
+    let o = run(&run_args(&p, &out, &[]), None);
     assert_refused(&o, &needles);
     assert!(!out.exists(), "refused before the design");
     // With --yes it is planned.
     let o = plan_study(&p, 4, &plan, &["--yes"], None);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{}", stderr(&o));
     let design = std::fs::read_to_string(plan.join("design.csv")).unwrap();
     assert_eq!(design.lines().count() as f64, runs + 1.0);
 }

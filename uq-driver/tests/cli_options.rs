@@ -1,39 +1,13 @@
-//! Command-line consistency pinned after the QA campaign: exact quantile column names
-//! through a whole study (F6), and `merge` / `slurm` taking `--no-report` as `run` does (F9).
+//! Command-line consistency pinned: exact quantile column names through a whole study, and
+//! `merge` / `slurm` taking `--no-report` as `run` does.
 
-#[path = "support/wheel.rs"]
-mod wheel;
+use crate::support::wheel;
+use crate::support::{assert_same_files, read, run_ok, run_study, stderr, utf8};
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
 
-fn driver(args: &[&str]) -> Output {
-    Command::new(DRIVER)
-        .args(args)
-        .env("RAILUQ_FMU_DIR", wheel::fmu_dir())
-        .output()
-        .expect("uq-driver runs")
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = driver(args);
-    assert!(
-        out.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// F6: `quantiles = [0.0015, 0.002, 0.9951]` gave the columns `q0.2,q0.2,q99.5`; the
+/// `quantiles = [0.0015, 0.002, 0.9951]` gave the columns `q0.2,q0.2,q99.5`; the
 /// names are the percentages written out (0.15, 0.2, 99.51), in the CSV and the band plot.
 #[test]
 fn quantile_columns_of_a_study_name_each_level_exactly() {
@@ -48,14 +22,14 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
         "[analysis]\nquantiles = [0.0015, 0.002, 0.9951]",
     );
     let out = dir.path().join("out");
-    run_ok(&["run", s(&study), "--out", s(&out)]);
-    let csv = std::fs::read_to_string(out.join("q.csv")).unwrap();
+    run_ok(&["run", utf8(&study), "--out", utf8(&out)]);
+    let csv = read(&out.join("q.csv"));
     assert!(
         csv.starts_with("time,mean,std,lower_3sigma,upper_3sigma,q0.15,q0.2,q99.51,"),
         "{}",
         csv.lines().next().unwrap()
     );
-    let band = std::fs::read_to_string(out.join("q_band.svg")).unwrap();
+    let band = read(&out.join("q_band.svg"));
     for name in ["q0.15 quantile", "q0.2 quantile", "q99.51 quantile"] {
         assert!(band.contains(name), "{name} not in the band plot");
     }
@@ -69,8 +43,8 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
         "kind = \"mc\"\nsamples = 16",
         "[analysis]\nquantiles = [0.5, 0.99, 0.5]",
     );
-    let o = driver(&["run", s(&twice), "--out", s(&dir.path().join("o2"))]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let o = run_study(&twice, &dir.path().join("o2"), &[]);
+    let err = stderr(&o);
     assert!(!o.status.success());
     assert!(
         err.contains("quantiles 0.5 and 0.5 both give the column 'q50'"),
@@ -79,7 +53,7 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
     assert!(!dir.path().join("o2/q.csv").exists());
 }
 
-/// F9: `merge` refused `--no-report`, which `run` takes. With it the merge writes the CSV
+/// `merge` refused `--no-report`, which `run` takes. With it the merge writes the CSV
 /// files and summary.json only, the same bytes as a merge with the report; `slurm` passes
 /// it to the merge job.
 #[test]
@@ -95,15 +69,15 @@ fn merge_and_slurm_take_no_report_as_run_does() {
         "",
     );
     let plan = dir.path().join("plan");
-    run_ok(&["plan", s(&study), "--shards", "2", "--out", s(&plan)]);
+    run_ok(&["plan", utf8(&study), "--shards", "2", "--out", utf8(&plan)]);
     for k in ["0", "1"] {
-        run_ok(&["run-shard", s(&plan), "--shard", k]);
+        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
     }
     let bare = dir.path().join("bare");
-    let said = run_ok(&["merge", s(&plan), "--out", s(&bare), "--no-report"]);
+    let said = run_ok(&["merge", utf8(&plan), "--out", utf8(&bare), "--no-report"]);
     assert!(said.contains("no report"), "{said}");
     let full = dir.path().join("full");
-    run_ok(&["merge", s(&plan), "--out", s(&full)]);
+    run_ok(&["merge", utf8(&plan), "--out", utf8(&full)]);
     assert!(full.join("index.html").exists());
     assert!(!bare.join("index.html").exists());
     let svgs = std::fs::read_dir(&bare)
@@ -117,26 +91,20 @@ fn merge_and_slurm_take_no_report_as_run_does() {
         })
         .count();
     assert_eq!(svgs, 0, "plots written with --no-report");
-    for f in ["q.csv", "points.csv"] {
-        assert_eq!(
-            std::fs::read(bare.join(f)).unwrap(),
-            std::fs::read(full.join(f)).unwrap(),
-            "{f}"
-        );
-    }
+    assert_same_files(&bare, &full, &["q.csv", "points.csv"]);
     // slurm --dry-run writes the scripts; the merge job carries the option.
     let sl = dir.path().join("sl");
     run_ok(&[
         "slurm",
-        s(&study),
+        utf8(&study),
         "--shards",
         "2",
         "--out",
-        s(&sl),
+        utf8(&sl),
         "--dry-run",
         "--no-report",
     ]);
-    let merge = std::fs::read_to_string(sl.join("slurm/merge.sbatch")).unwrap();
+    let merge = read(&sl.join("slurm/merge.sbatch"));
     let last = merge.lines().last().unwrap();
     assert!(
         last.starts_with("exec ") && last.ends_with(" --no-report"),
@@ -145,13 +113,13 @@ fn merge_and_slurm_take_no_report_as_run_does() {
     let sl2 = dir.path().join("sl2");
     run_ok(&[
         "slurm",
-        s(&study),
+        utf8(&study),
         "--shards",
         "2",
         "--out",
-        s(&sl2),
+        utf8(&sl2),
         "--dry-run",
     ]);
-    let merge = std::fs::read_to_string(sl2.join("slurm/merge.sbatch")).unwrap();
+    let merge = read(&sl2.join("slurm/merge.sbatch"));
     assert!(!merge.contains("--no-report"), "{merge}");
 }

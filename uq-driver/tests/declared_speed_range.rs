@@ -1,31 +1,19 @@
-//! QA5 M5: the VehicleTrack speed `v` declares its range [0, 160] m/s, so a speed given in
+//! The VehicleTrack speed `v` declares its range [0, 160] m/s, so a speed given in
 //! km/h (`v = 300`, 1080 km/h) is warned about by the driver and refused by the FMU, and a
 //! lateral Sperling weighting on the vertical carbody acceleration is warned about.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-fn fmu_dir() -> PathBuf {
-    std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-}
+use crate::support::{built_fmu, read, run_study, stderr, write_toml};
 
 /// A one-run VehicleTrack study (0.5 s, small window) with `fixed` in `[fixed]`, `direction`
 /// for its Sperling quantity; returns (success, stderr).
 fn run(dir: &Path, tag: &str, fixed: &str, direction: &str) -> (bool, String) {
-    let fmu = fmu_dir().join("VehicleTrack.fmu");
-    assert!(
-        fmu.is_file(),
-        "{} is missing: run `make fmu`",
-        fmu.display()
-    );
-    let study = dir.join(format!("{tag}.toml"));
-    std::fs::write(
-        &study,
-        format!(
+    let fmu = built_fmu("VehicleTrack");
+    let study = write_toml(
+        dir,
+        tag,
+        &format!(
             r#"name = "{tag}"
 fmu = "{fmu}"
 [experiment]
@@ -52,17 +40,9 @@ limits = [2.5]
 "#,
             fmu = fmu.display()
         ),
-    )
-    .unwrap();
-    let o = Command::new(DRIVER)
-        .args(["run", study.to_str().unwrap(), "--out"])
-        .arg(dir.join(tag))
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    );
+    let o = run_study(&study, &dir.join(tag), &[]);
+    (o.status.success(), stderr(&o))
 }
 
 #[test]
@@ -93,7 +73,7 @@ fn a_lateral_sperling_on_the_vertical_carbody_acceleration_is_warned_about() {
         err.contains("quantity 'W': direction = \"lateral\"") && err.contains("as vertical"),
         "{err}"
     );
-    let summary = std::fs::read_to_string(dir.path().join("lat/summary.json")).unwrap();
+    let summary = read(&dir.path().join("lat/summary.json"));
     assert!(
         summary.contains("which the FMU describes as vertical"),
         "{summary}"

@@ -1,4 +1,4 @@
-//! Regression tests for hostile or huge `modelDescription.xml` files (issue 12, items 1 and 9):
+//! Regression tests for hostile or huge `modelDescription.xml` files:
 //! big descriptions parse in one linear pass, and nesting, size and encoding are refused with
 //! errors that name the problem. Speed is measured in `make bench`, not asserted here.
 

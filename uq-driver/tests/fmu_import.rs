@@ -16,6 +16,8 @@ use uq_driver::fmu::{
 };
 use zip::write::SimpleFileOptions;
 
+use crate::support::{run, run_study, stderr, test_fmus, utf8};
+
 const MANIFEST_DIR: &str = env!("CARGO_MANIFEST_DIR");
 const GUID: &str = "{6a1c2d9e-3b7f-4e0a-9d51-uq-driver-test}";
 /// Value references of the C FMU.
@@ -39,39 +41,6 @@ fn model_description() -> String {
 struct Binaries {
     full: PathBuf,
     no_do_step: PathBuf,
-}
-
-fn find_headers() -> Result<PathBuf, String> {
-    if let Some(dir) = std::env::var_os("FMI2_HEADERS") {
-        let dir = PathBuf::from(dir);
-        if dir.join("fmi2Functions.h").is_file() {
-            return Ok(dir);
-        }
-        panic!(
-            "FMI2_HEADERS={} has no fmi2Functions.h",
-            dir.to_string_lossy()
-        );
-    }
-    let venv_lib = Path::new(MANIFEST_DIR).join("../.venv/lib");
-    let mut candidates: Vec<PathBuf> = fs::read_dir(&venv_lib)
-        .map(|entries| {
-            entries
-                .filter_map(Result::ok)
-                .filter(|e| e.file_name().to_string_lossy().starts_with("python3"))
-                .map(|e| e.path().join("site-packages/fmpy/c-code"))
-                .collect()
-        })
-        .unwrap_or_default();
-    candidates.sort();
-    candidates
-        .into_iter()
-        .find(|dir| dir.join("fmi2Functions.h").is_file())
-        .ok_or_else(|| {
-            format!(
-                "no FMI 2.0 headers: set FMI2_HEADERS or install fmpy in {}",
-                Path::new(MANIFEST_DIR).join("../.venv").display()
-            )
-        })
 }
 
 fn compile(headers: &Path, out: &Path, defines: &[&str]) -> Result<(), String> {
@@ -100,7 +69,7 @@ fn compile(headers: &Path, out: &Path, defines: &[&str]) -> Result<(), String> {
 }
 
 fn build_binaries() -> Result<Binaries, String> {
-    let headers = find_headers()?;
+    let headers = test_fmus::find_headers()?;
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("c_fmu");
     fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let full = dir.join("dahlquist.so");
@@ -113,16 +82,7 @@ fn build_binaries() -> Result<Binaries, String> {
 /// The compiled C FMU, or `None` (with a printed reason) when it cannot be built outside CI.
 fn binaries() -> Option<&'static Binaries> {
     static BUILT: OnceLock<Result<Binaries, String>> = OnceLock::new();
-    match BUILT.get_or_init(build_binaries) {
-        Ok(b) => Some(b),
-        Err(reason) if std::env::var_os("CI").is_some() => {
-            panic!("the C test FMU is required in CI: {reason}")
-        }
-        Err(reason) => {
-            eprintln!("SKIPPED (C test FMU unavailable): {reason}");
-            None
-        }
-    }
+    test_fmus::available("C test FMU binaries", BUILT.get_or_init(build_binaries))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -745,7 +705,7 @@ fn symlink_entry_is_refused() {
 
 #[test]
 fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
-    // QA round 3, L-1: an FMU declaring canHandleVariableCommunicationStepSize="false" was sent
+    // An FMU declaring canHandleVariableCommunicationStepSize="false" was sent
     // a shorter last step (stop - start not a whole number of steps) without a word; fmpy ends
     // such a run at the last whole step instead. Now `simulate` and `run` refuse, naming the
     // stop times that fit; a whole number of steps runs as before.
@@ -756,22 +716,9 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
         "canHandleVariableCommunicationStepSize=\"false\"",
     );
     let fmu = write_fmu(dir.path(), "Fixed.fmu", &xml, Some(&bins.full));
-    let driver = env!("CARGO_BIN_EXE_uq-driver");
-    let simulate = |stop: &str| {
-        Command::new(driver)
-            .args([
-                "simulate",
-                fmu.to_str().unwrap(),
-                "--stop",
-                stop,
-                "--step",
-                "0.1",
-            ])
-            .output()
-            .unwrap()
-    };
+    let simulate = |stop: &str| run(&["simulate", utf8(&fmu), "--stop", stop, "--step", "0.1"]);
     let o = simulate("1.05");
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
     assert!(
         err.contains("canHandleVariableCommunicationStepSize"),
@@ -787,21 +734,12 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
              [method]\nkind = \"mc\"\nsamples = 4\n\
              [[parameters]]\nname = \"k\"\ndistribution = \"uniform\"\nlow = 1.0\nhigh = 2.0\n\
              [outputs]\nvariables = [\"x\"]\n",
-            fmu.to_str().unwrap()
+            utf8(&fmu)
         ),
     )
     .unwrap();
-    let out = dir.path().join("out");
-    let o = Command::new(driver)
-        .args([
-            "run",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
+    let o = run_study(&study, &dir.path().join("out"), &[]);
+    let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
     assert!(
         err.contains("canHandleVariableCommunicationStepSize"),

@@ -1,37 +1,30 @@
-//! Robustness of the importer and the runner against FMUs that are legal but awkward (the QA
-//! campaign of 2026-11-30): FMUs with global state, each expectation computed here from the
-//! test FMU's documented behaviour (`tests/fmus/README.md`).
-
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
+//! Robustness of the importer and the runner against FMUs that are legal but awkward: FMUs
+//! with global state, each expectation computed here from the test FMU's documented behaviour
+//! (`tests/fmus/README.md`).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use uq_driver::fmu::Fmu;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-fn driver(args: &[&str]) -> Output {
-    Command::new(DRIVER).args(args).output().expect("runs")
-}
+use crate::support::{
+    csv_records, read, run, run_args, stderr, stdout, study_head, test_fmus, utf8, write_toml,
+};
 
 /// A Monte Carlo study of the Once FMU: x ~ U(0, 2), y recorded on [0, 1] by 0.1.
-fn once_study(dir: &Path, fmu: &Path) -> std::path::PathBuf {
-    let study = dir.join("once.toml");
-    std::fs::write(
-        &study,
-        format!(
-            "name = \"once\"\nfmu = {:?}\nseed = 3\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+fn once_study(dir: &Path, fmu: &Path) -> PathBuf {
+    write_toml(
+        dir,
+        "once",
+        &format!(
+            "{}\
              [method]\nkind = \"mc\"\nsamples = 24\n\
              [[parameters]]\nname = \"x\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 2\n\
              [fixed]\nstep_delay = 0.002\n\
              [outputs]\nvariables = [\"y\"]\n",
-            fmu.to_str().unwrap()
+            study_head("once", fmu, 3, "stop = 1.0\nstep = 0.1")
         ),
     )
-    .unwrap();
-    study
 }
 
 #[test]
@@ -44,18 +37,13 @@ fn an_fmu_instantiable_once_per_process_runs_on_every_thread_with_a_library_copy
     let mut files = Vec::new();
     for threads in ["1", "4"] {
         let out = dir.path().join(format!("t{threads}"));
-        let o = driver(&[
-            "run",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--threads",
-            threads,
-            "--no-report",
-        ]);
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{threads} threads: {stderr}");
-        let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+        let o = run(&run_args(
+            &study,
+            &out,
+            &["--threads", threads, "--no-report"],
+        ));
+        assert!(o.status.success(), "{threads} threads: {}", stderr(&o));
+        let points = read(&out.join("points.csv"));
         assert_eq!(points.lines().count(), 25, "{points}");
         assert!(
             points.lines().skip(1).all(|l| l.ends_with(",ok")),
@@ -68,7 +56,7 @@ fn an_fmu_instantiable_once_per_process_runs_on_every_thread_with_a_library_copy
             .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
             .collect();
         let mean_x = xs.iter().sum::<f64>() / xs.len() as f64;
-        let y = std::fs::read_to_string(out.join("y.csv")).unwrap();
+        let y = read(&out.join("y.csv"));
         let last = y.lines().last().unwrap();
         let fields: Vec<&str> = last.split(',').collect();
         assert_eq!(fields[0].parse::<f64>().unwrap(), 1.0, "{y}");
@@ -115,33 +103,30 @@ fn private_copies_of_a_library_keep_globals_apart() {
     }
 }
 
-/// Writes a study of the Once FMU with `parameter` (a `[[parameters]]` body for x) and
-/// `fixed` (the `[fixed]` body).
-fn study_of_once(dir: &Path, fmu: &Path, method: &str, parameter: &str, fixed: &str) -> PathBuf {
-    let study = dir.join("s.toml");
-    std::fs::write(
-        &study,
-        format!(
-            "name = \"s\"\nfmu = {:?}\nseed = 7\n[experiment]\nstop = 0.3\nstep = 0.1\n\
+/// Runs a study of the Once FMU with `method`, `parameter` (a `[[parameters]]` body for x)
+/// and `fixed` (the `[fixed]` body) into `dir/out` with `--no-report` and `extra` arguments;
+/// returns that folder and the run.
+fn run_once(
+    dir: &Path,
+    fmu: &Path,
+    [method, parameter, fixed]: [&str; 3],
+    extra: &[&str],
+) -> (PathBuf, Output) {
+    let study = write_toml(
+        dir,
+        "s",
+        &format!(
+            "{}\
              [method]\n{method}\n[[parameters]]\nname = \"x\"\n{parameter}\n\
              [fixed]\n{fixed}\n[outputs]\nvariables = [\"y\"]\n",
-            fmu.to_str().unwrap()
+            study_head("s", fmu, 7, "stop = 0.3\nstep = 0.1")
         ),
-    )
-    .unwrap();
-    study
-}
-
-fn run(study: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--no-report",
-    ];
+    );
+    let out = dir.join("out");
+    let mut args = run_args(&study, &out, &["--no-report"]);
     args.extend_from_slice(extra);
-    driver(&args)
+    let o = run(&args);
+    (out, o)
 }
 
 #[test]
@@ -151,18 +136,19 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
     };
     let dir = tempfile::tempdir().unwrap();
     // x declares [-10, 10]; N(0, 6) puts about 10 % of the draws outside.
-    let study = study_of_once(
+    let (out, o) = run_once(
         dir.path(),
         &fmu,
-        "kind = \"mc\"\nsamples = 200",
-        "distribution = \"normal\"\nmean = 0\nstd = 6",
-        "step_delay = 0",
+        [
+            "kind = \"mc\"\nsamples = 200",
+            "distribution = \"normal\"\nmean = 0\nstd = 6",
+            "step_delay = 0",
+        ],
+        &[],
     );
-    let out = dir.path().join("out");
-    let o = run(&study, &out, &[]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
-    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    let points = read(&out.join("points.csv"));
     let outside = points
         .lines()
         .skip(1)
@@ -180,7 +166,7 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
     assert!(stderr.contains(&want), "{stderr}\nwant: {want}");
     // Printed before the runs, and not a second time with the final warnings.
     assert_eq!(stderr.matches(&want).count(), 1, "{stderr}");
-    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary = read(&out.join("summary.json"));
     assert!(summary.contains(&want), "{summary}");
 }
 
@@ -190,16 +176,17 @@ fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run(
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let study = study_of_once(
+    let (out, o) = run_once(
         dir.path(),
         &fmu,
-        "kind = \"mc\"\nsamples = 4",
-        "distribution = \"uniform\"\nlow = 20\nhigh = 30",
-        "step_delay = 0",
+        [
+            "kind = \"mc\"\nsamples = 4",
+            "distribution = \"uniform\"\nlow = 20\nhigh = 30",
+            "step_delay = 0",
+        ],
+        &[],
     );
-    let out = dir.path().join("out");
-    let o = run(&study, &out, &[]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let stderr = stderr(&o);
     assert!(!o.status.success(), "{stderr}");
     assert!(
         stderr.contains(
@@ -209,15 +196,15 @@ fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run(
     );
     assert!(!out.join("store").exists());
     // simulate --set outside the range: a warning, and the run.
-    let o = driver(&["simulate", fmu.to_str().unwrap(), "--set", "x=12"]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let o = run(&["simulate", utf8(&fmu), "--set", "x=12"]);
+    let stderr = crate::support::stderr(&o);
     assert!(o.status.success(), "{stderr}");
     assert!(
         stderr.contains("x = 12 is outside the range [-10, 10]"),
         "{stderr}"
     );
-    let o = driver(&["inspect", fmu.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let o = run(&["inspect", utf8(&fmu)]);
+    let stdout = stdout(&o);
     assert!(stdout.contains("range [-10, 10] slope"), "{stdout}");
 }
 
@@ -228,18 +215,19 @@ fn huge_and_escaped_fmu_log_messages_are_cut_before_reaching_points_csv_and_the_
     };
     let dir = tempfile::tempdir().unwrap();
     // Every step logs 1 MB (a colour escape first); points with x > 1 fail with such a message.
-    let study = study_of_once(
+    let (out, o) = run_once(
         dir.path(),
         &fmu,
-        "kind = \"mc\"\nsamples = 12",
-        "distribution = \"uniform\"\nlow = 0\nhigh = 2",
-        "log_bytes = 1000000\nfail_above = 1",
+        [
+            "kind = \"mc\"\nsamples = 12",
+            "distribution = \"uniform\"\nlow = 0\nhigh = 2",
+            "log_bytes = 1000000\nfail_above = 1",
+        ],
+        &["--allow-failures"],
     );
-    let out = dir.path().join("out");
-    let o = run(&study, &out, &["--allow-failures"]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
-    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    let points = read(&out.join("points.csv"));
     let records = csv_records(&points);
     let failed: Vec<&String> = records[1..]
         .iter()
@@ -260,38 +248,14 @@ fn huge_and_escaped_fmu_log_messages_are_cut_before_reaching_points_csv_and_the_
     assert!(store < 2_000_000, "store of {store} bytes");
 }
 
-/// The records of a CSV text (RFC 4180: quoted fields may hold commas, quotes and newlines).
-fn csv_records(text: &str) -> Vec<Vec<String>> {
-    let (mut records, mut record, mut field) = (Vec::new(), Vec::new(), String::new());
-    let (mut quoted, mut chars) = (false, text.chars().peekable());
-    while let Some(c) = chars.next() {
-        match (quoted, c) {
-            (true, '"') if chars.peek() == Some(&'"') => {
-                chars.next();
-                field.push('"');
-            }
-            (true, '"') => quoted = false,
-            (true, c) => field.push(c),
-            (false, '"') => quoted = true,
-            (false, ',') => record.push(std::mem::take(&mut field)),
-            (false, '\n') => {
-                record.push(std::mem::take(&mut field));
-                records.push(std::mem::take(&mut record));
-            }
-            (false, c) => field.push(c),
-        }
-    }
-    records
-}
-
 #[test]
 fn inspect_prints_a_huge_start_value_in_exponent_form() {
-    // README audit F13: Once's `fail_above` (start 1e300) was printed as 301 digits.
+    // Once's `fail_above` (start 1e300) was printed as 301 digits.
     let Some(fmu) = test_fmus::test_fmu("Once") else {
         return;
     };
-    let o = driver(&["inspect", fmu.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let o = run(&["inspect", utf8(&fmu)]);
+    let stdout = stdout(&o);
     assert!(o.status.success(), "{stdout}");
     let line = stdout
         .lines()
@@ -303,21 +267,21 @@ fn inspect_prints_a_huge_start_value_in_exponent_form() {
 
 #[test]
 fn simulate_set_of_an_integer_outside_its_range_is_refused_as_a_fixed_one_is() {
-    // README audit F10: the README promised a warning for any `simulate --set` outside the
+    // The README promised a warning for any `simulate --set` outside the
     // range; an Integer is refused (as a `[fixed]` one is by `run`), and the message no longer
     // calls a `--set` value "the fixed value".
     let Some(fmu) = test_fmus::test_fmu("Features") else {
         return;
     };
-    let o = driver(&[
+    let o = run(&[
         "simulate",
-        fmu.to_str().unwrap(),
+        utf8(&fmu),
         "--set",
         "misbehave=13",
         "--stop",
         "0.1",
     ]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
     assert!(
         err.contains("'misbehave' is an Integer declared with min = 0, max = 12")

@@ -2,6 +2,8 @@
 //! every input saved under `uq-driver/fuzz/regressions/`, so that an input the fuzzer once
 //! broke the code with stays fixed. The fuzzing itself is `make fuzz`.
 
+// The fuzz crate's own file: the fuzz crate is a workspace of its own (libFuzzer), so the
+// checks are compiled here from its source. `cargo fmt` follows the path and formats it.
 #[path = "../fuzz/src/checks.rs"]
 mod checks;
 

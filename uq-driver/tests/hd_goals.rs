@@ -1,19 +1,15 @@
-//! Issue 11 goals on the analytic benchmarks, evaluated directly (no FMU), with the
-//! high-dimensional building blocks of `uq::hd`: sparse (LARS) polynomial chaos on
+//! The accuracy goals of the high-dimensional methods on the analytic benchmarks, evaluated
+//! directly (no FMU), with the building blocks of `uq::hd`: sparse (LARS) polynomial chaos on
 //! scrambled Sobol' points, degree chosen by the corrected leave-one-out error.
 //! References are closed forms or a tensor Gauss quadrature written here.
 //! Each goal is checked on three independent scramblings (replicates 0, 1, 2).
 
-#[path = "support/benchmarks.rs"]
-mod benchmarks;
-
 use std::f64::consts::PI;
 
-use uq_driver::uq::hd::lars::PathKind;
-use uq_driver::uq::hd::sobol_seq::Sobol;
-use uq_driver::uq::hd::sparse_chaos::{fit_chaos, FitKind};
-use uq_driver::uq::pce::askey::Family;
-use uq_driver::uq::special::norm_ppf;
+use uq_driver::internals::{fit_chaos, Family, FitKind, PathKind, Sobol};
+use uq_driver::uq::norm_ppf;
+
+use crate::support::benchmarks;
 
 /// `n` scrambled Sobol' points mapped to the germs: Hermite dims through `norm_ppf`,
 /// Legendre dims to [-1, 1].

@@ -1,4 +1,4 @@
-//! Issue 14 item 6: the constant-speed critical speed of the bogie by bisection
+//! The constant-speed critical speed of the bogie by bisection
 //! (`[[qoi]] kind = "hunting_speed"`) against a direct scan of constant-speed runs made here,
 //! with the hunting criterion written here (largest |Y| over the last second at or above the
 //! threshold). Fast configuration: 60 s runs, RK4 step 4 ms, communication step 0.02 s,
@@ -8,13 +8,13 @@
 //! the transition or settings that do not fit the FMU are clear errors.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use uq_driver::fmu::Fmu;
 use uq_driver::spec::FixedValue;
-use uq_driver::study::runner::simulate;
+use uq_driver::study::simulate;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8};
 
 /// Settings of the fast configuration.
 const DURATION: f64 = 60.0;
@@ -27,16 +27,7 @@ const HIGH: f64 = 80.0;
 const TOLERANCE: f64 = 0.1;
 
 fn bogie_fmu() -> PathBuf {
-    let dir = std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"));
-    let p = dir.join("Bogie.fmu");
-    assert!(
-        p.is_file(),
-        "{} is missing: run `make fmu` first",
-        p.display()
-    );
-    p
+    built_fmu("Bogie")
 }
 
 /// A study of the bogie's hunting speed: `method` (TOML inline table), the bracket.
@@ -56,35 +47,10 @@ fn study_text(method: &str, low: f64, high: f64) -> String {
     )
 }
 
-fn run(study: &Path, out: &Path, extra: &[&str]) -> Output {
-    Command::new(DRIVER)
-        .arg("run")
-        .arg(study)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .expect("uq-driver runs")
-}
-
-fn check(o: &Output) {
-    assert!(
-        o.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 /// The values of `<q>_samples.csv` (run index, value), as text and as numbers.
 fn samples(out: &Path, q: &str) -> (String, Vec<f64>) {
-    let text = std::fs::read_to_string(out.join(format!("{q}_samples.csv"))).unwrap();
-    let values = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
-        .collect();
-    (text, values)
+    let path = out.join(format!("{q}_samples.csv"));
+    (read(&path), Csv::read(&path).col(q))
 }
 
 /// One constant-speed run of the bogie at `speed` with `params`, classified here: whether
@@ -117,12 +83,10 @@ fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
     let study = dir.path().join("s.toml");
     std::fs::write(&study, study_text("kind = \"nominal\"", LOW, HIGH)).unwrap();
     let out = dir.path().join("out");
-    let o = run(&study, &out, &[]);
-    check(&o);
+    let stdout = run_study_ok(&study, &out, &[]);
     let (_, hunt) = samples(&out, "v_hunt");
     let (_, decay) = samples(&out, "v_hunt_decay");
     let (hunt, decay) = (hunt[0], decay[0]);
-    let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("v_hunt = ") && stdout.contains("v_hunt_decay = "));
     assert!(decay < hunt && hunt - decay <= TOLERANCE, "{decay} {hunt}");
 
@@ -169,7 +133,7 @@ fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_an
     )
     .unwrap();
     let base = dir.path().join("in-process");
-    check(&run(&study, &base, &["-t", "2"]));
+    run_study_ok(&study, &base, &["-t", "2"]);
     let (text, hunt) = samples(&base, "v_hunt");
     let (_, decay) = samples(&base, "v_hunt_decay");
     assert_eq!(hunt.len(), 8);
@@ -195,28 +159,23 @@ fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_an
 
     // --isolate: the same records.
     let isolated = dir.path().join("isolated");
-    check(&run(&study, &isolated, &["--isolate", "-t", "2"]));
+    run_study_ok(&study, &isolated, &["--isolate", "-t", "2"]);
     assert_eq!(samples(&isolated, "v_hunt").0, text);
     // Interrupted after 3 points, then resumed on one thread.
     let resumed = dir.path().join("resumed");
-    let o = run(&study, &resumed, &["--max-points", "3"]);
+    let o = run_study(&study, &resumed, &["--max-points", "3"]);
     assert!(!resumed.join("v_hunt_samples.csv").exists(), "{o:?}");
-    let o = run(&study, &resumed, &["-t", "1"]);
-    check(&o);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("(3 resumed)"));
+    let stdout = run_study_ok(&study, &resumed, &["-t", "1"]);
+    assert!(stdout.contains("(3 resumed)"));
     assert_eq!(samples(&resumed, "v_hunt").0, text);
     // Two shards, merged.
     let plan = dir.path().join("plan");
-    let cmd = |args: &[&str]| {
-        let o = Command::new(DRIVER).args(args).output().unwrap();
-        check(&o);
-    };
-    let (s, p) = (study.to_str().unwrap(), plan.to_str().unwrap());
-    cmd(&["plan", s, "--shards", "2", "--out", p]);
-    cmd(&["run-shard", p, "--shard", "0"]);
-    cmd(&["run-shard", p, "--shard", "1"]);
+    let (s, p) = (utf8(&study), utf8(&plan));
+    run_ok(&["plan", s, "--shards", "2", "--out", p]);
+    run_ok(&["run-shard", p, "--shard", "0"]);
+    run_ok(&["run-shard", p, "--shard", "1"]);
     let merged = dir.path().join("merged");
-    cmd(&["merge", p, "--out", merged.to_str().unwrap()]);
+    run_ok(&["merge", p, "--out", utf8(&merged)]);
     assert_eq!(samples(&merged, "v_hunt").0, text);
 }
 
@@ -237,9 +196,9 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
         ),
     ] {
         std::fs::write(&study, study_text("kind = \"nominal\"", low, high)).unwrap();
-        let o = run(&study, &dir.path().join(format!("out{low}")), &[]);
+        let o = run_study(&study, &dir.path().join(format!("out{low}")), &[]);
         assert!(!o.status.success());
-        let err = String::from_utf8_lossy(&o.stderr);
+        let err = stderr(&o);
         assert!(
             err.contains("quantity 'v_hunt'") && err.contains(needle),
             "{err}"
@@ -252,9 +211,9 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
         study_text("kind = \"scm\"\nnodes = 2\norder = 1", 60.0, 69.0),
     )
     .unwrap();
-    let o = run(&study, &dir.path().join("scm"), &[]);
+    let o = run_study(&study, &dir.path().join("scm"), &[]);
     assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(
         err.contains("widen the bracket (or use a method that can leave points out"),
         "{err}"
@@ -278,9 +237,9 @@ fn a_nested_study_whose_bracket_misses_the_transition_names_the_bracket() {
     );
     assert!(text.contains("level = \"outer\""));
     std::fs::write(&study, text).unwrap();
-    let o = run(&study, &dir.path().join("nested"), &[]);
+    let o = run_study(&study, &dir.path().join("nested"), &[]);
     assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(
         err.contains("quantity 'v_hunt'")
             && err.contains("the top of the bracket (high = 69)")
@@ -325,9 +284,9 @@ fn settings_that_do_not_fit_the_fmu_are_refused_before_any_run() {
     ] {
         std::fs::write(&study, text).unwrap();
         let out = dir.path().join("out");
-        let o = run(&study, &out, &[]);
+        let o = run_study(&study, &out, &[]);
         assert!(!o.status.success());
-        let err = String::from_utf8_lossy(&o.stderr);
+        let err = stderr(&o);
         assert!(err.contains(needle), "{err} should mention {needle}");
         assert!(
             !out.join("store").exists()
@@ -353,13 +312,12 @@ fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
          [[qoi]]\nkind = \"final\"\nname = \"end\"\nsignal = \"q\"\n\
          [[variants]]\nname = \"a\"\n\
          [[variants]]\nname = \"b\"\nmethod = {{ kind = \"mc\", samples = 12 }}\nquantities = [\"end\"]\n",
-        wheel.to_str().unwrap()
+        utf8(&wheel)
     );
     std::fs::write(&study, text).unwrap();
     let out = dir.path().join("out");
-    check(&run(&study, &out, &[]));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    run_study_ok(&study, &out, &[]);
+    let summary = summary(&out);
     let names = |v: &serde_json::Value| -> Vec<String> {
         v["quantities"]
             .as_array()
@@ -405,7 +363,7 @@ fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
     let cells: Vec<&str> = row_b.split("<td").skip(1).collect();
     // variant, method, runs, wall time, mean/Std end, mean/Std peak (blank).
     assert_eq!(cells.len(), 8, "{row_b}");
-    // The mean to the resolution of its Std, as the page writes statistics (QA round 3, M8).
+    // The mean to the resolution of its Std, as the page writes statistics (M8).
     let std_b = summary["variants"][1]["quantities"][0]["std"]
         .as_f64()
         .unwrap();

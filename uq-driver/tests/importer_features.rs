@@ -1,53 +1,31 @@
-//! Issue 13, importer: uq-driver against the Features test FMU (`tests/fmus/features`), every
+//! The importer: uq-driver against the Features test FMU (`tests/fmus/features`), every
 //! expectation computed here from the FMU's documented behaviour (its README), independently of
 //! the driver: parameters of every type read back through outputs, inputs applied as fmpy
 //! applies them, an FMU that ends the simulation, a stop time off the grid, and CSV numbers.
 //! The same runs are cross-checked against fmpy in `tests/python/test_importer_vs_fmpy.py`.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{
+    built_fmu, edit, read, run, run_study, run_study_ok, stderr, succeeded, test_fmus, utf8,
+    write_toml,
+};
 
 fn features() -> Option<PathBuf> {
     test_fmus::test_fmu("Features")
 }
 
-fn driver(args: &[&str]) -> Output {
-    Command::new(DRIVER).args(args).output().expect("runs")
-}
-
-/// Parses a CSV written by the driver: header and columns.
-fn read_csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let mut cols = vec![Vec::new(); header.len()];
-    for l in lines {
-        for (j, f) in l.split(',').enumerate() {
-            cols[j].push(f.parse::<f64>().unwrap_or_else(|_| panic!("{f} in {l}")));
-        }
-    }
-    (header, cols)
-}
-
-fn column<'a>(csv: &'a (Vec<String>, Vec<Vec<f64>>), name: &str) -> &'a [f64] {
-    let j = csv.0.iter().position(|h| h == name).expect(name);
-    &csv.1[j]
+/// Parses a CSV written by the driver (every field a number).
+fn read_csv(text: &str) -> Csv {
+    Csv::parse(text).numeric()
 }
 
 fn simulate(fmu: &Path, args: &[&str]) -> (String, String) {
-    let mut all = vec!["simulate", fmu.to_str().unwrap()];
+    let mut all = vec!["simulate", utf8(fmu)];
     all.extend_from_slice(args);
-    let o = driver(&all);
-    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    let o = run(&all);
+    let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
     (String::from_utf8(o.stdout).unwrap(), stderr)
 }
@@ -71,17 +49,17 @@ fn integer_boolean_enumeration_and_string_parameters_reach_the_fmu() {
         ],
     );
     let csv = read_csv(&out);
-    assert_eq!(column(&csv, "int_out"), [-17.0; 3]);
-    assert_eq!(column(&csv, "bool_out"), [1.0; 3]);
-    assert_eq!(column(&csv, "enum_out"), [3.0; 3]);
+    assert_eq!(csv.col("int_out"), [-17.0; 3]);
+    assert_eq!(csv.col("bool_out"), [1.0; 3]);
+    assert_eq!(csv.col("enum_out"), [3.0; 3]);
     // string_len = strlen(string_param) in bytes.
     let len = "grüße, 世界".len() as f64;
-    assert_eq!(column(&csv, "string_len"), [len; 3]);
+    assert_eq!(csv.col("string_len"), [len; 3]);
 }
 
 #[test]
 fn simulate_without_outputs_records_every_number_and_names_the_string_it_skips() {
-    // Issue 13: an FMU with only non-Real outputs wrote a CSV with only `time`, silently.
+    // An FMU with only non-Real outputs wrote a CSV with only `time`, silently.
     let Some(fmu) = features() else { return };
     let (out, err) = simulate(&fmu, &["--step", "0.5"]);
     let csv = read_csv(&out);
@@ -98,42 +76,38 @@ fn simulate_without_outputs_records_every_number_and_names_the_string_it_skips()
         "flag_echo",
     ] {
         assert!(
-            csv.0.iter().any(|h| h == name),
+            csv.header.iter().any(|h| h == name),
             "{name} missing: {:?}",
-            csv.0
+            csv.header
         );
     }
-    assert!(!csv.0.iter().any(|h| h == "string_out"));
+    assert!(!csv.header.iter().any(|h| h == "string_out"));
     assert!(
         err.contains("'string_out' not recorded") && err.contains("String"),
         "{err}"
     );
-    assert_eq!(column(&csv, "int_out"), [3.0; 3], "start value");
-    assert_eq!(column(&csv, "enum_out"), [2.0; 3], "start value (green)");
-    assert_eq!(
-        column(&csv, "file_value"),
-        [2.5e-3; 3],
-        "resources/value.txt"
-    );
+    assert_eq!(csv.col("int_out"), [3.0; 3], "start value");
+    assert_eq!(csv.col("enum_out"), [2.0; 3], "start value (green)");
+    assert_eq!(csv.col("file_value"), [2.5e-3; 3], "resources/value.txt");
 }
 
 #[test]
 fn wrong_values_for_typed_variables_are_refused_clearly() {
     let Some(fmu) = features() else { return };
-    let f = fmu.to_str().unwrap();
+    let f = utf8(&fmu);
     for (set, needle) in [
         ("int_param=2.5", "not a whole number"),
         ("bool_param=maybe", "true/false"),
         ("u=abc", "not a number"),
         ("nothere=1", "no variable named 'nothere'"),
     ] {
-        let o = driver(&["simulate", f, "--set", set]);
-        let err = String::from_utf8_lossy(&o.stderr);
+        let o = run(&["simulate", f, "--set", set]);
+        let err = stderr(&o);
         assert!(!o.status.success());
         assert!(err.contains(needle), "{set}: {err}");
     }
-    let o = driver(&["simulate", f, "--output", "string_out"]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("can be recorded"));
+    let o = run(&["simulate", f, "--output", "string_out"]);
+    assert!(stderr(&o).contains("can be recorded"));
 }
 
 #[test]
@@ -151,7 +125,7 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
         &fmu,
         &[
             "--input",
-            input.to_str().unwrap(),
+            utf8(&input),
             "--step",
             "0.1",
             "--output",
@@ -165,7 +139,7 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
         ],
     );
     let csv = read_csv(&out);
-    let t = column(&csv, "time");
+    let t = csv.col("time");
     assert_eq!(t.len(), 11);
     // fmpy sets the inputs at the start of each step t_n (after a jump there); the FMU holds
     // them over the step, so the row at t_{n+1} shows u(t_n), and u_integral is the left sum.
@@ -176,7 +150,7 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
             1.0 - 6.0 * (x - 0.5)
         }
     };
-    let (mut integral, echo, integ) = (0.0, column(&csv, "u_echo"), column(&csv, "u_integral"));
+    let (mut integral, echo, integ) = (0.0, csv.col("u_echo"), csv.col("u_integral"));
     assert_eq!(echo[0], 0.0);
     for n in 0..10 {
         let applied = u(t[n]);
@@ -192,17 +166,14 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
             t[n + 1]
         );
         let after = t[n] >= 0.5 - 1e-12;
-        assert_eq!(column(&csv, "k_echo")[n + 1], if after { 5.0 } else { 0.0 });
-        assert_eq!(
-            column(&csv, "flag_echo")[n + 1],
-            if after { 1.0 } else { 0.0 }
-        );
+        assert_eq!(csv.col("k_echo")[n + 1], if after { 5.0 } else { 0.0 });
+        assert_eq!(csv.col("flag_echo")[n + 1], if after { 1.0 } else { 0.0 });
     }
 }
 
 #[test]
 fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
-    // Issue 13: Stair (Reference-FMUs) asks to stop at t = 9; uq-driver reported a failure.
+    // Stair (Reference-FMUs) asks to stop at t = 9; uq-driver reported a failure.
     let Some(fmu) = features() else { return };
     for (stop_at, last, rows) in [("0.55", 0.55, 7), ("0.5", 0.5, 6)] {
         let (out, err) = simulate(
@@ -221,11 +192,11 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
             ],
         );
         let csv = read_csv(&out);
-        let t = column(&csv, "time");
+        let t = csv.col("time");
         assert_eq!(t.len(), rows, "{out}");
         assert_eq!(*t.last().unwrap(), last);
         assert!(t.windows(2).all(|w| w[1] > w[0]), "no duplicate row");
-        let integral = *column(&csv, "u_integral").last().unwrap();
+        let integral = *csv.col("u_integral").last().unwrap();
         assert!((integral - 2.0 * last).abs() < 1e-12, "{integral}");
         assert!(
             err.contains(&format!("ended the simulation at t = {last} s")),
@@ -238,30 +209,23 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
 fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_the_stop() {
     let Some(fmu) = features() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
     // stop_at uniform on [0.5, 2]: runs with stop_at < 1 end early (failed, allowed), the others
     // reach the stop time 1 s (stop_at = 1 exactly would end at the stop time: a whole run).
-    std::fs::write(
-        &study,
-        format!(
+    let study = write_toml(
+        dir.path(),
+        "s",
+        &format!(
             "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
              [method]\nkind = \"mc\"\nsamples = 16\n\
              [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
              [fixed]\nu = 1\n[outputs]\nvariables = [\"u_integral\"]\n\
              [analysis]\nallow_failures = true\n",
-            fmu.to_str().unwrap()
+            utf8(&fmu)
         ),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
-    let o = driver(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    run_study_ok(&study, &out, &[]);
+    let points = read(&out.join("points.csv"));
     let mut failed = 0;
     for line in points.lines().skip(1) {
         let stop_at: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
@@ -273,7 +237,7 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
         }
     }
     assert!(failed > 0 && failed < 16, "{points}");
-    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary = read(&out.join("summary.json"));
     assert!(
         summary.contains(&format!("\"failed_runs\": {failed}")),
         "{summary}"
@@ -282,7 +246,7 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
 
 #[test]
 fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
-    // Issue 13: "stop − start is not a whole number of steps" was an error; fmpy takes a
+    // "stop − start is not a whole number of steps" was an error; fmpy takes a
     // shorter last step.
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
@@ -299,24 +263,23 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
         ],
     );
     let csv = read_csv(&out);
-    let t = column(&csv, "time");
+    let t = csv.col("time");
     assert_eq!(t.len(), 12);
     assert_eq!(t[10], 10.0 * 0.1);
     assert_eq!(t[11], 1.05);
-    assert!((column(&csv, "u_integral")[11] - 1.05).abs() < 1e-12);
-    let o = driver(&["simulate", fmu.to_str().unwrap(), "--step", "0"]);
+    assert!((csv.col("u_integral")[11] - 1.05).abs() < 1e-12);
+    let o = run(&["simulate", utf8(&fmu), "--step", "0"]);
     assert!(!o.status.success());
     assert!(
-        String::from_utf8_lossy(&o.stderr)
-            .contains("--step 0: the communication step must be positive"),
+        stderr(&o).contains("--step 0: the communication step must be positive"),
         "{}",
-        String::from_utf8_lossy(&o.stderr)
+        stderr(&o)
     );
 }
 
 #[test]
 fn csv_numbers_are_short_and_read_back_exactly() {
-    // Issue 13: 2.2e-308 was written as a 326-character decimal.
+    // 2.2e-308 was written as a 326-character decimal.
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
         &fmu,
@@ -343,32 +306,21 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
     let dir = tempfile::tempdir().unwrap();
     // misbehave_at, an ordinary Real, is the random parameter; int_param, bool_param,
     // enum_param and string_param come from [fixed] in all their TOML forms.
-    let study = dir.path().join("s.toml");
-    std::fs::write(
-        &study,
-        format!(
+    let study = write_toml(
+        dir.path(),
+        "s",
+        &format!(
             "name = \"typed\"\nfmu = {:?}\n[experiment]\nstop = 0.2\nstep = 0.1\n\
              [method]\nkind = \"mc\"\nsamples = 3\n\
              [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
              [fixed]\nint_param = -4\nbool_param = true\nenum_param = 1\nstring_param = \"abcdef\"\nu = 2\n\
              [outputs]\nvariables = [\"int_out\", \"bool_out\", \"enum_out\", \"string_len\", \"u_gain\"]\n",
-            fmu.to_str().unwrap()
+            utf8(&fmu)
         ),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
-    let o = driver(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mean = |name: &str| -> Vec<f64> {
-        let text = std::fs::read_to_string(out.join(format!("{name}.csv"))).unwrap();
-        let csv = read_csv(&text);
-        column(&csv, "mean").to_vec()
-    };
+    run_study_ok(&study, &out, &[]);
+    let mean = |name: &str| read_csv(&read(&out.join(format!("{name}.csv")))).col("mean");
     assert_eq!(mean("int_out"), [-4.0; 3]);
     assert_eq!(mean("bool_out"), [1.0; 3]);
     assert_eq!(mean("enum_out"), [1.0; 3]);
@@ -379,19 +331,10 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
 
     // An Integer variable as the random parameter: a normal design has fractional values and
     // is refused before any run, with a message that says why.
-    let text = std::fs::read_to_string(&study)
-        .unwrap()
-        .replace("name = \"gain\"", "name = \"int_param\"")
-        .replace("int_param = -4\n", "");
-    std::fs::write(&study, text).unwrap();
-    let o = driver(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--fresh",
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    edit(&study, "name = \"gain\"", "name = \"int_param\"");
+    edit(&study, "int_param = -4\n", "");
+    let o = run_study(&study, &out, &["--fresh"]);
+    let err = stderr(&o);
     assert!(!o.status.success());
     assert!(
         err.contains("random parameter 'int_param' is an Integer variable")
@@ -405,49 +348,33 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
     let Some(fmu) = features() else { return };
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,1\n").unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(
-        &study,
-        format!(
+    let study = write_toml(
+        dir.path(),
+        "s",
+        &format!(
             "name = \"inputs\"\nfmu = {:?}\n[experiment]\nstop = 1\nstep = 0.25\n\
              [method]\nkind = \"mc\"\nsamples = 2\n\
              [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
              [inputs]\nfile = \"signal.csv\"\n\
              [outputs]\nvariables = [\"u_echo\"]\n",
-            fmu.to_str().unwrap()
+            utf8(&fmu)
         ),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            "run",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        driver(&args)
-    };
-    let o = run(&[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(out.join("u_echo.csv")).unwrap();
-    let csv = read_csv(&text);
+    let run = |extra: &[&str]| run_study(&study, &out, extra);
+    succeeded(&run(&[]), &study);
+    let csv = read_csv(&read(&out.join("u_echo.csv")));
     // u(t) = t applied at the start of each step: the row at t_{n+1} shows t_n.
-    assert_eq!(column(&csv, "mean"), [0.0, 0.0, 0.25, 0.5, 0.75]);
+    assert_eq!(csv.col("mean"), [0.0, 0.0, 0.25, 0.5, 0.75]);
     // Other signals change the records: the folder is not resumed with them.
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,2\n").unwrap();
     let o = run(&[]);
     assert!(!o.status.success());
-    assert!(
-        String::from_utf8_lossy(&o.stderr).contains("different study"),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert!(stderr(&o).contains("different study"), "{}", stderr(&o));
     // A column that is not an input is refused with the file's name.
     std::fs::write(dir.path().join("signal.csv"), "time,u_echo\n0,0\n1,2\n").unwrap();
     let o = run(&["--fresh"]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(
         err.contains("signal.csv") && err.contains("only inputs"),
         "{err}"
@@ -456,12 +383,8 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
 
 #[test]
 fn vehicle_track_measured_profile_is_set_from_the_command_line() {
-    // Issue 13: irregularity = 10 with profile_file could not be used from uq-driver.
-    let vt = std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-        .join("VehicleTrack.fmu");
-    assert!(vt.is_file(), "{} is missing: run `make fmu`", vt.display());
+    // irregularity = 10 with profile_file could not be used from uq-driver.
+    let vt = built_fmu("VehicleTrack");
     let dir = tempfile::tempdir().unwrap();
     let profile = dir.path().join("track.csv");
     // z = 1 mm sin(2 pi x / 5 m) from x = -50 m to 150 m: the rail under wheel 1 is this
@@ -493,13 +416,13 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
         ],
     );
     let csv = read_csv(&out);
-    let z = column(&csv, "Z0_1");
+    let z = csv.col("Z0_1");
     let peak = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert!(peak > 0.9e-3 && peak <= 1.0e-3 + 1e-12, "peak {peak}");
     // A missing profile is the FMU's error, named.
-    let o = driver(&[
+    let o = run(&[
         "simulate",
-        vt.to_str().unwrap(),
+        utf8(&vt),
         "--set",
         "irregularity=10",
         "--set",
@@ -510,5 +433,5 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
         "0.001",
     ]);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/track.csv"));
+    assert!(stderr(&o).contains("/nonexistent/track.csv"));
 }

@@ -1,30 +1,30 @@
-//! QA round 3, the instance lifecycle of a study, against the Features test FMU's `reset_bug`
+//! The instance lifecycle of a study, against the Features test FMU's `reset_bug`
 //! (a broken `fmi2Reset`), `name_dir` (working files keyed on the instance name) and `quiet`
-//! (messages only with logging on): H-2 (instances reused through a broken `fmi2Reset` gave
-//! failures or silently wrong numbers), M-3 (every instance was named `uq-driver`), M-2 (FMUs
-//! were always instantiated with `loggingOn = false`). Each test is named after the problem it
+//! (messages only with logging on): instances reused through a broken `fmi2Reset` gave
+//! failures or silently wrong numbers, every instance was named `uq-driver`, and FMUs were
+//! always instantiated with `loggingOn = false`. Each test is named after the problem it
 //! pins. Reference values are in closed form: with `u` = 0.7 held, `u_integral`(t) = 0.7 t and
 //! `u_gain` = 0.7 gain.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{
+    csv_records, read, run, run_args, run_ok, stderr, study_head, test_fmus, utf8, write_toml,
+};
 
 /// Eight Monte Carlo points with gain ~ U(1, 2), u = 0.7, stop 1 s, step 0.1 s; `fixed`
 /// extra `[fixed]` lines.
 fn study_text(fmu: &Path, fixed: &str) -> String {
     format!(
-        "name = \"lifecycle\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+        "{}\
          [method]\nkind = \"mc\"\nsamples = 8\n\
          [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1.0\nhigh = 2.0\n\
          [fixed]\nread_file = \"\"\nu = 0.7\n{fixed}\n\
          [outputs]\nvariables = [\"u_integral\", \"u_gain\", \"file_value\"]\n\
          [analysis]\nallow_failures = true\n",
-        fmu.to_str().unwrap()
+        study_head("lifecycle", fmu, 1, "stop = 1.0\nstep = 0.1")
     )
 }
 
@@ -36,8 +36,7 @@ struct Case {
 fn case(fixed: &str) -> Option<Case> {
     let fmu = test_fmus::test_fmu("Features")?;
     let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(&study, study_text(&fmu, fixed)).unwrap();
+    let study = write_toml(dir.path(), "s", &study_text(&fmu, fixed));
     Some(Case { dir, study })
 }
 
@@ -56,40 +55,23 @@ impl Case {
     /// `run` into folder `name` with `extra` options.
     fn try_run(&self, name: &str, extra: &[&str]) -> Output {
         let out = self.out(name);
-        let mut args = vec![
-            "run",
-            self.study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--no-report",
-        ];
+        let mut args = run_args(&self.study, &out, &["--no-report"]);
         args.extend_from_slice(extra);
-        Command::new(DRIVER).args(&args).output().expect("runs")
+        run(&args)
     }
 
     fn csv(&self, name: &str, file: &str) -> String {
-        std::fs::read_to_string(self.out(name).join(file)).unwrap()
+        read(&self.out(name).join(file))
     }
 
-    /// The statuses of points.csv, in point order.
+    /// The statuses of points.csv (`index,<parameter>,status`), in point order.
     fn statuses(&self, name: &str) -> Vec<String> {
-        let text = self.csv(name, "points.csv");
-        let mut rows = Vec::new();
-        let mut lines = text.lines().skip(1);
-        while let Some(line) = lines.next() {
-            let mut row = line.to_owned();
-            while row.matches('"').count() % 2 == 1 {
-                row.push('\n');
-                row.push_str(lines.next().unwrap());
-            }
-            rows.push(row.splitn(3, ',').nth(2).unwrap().to_owned());
-        }
-        rows
+        csv_records(&self.csv(name, "points.csv"))
+            .into_iter()
+            .skip(1)
+            .map(|r| r[2].clone())
+            .collect()
     }
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// The gain of each point, from points.csv (`index,gain,status`).
@@ -101,25 +83,12 @@ fn gains(points: &str) -> Vec<f64> {
         .collect()
 }
 
-/// Rows of a CSV file with a header: the numbers of each row.
-fn numbers(text: &str) -> Vec<Vec<f64>> {
-    text.lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
-
 /// Every run's series of output `name`, from `export --runs`: (run, time, value).
 fn runs(dir: &Path, name: &str) -> Vec<(usize, f64, f64)> {
-    let o = Command::new(DRIVER)
-        .args(["export", dir.to_str().unwrap(), "--runs"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(dir.join("runs/runs.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = header.iter().position(|h| *h == name).expect("column");
-    numbers(&text)
+    run_ok(&["export", utf8(dir), "--runs"]);
+    let csv = Csv::read(&dir.join("runs/runs.csv"));
+    let col = csv.index(name);
+    csv.numbers()
         .into_iter()
         .map(|r| (r[0] as usize, r[1], r[col]))
         .collect()
@@ -140,7 +109,7 @@ fn check_closed_form(dir: &Path) {
 
 #[test]
 fn a_reset_that_returns_error_fails_no_point_in_process_or_in_workers() {
-    // H-2 (a): every second point failed (every point under --isolate).
+    // Every second point failed (every point under --isolate).
     let Some(c) = case("reset_bug = 1") else {
         return;
     };
@@ -170,7 +139,7 @@ fn a_reset_that_returns_error_fails_no_point_in_process_or_in_workers() {
 
 #[test]
 fn a_reset_that_forgets_start_values_gives_the_numbers_of_fresh_instances() {
-    // H-2 (b): silently wrong numbers, different per thread count and under --isolate.
+    // Silently wrong numbers, different per thread count and under --isolate.
     let Some(c) = case("reset_bug = 2") else {
         return;
     };
@@ -202,7 +171,7 @@ fn a_reset_that_forgets_start_values_gives_the_numbers_of_fresh_instances() {
 
 #[test]
 fn a_reset_that_fails_after_some_runs_only_gives_a_fresh_instance_and_one_warning() {
-    // H-2: a reset that fails after the self-check passed (here after runs with gain < 1.5):
+    // A reset that fails after the self-check passed (here after runs with gain < 1.5):
     // the point runs on a fresh instance, never fails, and the warning comes once.
     let Some(c) = case("reset_bug = 3") else {
         return;
@@ -253,7 +222,7 @@ fn is_unique_name(file: &str) -> bool {
 
 #[test]
 fn concurrent_instances_have_names_of_their_own() {
-    // M-3: every instance was named `uq-driver`; an FMU that keys its files on the instance
+    // Every instance was named `uq-driver`; an FMU that keys its files on the instance
     // name read another run's file (61 of 120 rows wrong with two threads).
     let Some(c) = case("") else { return };
     let base = std::fs::read_to_string(&c.study).unwrap();
@@ -266,7 +235,7 @@ fn concurrent_instances_have_names_of_their_own() {
         std::fs::create_dir(&files).unwrap();
         let text = base.replace(
             "u = 0.7\n",
-            &format!("u = 0.7\nname_dir = {:?}\n", files.to_str().unwrap()),
+            &format!("u = 0.7\nname_dir = {:?}\n", utf8(&files)),
         );
         std::fs::write(&c.study, text).unwrap();
         c.run(name, extra);
@@ -333,7 +302,7 @@ fn fresh_instances_and_fmu_logging_change_no_result_of_a_well_behaved_fmu() {
 
 #[test]
 fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
-    // M-2: instances were always made with loggingOn = false, so an FMU that logs only when
+    // Instances were always made with loggingOn = false, so an FMU that logs only when
     // asked (pythonfmu) gave "the FMU logged nothing", even for its errors.
     let Some(c) = case("misbehave = 1\nquiet = true") else {
         return;
@@ -375,14 +344,14 @@ fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
     let sim = |extra: &[&str]| {
         let mut args = vec![
             "simulate",
-            fmu.to_str().unwrap(),
+            utf8(&fmu),
             "--set",
             "misbehave=1",
             "--set",
             "quiet=true",
         ];
         args.extend_from_slice(extra);
-        Command::new(DRIVER).args(&args).output().unwrap()
+        run(&args)
     };
     let quiet = sim(&[]);
     assert!(!quiet.status.success());

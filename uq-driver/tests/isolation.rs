@@ -1,33 +1,33 @@
-//! Issue 12, hardening of the runner, against the Features test FMU's `misbehave` modes
+//! Hardening of the runner, against the Features test FMU's `misbehave` modes
 //! (1 error, 2 segfault, 3 abort, 4 exit(0), 5 hang, 6 NaN outputs, 7 fatal, 8 warning, at
 //! `misbehave_at`): `--isolate`, `--timeout-per-run`, an in-process `exit()`, `--retry-failed`,
 //! the output folder's lock, and the smaller items. Each test is named after the problem it pins.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
 
+use uq_driver::internals as runner;
 use uq_driver::spec::Study;
-use uq_driver::study::runner::{self, RunOptions};
-use uq_driver::uq::distributions::Germ;
+use uq_driver::study::RunOptions;
 use uq_driver::uq::method::Design;
+use uq_driver::uq::Germ;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::{
+    built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head, test_fmus, utf8,
+};
 
 /// Eight Monte Carlo points with misbehave_at ~ U(0.3, 1.8) and stop = 1: the points with
 /// misbehave_at <= 1 misbehave (by mode `mode`), the others run to the end.
 fn study_text(fmu: &Path, mode: i32) -> String {
     format!(
-        "name = \"misbehave\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+        "{}\
          [method]\nkind = \"mc\"\nsamples = 8\n\
          [[parameters]]\nname = \"misbehave_at\"\ndistribution = \"uniform\"\nlow = 0.3\nhigh = 1.8\n\
          [fixed]\nmisbehave = {mode}\nread_file = \"\"\n\
          [outputs]\nvariables = [\"u_integral\", \"int_out\"]\n\
          [analysis]\nallow_failures = true\n",
-        fmu.to_str().unwrap()
+        study_head("misbehave", fmu, 1, "stop = 1.0\nstep = 0.1")
     )
 }
 
@@ -40,23 +40,15 @@ struct Case {
 fn case(mode: i32) -> Option<Case> {
     let fmu = test_fmus::test_fmu("Features")?;
     let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(&study, study_text(&fmu, mode)).unwrap();
+    let study = crate::support::write_toml(dir.path(), "s", &study_text(&fmu, mode));
     let out = dir.path().join("out");
     Some(Case { dir, study, out })
 }
 
 impl Case {
     fn run(&self, extra: &[&str]) -> Output {
-        let mut args = vec![
-            "run",
-            self.study.to_str().unwrap(),
-            "--out",
-            self.out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        Command::new(DRIVER)
-            .args(&args)
+        driver()
+            .args(run_args(&self.study, &self.out, extra))
             .env("TMPDIR", self.tmp())
             .output()
             .expect("runs")
@@ -69,23 +61,14 @@ impl Case {
         t
     }
 
+    /// `misbehave_at` and the status of each point (`index,misbehave_at,status`; a failure
+    /// message may span lines: the FMU's log).
     fn points(&self) -> Vec<(f64, String)> {
-        let text = std::fs::read_to_string(self.out.join("points.csv")).unwrap();
-        let mut rows = Vec::new();
-        let mut lines = text.lines().skip(1).peekable();
-        while let Some(line) = lines.next() {
-            // A failure message may span lines (the FMU's log): join until the closing quote.
-            let mut row = line.to_owned();
-            while row.matches('"').count() % 2 == 1 {
-                row.push('\n');
-                row.push_str(lines.next().unwrap());
-            }
-            let mut parts = row.splitn(3, ',');
-            parts.next();
-            let at: f64 = parts.next().unwrap().parse().unwrap();
-            rows.push((at, parts.next().unwrap().to_owned()));
-        }
-        rows
+        csv_records(&read(&self.out.join("points.csv")))
+            .into_iter()
+            .skip(1)
+            .map(|r| (r[1].parse().unwrap(), r[2].clone()))
+            .collect()
     }
 
     /// Checks that the points that misbehave failed with `needle` in their message and the
@@ -105,13 +88,14 @@ impl Case {
         assert!(failed >= 2, "the seed gives misbehaving points: {points:?}");
     }
 
+    /// `u_integral.csv` of the output folder.
+    fn u_integral(&self) -> String {
+        read(&self.out.join("u_integral.csv"))
+    }
+
     fn leftover_temp_folders(&self) -> usize {
         std::fs::read_dir(self.tmp()).unwrap().count()
     }
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 #[test]
@@ -163,7 +147,7 @@ fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
 
 #[test]
 fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnable() {
-    // QA round 3, H-1: after one point's fmi2Fatal in-process, every later point was refused by
+    // After one point's fmi2Fatal in-process, every later point was refused by
     // the FMU layer and stored as *failed*; with --allow-failures the study then analysed the
     // points that happened to finish first (a thread-count-dependent subset), exit 0. Now the
     // study stops at the Fatal, naming the point and --isolate; only that point is stored as
@@ -191,11 +175,11 @@ fn isolate_errors_nan_and_warnings_behave_as_in_process() {
         assert!(o.status.success(), "{}", stderr(&o));
         c.check_failed_with(needle);
         // In-process gives the same statuses and the same numbers.
-        let isolated = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+        let isolated = c.u_integral();
         let o = c.run(&["--fresh"]);
         assert!(o.status.success(), "{}", stderr(&o));
         c.check_failed_with(needle);
-        let in_process = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+        let in_process = c.u_integral();
         assert_eq!(isolated, in_process);
     }
     let Some(c) = case(8) else { return };
@@ -208,21 +192,18 @@ fn isolate_gives_the_in_process_records_bit_for_bit() {
     // 101 communication points of 0.01 s (times like 0.41000000000000003 reach the worker
     // exactly: its setup is JSON, parsed with exact float round trips) and a Real input.
     let Some(c) = case(0) else { return };
-    let text = std::fs::read_to_string(&c.study)
-        .unwrap()
-        .replace("step = 0.1", "step = 0.01")
-        .replace("read_file = \"\"", "read_file = \"\"\nu = 0.7");
-    std::fs::write(&c.study, text).unwrap();
+    edit(&c.study, "step = 0.1", "step = 0.01");
+    edit(&c.study, "read_file = \"\"", "read_file = \"\"\nu = 0.7");
     assert!(c.run(&["--isolate", "-t", "2"]).status.success());
-    let a = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    let a = c.u_integral();
     assert!(c.run(&["--fresh", "-t", "1"]).status.success());
-    let b = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    let b = c.u_integral();
     assert_eq!(a, b);
 }
 
 #[test]
 fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
-    // Issue 12: an FMU calling exit(0) made `uq-driver run` exit 0 with no output and no
+    // An FMU calling exit(0) made `uq-driver run` exit 0 with no output and no
     // message. Two threads: two instances may call exit() at the same moment.
     let Some(c) = case(4) else { return };
     for threads in ["1", "2"] {
@@ -242,7 +223,7 @@ fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
 
 #[test]
 fn in_process_timeout_stops_the_study_naming_the_point_and_keeps_the_store() {
-    // Issue 12: an FMU that blocks hung uq-driver forever.
+    // An FMU that blocks hung uq-driver forever.
     let Some(c) = case(5) else { return };
     let t0 = Instant::now();
     let o = c.run(&["--timeout-per-run", "0.5", "-t", "1"]);
@@ -268,24 +249,17 @@ fn in_process_timeout_stops_the_study_naming_the_point_and_keeps_the_store() {
 
 #[test]
 fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
-    // Issue 12: failed points were never retried on a re-run; only --fresh helped, and the
+    // Failed points were never retried on a re-run; only --fresh helped, and the
     // message did not say so.
     let Some(c) = case(1) else { return };
     // Failures not allowed: the study stops and names --retry-failed.
-    let text = std::fs::read_to_string(&c.study)
-        .unwrap()
-        .replace("allow_failures = true", "allow_failures = false");
-    std::fs::write(&c.study, &text).unwrap();
+    edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--retry-failed"), "{}", stderr(&o));
     // The FMU is "fixed" (misbehave = 0 is a different study, so the fix is simulated by the
     // same study with failures allowed): a plain re-run keeps the failures and says so ...
-    std::fs::write(
-        &c.study,
-        text.replace("allow_failures = false", "allow_failures = true"),
-    )
-    .unwrap();
+    edit(&c.study, "allow_failures = false", "allow_failures = true");
     let o = c.run(&[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
@@ -309,7 +283,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
 
 #[test]
 fn a_retried_point_that_now_succeeds_replaces_its_failure_in_the_store() {
-    use uq_driver::study::store::{Manifest, Record, Store};
+    use uq_driver::internals::store::{Manifest, Record, Store};
     let dir = tempfile::tempdir().unwrap();
     let m = Manifest {
         study_hash: "s".into(),
@@ -338,17 +312,10 @@ fn a_retried_point_that_now_succeeds_replaces_its_failure_in_the_store() {
 
 #[test]
 fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
-    // Issue 12: two runs in one folder both computed every point and doubled the store.
+    // Two runs in one folder both computed every point and doubled the store.
     let Some(c) = case(5) else { return };
-    let mut first = Command::new(DRIVER)
-        .args([
-            "run",
-            c.study.to_str().unwrap(),
-            "--out",
-            c.out.to_str().unwrap(),
-            "-t",
-            "1",
-        ])
+    let mut first = driver()
+        .args(run_args(&c.study, &c.out, &["-t", "1"]))
         .env("TMPDIR", c.tmp())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -381,7 +348,7 @@ fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
 
 #[test]
 fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
-    // Issue 12: reported as "File exists".
+    // Reported as "File exists".
     let Some(c) = case(0) else { return };
     std::fs::write(&c.out, "x").unwrap();
     let o = c.run(&[]);
@@ -393,36 +360,26 @@ fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
 
 #[test]
 fn error_causes_are_printed_once() {
-    // Issue 12: error causes were printed twice.
+    // Error causes were printed twice.
     let Some(c) = case(1) else { return };
-    let text = std::fs::read_to_string(&c.study)
-        .unwrap()
-        .replace("allow_failures = true", "allow_failures = false");
-    std::fs::write(&c.study, text).unwrap();
+    edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
     let err = stderr(&o);
     assert!(!o.status.success());
     assert_eq!(err.matches("fails on purpose").count(), 1, "{err}");
-    let o = Command::new(DRIVER)
-        .args(["inspect", "/nonexistent/M.fmu"])
-        .output()
-        .unwrap();
+    let o = crate::support::run(&["inspect", "/nonexistent/M.fmu"]);
     let err = stderr(&o);
     assert_eq!(err.matches("No such file").count(), 1, "{err}");
 }
 
 #[test]
 fn inspect_stopped_by_sigterm_leaves_no_temporary_folder() {
-    // Issue 12: a temp folder was left behind when `inspect` was stopped by SIGTERM.
-    let vt = std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-        .join("VehicleTrack.fmu");
-    assert!(vt.is_file(), "{} is missing: run `make fmu`", vt.display());
+    // A temp folder was left behind when `inspect` was stopped by SIGTERM.
+    let vt = built_fmu("VehicleTrack");
     let tmp = tempfile::tempdir().unwrap();
     for delay_ms in [0, 2, 5, 10, 20] {
-        let child = Command::new(DRIVER)
-            .args(["inspect", vt.to_str().unwrap()])
+        let child = driver()
+            .args(["inspect", utf8(&vt)])
             .env("TMPDIR", tmp.path())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
@@ -453,7 +410,7 @@ fn integral_design_values_set_an_integer_random_parameter() {
          [method]\nkind = \"mc\"\nsamples = 3\n\
          [[parameters]]\nname = \"int_param\"\ndistribution = \"uniform\"\nlow = -10\nhigh = 10\n\
          [outputs]\nvariables = [\"int_out\"]\n",
-        fmu_path.to_str().unwrap()
+        utf8(&fmu_path)
     );
     let study = Study::parse(&text, "int.toml", None).unwrap();
     let fmu = uq_driver::fmu::Fmu::open(&fmu_path).unwrap();
@@ -470,11 +427,12 @@ fn integral_design_values_set_an_integer_random_parameter() {
     let outcome =
         runner::run_points(&study, &fmu, &design, dir.path(), &RunOptions::default()).unwrap();
     let got: Vec<Vec<f64>> = outcome
+        .runs
         .records()
         .unwrap()
         .iter()
         .map(|r| match r {
-            Some(uq_driver::study::store::Record::Ok(v)) => v.clone(),
+            Some(uq_driver::internals::store::Record::Ok(v)) => v.clone(),
             other => panic!("{other:?}"),
         })
         .collect();
@@ -518,7 +476,7 @@ fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read
 /// Runs uq-driver with `args` (and `TMPDIR` = `tmp`), killing it after `limit`: a regression
 /// must fail the test, never hang the suite. `None` when it had to be killed.
 fn run_limited(args: &[&str], tmp: &Path, limit: Duration) -> Option<Output> {
-    let mut child = Command::new(DRIVER)
+    let mut child = driver()
         .args(args)
         .env("TMPDIR", tmp)
         .stdin(Stdio::null())
@@ -540,20 +498,13 @@ fn run_limited(args: &[&str], tmp: &Path, limit: Duration) -> Option<Output> {
 
 impl Case {
     fn run_limited(&self, extra: &[&str], limit: Duration) -> Option<Output> {
-        let mut args = vec![
-            "run",
-            self.study.to_str().unwrap(),
-            "--out",
-            self.out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        run_limited(&args, &self.tmp(), limit)
+        run_limited(&run_args(&self.study, &self.out, extra), &self.tmp(), limit)
     }
 }
 
 #[test]
 fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers() {
-    // QA finding 6: fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
+    // Fd 3 of a worker was its answer pipe; 12 stray bytes there hung the driver
     // forever, --timeout-per-run or not. The pipes now sit at high descriptors.
     let Some(c) = case(9) else { return };
     let o = c
@@ -569,18 +520,17 @@ fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers(
         c.points()
     );
     // The same numbers as in-process with a well-behaved FMU (mode 9 changes no value).
-    let isolated = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
-    let text = std::fs::read_to_string(&c.study).unwrap();
-    std::fs::write(&c.study, text.replace("misbehave = 9", "misbehave = 0")).unwrap();
+    let isolated = c.u_integral();
+    edit(&c.study, "misbehave = 9", "misbehave = 0");
     let o = c.run(&["--fresh", "-t", "1"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let in_process = std::fs::read_to_string(c.out.join("u_integral.csv")).unwrap();
+    let in_process = c.u_integral();
     assert_eq!(isolated, in_process);
 }
 
 #[test]
 fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_its_pipes() {
-    // QA finding 7: the driver noticed a crashed worker only when its pipes closed, i.e. when
+    // The driver noticed a crashed worker only when its pipes closed, i.e. when
     // a helper process the FMU had started (here one that lives 20 s) ended.
     let Some(c) = case(10) else { return };
     let t0 = Instant::now();
@@ -596,7 +546,7 @@ fn isolate_a_crashed_worker_is_noticed_at_once_though_a_helper_it_started_holds_
 
 #[test]
 fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finishes() {
-    // QA finding L11: a worker dead of SIGTERM was taken for a driver being stopped from
+    // A worker dead of SIGTERM was taken for a driver being stopped from
     // outside, so the study stopped at that point on every re-run and could never finish.
     let Some(c) = case(11) else { return };
     let o = c
@@ -609,7 +559,7 @@ fn isolate_an_fmu_raising_sigterm_on_itself_fails_its_points_and_the_study_finis
 
 #[test]
 fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status() {
-    // QA finding 12: an FMU crashing in-process killed the driver printing only the plan line.
+    // An FMU crashing in-process killed the driver printing only the plan line.
     use std::os::unix::process::ExitStatusExt;
     for (mode, sig, name) in [(2, 11, "SIGSEGV"), (3, 6, "SIGABRT")] {
         let Some(c) = case(mode) else { return };
@@ -633,7 +583,7 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
 
 #[test]
 fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
-    // QA finding 5: `simulate` exited 0 with no CSV and no message.
+    // `simulate` exited 0 with no CSV and no message.
     let Some(fmu) = test_fmus::test_fmu("Features") else {
         return;
     };
@@ -642,11 +592,11 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
     let o = run_limited(
         &[
             "simulate",
-            fmu.to_str().unwrap(),
+            utf8(&fmu),
             "--set",
             "misbehave=4",
             "--out",
-            csv.to_str().unwrap(),
+            utf8(&csv),
         ],
         dir.path(),
         Duration::from_secs(60),
@@ -660,7 +610,7 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
 
 #[test]
 fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
-    // QA finding 9: the FMU's printf output was interleaved with the CSV rows on stdout.
+    // The FMU's printf output was interleaved with the CSV rows on stdout.
     let Some(fmu) = test_fmus::test_fmu("Features") else {
         return;
     };
@@ -668,7 +618,7 @@ fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
     let o = run_limited(
         &[
             "simulate",
-            fmu.to_str().unwrap(),
+            utf8(&fmu),
             "--set",
             "misbehave=12",
             "--output",

@@ -1,39 +1,20 @@
-//! Oversized designs (issue 12 item 3, issue 11 item 7): `samples = 1000000000000`,
+//! Oversized designs: `samples = 1000000000000`,
 //! `step = 1e-12` and `stop = 1e15` with `step = 1` used to end in an out-of-memory abort
 //! (exit 134) and an empty output folder. They must end in a clear refusal with the estimate
 //! and the limit, whatever `--yes` says, before anything is allocated, with the output folder
 //! as it was. A study of more than 100 000 runs starts only with `--yes`.
 
-#[path = "support/refusal.rs"]
-mod refusal;
-#[path = "support/wheel.rs"]
-mod wheel;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use refusal::assert_refused;
-use wheel::{fmu_dir, wheel_fmu};
-
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::refusal::assert_refused;
+use crate::support::wheel::{self, wheel_fmu};
+use crate::support::{driver, run, run_ok, run_study, stderr, utf8};
 
 fn study(dir: &Path, name: &str, experiment: &str, method: &str) -> PathBuf {
     wheel::write_study(dir, name, name, 42, experiment, method, "")
 }
 
 const WHEEL_GRID: &str = "stop = 5.0\nstep = 0.01";
-
-fn run(args: &[&str]) -> Output {
-    Command::new(DRIVER)
-        .args(args)
-        .env("RAILUQ_FMU_DIR", fmu_dir())
-        .output()
-        .expect("uq-driver runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 /// Every file under `dir` with its bytes, sorted by path.
 fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
@@ -53,8 +34,6 @@ fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     out
 }
 
-/// A refusal: exit status 1 (an error, not an abort), a message, no panic.
-
 #[test]
 fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
     let dir = tempfile::tempdir().unwrap();
@@ -66,14 +45,7 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
         WHEEL_GRID,
         "kind = \"lhs\"\nsamples = 20",
     );
-    assert!(run(&[
-        "run",
-        small.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap()
-    ])
-    .status
-    .success());
+    assert!(run_study(&small, &out, &[]).status.success());
     let before = snapshot(&out);
     for method in [
         "kind = \"lhs\"\nsamples = 1000000000000",
@@ -83,14 +55,7 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
     ] {
         let huge = study(dir.path(), "huge", WHEEL_GRID, method);
         for extra in [&[][..], &["--yes"][..], &["--yes", "--fresh"][..]] {
-            let mut args = vec![
-                "run",
-                huge.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ];
-            args.extend(extra);
-            let o = run(&args);
+            let o = run_study(&huge, &out, extra);
             assert_refused(
                 &o,
                 &[
@@ -105,19 +70,13 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
             assert_eq!(snapshot(&out), before, "{method} {extra:?}: folder changed");
         }
     }
-    let o = run(&[
-        "run",
-        study(
-            dir.path(),
-            "h",
-            WHEEL_GRID,
-            "kind = \"lhs\"\nsamples = 1000000000000",
-        )
-        .to_str()
-        .unwrap(),
-        "--out",
-        dir.path().join("new").to_str().unwrap(),
-    ]);
+    let h = study(
+        dir.path(),
+        "h",
+        WHEEL_GRID,
+        "kind = \"lhs\"\nsamples = 1000000000000",
+    );
+    let o = run_study(&h, &dir.path().join("new"), &[]);
     assert!(stderr(&o).contains("1000000000000 model runs"));
     assert!(!dir.path().join("new").exists(), "nothing is created");
     // A quasi-Monte Carlo design beyond 2^32 points per sequence is refused at load time.
@@ -127,13 +86,7 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
         WHEEL_GRID,
         "kind = \"qmc\"\nsamples = 1000000000000",
     );
-    let o = run(&[
-        "run",
-        qmc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--yes",
-    ]);
+    let o = run_study(&qmc, &out, &["--yes"]);
     assert_refused(&o, &["2^32"]);
     // Planning refuses too.
     let huge = study(
@@ -145,11 +98,11 @@ fn huge_samples_are_refused_with_the_estimate_and_the_limit_even_with_yes() {
     let plan = dir.path().join("plan");
     let o = run(&[
         "plan",
-        huge.to_str().unwrap(),
+        utf8(&huge),
         "--shards",
         "4",
         "--out",
-        plan.to_str().unwrap(),
+        utf8(&plan),
         "--yes",
     ]);
     assert_refused(&o, &["refused even with --yes"]);
@@ -167,13 +120,7 @@ fn refused_grid(experiment: &str, needles: &[&str]) -> tempfile::TempDir {
         "kind = \"lhs\"\nsamples = 10",
     );
     let out = dir.path().join("out");
-    let o = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--yes",
-    ]);
+    let o = run_study(&p, &out, &["--yes"]);
     assert_refused(&o, needles);
     assert!(!out.exists());
     dir
@@ -208,7 +155,7 @@ fn a_huge_stop_is_refused_before_the_grid_is_allocated() {
         "--step",
         "1",
         "--out",
-        csv.to_str().unwrap(),
+        utf8(&csv),
     ]);
     assert_refused(&o, &["communication points", "limit of 1e8"]);
     assert!(!csv.exists());
@@ -220,13 +167,7 @@ fn a_huge_stop_is_refused_before_the_grid_is_allocated() {
         "stop = 2e7\nstep = 1.0",
         "kind = \"lhs\"\nsamples = 2000",
     );
-    let o = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--yes",
-    ]);
+    let o = run_study(&p, &out, &["--yes"]);
     assert_refused(&o, &["2000 model runs", "refused even with --yes"]);
     assert!(!out.exists());
 }
@@ -241,7 +182,7 @@ fn more_than_100000_runs_need_yes() {
         "kind = \"lhs\"\nsamples = 100001",
     );
     let out = dir.path().join("out");
-    let o = run(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = run_study(&p, &out, &[]);
     assert_refused(
         &o,
         &[
@@ -253,15 +194,7 @@ fn more_than_100000_runs_need_yes() {
     );
     assert!(!out.exists());
     // With --yes it starts (stopped after a few points here; it would resume).
-    let o = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--yes",
-        "--max-points",
-        "4",
-    ]);
+    let o = run_study(&p, &out, &["--yes", "--max-points", "4"]);
     assert!(
         stderr(&o).contains("stopped after 4 of 100001 points"),
         "{}",
@@ -276,9 +209,9 @@ fn more_than_100000_runs_need_yes() {
     );
     let o = run(&[
         "run",
-        p.to_str().unwrap(),
+        utf8(&p),
         "--out",
-        dir.path().join("edge").to_str().unwrap(),
+        utf8(&dir.path().join("edge")),
         "--max-points",
         "1",
     ]);
@@ -304,14 +237,7 @@ fn a_long_study_needs_yes() {
     let p = dir.path().join("long.toml");
     std::fs::write(&p, text).unwrap();
     let out = dir.path().join("out");
-    let o = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--threads",
-        "1",
-    ]);
+    let o = run_study(&p, &out, &["--threads", "1"]);
     assert_refused(
         &o,
         &[
@@ -329,7 +255,7 @@ fn a_long_study_needs_yes() {
 
 #[test]
 fn merge_checks_the_memory_of_the_analysis_as_run_does() {
-    // QA 5 H4: `merge` analysed a study `run` refuses, and aborted (SIGABRT) on a failed
+    // `merge` analysed a study `run` refuses, and aborted (SIGABRT) on a failed
     // allocation after reading every shard. It is now refused first, with the estimate.
     let dir = tempfile::tempdir().unwrap();
     let path = study(
@@ -339,16 +265,13 @@ fn merge_checks_the_memory_of_the_analysis_as_run_does() {
         "kind = \"lhs\"\nsamples = 20",
     );
     let plan = dir.path().join("plan");
-    let p = plan.to_str().unwrap();
-    let o = run(&["plan", path.to_str().unwrap(), "--shards", "1", "--out", p]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = run(&["run-shard", p, "--shard", "0"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let p = utf8(&plan);
+    run_ok(&["plan", utf8(&path), "--shards", "1", "--out", p]);
+    run_ok(&["run-shard", p, "--shard", "0"]);
     let merged = dir.path().join("merged");
-    let m = merged.to_str().unwrap();
-    let o = Command::new(DRIVER)
+    let m = utf8(&merged);
+    let o = driver()
         .args(["merge", p, "--out", m, "--yes"])
-        .env("RAILUQ_FMU_DIR", fmu_dir())
         .env("RAILUQ_MEMORY_LIMIT", "1000")
         .output()
         .unwrap();
@@ -360,7 +283,6 @@ fn merge_checks_the_memory_of_the_analysis_as_run_does() {
     );
     assert!(!e.contains("panicked"), "{e}");
     // Within the memory it merges, as before.
-    let o = run(&["merge", p, "--out", m, "--no-report"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_ok(&["merge", p, "--out", m, "--no-report"]);
     assert!(merged.join("summary.json").exists());
 }

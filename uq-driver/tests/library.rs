@@ -1,55 +1,32 @@
-//! uq-driver used as a library (QA qa4/lib): bad studies and options give typed errors
+//! uq-driver used as a library: bad studies and options give typed errors
 //! instead of panics, wrong results or files in the current folder, and a study leaves the
 //! host's process alone (no `atexit` handler, no signal handlers, no `_exit`) unless the host
 //! opts in with `install_process_guards`.
 //!
-//! This test binary never calls `install_process_guards` (it would change every test of the
-//! binary): the opted-in behaviour is the command line's, tested in `isolation.rs`.
-
-#[path = "support/wheel.rs"]
-mod wheel;
+//! No test of this test binary calls `install_process_guards` (it would change every test of
+//! the process, see `main.rs`): the opted-in behaviour is the command line's, tested in
+//! `isolation.rs`.
 
 use std::path::Path;
 use std::time::Duration;
 
 use uq_driver::spec::{Experiment, Study, StudyError};
-use uq_driver::study::runner::{simulate, PointError};
 use uq_driver::study::{run_study, Outcome, RunError, RunOptions, StudyRunError};
+use uq_driver::study::{simulate, PointError};
+
+use crate::support::wheel;
 
 fn study(method: &str) -> Study {
-    let text = format!(
-        r#"name = "lib"
-fmu = "{}"
-seed = 1
-[experiment]
-start = 0.0
-stop = 1.0
-step = 0.01
-[[parameters]]
-name = "K"
-mean = 100.0
-std = 10.0
-[[parameters]]
-name = "C"
-mean = 20.0
-std = 2.0
-[outputs]
-variables = ["q"]
-[method]
-{method}
-"#,
-        wheel::wheel_fmu().display()
-    );
+    let experiment = "start = 0.0\nstop = 1.0\nstep = 0.01";
+    let text = wheel::study_text("lib", 1, experiment, method, "");
     Study::parse(&text, "inline", None).unwrap()
 }
 
 fn opts() -> RunOptions {
-    RunOptions {
-        threads: Some(2),
-        no_report: true,
-        fresh: true,
-        ..RunOptions::default()
-    }
+    RunOptions::default()
+        .with_threads(2)
+        .with_no_report(true)
+        .with_fresh(true)
 }
 
 fn invalid_message(r: Result<Outcome, StudyRunError>) -> String {
@@ -60,7 +37,7 @@ fn invalid_message(r: Result<Outcome, StudyRunError>) -> String {
     }
 }
 
-/// QA qa4/lib H4: `run_study` did not validate a `Study` whose public fields were changed
+/// `run_study` did not validate a `Study` whose public fields were changed
 /// after `Study::parse`: stop < start returned `Ok` with the initial state as the result, no
 /// parameters ran 50 identical runs, no outputs analysed nothing, and step 0 or NaN gave a
 /// misleading "inf B of memory" size error.
@@ -111,7 +88,7 @@ fn run_study_refuses_a_study_changed_into_an_invalid_one() {
     assert_eq!(r.outputs[0].times.len(), 101);
 }
 
-/// QA qa4/lib H5: `run_study(&study, Path::new(""), …)` wrote `store/`, `points.csv`, `q.csv`
+/// `run_study(&study, Path::new(""), …)` wrote `store/`, `points.csv`, `q.csv`
 /// … into the host's current folder.
 #[test]
 fn an_empty_output_folder_is_refused() {
@@ -123,17 +100,14 @@ fn an_empty_output_folder_is_refused() {
     }
 }
 
-/// QA qa4/lib H1: `timeout_per_run` without `isolate` ended the host process with
+/// `timeout_per_run` without `isolate` ended the host process with
 /// `_exit(1)` when a run overran; a library caller now gets a typed error before anything
 /// runs, saying why and what to use instead.
 #[test]
 fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
     let dir = tempfile::tempdir().unwrap();
     let s = study("kind = \"lhs\"\nsamples = 50");
-    let o = RunOptions {
-        timeout_per_run: Some(Duration::from_millis(1)),
-        ..opts()
-    };
+    let o = opts().with_timeout_per_run(Duration::from_millis(1));
     match run_study(&s, &dir.path().join("out"), &o) {
         Err(StudyRunError::Run(RunError::Options(m))) => {
             assert!(
@@ -144,19 +118,13 @@ fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
         Err(e) => panic!("{e}"),
         Ok(_) => panic!("timeout_per_run in-process was accepted"),
     }
-    // threads = 0 was silently made 1 (QA L5); points outside the design were dropped.
-    let o = RunOptions {
-        threads: Some(0),
-        ..opts()
-    };
+    // threads = 0 was silently made 1 ; points outside the design were dropped.
+    let o = opts().with_threads(0);
     assert!(matches!(
         run_study(&s, &dir.path().join("out0"), &o),
         Err(StudyRunError::Run(RunError::Options(_)))
     ));
-    let o = RunOptions {
-        points: Some(vec![1_000_000]),
-        ..opts()
-    };
+    let o = opts().with_points(vec![1_000_000]);
     match run_study(&s, &dir.path().join("out1"), &o) {
         Err(StudyRunError::Run(RunError::Options(m))) => assert!(m.contains("1000000"), "{m}"),
         Err(e) => panic!("{e}"),
@@ -164,7 +132,7 @@ fn timeout_per_run_in_process_is_refused_without_the_process_guards() {
     }
 }
 
-/// QA qa4/lib H3: `simulate` with an empty time grid panicked ("at least one time"), and
+/// `simulate` with an empty time grid panicked ("at least one time"), and
 /// `Experiment::times()` of a 1e21-point grid panicked with "capacity overflow".
 #[test]
 fn an_empty_or_invalid_time_grid_is_a_typed_error() {
@@ -207,7 +175,7 @@ fn handler_of(sig: i32) -> usize {
     }
 }
 
-/// QA qa4/lib H2: an in-process study installed SIGSEGV, SIGBUS, SIGILL, SIGFPE and SIGABRT
+/// An in-process study installed SIGSEGV, SIGBUS, SIGILL, SIGFPE and SIGABRT
 /// handlers for the rest of the host's process.
 #[test]
 fn an_in_process_study_leaves_the_signal_handlers_alone() {
@@ -235,7 +203,14 @@ fn an_in_process_study_leaves_the_signal_handlers_alone() {
 /// Set in the child process of the next test.
 const HOST_EXIT_CHILD: &str = "UQ_DRIVER_TEST_HOST_EXIT_CHILD";
 
-/// QA qa4/lib H2: while a study ran in a background thread, the host's own
+/// The name the test harness knows the test function `name` of this module by
+/// (`library::name`), to run it alone in a child process.
+fn test_name(name: &str) -> String {
+    let module = module_path!().split_once("::").map_or("", |m| m.1);
+    format!("{module}::{name}")
+}
+
+/// While a study ran in a background thread, the host's own
 /// `std::process::exit(0)` became exit status 1 with a message blaming an FMU (an `atexit`
 /// handler registered by the study). The host (this test binary, run again as a child)
 /// exits with its own status and no such message.
@@ -266,7 +241,7 @@ fn the_hosts_own_exit_during_a_study_keeps_its_status() {
     let child = std::process::Command::new(std::env::current_exe().unwrap())
         .args([
             "--exact",
-            "the_hosts_own_exit_during_a_study_keeps_its_status",
+            &test_name("the_hosts_own_exit_during_a_study_keeps_its_status"),
             "--nocapture",
         ])
         .env(HOST_EXIT_CHILD, dir.path().join("out"))

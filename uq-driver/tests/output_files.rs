@@ -3,34 +3,15 @@
 //! paths outside it nor overwrite the folder's own files; a device or pipe named as output
 //! is written into, never replaced.
 
-#[path = "support/wheel.rs"]
-mod wheel;
-
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::os::unix::fs::symlink;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use wheel::{fmu_dir, write_study};
-
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-fn run(args: &[&str]) -> Output {
-    Command::new(DRIVER)
-        .args(args)
-        .env("RAILUQ_FMU_DIR", fmu_dir())
-        .output()
-        .unwrap()
-}
+use crate::support::wheel::{self, write_study};
+use crate::support::{read, run, run_study, stderr, stdout, study_head, test_fmus, utf8};
 
 fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    format!("{}{}", stdout(o), stderr(o))
 }
 
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
@@ -49,20 +30,12 @@ fn a_symlink_planted_as_the_lock_file_is_refused_and_its_target_kept() {
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
     symlink(&victim, out.join("uq-driver.lock")).unwrap();
-    let o = run(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_study(&study, &out, &[]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
     assert!(t.contains("symbolic link"), "{t}");
     assert!(!t.contains("VICTIM"), "the target's content is echoed: {t}");
-    assert_eq!(
-        std::fs::read_to_string(&victim).unwrap(),
-        "root:x:0:0:VICTIM:/root:/bin/sh\n"
-    );
+    assert_eq!(read(&victim), "root:x:0:0:VICTIM:/root:/bin/sh\n");
     assert!(!out.join("store").exists(), "refused before any run");
 }
 
@@ -85,15 +58,10 @@ fn symlinks_planted_as_summary_json_and_points_csv_are_replaced_not_written_thro
         symlink(&victim, out.join(name)).unwrap();
         victims.push((victim, out.join(name)));
     }
-    let o = run(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_study(&study, &out, &[]);
     assert!(o.status.success(), "{}", text(&o));
     for (victim, planted) in victims {
-        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
+        assert_eq!(read(&victim), "precious\n");
         assert!(!is_link(&planted), "{}", planted.display());
         assert!(std::fs::metadata(&planted).unwrap().len() > 0);
     }
@@ -125,12 +93,7 @@ signal = "q"
     let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
     let out = dir.path().join("a").join("b").join("out");
     std::fs::create_dir_all(&out).unwrap();
-    let o = run(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_study(&study, &out, &[]);
     assert!(o.status.success(), "{}", text(&o));
     // Nothing beside or above the folder.
     let above: Vec<_> = std::fs::read_dir(dir.path().join("a"))
@@ -141,7 +104,7 @@ signal = "q"
     assert_eq!(above, ["b", "out"]);
     assert!(!Path::new("/tmp/uq-driver-abs-test_pdf.csv").exists());
     // points.csv is still the design; the quantity has its own, escaped files.
-    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    let points = read(&out.join("points.csv"));
     assert!(points.starts_with("index,weight,K,C,status\n"), "{points}");
     for f in [
         "%2E.%2F..%2Fescape_y_samples.csv",
@@ -151,10 +114,10 @@ signal = "q"
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
-    let samples = std::fs::read_to_string(out.join("%70oints_samples.csv")).unwrap();
+    let samples = read(&out.join("%70oints_samples.csv"));
     assert!(samples.starts_with("run,points\n"), "{samples}");
     // index.html links the real files.
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     assert!(
         html.contains("href=\"%2570oints_pdf.csv\""),
         "link to the escaped file"
@@ -176,12 +139,7 @@ signal = "q"
 "#;
     let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
     let out = dir.path().join("out");
-    let o = run(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_study(&study, &out, &[]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
     assert!(t.contains("'y'") && t.contains("'y_pdf'"), "{t}");
@@ -193,13 +151,7 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
     let dir = tempfile::tempdir().unwrap();
     let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
     let out = dir.path().join("out");
-    let o = run(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--no-report",
-    ]);
+    let o = run_study(&study, &out, &["--no-report"]);
     let t = text(&o);
     assert!(o.status.success(), "{t}");
     assert!(!out.join("index.html").exists());
@@ -210,7 +162,7 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
 
 #[test]
 fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
-    // QA round 3, L-2: a study that stopped at its first failure, or had too few successful
+    // A study that stopped at its first failure, or had too few successful
     // runs to analyse, left only store/: the per-point messages could not be read. Now
     // points.csv is written with every point's status (the Features FMU fails its step at
     // t = misbehave_at with mode 1, an fmi2Error).
@@ -231,26 +183,19 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
         std::fs::write(
             &study,
             format!(
-                "name = \"{name}\"\nfmu = {:?}\nseed = 1\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+                "{}\
                  [method]\nkind = \"mc\"\nsamples = 8\n\
                  [[parameters]]\nname = \"misbehave_at\"\ndistribution = \"uniform\"\n\
                  low = {low}\nhigh = {}\n\
                  [fixed]\nmisbehave = 1\nread_file = \"\"\n\
                  [outputs]\nvariables = [\"u_integral\"]\n{extra}",
-                fmu.to_str().unwrap(),
+                study_head(name, &fmu, 1, "stop = 1.0\nstep = 0.1"),
                 if name == "none-ok" { 0.9 } else { 1.8 },
             ),
         )
         .unwrap();
         let out = dir.path().join(name);
-        let o = run(&[
-            "run",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "-t",
-            "1",
-        ]);
+        let o = run_study(&study, &out, &["-t", "1"]);
         let all = text(&o);
         assert!(!o.status.success(), "{all}");
         assert!(all.contains(failures), "{all}");
@@ -268,7 +213,7 @@ fn simulate_to(out: &str) -> Output {
     let fmu = wheel::wheel_fmu();
     run(&[
         "simulate",
-        fmu.to_str().unwrap(),
+        utf8(&fmu),
         "--stop",
         "0.5",
         "--step",
@@ -294,9 +239,9 @@ fn simulate_out_a_named_pipe_writes_into_it_and_leaves_it_a_pipe() {
         .success());
     let reader = {
         let pipe = pipe.clone();
-        std::thread::spawn(move || std::fs::read_to_string(pipe).unwrap())
+        std::thread::spawn(move || read(&pipe))
     };
-    let o = simulate_to(pipe.to_str().unwrap());
+    let o = simulate_to(utf8(&pipe));
     assert!(o.status.success(), "{}", text(&o));
     let got = reader.join().unwrap();
     assert!(got.starts_with("time,"), "{got}");
@@ -304,9 +249,9 @@ fn simulate_out_a_named_pipe_writes_into_it_and_leaves_it_a_pipe() {
     assert!(file_type(&pipe).is_fifo());
     // What a regular file gets is the same text.
     let file = dir.path().join("q.csv");
-    let o = simulate_to(file.to_str().unwrap());
+    let o = simulate_to(utf8(&file));
     assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(std::fs::read_to_string(&file).unwrap(), got);
+    assert_eq!(read(&file), got);
 }
 
 #[test]
@@ -335,7 +280,7 @@ fn simulate_out_a_character_device_leaves_it_that_device() {
         eprintln!("skipped: mknod needs root");
         return;
     }
-    let o = simulate_to(dev.to_str().unwrap());
+    let o = simulate_to(utf8(&dev));
     assert!(o.status.success(), "{}", text(&o));
     let m = std::fs::symlink_metadata(&dev).unwrap();
     assert!(m.file_type().is_char_device());
@@ -345,7 +290,7 @@ fn simulate_out_a_character_device_leaves_it_that_device() {
 #[test]
 fn simulate_out_a_folder_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let o = simulate_to(dir.path().to_str().unwrap());
+    let o = simulate_to(utf8(dir.path()));
     assert!(!o.status.success());
     assert!(text(&o).contains("is a folder"), "{}", text(&o));
 }

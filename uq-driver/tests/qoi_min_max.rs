@@ -1,42 +1,29 @@
-//! QA5 M3: the `min` and `max` quantity kinds (signed smallest and largest value of a signal
+//! The `min` and `max` quantity kinds (signed smallest and largest value of a signal
 //! over a window) on the Wheel FMU, against its closed form q(t) of m q'' + C q' + K q = 0
 //! (`support/wheel.rs`) at each run's K and C.
 
-#[path = "support/wheel.rs"]
-mod wheel;
+use std::path::Path;
 
-use std::process::Command;
+use crate::support::csv::Csv;
+use crate::support::wheel;
+use crate::support::{read, run_study_ok};
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-/// `run,value` rows of `<quantity>_samples.csv`, by run.
-fn samples(path: &std::path::Path) -> Vec<f64> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut rows: Vec<(usize, f64)> = text
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let (r, v) = l.split_once(',').unwrap();
-            (r.parse().unwrap(), v.parse().unwrap())
-        })
+/// The values of `<quantity>_samples.csv` (`run,<quantity>`), by run.
+fn samples(path: &Path) -> Vec<f64> {
+    let csv = Csv::read(path);
+    let mut rows: Vec<(usize, f64)> = csv
+        .numbers()
+        .iter()
+        .map(|r| (r[0] as usize, r[1]))
         .collect();
     rows.sort_by_key(|r| r.0);
     rows.into_iter().map(|r| r.1).collect()
 }
 
 /// The (K, C) of each design point, from points.csv.
-fn points(path: &std::path::Path) -> Vec<(f64, f64)> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (k, c) = (col("K"), col("C"));
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f[k].parse().unwrap(), f[c].parse().unwrap())
-        })
-        .collect()
+fn points(path: &Path) -> Vec<(f64, f64)> {
+    let csv = Csv::read(path);
+    csv.col("K").into_iter().zip(csv.col("C")).collect()
 }
 
 #[test]
@@ -69,13 +56,7 @@ from = 1.5
         extra,
     );
     let out = dir.path().join("out");
-    let o = Command::new(DRIVER)
-        .args(["run", study.to_str().unwrap(), "--out"])
-        .arg(&out)
-        .env("RAILUQ_FMU_DIR", wheel::fmu_dir())
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_study_ok(&study, &out, &[]);
     let kc = points(&out.join("points.csv"));
     // The communication grid 0, 0.01, ..., 5 s.
     let grid: Vec<f64> = (0..=500).map(|i| i as f64 * 0.01).collect();
@@ -119,6 +100,6 @@ from = 1.5
             "{g} vs {extremum}"
         );
     }
-    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary = read(&out.join("summary.json"));
     assert!(summary.contains("smallest value of q"), "{summary}");
 }

@@ -1,69 +1,26 @@
-//! Honest reports (issue 15): degenerate studies (one run, zero spread, no exceedance) get no
+//! Honest reports: degenerate studies (one run, zero spread, no exceedance) get no
 //! density and the right words; units from the modelDescription appear on the axes, in
 //! summary.json and in units.csv; every plot file is well-formed SVG (parsed with quick-xml)
 //! or PNG (decoded); `--no-report` writes the data files only; `export --runs` and `compare`
 //! write what they promise.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
-
-fn fmu_dir() -> PathBuf {
-    std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-}
-
-fn wheel_fmu() -> PathBuf {
-    let p = fmu_dir().join("Wheel.fmu");
-    assert!(
-        p.is_file(),
-        "{} is missing: run `make fmu` first",
-        p.display()
-    );
-    p
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    Command::new(DRIVER)
-        .args(args)
-        .env("RAILUQ_FMU_DIR", fmu_dir())
-        .output()
-        .expect("uq-driver runs")
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = run(args);
-    assert!(
-        out.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use crate::support::csv::Csv;
+use crate::support::wheel::wheel_fmu;
+use crate::support::{
+    final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok, stderr, study_head,
+    summary, utf8, write_toml,
+};
 
 /// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
 /// with a limit no run reaches and `q_peak` (largest |q| after 0.5 s).
 fn study(dir: &Path, name: &str, method: &str, parameters: &str) -> PathBuf {
     let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = 3
-[experiment]
-start = 0.0
-stop = 2.0
-step = 0.01
-[method]
+        r#"{head}[method]
 {method}
 {parameters}
-[outputs]
-variables = ["q"]
-[[qoi]]
-kind = "final"
-name = "q_end"
-signal = "q"
-limits = [1.0]
+{outputs}limits = [1.0]
 [[qoi]]
 kind = "max_abs"
 name = "q_peak"
@@ -71,11 +28,15 @@ signal = "q"
 from = 0.5
 limits = [10.0]
 "#,
-        fmu = wheel_fmu().display()
+        head = study_head(
+            name,
+            &wheel_fmu(),
+            3,
+            "start = 0.0\nstop = 2.0\nstep = 0.01"
+        ),
+        outputs = final_quantity("q", "q_end")
     );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    write_toml(dir, name, &text)
 }
 
 /// Every `.svg` of `dir` parses as XML (quick-xml, to the end) with an `<svg>` root, every
@@ -86,7 +47,7 @@ fn plots_are_well_formed(dir: &Path) -> usize {
         let p = e.unwrap().path();
         match p.extension().and_then(|x| x.to_str()) {
             Some("svg") => {
-                let text = std::fs::read_to_string(&p).unwrap();
+                let text = read(&p);
                 let mut reader = quick_xml::Reader::from_str(&text);
                 let mut depth = 0i64;
                 let mut root = None;
@@ -121,10 +82,6 @@ fn plots_are_well_formed(dir: &Path) -> usize {
     n
 }
 
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
 #[test]
 fn a_single_run_has_no_density_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
@@ -135,7 +92,7 @@ fn a_single_run_has_no_density_and_says_so() {
         "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
     );
     let out = dir.path().join("out");
-    let stdout = run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let stdout = run_study_ok(&s, &out, &[]);
     assert!(stdout.contains("q_end = "), "{stdout}");
     assert!(stdout.contains("(nominal run;"), "{stdout}");
     assert!(
@@ -152,8 +109,8 @@ fn a_single_run_has_no_density_and_says_so() {
     ] {
         assert!(!out.join(f).exists(), "{f} drawn for a single run");
     }
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
-    // QA round 3, M3: a nominal run is a value against each limit, not a probability
+    let html = read(&out.join("index.html"));
+    // A nominal run is a value against each limit, not a probability
     // ("0 of 1 runs exceeded 1 (95 % upper bound of P: 0.950)"), and its inputs were held at
     // their means, not sampled.
     assert!(
@@ -183,7 +140,7 @@ fn a_single_run_has_no_density_and_says_so() {
     assert!(!html.contains("1 model runs"), "{html}");
     assert!(!html.contains("Some("), "Rust debug text in the page");
     assert!(!html.contains("Normal {"), "Rust debug text in the page");
-    let s = json(&out.join("summary.json"));
+    let s = summary(&out);
     assert_eq!(s["quantities"]["q_end"]["deterministic"], true);
     assert_eq!(s["quantities"]["q_end"]["pdf"], serde_json::json!([]));
     assert_eq!(s["outputs"]["q"]["deterministic"], true);
@@ -202,13 +159,13 @@ fn zero_spread_and_no_exceedance_read_as_such() {
         "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
     );
     let out = dir.path().join("out");
-    let printed = run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let printed = run_study_ok(&s, &out, &[]);
     assert!(
         !out.join("q_pdf.svg").exists(),
         "heat map of a deterministic output"
     );
     assert!(!out.join("q_end_pdf.svg").exists());
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     assert!(
         html.contains("every one of the 20 runs gives the same value"),
         "{html}"
@@ -225,7 +182,7 @@ fn zero_spread_and_no_exceedance_read_as_such() {
         "{printed}"
     );
     assert!(!html.contains("± 0"), "{html}");
-    let s = json(&out.join("summary.json"));
+    let s = summary(&out);
     let e = &s["quantities"]["q_end"]["exceedance_counts"][0];
     assert_eq!(
         (e["exceeded"].as_u64(), e["of"].as_u64()),
@@ -247,8 +204,8 @@ fn units_reach_axes_summary_and_sidecar() {
          [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
     );
     let out = dir.path().join("out");
-    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let s = json(&out.join("summary.json"));
+    run_study_ok(&s, &out, &[]);
+    let s = summary(&out);
     assert_eq!(s["outputs"]["q"]["unit"], "m");
     assert_eq!(s["quantities"]["q_peak"]["unit"], "m");
     assert_eq!(s["units"]["K"], "N/m");
@@ -258,7 +215,7 @@ fn units_reach_axes_summary_and_sidecar() {
         assert!(s["timing"][k].as_f64().unwrap() >= 0.0, "{k}");
     }
     assert_eq!(s["record_layout"]["outputs"], serde_json::json!(["q"]));
-    let units = std::fs::read_to_string(out.join("units.csv")).unwrap();
+    let units = read(&out.join("units.csv"));
     for line in [
         "q.csv,time,s",
         "q.csv,mean,m",
@@ -271,29 +228,29 @@ fn units_reach_axes_summary_and_sidecar() {
     ] {
         assert!(units.lines().any(|l| l == line), "{line} not in:\n{units}");
     }
-    let band = std::fs::read_to_string(out.join("q_band.svg")).unwrap();
+    let band = read(&out.join("q_band.svg"));
     assert!(band.contains("q [m]") && band.contains("time [s]"));
-    let pdf = std::fs::read_to_string(out.join("q_peak_pdf.svg")).unwrap();
+    let pdf = read(&out.join("q_peak_pdf.svg"));
     assert!(pdf.contains("q_peak [m]"));
-    let heat = std::fs::read_to_string(out.join("q_pdf.svg")).unwrap();
+    let heat = read(&out.join("q_pdf.svg"));
     assert!(heat.contains("PDF of q [1/m]"));
     // The colour bar starts at 0.
     assert!(heat.contains(">0</text>"), "colour bar without 0");
     // Sobol' bars of the scalar quantities, labelled by parameter.
-    let bars = std::fs::read_to_string(out.join("q_peak_sobol.svg")).unwrap();
+    let bars = read(&out.join("q_peak_sobol.svg"));
     assert!(bars.contains(">K</text>") && bars.contains(">C</text>"));
     assert!(bars.contains("first order S") && bars.contains("total ST"));
     // And of the whole series of q: shares in [0, 1], first order at most total.
-    let overall = std::fs::read_to_string(out.join("q_sobol_overall.svg")).unwrap();
+    let overall = read(&out.join("q_sobol_overall.svg"));
     assert!(overall.contains(">K</text>") && overall.contains("whole series"));
-    let csv = std::fs::read_to_string(out.join("q_sobol_overall.csv")).unwrap();
+    let csv = read(&out.join("q_sobol_overall.csv"));
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "S_K,S_C,ST_K,ST_C");
     let v: Vec<f64> = lines[1].split(',').map(|x| x.parse().unwrap()).collect();
     assert!(v.iter().all(|x| (0.0..=1.0 + 1e-12).contains(x)), "{v:?}");
     assert!(v[0] <= v[2] + 1e-12 && v[1] <= v[3] + 1e-12, "{v:?}");
     // Inputs as written.
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     assert!(html.contains("normal, mean 20, std 2 (cov 0.1)"), "{html}");
     assert!(plots_are_well_formed(&out) >= 6);
 }
@@ -308,17 +265,11 @@ fn no_report_export_and_compare() {
         "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
     );
     let a = dir.path().join("a");
-    run_ok(&[
-        "run",
-        s.to_str().unwrap(),
-        "--out",
-        a.to_str().unwrap(),
-        "--no-report",
-    ]);
+    run_study_ok(&s, &a, &["--no-report"]);
     assert!(a.join("q.csv").exists() && a.join("summary.json").exists());
     assert!(!a.join("index.html").exists() && !a.join("q_band.svg").exists());
-    run_ok(&["export", a.to_str().unwrap(), "--runs"]);
-    let csv = std::fs::read_to_string(a.join("runs/runs.csv")).unwrap();
+    run_ok(&["export", utf8(&a), "--runs"]);
+    let csv = read(&a.join("runs/runs.csv"));
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("run,time,q"));
     assert_eq!(lines.count(), 30 * 201);
@@ -355,9 +306,9 @@ fn no_report_export_and_compare() {
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("store/manifest.json")).unwrap()).unwrap();
     let n_values = manifest["n_values"].as_u64().unwrap() as usize;
-    let extra = uq_driver::study::store::encode(
+    let extra = uq_driver::internals::store::encode(
         0,
-        &uq_driver::study::store::Record::Ok(vec![42.0; n_values]),
+        &uq_driver::internals::store::Record::Ok(vec![42.0; n_values]),
     );
     let mut f = std::fs::OpenOptions::new()
         .append(true)
@@ -365,28 +316,22 @@ fn no_report_export_and_compare() {
         .unwrap();
     std::io::Write::write_all(&mut f, &extra).unwrap();
     drop(f);
-    run_ok(&["export", a.to_str().unwrap(), "--runs"]);
-    let again = std::fs::read_to_string(a.join("runs/runs.csv")).unwrap();
+    run_ok(&["export", utf8(&a), "--runs"]);
+    let again = read(&a.join("runs/runs.csv"));
     assert_eq!(again, csv);
     // While a run holds the folder, export refuses instead of reading a store being written.
-    let held = uq_driver::study::lock::FolderLock::acquire(&a).unwrap();
-    let o = run(&["export", a.to_str().unwrap(), "--runs"]);
+    let held = uq_driver::internals::store::FolderLock::acquire(&a).unwrap();
+    let o = run(&["export", utf8(&a), "--runs"]);
     assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(err.contains("is in use by another uq-driver run"), "{err}");
     drop(held);
 
     let b = dir.path().join("b");
-    run_ok(&["run", s.to_str().unwrap(), "--out", b.to_str().unwrap()]);
+    run_study_ok(&s, &b, &[]);
     let page = dir.path().join("page");
-    run_ok(&[
-        "compare",
-        a.to_str().unwrap(),
-        b.to_str().unwrap(),
-        "--out",
-        page.to_str().unwrap(),
-    ]);
-    let html = std::fs::read_to_string(page.join("index.html")).unwrap();
+    run_ok(&["compare", utf8(&a), utf8(&b), "--out", utf8(&page)]);
+    let html = read(&page.join("index.html"));
     assert!(html.contains("href=\"../b/index.html\""), "{html}");
     assert!(html.contains("Quantity q_end"));
     plots_are_well_formed(&page);
@@ -398,7 +343,7 @@ fn names_are_forgiven_or_suggested() {
     let out = run(&["show", "wheel-scm"]);
     assert!(out.status.success());
     let out = run(&["run", "wheel-sgn", "--out", "/nonexistent/x"]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = stderr(&out);
     assert!(!out.status.success());
     assert!(
         err.contains("did you mean the built-in study wheel-sgm?"),
@@ -412,8 +357,8 @@ fn names_are_forgiven_or_suggested() {
         "kind = \"scm\"\nnodse = 3",
         "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
     );
-    let out = run(&["run", s.to_str().unwrap(), "--out", "/nonexistent/x"]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = run(&["run", utf8(&s), "--out", "/nonexistent/x"]);
+    let err = stderr(&out);
     assert!(err.contains("hint: did you mean `nodes`?"), "{err}");
     let s = study(
         dir.path(),
@@ -421,13 +366,8 @@ fn names_are_forgiven_or_suggested() {
         "kind = \"scm\"\nnodes = 2",
         "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0",
     );
-    let out = run(&[
-        "run",
-        s.to_str().unwrap(),
-        "--out",
-        dir.path().join("v").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("v"))]);
+    let err = stderr(&out);
     assert!(err.contains("'Kk': did you mean 'K'?"), "{err}");
     // cov = 15 is most likely 15 %.
     let s = study(
@@ -436,13 +376,8 @@ fn names_are_forgiven_or_suggested() {
         "kind = \"scm\"\nnodes = 2",
         "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15",
     );
-    let out = run(&[
-        "run",
-        s.to_str().unwrap(),
-        "--out",
-        dir.path().join("c").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("c"))]);
+    let err = stderr(&out);
     assert!(err.contains("did you mean cov = 0.15?"), "{err}");
 }
 
@@ -457,13 +392,8 @@ fn a_missing_fmu_lists_every_place_searched() {
          [outputs]\nvariables = [\"q\"]\n",
     )
     .unwrap();
-    let out = run(&[
-        "run",
-        p.to_str().unwrap(),
-        "--out",
-        dir.path().join("o").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = run(&["run", utf8(&p), "--out", utf8(&dir.path().join("o"))]);
+    let err = stderr(&out);
     assert!(
         err.contains("FMU Nowhere.fmu not found; looked in:"),
         "{err}"
@@ -475,14 +405,14 @@ fn a_missing_fmu_lists_every_place_searched() {
 
 #[test]
 fn a_one_letter_signal_is_described_after_its_name() {
-    // QA round 3, H3: with `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
+    // With `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
     // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
     // description went after the first "a" of the sentence, inside "peak".
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("a.toml");
-    std::fs::write(
-        &p,
-        format!(
+    let p = write_toml(
+        dir.path(),
+        "a",
+        &format!(
             "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
              [method]\nkind = \"lhs\"\nsamples = 10\n\
              [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
@@ -491,12 +421,11 @@ fn a_one_letter_signal_is_described_after_its_name() {
              to = 2.0\nlimits = [1.0]\n",
             wheel_fmu().display()
         ),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
-    let stdout = run_ok(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let stdout = run_study_ok(&p, &out, &[]);
     let expected = "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s";
-    let s = json(&out.join("summary.json"));
+    let s = summary(&out);
     assert_eq!(
         s["quantities"]["a_range"]["definition"]["text"], expected,
         "summary.json"
@@ -506,7 +435,7 @@ fn a_one_letter_signal_is_described_after_its_name() {
         "Acceleration q''"
     );
     assert!(stdout.contains(expected), "{stdout}");
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     assert!(
         html.contains(&expected.replace('\'', "&#39;")),
         "{expected} not on the page"
@@ -516,13 +445,13 @@ fn a_one_letter_signal_is_described_after_its_name() {
 
 #[test]
 fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
-    // QA round 3, L10 and M8: a variant's page was headed "railuq study scm" with no word of
+    // A variant's page was headed "railuq study scm" with no word of
     // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("s.toml");
-    std::fs::write(
-        &p,
-        format!(
+    let p = write_toml(
+        dir.path(),
+        "s",
+        &format!(
             "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
              [method]\nkind = \"scm\"\nnodes = 2\n\
              [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
@@ -531,34 +460,31 @@ fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_diff
              [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
             wheel_fmu().display()
         ),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
-    run_ok(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let page = std::fs::read_to_string(out.join("lhs/index.html")).unwrap();
+    run_study_ok(&p, &out, &[]);
+    let page = read(&out.join("lhs/index.html"));
     assert!(
         page.contains("railuq study lhs, a variant of the suite"),
         "{page}"
     );
     assert!(page.contains("href=\"../index.html\""), "{page}");
-    let suite = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let suite = read(&out.join("index.html"));
     assert!(!suite.contains("0.000e0"), "{suite}");
     assert!(suite.contains("(reference)"), "{suite}");
 }
 
 #[test]
 fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
-    // QA round 3, M2: the SGM page said "1 model runs … on 1 threads" and "Units are those the
+    // The SGM page said "1 model runs … on 1 threads" and "Units are those the
     // FMU declares" (there is no FMU), and its description promised a system "given below"
     // that the page did not show.
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("sgm");
-    let stdout = run_ok(&["run", "builtin:wheel-sgm", "--out", out.to_str().unwrap()]);
+    let (_dir, out, stdout) = run_builtin("wheel-sgm");
     assert!(
         stdout.contains("the Galerkin system solved once"),
         "{stdout}"
     );
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     for wrong in [
         "1 model runs",
         "1 threads",
@@ -573,11 +499,11 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
         "{html}"
     );
     assert!(html.contains("K += K · [[1]]"), "{html}");
-    // README audit F20: `export --runs` of this folder failed with "cannot read
+    // `export --runs` of this folder failed with "cannot read
     // .../store/manifest.json: No such file or directory"; an SGM study ran no model.
     assert!(!out.join("points.csv").exists() && !out.join("store").exists());
-    let o = run(&["export", out.to_str().unwrap(), "--runs"]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let o = run(&["export", utf8(&out), "--runs"]);
+    let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
     assert!(
         err.contains("an SGM study has no model runs to export"),
@@ -589,32 +515,16 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
 
 /// Column `name` of a CSV file with a header row.
 fn csv_column(path: &Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header
-        .iter()
-        .position(|h| *h == name)
-        .unwrap_or_else(|| panic!("{name} not in {header:?} of {}", path.display()));
-    lines
-        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
-        .collect()
+    Csv::read(path).col(name)
 }
 
-/// QA3 H1: the wheel-rail impact of `vehicle-track-defect` lasts about 2 ms, between two
+/// The wheel-rail impact of `vehicle-track-defect` lasts about 2 ms, between two
 /// evenly spaced heat-map columns; the columns must include the times of the extremes of
 /// the quantiles and of the mean, and the grid must span the band over every time (the old
 /// heat map took its range from the sampled columns and cut the peak off).
 #[test]
 fn pdf_heat_map_columns_catch_a_short_event() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out");
-    run_ok(&[
-        "run",
-        "builtin:vehicle-track-defect",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (_dir, out, _) = run_builtin("vehicle-track-defect");
     let csv = out.join("P1.csv");
     let t = csv_column(&csv, "time");
     let pdf = out.join("P1_pdf.csv");
@@ -671,11 +581,11 @@ fn sobol_sampling_study(dir: &Path) -> PathBuf {
          [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
     );
     let out = dir.join("out");
-    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    run_study_ok(&s, &out, &[]);
     out
 }
 
-/// QA3 H2 and M9: the Sobol' bars of `sobol_sampling` carry the intervals the method
+/// The Sobol' bars of `sobol_sampling` carry the intervals the method
 /// computes (a whisker per bar, labelled in the words of the method's summary), and the
 /// running mean and Std of the convergence plot end at the reported mean and Std (they were
 /// taken over every pick-freeze row, the statistics over A and B only).
@@ -683,13 +593,13 @@ fn sobol_sampling_study(dir: &Path) -> PathBuf {
 fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
     let dir = tempfile::tempdir().unwrap();
     let out = sobol_sampling_study(dir.path());
-    let s = json(&out.join("summary.json"));
+    let s = summary(&out);
     let q = &s["quantities"]["q_peak"];
     let ci = q["sobol"]["first_ci"]["C"]
         .as_array()
         .expect("first_ci of C");
     assert_eq!(ci.len(), 2);
-    let bars = std::fs::read_to_string(out.join("q_peak_sobol.svg")).unwrap();
+    let bars = read(&out.join("q_peak_sobol.svg"));
     assert!(
         bars.contains(">95 % interval (8 replicates,<") && bars.contains(">Student t)<"),
         "{bars}"
@@ -716,15 +626,15 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
     );
     let runs = csv_column(&out.join("q_peak_convergence.csv"), "runs");
     assert_eq!(*runs.last().unwrap(), 512.0, "A and B of 256 base rows");
-    let band = std::fs::read_to_string(out.join("q_peak_convergence.svg")).unwrap();
+    let band = read(&out.join("q_peak_convergence.svg"));
     assert!(band.contains("iid standard errors"), "{band}");
-    // Scalar densities are per unit of the quantity (QA3 M10).
-    let pdf = std::fs::read_to_string(out.join("q_peak_pdf.svg")).unwrap();
+    // Scalar densities are per unit of the quantity .
+    let pdf = read(&out.join("q_peak_pdf.svg"));
     assert!(pdf.contains("probability density [1/m]"), "{pdf}");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
-/// QA3 H4, M6, M7: every single-study page shows Std(t) (`<V>_std.svg`, with the chaos's
+/// Every single-study page shows Std(t) (`<V>_std.svg`, with the chaos's
 /// Std and its truncation-error estimate where there are), and the convergence against the
 /// chaos order has whole-number ticks and a dot at every order.
 #[test]
@@ -738,10 +648,10 @@ fn std_over_time_and_chaos_convergence_read_as_such() {
          [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
     );
     let out = dir.path().join("out");
-    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    run_study_ok(&s, &out, &[]);
+    let html = read(&out.join("index.html"));
     assert!(html.contains("q_std.svg"), "Std plot not on the page");
-    let std = std::fs::read_to_string(out.join("q_std.svg")).unwrap();
+    let std = read(&out.join("q_std.svg"));
     assert!(
         std.contains("Std q [m]") && std.contains("Std of q"),
         "{std}"
@@ -750,7 +660,7 @@ fn std_over_time_and_chaos_convergence_read_as_such() {
         std.contains("std_pce") && std.contains("order_difference"),
         "{std}"
     );
-    let conv = std::fs::read_to_string(out.join("q_convergence.svg")).unwrap();
+    let conv = read(&out.join("q_convergence.svg"));
     let orders = csv_column(&out.join("q_convergence.csv"), "order").len();
     // Two curves, a dot at every order but 0 on each, plus two legend dots.
     assert_eq!(
@@ -768,9 +678,7 @@ fn std_over_time_and_chaos_convergence_read_as_such() {
 /// The header fields of a CSV file (RFC 4180 quoting of the header is not needed for the
 /// plain names these studies use).
 fn csv_header(path: &Path) -> Vec<String> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let first = text.lines().next().unwrap_or("");
-    first.split(',').map(str::to_owned).collect()
+    Csv::read(path).header
 }
 
 /// Columns that are counts or text, which have no unit.
@@ -780,7 +688,7 @@ const UNITLESS: [&str; 5] = ["index", "status", "run", "runs", "order"];
 /// has a row, no row names a file or column that does not exist, and the truncation-error
 /// estimates are dimensionless.
 fn units_match_the_files(out: &Path) {
-    let units = std::fs::read_to_string(out.join("units.csv")).unwrap();
+    let units = read(&out.join("units.csv"));
     let rows: Vec<(String, String, String)> = units
         .lines()
         .skip(1)
@@ -825,7 +733,7 @@ fn units_match_the_files(out: &Path) {
 
 #[test]
 fn units_csv_names_every_column_written_and_no_other() {
-    // README audit F3/F4: the truncation-error columns had the output's unit, the
+    // The truncation-error columns had the output's unit, the
     // `<V>_convergence.csv` columns and the Sobol' interval columns were missing, and a
     // sampling method's `<q>_convergence.csv` was listed with a `std_of_order` it lacks.
     let dir = tempfile::tempdir().unwrap();
@@ -846,12 +754,12 @@ fn units_csv_names_every_column_written_and_no_other() {
     ] {
         let s = study(dir.path(), name, method, params);
         let out = dir.path().join(name);
-        run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        run_study_ok(&s, &out, &[]);
         units_match_the_files(&out);
     }
-    let u = std::fs::read_to_string(dir.path().join("sobol/units.csv")).unwrap();
+    let u = read(&dir.path().join("sobol/units.csv"));
     assert!(u.lines().any(|l| l == "q_sobol.csv,ST_C_hi,1"), "{u}");
-    let u = std::fs::read_to_string(dir.path().join("scm/units.csv")).unwrap();
+    let u = read(&dir.path().join("scm/units.csv"));
     assert!(u.lines().any(|l| l == "q.csv,order_difference,1"), "{u}");
     assert!(
         u.lines().any(|l| l == "q_convergence.csv,std_of_order,m"),
@@ -861,7 +769,7 @@ fn units_csv_names_every_column_written_and_no_other() {
 
 #[test]
 fn nominal_studies_write_no_header_only_density_files() {
-    // README audit F11: a nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
+    // A nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
     // and no rows, although the README says none is written for a deterministic result.
     let dir = tempfile::tempdir().unwrap();
     let s = study(
@@ -871,25 +779,25 @@ fn nominal_studies_write_no_header_only_density_files() {
         "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
     );
     let out = dir.path().join("out");
-    run_ok(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    run_study_ok(&s, &out, &[]);
     for f in ["q_pdf.csv", "q_end_pdf.csv", "q_peak_pdf.csv"] {
         assert!(!out.join(f).exists(), "{f} written for a nominal study");
     }
     assert!(out.join("q.csv").is_file() && out.join("q_end_samples.csv").is_file());
-    let s = json(&out.join("summary.json"));
+    let s = summary(&out);
     assert!(
         s["outputs"]["q"]["pdf_csv"].is_null(),
         "{}",
         s["outputs"]["q"]
     );
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = read(&out.join("index.html"));
     assert!(!html.contains("_pdf.csv"), "the page links a missing file");
     units_match_the_files(&out);
 }
 
 #[test]
 fn summary_json_gives_each_inputs_own_mean_and_std() {
-    // QA round 4: the README promised a truncated normal's own mean and Std in summary.json;
+    // The README promised a truncated normal's own mean and Std in summary.json;
     // only the page had them. K: N(100, 10²) truncated to [95, ∞): α = −0.5, λ = φ(α)/(1 − Φ(α)),
     // mean = 100 + 10 λ, variance = 10² (1 + α λ − λ²), with Φ(−0.5) from the normal table.
     let dir = tempfile::tempdir().unwrap();
@@ -901,14 +809,8 @@ fn summary_json_gives_each_inputs_own_mean_and_std() {
          [[parameters]]\nname = \"C\"\ndistribution = \"lognormal\"\nmean = 20.0\nstd = 2.0",
     );
     let out = dir.path().join("out");
-    run_ok(&[
-        "run",
-        s.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--no-report",
-    ]);
-    let summary = json(&out.join("summary.json"));
+    run_study_ok(&s, &out, &["--no-report"]);
+    let summary = summary(&out);
     let p = &summary["parameters"];
     let alpha: f64 = -0.5;
     let phi = (-alpha * alpha / 2.0).exp() / (2.0 * std::f64::consts::PI).sqrt();

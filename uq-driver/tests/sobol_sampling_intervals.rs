@@ -1,4 +1,4 @@
-//! The intervals of `sobol_sampling` (QA2 F1): with the default `base = "qmc"` they come from
+//! The intervals of `sobol_sampling`: with the default `base = "qmc"` they come from
 //! the spread of independently scrambled replicates of the design, not from a bootstrap over
 //! the rows of one scrambled net (which treats them as independent: on the 20-input Morris
 //! function its 95 % intervals of ST_x4 missed the truth in every seed). The functions are
@@ -7,10 +7,11 @@
 use std::collections::BTreeMap;
 
 use nalgebra::DMatrix;
-use uq_driver::uq::hd::sensitivity;
+use uq_driver::internals::pick_freeze_bootstrap;
 use uq_driver::uq::method::sobol_sampling::SobolSampling;
+use uq_driver::uq::method::Estimate;
 use uq_driver::uq::method::{Method, Sampling};
-use uq_driver::uq::{Distribution, Estimate, RandomInputs, RandomParameter};
+use uq_driver::uq::{Distribution, RandomInputs, RandomParameter};
 
 fn unit_inputs(d: usize, low: f64, high: f64) -> RandomInputs {
     RandomInputs::independent(
@@ -40,7 +41,7 @@ fn run(
 }
 
 // ---------------------------------------------------------------------------------------
-// The Morris function (Morris 1991; QA2's Bench.fmu, fn = 2): 20 inputs U(0, 1),
+// The Morris function (Morris 1991): 20 inputs U(0, 1),
 // w_i = 2 (x_i - 1/2) except w_i = 2 (1.1 x_i / (x_i + 0.1) - 1/2) for i = 3, 5, 7;
 // y = sum b_i w_i + sum_{i<j} b_ij w_i w_j + sum_{i<j<l<=5} -10 w_i w_j w_l + 5 w1 w2 w3 w4,
 // b_i = 20 (i <= 10) else (-1)^(i+1); b_ij = -15 (i, j <= 6) else (-1)^(i+j+1).
@@ -144,7 +145,7 @@ fn morris_exact() -> (Vec<f64>, Vec<f64>) {
 
 #[test]
 fn morris_exact_sobol_indices_are_those_of_an_independent_monte_carlo() {
-    // QA2's plain Monte Carlo pick-freeze in numpy (400 000 rows, Jansen): ST_x2 0.2477,
+    // A plain Monte Carlo pick-freeze in numpy (400 000 rows, Jansen): ST_x2 0.2477,
     // ST_x4 0.2481 (± 0.0019), S_x6 -0.0009 ± 0.0019.
     let (s, st) = morris_exact();
     assert!((st[1] - 0.2477).abs() < 0.004, "ST_x2 {}", st[1]);
@@ -153,7 +154,7 @@ fn morris_exact_sobol_indices_are_those_of_an_independent_monte_carlo() {
     assert_eq!(st[1], st[3], "x2 and x4 enter alike");
 }
 
-/// QA2 F1: on the Morris function (N = 4096, 20 seeds) the single scrambled net's bootstrap
+/// On the Morris function (N = 4096, 20 seeds) the single scrambled net's bootstrap
 /// intervals of ST_x4 and S_x6 covered the exact value in 0 of 20 seeds (the estimates
 /// cluster by scrambling), and 716 of the 800 intervals in all (89.5 %); the replicate
 /// intervals (R = 8) cover ST_x4 and S_x6 in 20 of 20 and 767 of 800 (95.9 %).
@@ -301,7 +302,7 @@ fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
         let (m, values, e) = run(text, &inputs, 4, ishigami);
         let n = m.samples;
         // The bootstrap of before: resample k of the rows from the stream (0x5eed_b007, k).
-        let want = sensitivity::pick_freeze_bootstrap(
+        let want = pick_freeze_bootstrap(
             &centred(&values, n),
             n,
             3,
@@ -328,8 +329,8 @@ fn sobol_sampling_mc_and_lhs_bases_keep_their_percentile_bootstrap_intervals() {
 #[test]
 fn sobol_sampling_qmc_base_of_replicates_does_not_resume_a_single_net_store() {
     use sha2::{Digest, Sha256};
+    use uq_driver::internals::study_hash;
     use uq_driver::spec::{builtin, Study};
-    use uq_driver::study::runner::study_hash;
     let text = builtin("wheel-sobol-sampling").unwrap();
     let study = |base: &str, extra: &str| {
         let t = text

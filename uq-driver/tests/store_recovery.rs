@@ -1,4 +1,4 @@
-//! Regression tests for the results store (issue 12, item 2): it never panics, keeps every
+//! Regression tests for the results store: it never panics, keeps every
 //! good record after a bad one, and reports what it skipped and which points run again.
 //!
 //! The expected records are known independently: the test writes them itself, then damages the
@@ -9,7 +9,7 @@ use std::path::Path;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use uq_driver::study::store::{self, format, Manifest, Record, Store};
+use uq_driver::internals::store::{self, Manifest, Record, Store};
 
 fn manifest(n_points: usize, n_values: usize) -> Manifest {
     Manifest {
@@ -139,7 +139,7 @@ fn flipped_byte_in_record_1_of_1000_keeps_the_other_999() {
 
 #[test]
 fn huge_length_field_never_panics_in_either_format() {
-    // Format 1 (the store before issue 12): a huge length wrapped around and panicked
+    // Format 1 (the store before format 2): a huge length wrapped around and panicked
     // ("slice index starts at 21 but ends at 5") on this and every later run.
     let m = manifest(3, 2);
     let dir = tempfile::tempdir().unwrap();
@@ -216,7 +216,7 @@ fn record_format_is_as_documented() {
     assert_eq!(&rec[33..], &crc32(&covered).to_le_bytes());
 }
 
-/// A format-1 record, as the store wrote it before issue 12.
+/// A format-1 record, as the store wrote it before format 2.
 fn v1_record(index: u64, kind: u8, payload: &[u8]) -> Vec<u8> {
     let mut out = b"REC1".to_vec();
     out.extend_from_slice(&index.to_le_bytes());
@@ -265,7 +265,7 @@ fn old_format_store_is_converted_and_kept_as_records_v1() {
     assert!(r
         .summary()
         .unwrap()
-        .contains("converted from the format before issue 12"));
+        .contains("converted from the format before format 2"));
     s.append(1, &Record::Ok(vec![1.0])).unwrap();
     drop(s);
     let (s, done) = Store::open(dir.path(), &m, false).unwrap();
@@ -307,7 +307,7 @@ fn torn_tail_is_cut_and_its_point_reported() {
 #[test]
 fn random_garbage_never_panics() {
     let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let magic2 = format::MAGIC;
+    let magic2 = store::MAGIC;
     for round in 0..3000 {
         let len = rng.gen_range(0..400);
         let mut bytes: Vec<u8> = (0..len).map(|_| rng.gen()).collect();

@@ -4,134 +4,35 @@
 //! 4 `x1 + x2²`). References are closed forms or tensor quadratures written in
 //! `support/benchmarks.rs`, independently of the code under test.
 
-#[path = "support/benchmarks.rs"]
-mod benchmarks;
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{
+    benchmarks, final_quantity, run, run_beside, run_ok, run_study, stderr, study_head, summary,
+    test_fmus, uniform, utf8, write_toml,
+};
 
 /// A study on the Functions FMU: `function`, the random parameters and the method (TOML),
 /// the output `y` at t = 0 and 0.1, and the quantity `Y` (its final value).
 fn study(dir: &Path, name: &str, function: u32, parameters: &str, method: &str) -> PathBuf {
     let fmu = test_fmus::test_fmu("Functions").expect("the Functions test FMU");
     let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = 11
-[experiment]
-start = 0.0
-stop = 0.1
-step = 0.1
-[fixed]
+        r#"{head}[fixed]
 function = {function}
 sigma_h = 0.0
 {parameters}
-[outputs]
-variables = ["y"]
-[[qoi]]
-kind = "final"
-name = "Y"
-signal = "y"
-[method]
+{outputs}[method]
 {method}
 "#,
-        fmu = fmu.display()
+        head = study_head(name, &fmu, 11, "start = 0.0\nstop = 0.1\nstep = 0.1"),
+        outputs = final_quantity("y", "Y")
     );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    write_toml(dir, name, &text)
 }
 
-fn uniform(names: &[&str], low: f64, high: f64) -> String {
-    names
-        .iter()
-        .map(|n| {
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = {low}\nhigh = {high}\n"
-            )
-        })
-        .collect()
-}
-
-fn driver(args: &[&str]) -> std::process::Output {
-    Command::new(DRIVER)
-        .args(args)
-        .output()
-        .expect("uq-driver runs")
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = driver(args);
-    assert!(
-        out.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Runs `study` into `dir/out`; returns the output folder.
-fn run_study(study: &Path) -> PathBuf {
-    let out = study.with_extension("out");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    out
-}
-
-/// A CSV file: header and rows of numbers (non-numeric fields as NaN).
-struct Csv {
-    header: Vec<String>,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Csv {
-    fn parse(text: &str) -> Csv {
-        let mut lines = text.lines();
-        let header = lines
-            .next()
-            .unwrap()
-            .split(',')
-            .map(str::to_owned)
-            .collect();
-        let rows = lines
-            .map(|l| {
-                l.split(',')
-                    .map(|x| x.parse::<f64>().unwrap_or(f64::NAN))
-                    .collect()
-            })
-            .collect();
-        Csv { header, rows }
-    }
-
-    fn read(path: &Path) -> Csv {
-        Csv::parse(&std::fs::read_to_string(path).unwrap())
-    }
-
-    fn col(&self, name: &str) -> Vec<f64> {
-        let c = self
-            .header
-            .iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header));
-        self.rows.iter().map(|r| r[c]).collect()
-    }
-
-    /// Column `name` in the last row.
-    fn last(&self, name: &str) -> f64 {
-        *self.col(name).last().unwrap()
-    }
-}
-
-fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+/// Runs [`study`] into `<name>.out`; returns that folder.
+fn run_functions(dir: &Path, name: &str, function: u32, parameters: &str, method: &str) -> PathBuf {
+    run_beside(&study(dir, name, function, parameters, method), &[])
 }
 
 #[test]
@@ -141,14 +42,13 @@ fn ishigami_sobol_indices_within_0_01_by_sparse_regression_with_200_runs() {
     }
     let dir = tempfile::tempdir().unwrap();
     let pi = std::f64::consts::PI;
-    let s = study(
+    let out = run_functions(
         dir.path(),
         "ishigami",
         1,
         &uniform(&["x1", "x2", "x3"], -pi, pi),
         "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 200\norder = 14\nsparse = true",
     );
-    let out = run_study(&s);
     let (first, total) = benchmarks::ishigami_indices();
     let sobol = Csv::read(&out.join("y_sobol.csv"));
     for (i, x) in ["x1", "x2", "x3"].iter().enumerate() {
@@ -194,13 +94,13 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     let (mean, var) = benchmarks::ishigami_moments();
     let (first, total) = benchmarks::ishigami_indices();
     let params = uniform(&["x1", "x2", "x3"], -pi, pi);
-    let askey = run_study(&study(
+    let askey = run_functions(
         dir.path(),
         "scm-askey",
         1,
         &params,
         "kind = \"scm\"\nnodes = 12\norder = 11",
-    ));
+    );
     let q = &summary(&askey)["quantities"]["Y"];
     let (m, s) = (q["mean"].as_f64().unwrap(), q["std"].as_f64().unwrap());
     assert!((m - mean).abs() < 1e-6, "mean {m} vs {mean}");
@@ -222,13 +122,13 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     let warnings = summary(&askey)["warnings"].to_string();
     assert!(!warnings.contains("the chaos holds"), "{warnings}");
 
-    let hermite = run_study(&study(
+    let hermite = run_functions(
         dir.path(),
         "scm-hermite",
         1,
         &params,
         "kind = \"scm\"\nnodes = 12\norder = 8\nchaos = \"hermite\"",
-    ));
+    );
     let sum = summary(&hermite);
     let m = sum["quantities"]["Y"]["mean"].as_f64().unwrap();
     assert!((m - mean).abs() > 0.1, "the normal mapping's mean {m}");
@@ -280,8 +180,7 @@ fn borehole_mean_and_std_by_sparse_regression_and_sparse_grid() {
         ),
         ("sparse", "kind = \"sparse_grid\"\nlevel = 2", 0, 1e-3, 2e-2),
     ] {
-        let s = study(dir.path(), name, 2, &borehole_parameters(), method);
-        let out = run_study(&s);
+        let out = run_functions(dir.path(), name, 2, &borehole_parameters(), method);
         let y = Csv::read(&out.join("y.csv"));
         let (em, es) = (
             (y.last("mean") / m_ref - 1.0).abs(),
@@ -341,8 +240,7 @@ fn beta_and_gamma_inputs_through_the_fmu_have_the_closed_form_moments() {
     .iter()
     .enumerate()
     {
-        let s = study(dir.path(), &format!("askey{i}"), 4, &params, method);
-        let out = run_study(&s);
+        let out = run_functions(dir.path(), &format!("askey{i}"), 4, &params, method);
         let y = Csv::read(&out.join("y.csv"));
         assert!(
             (y.last("mean") - mean).abs() < 1e-12,
@@ -356,14 +254,13 @@ fn beta_and_gamma_inputs_through_the_fmu_have_the_closed_form_moments() {
         );
     }
     // Latin hypercube: the sample mean within 4 standard errors.
-    let s = study(
+    let out = run_functions(
         dir.path(),
         "lhs",
         4,
         &params,
         "kind = \"lhs\"\nsamples = 4000",
     );
-    let out = run_study(&s);
     let y = Csv::read(&out.join("y.csv"));
     let se = var.sqrt() / 4000f64.sqrt();
     assert!(
@@ -398,8 +295,7 @@ fn correlated_inputs_reproduce_the_target_correlation_in_points_csv() {
     .iter()
     .enumerate()
     {
-        let s = study(dir.path(), &format!("corr{i}"), 4, params, method);
-        let out = run_study(&s);
+        let out = run_functions(dir.path(), &format!("corr{i}"), 4, params, method);
         let pts = Csv::read(&out.join("points.csv"));
         let cols = [pts.col("x1"), pts.col("x2"), pts.col("x3")];
         let corr = |a: &[f64], b: &[f64]| {
@@ -439,15 +335,14 @@ fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
     let params = "[[parameters]]\nname = \"x1\"\nmean = 1.0\nstd = 0.5\n\
          [[parameters]]\nname = \"x2\"\ndistribution = \"uniform\"\nlow = -1.0\nhigh = 2.0\n";
     let dir = tempfile::tempdir().unwrap();
-    let s = study(
+    let out = run_functions(
         dir.path(),
         "surr",
         4,
         params,
         "kind = \"sparse_grid\"\nlevel = 2",
     );
-    let out = run_study(&s);
-    let out_s = out.to_str().unwrap();
+    let out_s = utf8(&out);
     let eval = Csv::parse(&run_ok(&[
         "surrogate",
         "eval",
@@ -461,7 +356,7 @@ fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
     let fmu = test_fmus::test_fmu("Functions").unwrap();
     let sim = Csv::parse(&run_ok(&[
         "simulate",
-        fmu.to_str().unwrap(),
+        utf8(&fmu),
         "--set",
         "function=4",
         "--set",
@@ -485,11 +380,11 @@ fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
         assert!((v - model).abs() < 1e-12, "surrogate {v} vs model {model}");
     }
     // An unknown input or one outside its support is refused.
-    assert!(!driver(&["surrogate", "eval", out_s, "--at", "zz=1"])
+    assert!(!run(&["surrogate", "eval", out_s, "--at", "zz=1"])
         .status
         .success());
-    let bad = driver(&["surrogate", "eval", out_s, "--at", "x2=5"]);
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("outside the support"));
+    let bad = run(&["surrogate", "eval", out_s, "--at", "x2=5"]);
+    assert!(stderr(&bad).contains("outside the support"));
     // Sampling: reproducible for a seed, different for another, right mean.
     let a = run_ok(&["surrogate", "sample", out_s, "-n", "4000", "--seed", "3"]);
     let b = run_ok(&["surrogate", "sample", out_s, "-n", "4000", "--seed", "3"]);
@@ -498,7 +393,7 @@ fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
     assert_ne!(a, c);
     let draws = Csv::parse(&a);
     assert_eq!(draws.header, ["x1", "x2", "Y", "y@0.1"]);
-    for r in &draws.rows {
+    for r in &draws.numbers() {
         assert!((r[2] - (r[0] + r[1] * r[1])).abs() < 1e-12, "{r:?}");
         assert_eq!(r[2], r[3]);
     }
@@ -514,7 +409,7 @@ fn surrogate_eval_matches_the_model_and_sample_is_reproducible() {
         "-n",
         "10",
         "--out",
-        file.to_str().unwrap(),
+        utf8(&file),
     ]);
     assert_eq!(Csv::read(&file).rows.len(), 10);
 }
@@ -534,27 +429,21 @@ fn chaos_methods_refuse_integer_inputs_and_sampling_runs_them() {
         "kind = \"scm\"\nnodes = 3",
     ] {
         let s = study(dir.path(), "int", 4, params, method);
-        let o = driver(&[
-            "run",
-            s.to_str().unwrap(),
-            "--out",
-            dir.path().join("o").to_str().unwrap(),
-        ]);
+        let o = run_study(&s, &dir.path().join("o"), &[]);
         assert!(!o.status.success());
-        let err = String::from_utf8_lossy(&o.stderr);
+        let err = stderr(&o);
         assert!(
             err.contains("integer_uniform") && err.contains("'x1'"),
             "{err}"
         );
     }
-    let s = study(
+    let out = run_functions(
         dir.path(),
         "int-lhs",
         4,
         params,
         "kind = \"lhs\"\nsamples = 400",
     );
-    let out = run_study(&s);
     let x1 = Csv::read(&out.join("points.csv")).col("x1");
     for k in 1..=4 {
         assert_eq!(x1.iter().filter(|&&v| v == k as f64).count(), 100, "{k}");
@@ -570,13 +459,7 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
          [[parameters]]\nname = \"x2\"\ndistribution = \"uniform\"\nlow = -1.0\nhigh = 2.0\n";
     let dir = tempfile::tempdir().unwrap();
     // A previous study's points.csv is a points file.
-    let lhs = run_study(&study(
-        dir.path(),
-        "src",
-        4,
-        params,
-        "kind = \"lhs\"\nsamples = 12",
-    ));
+    let lhs = run_functions(dir.path(), "src", 4, params, "kind = \"lhs\"\nsamples = 12");
     std::fs::copy(lhs.join("points.csv"), dir.path().join("pts.csv")).unwrap();
     let s = study(
         dir.path(),
@@ -585,7 +468,7 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
         params,
         "kind = \"pce_regression\"\npoints = \"pts.csv\"\norder = 2",
     );
-    let out = run_study(&s);
+    let out = run_beside(&s, &[]);
     let y = Csv::read(&out.join("y.csv"));
     // y = x1 + x2²: E = 1 + 1 = 2; Var = 0.25 + Var(x2²) = 0.25 + (E x2⁴ - 1),
     // E x2⁴ = (2⁵ + 1) / 15 = 2.2.
@@ -600,9 +483,9 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
     let mut rows: Vec<&str> = text.lines().collect();
     rows.pop();
     std::fs::write(dir.path().join("pts.csv"), rows.join("\n")).unwrap();
-    let o = driver(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = run_study(&s, &out, &[]);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("different study"));
+    assert!(stderr(&o).contains("different study"));
 }
 
 #[test]
@@ -610,7 +493,7 @@ fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not(
     if test_fmus::built().is_none() {
         return;
     }
-    // QA: a 30-input G function at level 2 gave a mean of 0.013 (true 1) with a level
+    // A 30-input G function at level 2 gave a mean of 0.013 (true 1) with a level
     // difference of 1.45 written only to a CSV column, and no warning. Here: the g-function
     // (|4x - 2| kinks) of 8 uniform inputs at level 1, and by LARS on 20 runs.
     let dir = tempfile::tempdir().unwrap();
@@ -628,7 +511,7 @@ fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not(
             "loo",
         ),
     ] {
-        let out = run_study(&study(dir.path(), name, 3, &params, method));
+        let out = run_functions(dir.path(), name, 3, &params, method);
         let s = summary(&out);
         let warnings = s["warnings"].to_string();
         let estimate = s["quantities"]["Y"]["chaos_error"]["value"]
@@ -645,24 +528,24 @@ fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not(
     // y = x1 + x2² (function 4, sigma_h = 0) is a polynomial the chaos holds exactly: no
     // warning; with a Beta input the sparse grid's rules are not nested: no estimate, said so.
     let poly = uniform(&["x1", "x2"], 0.0, 1.0);
-    let out = run_study(&study(
+    let out = run_functions(
         dir.path(),
         "poly",
         4,
         &poly,
         "kind = \"sparse_grid\"\nlevel = 3",
-    ));
+    );
     let warnings = summary(&out)["warnings"].to_string();
     assert!(!warnings.contains("truncation-error"), "{warnings}");
     let beta = "[[parameters]]\nname = \"x1\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 1\n\
                 [[parameters]]\nname = \"x2\"\ndistribution = \"beta\"\nalpha = 2\nbeta = 3\nlow = 0\nhigh = 1\n";
-    let out = run_study(&study(
+    let out = run_functions(
         dir.path(),
         "beta",
         4,
         beta,
         "kind = \"sparse_grid\"\nlevel = 2",
-    ));
+    );
     let warnings = summary(&out)["warnings"].to_string();
     assert!(
         warnings.contains("no truncation-error estimate"),
@@ -675,7 +558,7 @@ fn correlated_inputs_say_their_sobol_indices_depend_on_the_parameter_order() {
     if test_fmus::built().is_none() {
         return;
     }
-    // QA: with [[correlation]] the indices are those of the Cholesky-ordered germs; S of one
+    // With [[correlation]] the indices are those of the Cholesky-ordered germs; S of one
     // input was 0.0006 in file order and 0.116 listed first, while the report called it "the
     // share of the variance it causes alone". y = x1 + x2² (function 4), rho = 0.8.
     let p = |n: &str, m: f64| format!("[[parameters]]\nname = \"{n}\"\nmean = {m}\nstd = 1.0\n");
@@ -684,13 +567,13 @@ fn correlated_inputs_say_their_sobol_indices_depend_on_the_parameter_order() {
     let mut s_x1 = Vec::new();
     for (name, order) in [("x1_first", ["x1", "x2"]), ("x2_first", ["x2", "x1"])] {
         let params = format!("{}{}{corr}", p(order[0], 0.0), p(order[1], 0.0));
-        let out = run_study(&study(
+        let out = run_functions(
             dir.path(),
             name,
             4,
             &params,
             "kind = \"sparse_grid\"\nlevel = 3",
-        ));
+        );
         let s = summary(&out);
         let warnings = s["warnings"].to_string();
         assert!(
@@ -716,13 +599,13 @@ fn correlated_inputs_say_their_sobol_indices_depend_on_the_parameter_order() {
     assert!((s_x1[1] - (1.0 - 0.64) / 3.0).abs() < 1e-6, "{s_x1:?}");
     // Independent inputs: no such warning.
     let params = format!("{}{}", p("x1", 0.0), p("x2", 0.0));
-    let out = run_study(&study(
+    let out = run_functions(
         dir.path(),
         "indep",
         4,
         &params,
         "kind = \"sparse_grid\"\nlevel = 3",
-    ));
+    );
     assert!(!summary(&out)["warnings"].to_string().contains("correlated"));
 }
 
@@ -731,7 +614,7 @@ fn a_chaos_of_correlated_non_normal_inputs_says_its_error_estimate_may_be_optimi
     if test_fmus::built().is_none() {
         return;
     }
-    // QA round 4: a lognormal and a gamma input at rho = -0.5 by LARS gave a Std 7.7 % off
+    // A lognormal and a gamma input at rho = -0.5 by LARS gave a Std 7.7 % off
     // with a leave-one-out error of 0.55 %, and no warning: the copula's transform makes the
     // model far from a polynomial in the germs. Normal inputs keep it linear: no warning.
     let dir = tempfile::tempdir().unwrap();
@@ -745,13 +628,7 @@ fn a_chaos_of_correlated_non_normal_inputs_says_its_error_estimate_may_be_optimi
          [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n{corr}"
     );
     for (name, params, warned) in [("bounded", bounded, true), ("normal", normal, false)] {
-        let out = run_study(&study(
-            dir.path(),
-            name,
-            4,
-            &params,
-            "kind = \"scm\"\nnodes = 4",
-        ));
+        let out = run_functions(dir.path(), name, 4, &params, "kind = \"scm\"\nnodes = 4");
         let warnings = summary(&out)["warnings"].to_string();
         assert_eq!(
             warnings.contains("correlated inputs that are not normal (x1, x2)"),
@@ -766,7 +643,7 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     if test_fmus::built().is_none() {
         return;
     }
-    // QA round 4: exp(x) by SCM on 4 nodes kept 7 % of its variance in the top order, gave
+    // Exp(x) by SCM on 4 nodes kept 7 % of its variance in the top order, gave
     // P(q > limit) = 3.7e-4 for a true 1e-3 (a limit beyond every model run) and a negative
     // 0.1 % quantile of a positive quantity, and warned of nothing. Here Ishigami on 4 nodes
     // per input (the quadrature's Std is off by more than 5 % of the closed form's) against
@@ -778,13 +655,13 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     // Y2: Ishigami's largest value is 1 + 7 + 0.1 π⁴ ≈ 17.7, so 20 is beyond every run; 0 is
     // within them.
     let limits = "\n[[qoi]]\nkind = \"final\"\nname = \"Y2\"\nsignal = \"y\"\nlimits = [20.0, 0.0]";
-    let coarse = run_study(&study(
+    let coarse = run_functions(
         dir.path(),
         "scm4",
         1,
         &params,
         &format!("kind = \"scm\"\nnodes = 4{limits}"),
-    ));
+    );
     let s = summary(&coarse);
     let std = s["quantities"]["Y"]["std"].as_f64().unwrap();
     assert!((std / var.sqrt() - 1.0).abs() > 0.05, "std {std}");
@@ -808,13 +685,13 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
         "the page says where P comes from"
     );
 
-    let fine = run_study(&study(
+    let fine = run_functions(
         dir.path(),
         "scm12",
         1,
         &params,
         "kind = \"scm\"\nnodes = 12",
-    ));
+    );
     let s = summary(&fine);
     let std = s["quantities"]["Y"]["std"].as_f64().unwrap();
     assert!((std / var.sqrt() - 1.0).abs() < 1e-5, "std {std}");

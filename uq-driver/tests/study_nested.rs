@@ -1,18 +1,19 @@
 //! Two-level (nested) studies through uq-driver on the C test FMU `Functions` with
 //! `function = 4`: y = x1 + x2² + h(seed), h a standard normal hashed from the Integer `seed`
-//! (issue 14). The references are computed here, independently of the driver: the hash is
+//!. The references are computed here, independently of the driver: the hash is
 //! written again below (SplitMix64 + Box–Muller, as in `tests/fmus/README.md`), the inner
 //! moments are those of x1 + x2² with x1, x2 ~ N(0, 1) (mean 1, variance 1 + 2 = 3), and the
 //! exceedance probability is a one-dimensional quadrature over x2 of the normal tail of x1.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{
+    assert_same_files, final_quantity, read_json, run, run_beside, run_ok, run_study_ok,
+    study_head, summary, test_fmus, uniform, utf8, write_toml,
+};
+
 /// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
 const SEEDS: i64 = 20_000;
 
@@ -69,27 +70,14 @@ fn inner_exceedance(c: f64) -> f64 {
         * h
 }
 
-fn run(args: &[&str]) -> Output {
-    let o = Command::new(DRIVER)
-        .args(args)
-        .output()
-        .expect("uq-driver runs");
-    assert!(
-        o.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-fn summary(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
-}
-
 /// A two-level study of `Functions` (function 4): `seed` outer, x1 and x2 ~ N(0, 1) inner.
 fn study(dir: &Path, fmu: &Path, name: &str, outer: &str, inner: &str) -> PathBuf {
     study_with(dir, fmu, name, outer, inner, 3, "[3.0]")
 }
+
+/// x1 and x2 ~ N(0, 1).
+const X1_X2: &str = "[[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
+                     [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n";
 
 /// [`study`] with the study seed and the limits of `y_end` (a TOML array).
 fn study_with(
@@ -101,14 +89,24 @@ fn study_with(
     seed: u64,
     limits: &str,
 ) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = {seed}
-[experiment]
-stop = 0.2
-step = 0.1
-[method]
+    let text = nested_text(name, fmu, seed, [outer, inner], [X1_X2, ""], limits);
+    write_toml(dir, name, &text)
+}
+
+/// The text of a two-level study `name` of `Functions` (function 4) with the study seed
+/// `seed`: the method `nested` of `outer` and `inner`; `seed` the outer parameter, the inner
+/// `parameters` and the `[fixed]` values `fixed` besides the function; `y` and its final value
+/// `y_end` with the limits `limits` (a TOML array).
+fn nested_text(
+    name: &str,
+    fmu: &Path,
+    seed: u64,
+    [outer, inner]: [&str; 2],
+    [parameters, fixed]: [&str; 2],
+    limits: &str,
+) -> String {
+    format!(
+        r#"{head}[method]
 kind = "nested"
 outer = {outer}
 inner = {inner}
@@ -118,44 +116,22 @@ distribution = "integer_uniform"
 low = 1
 high = {SEEDS}
 level = "outer"
-[[parameters]]
-name = "x1"
-mean = 0.0
-std = 1.0
-[[parameters]]
-name = "x2"
-mean = 0.0
-std = 1.0
-[fixed]
+{parameters}[fixed]
 function = 4
-[outputs]
-variables = ["y"]
-[[qoi]]
-kind = "final"
-name = "y_end"
-signal = "y"
-limits = {limits}
+{fixed}{outputs}limits = {limits}
 "#,
-        fmu = fmu.display()
-    );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+        head = study_head(name, fmu, seed, "stop = 0.2\nstep = 0.1"),
+        outputs = final_quantity("y", "y_end")
+    )
 }
 
 fn pair(v: &serde_json::Value) -> [f64; 2] {
     [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]
 }
 
-/// The conditional CSV as (header, rows of numbers).
-fn conditional(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("y_end_conditional.csv")).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
+/// The conditional CSV of an output folder (every field a number).
+fn conditional(dir: &Path) -> Csv {
+    Csv::read(&dir.join("y_end_conditional.csv")).numeric()
 }
 
 #[test]
@@ -186,8 +162,7 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
         "{ kind = \"mc\", samples = 2000 }",
         "{ kind = \"scm\", nodes = 3 }",
     );
-    let out = dir.path().join("out");
-    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let out = run_beside(&s, &[]);
     let q = &summary(&out)["quantities"]["y_end"];
     let split = &q["variance_split"];
     let (inner, outer) = (
@@ -225,7 +200,7 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     assert!((p - p_exact).abs() < 0.02, "P {p} vs {p_exact}");
     assert!(p_ci[0] <= p_exact && p_exact <= p_ci[1], "{p_ci:?}");
     // The count's interval (printed by `run`) is that same bootstrap over the outer samples,
-    // not a Clopper–Pearson interval of the pooled draws as if they were independent (QA: that
+    // not a Clopper–Pearson interval of the pooled draws as if they were independent (that
     // held the true P in 3 of 30 seeds), and the pooled values are named as chaos draws.
     let c = &q["exceedance_counts"][0];
     assert_eq!(pair(&c["ci_95"]), p_ci);
@@ -234,8 +209,8 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     assert_eq!(c["of_what"], "draws of the inner chaos surrogates");
 
     // Per outer sample: the seed, the exact conditional moments, the conditional P.
-    let (header, rows) = conditional(&out);
-    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    let table = conditional(&out);
+    let (col, rows) = (|n: &str| table.index(n), table.numbers());
     assert_eq!(rows.len(), 2000);
     for r in rows.iter().take(200) {
         let seed = r[col("seed")];
@@ -268,8 +243,7 @@ fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() 
         "{ kind = \"lhs\", samples = 3000 }",
         "{ kind = \"mc\", samples = 6 }",
     );
-    let out = dir.path().join("out");
-    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let out = run_beside(&s, &[]);
     let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
     let n = h.len() as f64;
     let m = h.iter().sum::<f64>() / n;
@@ -301,9 +275,9 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
         "{ kind = \"qmc\", samples = 4, replicates = 2 }",
         "{ kind = \"lhs\", samples = 5 }",
     );
-    let s = s.to_str().unwrap();
+    let s = utf8(&s);
     let whole = dir.path().join("whole");
-    run(&["run", s, "--out", whole.to_str().unwrap(), "-t", "2"]);
+    run_ok(&["run", s, "--out", utf8(&whole), "-t", "2"]);
     let files = [
         "y_end_conditional.csv",
         "y_end_samples.csv",
@@ -312,41 +286,26 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
         "y_split.csv",
         "points.csv",
     ];
-    let read = |d: &Path, f: &str| std::fs::read_to_string(d.join(f)).unwrap();
     let split = |d: &Path| summary(d)["quantities"]["y_end"]["variance_split"].clone();
 
     let resumed = dir.path().join("resumed");
-    let r = resumed.to_str().unwrap();
-    let o = Command::new(DRIVER)
-        .args(["run", s, "--out", r, "--max-points", "17"])
-        .output()
-        .unwrap();
+    let r = utf8(&resumed);
+    let o = run(&["run", s, "--out", r, "--max-points", "17"]);
     assert!(!resumed.join("y_end_conditional.csv").exists(), "{o:?}");
-    let o = run(&["run", s, "--out", r, "-t", "1"]);
-    assert!(
-        String::from_utf8_lossy(&o.stdout).contains("(17 resumed)"),
-        "{}",
-        String::from_utf8_lossy(&o.stdout)
-    );
+    let o = run_ok(&["run", s, "--out", r, "-t", "1"]);
+    assert!(o.contains("(17 resumed)"), "{o}");
 
     let plan = dir.path().join("plan");
-    let p = plan.to_str().unwrap();
-    run(&["plan", s, "--shards", "3", "--out", p]);
+    let p = utf8(&plan);
+    run_ok(&["plan", s, "--shards", "3", "--out", p]);
     for k in ["0", "1", "2"] {
-        run(&["run-shard", p, "--shard", k]);
+        run_ok(&["run-shard", p, "--shard", k]);
     }
     let merged = dir.path().join("merged");
-    run(&["merge", p, "--out", merged.to_str().unwrap()]);
+    run_ok(&["merge", p, "--out", utf8(&merged)]);
 
     for other in [&resumed, &merged] {
-        for f in files {
-            assert_eq!(
-                read(&whole, f),
-                read(other, f),
-                "{f} in {}",
-                other.display()
-            );
-        }
+        assert_same_files(&whole, other, &files);
         assert_eq!(split(&whole), split(other));
     }
     assert_eq!(summary(&whole)["model_runs"], 40);
@@ -361,50 +320,26 @@ fn conditional_sobol_indices_of_an_outer_sample_without_inner_variance_are_nan_n
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        r#"name = "flat-inner"
-fmu = "{fmu}"
-seed = 3
-[experiment]
-stop = 0.2
-step = 0.1
-[method]
-kind = "nested"
-outer = {{ kind = "mc", samples = 3 }}
-inner = {{ kind = "scm", nodes = 2, order = 1 }}
-[[parameters]]
-name = "seed"
-distribution = "integer_uniform"
-low = 1
-high = {SEEDS}
-level = "outer"
-[[parameters]]
-name = "x3"
-mean = 0.0
-std = 1.0
-[fixed]
-function = 4
-x1 = 0.5
-x2 = 0.0
-[outputs]
-variables = ["y"]
-[[qoi]]
-kind = "final"
-name = "y_end"
-signal = "y"
-limits = [3.0]
-"#,
-        fmu = fmu.display()
+    let text = nested_text(
+        "flat-inner",
+        &fmu,
+        3,
+        [
+            "{ kind = \"mc\", samples = 3 }",
+            "{ kind = \"scm\", nodes = 2, order = 1 }",
+        ],
+        [
+            "[[parameters]]\nname = \"x3\"\nmean = 0.0\nstd = 1.0\n",
+            "x1 = 0.5\nx2 = 0.0\n",
+        ],
+        "[3.0]",
     );
-    let s = dir.path().join("flat.toml");
-    std::fs::write(&s, text).unwrap();
+    let s = write_toml(dir.path(), "flat", &text);
     let out = dir.path().join("flat");
-    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let (header, rows) = conditional(&out);
-    let (std, s3) = (
-        header.iter().position(|h| h == "std").unwrap(),
-        header.iter().position(|h| h == "S_x3").unwrap(),
-    );
+    run_study_ok(&s, &out, &[]);
+    let table = conditional(&out);
+    let (header, rows) = (&table.header, table.numbers());
+    let (std, s3) = (table.index("std"), table.index("S_x3"));
     assert_eq!(rows.len(), 3);
     for r in &rows {
         assert_eq!(r[std], 0.0, "{header:?} {r:?}");
@@ -412,30 +347,9 @@ limits = [3.0]
     }
 }
 
-/// Reads a CSV strictly: every row must have as many fields as the header.
-fn strict_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows: Vec<Vec<String>> = lines
-        .map(|l| l.split(',').map(String::from).collect())
-        .collect();
-    for (i, r) in rows.iter().enumerate() {
-        assert_eq!(
-            r.len(),
-            header.len(),
-            "row {i} of {} has {} fields under a header of {}",
-            path.display(),
-            r.len(),
-            header.len()
-        );
-    }
-    (header, rows)
-}
-
 #[test]
 fn a_sparse_inner_chaos_writes_a_rectangular_conditional_table_on_the_union_of_its_bases() {
-    // QA round qa5/rail M2: LARS keeps a different basis per outer sample; the conditional CSV
+    // LARS keeps a different basis per outer sample; the conditional CSV
     // had rows of 31 to 44 fields under the first sample's 41 labels, no `loo` column, and
     // the inner chaos's error warnings were dropped. Ishigami (function 1) with its `a` and
     // `b` outer: the terms LARS keeps depend on them.
@@ -444,36 +358,17 @@ fn a_sparse_inner_chaos_writes_a_rectangular_conditional_table_on_the_union_of_i
     };
     let dir = tempfile::tempdir().unwrap();
     let pi = PI;
-    let inner_params: String = ["x1", "x2", "x3"]
-        .iter()
-        .map(|n| {
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = {}\nhigh = {pi}\n",
-                -pi
-            )
-        })
-        .collect();
+    let inner_params = uniform(&["x1", "x2", "x3"], -pi, pi);
     let head = |name: &str, method: &str, params: &str, fixed: &str| {
         format!(
-            r#"name = "{name}"
-fmu = "{fmu}"
-seed = 5
-[experiment]
-stop = 0.2
-step = 0.1
-[method]
+            r#"{head}[method]
 {method}
 {params}{inner_params}[fixed]
 function = 1
-{fixed}[outputs]
-variables = ["y"]
-[[qoi]]
-kind = "final"
-name = "y_end"
-signal = "y"
-limits = [4.0]
+{fixed}{outputs}limits = [4.0]
 "#,
-            fmu = fmu.display()
+            head = study_head(name, &fmu, 5, "stop = 0.2\nstep = 0.1"),
+            outputs = final_quantity("y", "y_end")
         )
     };
     let method = "kind = \"nested\"\nouter = { kind = \"mc\", samples = 4 }\n\
@@ -485,13 +380,14 @@ limits = [4.0]
     let s = dir.path().join("nested.toml");
     std::fs::write(&s, head("ishigami-nested", method, outer_params, "")).unwrap();
     let out = dir.path().join("out");
-    run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let (header, rows) = strict_csv(&out.join("y_end_conditional.csv"));
-    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    run_study_ok(&s, &out, &[]);
+    let table = Csv::read(&out.join("y_end_conditional.csv")).rectangular();
+    let (header, rows) = (&table.header, &table.rows);
+    let col = |n: &str| table.index(n);
     let num = |r: &[String], c: usize| -> f64 { r[c].parse().unwrap() };
     assert_eq!(rows.len(), 4);
     let loo = col("loo");
-    for r in &rows {
+    for r in rows {
         assert!(num(r, loo) >= 0.0, "{r:?}");
     }
     // Different bases: some coefficient column is 0 in one row and not in another.
@@ -550,10 +446,8 @@ limits = [4.0]
     let s1 = dir.path().join("alone.toml");
     std::fs::write(&s1, head("ishigami-alone", alone, "", &fixed)).unwrap();
     let out1 = dir.path().join("alone");
-    run(&["run", s1.to_str().unwrap(), "--out", out1.to_str().unwrap()]);
-    let sur: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out1.join("surrogate.json")).unwrap())
-            .unwrap();
+    run_study_ok(&s1, &out1, &[]);
+    let sur = read_json(&out1.join("surrogate.json"));
     let q = &sur["quantities"][0];
     let idx = q["multi_indices"].as_array().unwrap();
     let coeffs = q["coefficients"][0].as_array().unwrap();
@@ -589,7 +483,7 @@ limits = [4.0]
 
 #[test]
 fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
-    // QA round qa5/rail H2: a percentile bootstrap over 4 outer samples is about half as wide
+    // A percentile bootstrap over 4 outer samples is about half as wide
     // as Student's t, and covers far less than 95 %. Here 40 studies of 4 outer samples
     // (seeds 1..=40), each with an exact inner chaos; the true P(y > 1) and P(y > 3) from the
     // whole population of seeds. A simulation of the same (numpy, 2 000 repetitions) gives
@@ -618,8 +512,7 @@ fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
             seed,
             "[1.0, 3.0]",
         );
-        let out = dir.path().join(format!("out-{seed}"));
-        run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let out = run_beside(&s, &[]);
         let q = &summary(&out)["quantities"]["y_end"];
         for l in 0..2 {
             let e = &q["exceedance_ci"][l];
@@ -647,7 +540,7 @@ fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
 
 #[test]
 fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extrapolation() {
-    // QA round qa5/rail H2: every track exceeding gave the interval [1, 1]; M2: a limit
+    // Every track exceeding gave the interval [1, 1]; M2: a limit
     // beyond every model run, counted over the inner chaoses' draws, said nothing of it; L1:
     // the count line printed the pooled-draw P beside the interval of the mean of the
     // conditional P. y = x1 + x2² + h ≥ −4.3 or so in every run: −30 is below all of them,
@@ -666,8 +559,7 @@ fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extr
         "[-30.0, 2.0, 40.0]",
     );
     let out = dir.path().join("out");
-    let o = run(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    let stdout = run_study_ok(&s, &out, &[]);
     let q = &summary(&out)["quantities"]["y_end"];
     let (low, high) = (&q["exceedance_counts"][0], &q["exceedance_counts"][2]);
     let bound = 0.05f64.powf(1.0 / 16.0);

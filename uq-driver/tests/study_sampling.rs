@@ -1,40 +1,18 @@
 //! Quasi-Monte Carlo, replicated Latin hypercubes and Sobol' indices, run through uq-driver on
-//! FMUs (issue 11 items 3, 4 and 8), against references computed here: the wheel's closed form
+//! FMUs, against references computed here: the wheel's closed form
 //! on a Gauss–Hermite grid (`support/wheel.rs`), the closed-form indices of the Ishigami and
 //! g-functions on the C test FMU `Functions` (`support/test_fmus.rs`).
 
-#[path = "support/benchmarks.rs"]
-mod benchmarks;
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-#[path = "support/wheel.rs"]
-mod wheel;
-
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use wheel::{read_csv, reference, reference_sobol};
+use crate::support::wheel::{self, read_csv, reference, reference_sobol};
+use crate::support::{
+    assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_ok, run_study_ok,
+    study_head, summary, test_fmus, uniform, utf8, write_toml,
+};
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
-
-fn run_ok(args: &[&str]) {
-    let out = Command::new(DRIVER)
-        .args(args)
-        .env("RAILUQ_FMU_DIR", wheel::fmu_dir())
-        .output()
-        .expect("uq-driver runs");
-    assert!(
-        out.status.success(),
-        "uq-driver {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-fn summary(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
-}
 
 /// A wheel study (stop 5 s, step 0.01 s, output q) with `method`, seed `seed` and `extra`.
 fn wheel_study(dir: &Path, name: &str, seed: u64, method: &str, extra: &str) -> PathBuf {
@@ -46,12 +24,7 @@ fn wheel_study(dir: &Path, name: &str, seed: u64, method: &str, extra: &str) -> 
 fn z_scores(dir: &Path, tag: &str, method: &str, seed: u64) -> Vec<f64> {
     let study = wheel_study(dir, tag, seed, method, "");
     let out = dir.join(format!("{tag}-{seed}"));
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &out, &[]);
     let csv = read_csv(&out.join("q.csv"));
     TIMES
         .iter()
@@ -120,9 +93,7 @@ fn qmc_meets_the_wheel_reference_within_its_standard_error_and_the_error_is_hone
 
 #[test]
 fn builtin_wheel_qmc_meets_the_reference_within_4_standard_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("qmc");
-    run_ok(&["run", "builtin:wheel-qmc", "--out", out.to_str().unwrap()]);
+    let (_dir, out, _) = run_builtin("wheel-qmc");
     let csv = read_csv(&out.join("q.csv"));
     for t in TIMES {
         let (m, s) = reference(t);
@@ -167,22 +138,9 @@ fn qmc_and_sobol_sampling_do_not_depend_on_the_thread_count() {
             dir.path().join(format!("{name}-2")),
         );
         for (out, threads) in [(&a, "1"), (&b, "2")] {
-            run_ok(&[
-                "run",
-                study.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--threads",
-                threads,
-            ]);
+            run_study_ok(&study, out, &["--threads", threads]);
         }
-        for f in files {
-            assert_eq!(
-                std::fs::read(a.join(f)).unwrap(),
-                std::fs::read(b.join(f)).unwrap(),
-                "{name}: {f}"
-            );
-        }
+        assert_same_files(&a, &b, files);
     }
 }
 
@@ -198,52 +156,22 @@ fn a_sharded_qmc_study_gives_the_files_of_the_whole_study() {
         "",
     );
     let whole = dir.path().join("whole");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        whole.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &whole, &[]);
     let plan = dir.path().join("plan");
     let result = dir.path().join("result");
-    run_ok(&[
-        "plan",
-        study.to_str().unwrap(),
-        "--shards",
-        "3",
-        "--out",
-        plan.to_str().unwrap(),
-    ]);
+    run_ok(&["plan", utf8(&study), "--shards", "3", "--out", utf8(&plan)]);
     for k in ["0", "1", "2"] {
-        run_ok(&["run-shard", plan.to_str().unwrap(), "--shard", k]);
+        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
     }
-    run_ok(&[
-        "merge",
-        plan.to_str().unwrap(),
-        "--out",
-        result.to_str().unwrap(),
-    ]);
-    for f in ["q.csv", "q_pdf.csv", "points.csv"] {
-        assert_eq!(
-            std::fs::read(whole.join(f)).unwrap(),
-            std::fs::read(result.join(f)).unwrap(),
-            "{f}"
-        );
-    }
+    run_ok(&["merge", utf8(&plan), "--out", utf8(&result)]);
+    assert_same_files(&whole, &result, &["q.csv", "q_pdf.csv", "points.csv"]);
 }
 
 /// The Sobol' indices of the wheel by pick-freeze sampling (the built-in study) against the
 /// indices of the closed form on the Gauss–Hermite grid.
 #[test]
 fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("s");
-    run_ok(&[
-        "run",
-        "builtin:wheel-sobol-sampling",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (_dir, out, _) = run_builtin("wheel-sobol-sampling");
     let csv = read_csv(&out.join("q_sobol.csv"));
     let mut covered = 0;
     for t in TIMES {
@@ -275,7 +203,7 @@ fn builtin_wheel_sobol_sampling_meets_the_reference_indices() {
         "{covered} of 20 intervals cover the reference"
     );
     // At t = 0 every run starts at q0: no variance, so the indices (0/0) and their
-    // intervals are undefined: NaN, not 0 with a [0, 0] interval (QA F5).
+    // intervals are undefined: NaN, not 0 with a [0, 0] interval .
     for col in ["S_K", "ST_C", "S_K_lo", "S_K_hi", "ST_C_lo", "ST_C_hi"] {
         assert!(
             csv.at(0.0, col).is_nan(),
@@ -314,15 +242,9 @@ fn scm_sobol_indices_of_a_quantity_are_labelled_by_parameter_name() {
         "kind = \"scm\"\nnodes = 6\norder = 5",
         "[[qoi]]\nkind = \"final\"\nname = \"q_at_1\"\nsignal = \"q\"\n",
     );
-    let text = std::fs::read_to_string(&study).unwrap();
-    std::fs::write(&study, text.replace("stop = 5.0", "stop = 1.0")).unwrap();
+    edit(&study, "stop = 5.0", "stop = 1.0");
     let out = dir.path().join("scm");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &out, &[]);
     let s = summary(&out);
     let q = &s["quantities"]["q_at_1"];
     let (first, total) = reference_sobol(1.0);
@@ -355,35 +277,21 @@ fn functions_study(
     high: f64,
     samples: usize,
 ) -> PathBuf {
-    let mut text = format!(
-        r#"name = "f{function}"
-fmu = "{fmu}"
-seed = 5
-[experiment]
-stop = 0.2
-step = 0.1
-[method]
+    let name = format!("f{function}");
+    let names: Vec<String> = (1..=d).map(|i| format!("x{i}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let text = format!(
+        r#"{head}[method]
 kind = "sobol_sampling"
 samples = {samples}
 [fixed]
 function = {function}
-[outputs]
-variables = ["y"]
-[[qoi]]
-kind = "final"
-name = "y_end"
-signal = "y"
-"#,
-        fmu = fmu.display()
+{outputs}{parameters}"#,
+        head = study_head(&name, fmu, 5, "stop = 0.2\nstep = 0.1"),
+        outputs = final_quantity("y", "y_end"),
+        parameters = uniform(&names, low, high)
     );
-    for i in 1..=d {
-        text.push_str(&format!(
-            "[[parameters]]\nname = \"x{i}\"\ndistribution = \"uniform\"\nlow = {low}\nhigh = {high}\n"
-        ));
-    }
-    let p = dir.join(format!("f{function}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    write_toml(dir, &name, &text)
 }
 
 #[test]
@@ -394,12 +302,7 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
     let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, 8192);
     let out = dir.path().join("ishigami");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &out, &[]);
     let (s, st) = benchmarks::ishigami_indices();
     assert!((s[0] - 0.3139).abs() < 1e-4 && (st[2] - 0.2437).abs() < 1e-4);
     let q = &summary(&out)["quantities"]["y_end"]["sobol"];
@@ -440,12 +343,7 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices(
     let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 3, 8, 0.0, 1.0, 4096);
     let out = dir.path().join("g");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &out, &[]);
     // g = prod (|4 x_i − 2| + a_i) / (1 + a_i): closed-form indices.
     let (first, total) = benchmarks::g_function_indices();
     let q = &summary(&out)["quantities"]["y_end"]["sobol"];
@@ -512,7 +410,7 @@ fn clopper_pearson_by_bisection(k: usize, n: usize) -> (f64, f64) {
     (lower, upper)
 }
 
-/// QA5 M6: the exceedance of a pick-freeze design used to count all N·(d + 2) runs as
+/// The exceedance of a pick-freeze design used to count all N·(d + 2) runs as
 /// independent draws (768 of 768 → 0.995–1.00, where the 128 independent runs of A and B give
 /// 0.977). It is counted over the 2N runs of A and B alone.
 #[test]
@@ -524,17 +422,13 @@ fn sobol_sampling_counts_its_exceedance_over_the_independent_a_and_b_runs() {
     let n = 64;
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, n);
     // The limit belongs to the [[qoi]] table: right after its signal.
-    let text = std::fs::read_to_string(&study)
-        .unwrap()
-        .replace("signal = \"y\"\n", "signal = \"y\"\nlimits = [5.0]\n");
-    std::fs::write(&study, text).unwrap();
+    edit(
+        &study,
+        "signal = \"y\"\n",
+        "signal = \"y\"\nlimits = [5.0]\n",
+    );
     let out = dir.path().join("exceed");
-    run_ok(&[
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    run_study_ok(&study, &out, &[]);
     let e = &summary(&out)["quantities"]["y_end"]["exceedance_counts"][0];
     assert_eq!(e["of"].as_u64().unwrap() as usize, 2 * n, "{e}");
     // The runs of A and B are design points 0..2N (blocks A, B, AB_1, ...).

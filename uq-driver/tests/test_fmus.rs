@@ -3,11 +3,10 @@
 //! functions, and its resources. What the FMUs compute is checked against fmpy and closed forms in
 //! `tests/python/test_test_fmus.py`.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::fs;
 use std::io::Read;
+
+use crate::support::test_fmus;
 
 const FMI2_CS_FUNCTIONS: [&str; 34] = [
     "fmi2GetTypesPlatform",

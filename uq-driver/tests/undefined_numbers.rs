@@ -1,35 +1,38 @@
-//! Numbers a method cannot know are not written as exact ones (QA findings F2–F5, through the
+//! Numbers a method cannot know are not written as exact ones (through the
 //! `uq-driver` binary and the Functions / Features test FMUs, `tests/fmus`):
-//! - F2: a chaos method has no sampling standard error of the mean: `null`, not 0;
-//! - F3: only a positive-mean normal input warns of points at x <= 0;
-//! - F4: a study stopped by failures counts only what is known, and a `[fixed]` Integer
+//! - a chaos method has no sampling standard error of the mean: `null`, not 0;
+//! - only a positive-mean normal input warns of points at x <= 0;
+//! - a study stopped by failures counts only what is known, and a `[fixed]` Integer
 //!   outside its declared range is refused before any run;
-//! - F5: the Sobol' indices of an output without variance are NaN (0/0), not 0, and its Std
+//! - the Sobol' indices of an output without variance are NaN (0/0), not 0, and its Std
 //!   is 0, never −0.
 //!
 //! Expected values are closed forms of the test functions (function 4: y = x1 + x2²), counts
 //! of the design, or the runs' own values recomputed here.
 
-#[path = "support/test_fmus.rs"]
-mod test_fmus;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const DRIVER: &str = env!("CARGO_BIN_EXE_uq-driver");
+use crate::support::csv::Csv;
+use crate::support::{
+    final_quantity, run, run_args, run_beside, run_study, stderr, stdout, study_head, summary,
+    test_fmus, write_toml,
+};
 
 /// A study on the test FMU `model` (1 s or 0.1 s long), with `body` (fixed values, parameters,
 /// outputs, quantities) and the method `method` (TOML).
 fn study(dir: &Path, name: &str, model: &str, stop: f64, body: &str, method: &str) -> PathBuf {
     let fmu = test_fmus::test_fmu(model).expect("the test FMU");
     let text = format!(
-        "name = \"{name}\"\nfmu = \"{}\"\nseed = 5\n[experiment]\nstart = 0.0\nstop = {stop}\n\
-         step = 0.1\n[method]\n{method}\n{body}",
-        fmu.display()
+        "{}[method]\n{method}\n{body}",
+        study_head(
+            name,
+            &fmu,
+            5,
+            &format!("start = 0.0\nstop = {stop}\nstep = 0.1")
+        )
     );
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+    write_toml(dir, name, &text)
 }
 
 /// Function 4 (y = x1 + x2²) of the Functions FMU with x1, x2 fixed (y = 1.3 + 0.49 = 1.79 in
@@ -37,8 +40,8 @@ fn study(dir: &Path, name: &str, model: &str, stop: f64, body: &str, method: &st
 fn function4(random: &str, fixed_x: bool) -> String {
     let fixed = if fixed_x { "x1 = 1.3\nx2 = 0.7\n" } else { "" };
     format!(
-        "[fixed]\nfunction = 4\nsigma_h = 0.0\nseed = 0\n{fixed}{random}\n[outputs]\n\
-         variables = [\"y\"]\n[[qoi]]\nkind = \"final\"\nname = \"Y\"\nsignal = \"y\"\n"
+        "[fixed]\nfunction = 4\nsigma_h = 0.0\nseed = 0\n{fixed}{random}\n{}",
+        final_quantity("y", "Y")
     )
 }
 
@@ -54,50 +57,10 @@ const NORMAL_X1_X2: &str = "[[parameters]]\nname = \"x1\"\ndistribution = \"norm
                             mean = 0.5\nstd = 1.0\n[[parameters]]\nname = \"x2\"\n\
                             distribution = \"normal\"\nmean = 0.5\nstd = 1.0\n";
 
-fn driver(args: &[&str]) -> Output {
-    Command::new(DRIVER)
-        .args(args)
-        .output()
-        .expect("uq-driver runs")
-}
-
-/// Runs `study` into `<study>.out` (extra `args`); returns the folder.
-fn run_ok(study: &Path, args: &[&str]) -> PathBuf {
-    let out = study.with_extension("out");
-    let mut all = vec![
-        "run",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    all.extend(args);
-    let o = driver(&all);
-    assert!(
-        o.status.success(),
-        "uq-driver {all:?} failed:\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    out
-}
-
-fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
-}
-
 /// Header and rows of a CSV file, the fields as text.
 fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(str::to_owned).collect())
-        .collect();
-    (header, rows)
+    let c = Csv::read(path);
+    (c.header, c.rows)
 }
 
 #[test]
@@ -122,7 +85,7 @@ fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
             &function4(NORMAL_X1_X2, false),
             method,
         );
-        let out = run_ok(&s, &["--no-report"]);
+        let out = run_beside(&s, &["--no-report"]);
         let sum = summary(&out);
         assert!(sum["method"]["standard_error"].is_null(), "{name}");
         let q = &sum["quantities"]["Y"];
@@ -150,7 +113,7 @@ fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
         &function4(X1_X2, false),
         "kind = \"mc\"\nsamples = 200",
     );
-    let out = run_ok(&s, &["--no-report"]);
+    let out = run_beside(&s, &["--no-report"]);
     let (_, rows) = csv(&out.join("Y_samples.csv"));
     let y: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
     let n = y.len() as f64;
@@ -174,18 +137,19 @@ fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let fmu = test_fmus::test_fmu("Functions").unwrap();
-    let text = format!(
-        "name = \"suite\"\nfmu = \"{}\"\nseed = 5\n[experiment]\nstart = 0.0\nstop = 0.1\n\
-         step = 0.1\n[method]\nkind = \"mc\"\nsamples = 100\n{}\n[[variants]]\nname = \"sg\"\n\
-         method = {{ kind = \"sparse_grid\", level = 2 }}\n\n[[variants]]\nname = \"mc\"\n\
-         method = {{ kind = \"mc\", samples = 100 }}\n",
-        fmu.display(),
-        function4(NORMAL_X1_X2, false)
+    let variants =
+        "[[variants]]\nname = \"sg\"\nmethod = { kind = \"sparse_grid\", level = 2 }\n\n\
+                    [[variants]]\nname = \"mc\"\nmethod = { kind = \"mc\", samples = 100 }\n";
+    let body = format!("{}\n{variants}", function4(NORMAL_X1_X2, false));
+    let s = study(
+        dir.path(),
+        "suite",
+        "Functions",
+        0.1,
+        &body,
+        "kind = \"mc\"\nsamples = 100",
     );
-    let s = dir.path().join("suite.toml");
-    std::fs::write(&s, text).unwrap();
-    let out = run_ok(&s, &[]);
+    let out = run_beside(&s, &[]);
     let (header, rows) = csv(&out.join("Y_compare.csv"));
     let se = header.iter().position(|h| h == "std_error_mean").unwrap();
     assert_eq!(rows.len(), 2, "{rows:?}");
@@ -212,7 +176,7 @@ fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
         &function4(X1_X2, false),
         "kind = \"qmc\"\nsamples = 256\nreplicates = 4",
     );
-    let out = run_ok(&s, &["--no-report"]);
+    let out = run_beside(&s, &["--no-report"]);
     let warnings = summary(&out)["warnings"].clone();
     let text = warnings.to_string();
     assert!(!text.contains("<= 0"), "{text}");
@@ -240,22 +204,13 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     );
     let out = dir.path().join("nan.out");
     let args = |threads: &str, extra: &[&'static str]| -> Output {
-        let mut a = vec![
-            "run",
-            s.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--fresh",
-            "--no-report",
-            "--threads",
-        ];
-        a.push(threads);
+        let mut a = run_args(&s, &out, &["--fresh", "--no-report", "--threads", threads]);
         a.extend(extra);
-        driver(&a)
+        run(&a)
     };
     // The truth: with --allow-failures every point is run; points.csv says which failed.
     let o = args("2", &["--allow-failures"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{}", stderr(&o));
     let (_, rows) = csv(&out.join("points.csv"));
     let failed: Vec<usize> = rows
         .iter()
@@ -264,7 +219,7 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
         .collect();
     let n_failed = failed.len();
     assert!(n_failed > 2 && n_failed < 64, "{n_failed} failed");
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stdout = stdout(&o);
     assert!(
         stdout.contains(&format!("{n_failed} points failed")),
         "{stdout}"
@@ -274,7 +229,7 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     let f = failed[0];
     let o = args("1", &[]);
     assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     let want = format!(
         "stopped at the first failure of 64 points (runs not started: {}; how many of those \
          would fail is not known); first: point {f} with",
@@ -285,7 +240,7 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     // Two threads: however many failed before the stop, they are at most the true count and
     // failures + not started <= 64.
     let o = args("2", &[]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     let (seen, not_started) = if err.contains("stopped at the first failure") {
         (1, number_after(&err, "runs not started: "))
     } else if err.contains("stopped after the first ") {
@@ -333,9 +288,9 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
         "kind = \"mc\"\nsamples = 16",
     );
     let out = dir.path().join("f7.out");
-    let o = driver(&["run", s.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = run_study(&s, &out, &[]);
     assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr(&o);
     assert!(
         err.contains("'function' is an Integer declared with min = 1, max = 4")
             && err.contains("the value 7 given for it is outside that range"),
@@ -352,7 +307,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
         &function4(X1_X2, false),
         "kind = \"mc\"\nsamples = 16",
     );
-    run_ok(&ok, &["--no-report"]);
+    run_beside(&ok, &["--no-report"]);
 }
 
 #[test]
@@ -385,7 +340,7 @@ fn sobol_indices_of_an_output_without_variance_are_nan_not_zero() {
             &function4(X3_X4, true),
             method,
         );
-        let out = run_ok(&s, &[]);
+        let out = run_beside(&s, &[]);
         let (header, rows) = csv(&out.join("y_sobol.csv"));
         for row in &rows {
             for (h, v) in header.iter().zip(row).skip(1) {

@@ -86,7 +86,7 @@ impl VehicleTrack {
     /// mode, `ω = (NM π / l)² √(EI / mr)` (bending alone; the supports only raise it), beyond
     /// the undamped stability limit `ω dt = 2` of Zhai's method (damping lowers the limit
     /// further). Such a run used to return fmi2OK with forces of 1e63 N until the state
-    /// overflowed (found by QA: dt = 0.01 s).
+    /// overflowed (dt = 0.01 s).
     fn check_stability_limit(&self) -> Result<(), ModelError> {
         let p = &self.p;
         let length = (f64::from(p.n_sleepers) + 1.0) * p.r(VR_LS);

@@ -250,7 +250,7 @@ fn refuses_bad_parameters_with_clear_messages() {
     assert!(m.set_real(VR_CPZ, 0.0).is_ok());
     assert!(m.set_integer(VR_N_SLEEPERS, 100).is_err());
     assert!(m.set_integer(VR_N_SLEEPERS, 511).is_ok());
-    // QA: 2^24 - 1 sleepers were accepted and aborted the importer at initialization when
+    // 2^24 - 1 sleepers were accepted and aborted the importer at initialization when
     // the allocation failed; the window is bounded instead.
     assert!(m.set_integer(VR_N_SLEEPERS, 65_535).is_ok());
     let e = m
@@ -564,7 +564,7 @@ fn p1_swing_with_steps(steps: &[f64]) -> Result<f64, String> {
 
 #[test]
 fn communication_steps_that_change_length_every_step_stay_stable() {
-    // QA: alternating steps of 1e-4 and 0.99e-4 s (each one substep) restarted the two-step
+    // Alternating steps of 1e-4 and 0.99e-4 s (each one substep) restarted the two-step
     // integrator at every step with its one-step formula, which gains energy: fmi2Error
     // "state became non-finite" at t = 0.033 s although every step was <= dt.
     let constant = p1_swing_with_steps(&[1e-4]).unwrap();
@@ -581,7 +581,7 @@ fn communication_steps_that_change_length_every_step_stay_stable() {
 
 #[test]
 fn a_dt_beyond_the_stability_limit_is_refused_at_initialization() {
-    // QA: dt = 0.01 s returned fmi2OK with P1 up to 4.7e63 N until the state overflowed.
+    // Dt = 0.01 s returned fmi2OK with P1 up to 4.7e63 N until the state overflowed.
     // Highest rail mode of the defaults: (255 π / 153.6 m)² √(6.6e6 / 60.64) ≈ 8980 rad/s,
     // so 2/ω ≈ 2.23e-4 s.
     let omega = (255.0 * std::f64::consts::PI / 153.6f64).powi(2) * (6.6e6f64 / 60.64).sqrt();
@@ -617,7 +617,7 @@ fn a_dt_beyond_the_stability_limit_is_refused_at_initialization() {
     }
 }
 
-/// QA5 M5: `v = 300` (meant as km/h) ran at 1080 km/h without a word. The speed declares the
+/// `v = 300` (meant as km/h) ran at 1080 km/h without a word. The speed declares the
 /// range [0, 160] m/s (576 km/h, above the 574.8 km/h record) and refuses a value outside it.
 #[test]
 fn a_speed_in_km_per_hour_is_refused() {

@@ -26,7 +26,7 @@ fn invalid(name: &'static str, value: i32, reason: &str) -> SetResult {
 
 /// Largest computing window (sleepers): 2^16 − 1 sleepers are about 39 km of track at 0.6 m,
 /// a few tens of MB. A larger value is refused here rather than failing to allocate at
-/// initialization, which would abort the importing process (found by QA: 2^24 − 1 sleepers
+/// initialization, which would abort the importing process (2^24 − 1 sleepers
 /// under a 3 GB limit).
 pub const MAX_SLEEPERS: i32 = 65_535;
 

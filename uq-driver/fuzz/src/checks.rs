@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use uq_driver::fmu::description::ParseLimits;
 use uq_driver::fmu::ModelDescription;
-use uq_driver::study::store::{self, Format, Manifest, Record, Store};
+use uq_driver::internals::store::{self, Format, Manifest, Record, Store};
 
 /// `ModelDescription::parse` on arbitrary bytes: no panic; what it accepts is consistent; a
 /// tighter limit never accepts more.

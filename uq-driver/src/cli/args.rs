@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 
-use uq_driver::study::RunOptions;
+use crate::study::RunOptions;
 
 #[derive(Parser)]
 #[command(
@@ -237,7 +237,7 @@ impl SafetyArgs {
         opts.fmu_logging = self.fmu_logging;
         if self.isolate {
             opts.isolate = Some(
-                uq_driver::study::isolate::default_exe()
+                crate::study::run::isolate::default_exe()
                     .context("locating the uq-driver executable for --isolate")?,
             );
         }

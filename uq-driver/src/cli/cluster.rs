@@ -7,8 +7,9 @@ use anyhow::{Context, Result};
 
 use super::args::*;
 use super::load::*;
-use uq_driver::spec::Study;
-use uq_driver::study::{shard, size, RunOptions};
+use crate::spec::Study;
+use crate::study::plan::size;
+use crate::study::{shard, RunOptions};
 
 /// The size checks of `run` for a plan (whose shards run with the default thread count).
 pub(crate) fn check_plan_size(s: &Study, dir: &Path, yes: bool) -> Result<()> {

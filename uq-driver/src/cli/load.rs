@@ -4,8 +4,8 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use uq_driver::spec::{fmu_candidates, Study, BUILTINS};
-use uq_driver::suggest;
+use crate::spec::{fmu_candidates, Study, BUILTINS};
+use crate::suggest;
 
 /// A study argument as `Study::load` takes it: a file, `builtin:NAME`, or a bare built-in
 /// NAME when no file of that name exists; a misspelt name gets the closest built-in.

@@ -6,3 +6,234 @@ pub(crate) mod cluster;
 pub(crate) mod load;
 pub(crate) mod print;
 pub(crate) mod tools;
+
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+
+use crate::fmu::Fmu;
+use crate::spec::{builtin, Study, StudyError, BUILTINS};
+use crate::study::plan::interface::{InterfaceError, VariableProblem};
+use crate::study::{run_study, shard, Outcome, RunError, RunOptions, StudyRunError};
+use crate::suggest;
+
+use args::*;
+use cluster::*;
+use load::*;
+use print::*;
+use tools::*;
+
+/// The `uq-driver` program: parses the command line, runs the command, prints errors (with
+/// hints) and returns the exit status.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if matches!(cli.command, Command::Worker) {
+        return ExitCode::from(u8::try_from(crate::study::run::isolate::serve()).unwrap_or(1));
+    }
+    // The CLI owns its process: signal handlers, the atexit check of an FMU calling exit(),
+    // and the in-process --timeout-per-run (library hosts leave them off).
+    crate::study::run::guard::install_process_guards();
+    // The library's notes and warnings (silent by default) go to stderr.
+    crate::study::progress::print_messages();
+    match dispatch(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        // `uq-driver inspect X | head`: the reader went away; nothing left to say.
+        Err(e)
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("uq-driver: error: {}", causes(&e));
+            for h in hints(&e) {
+                eprintln!("uq-driver: hint: {h}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes, each once: a cause whose text an outer message already
+/// contains (libraries that print their source in their own message) is not repeated.
+fn causes(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let msg = cause.to_string();
+        if text.contains(&msg) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&msg);
+    }
+    text
+}
+
+/// "Did you mean" for the errors that name something misspelt: a TOML key or kind, a
+/// variable the FMU does not have.
+fn hints(e: &anyhow::Error) -> Vec<String> {
+    let mut out = Vec::new();
+    for cause in e.chain() {
+        if let Some(StudyError::Parse { message, .. }) = cause.downcast_ref::<StudyError>() {
+            out.extend(suggest::for_serde_message(message));
+        }
+        // `transparent` errors hide their inner error from the chain: look inside.
+        let ie = cause
+            .downcast_ref::<InterfaceError>()
+            .or_else(|| match cause.downcast_ref::<RunError>() {
+                Some(RunError::Interface(ie)) => Some(ie),
+                _ => None,
+            })
+            .or_else(|| match cause.downcast_ref::<StudyRunError>() {
+                Some(StudyRunError::Run(RunError::Interface(ie))) => Some(ie),
+                _ => None,
+            });
+        if let Some(ie) = ie {
+            if let VariableProblem::Unknown { name, .. } = &ie.problem {
+                if let Ok(fmu) = Fmu::open(&ie.fmu) {
+                    let names = fmu.description().variables.iter().map(|v| v.name.as_str());
+                    if let Some(c) = suggest::closest(name, names) {
+                        out.push(format!("'{name}': did you mean '{c}'?"));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn dispatch(cmd: Command) -> Result<()> {
+    match cmd {
+        Command::Run(args) => run(args),
+        Command::Plan {
+            study,
+            shards,
+            out,
+            yes,
+        } => {
+            let s = load_study(&study)?;
+            check_plan_size(&s, &out, yes)?;
+            let p = shard::plan(&s, shards, &out)?;
+            println!(
+                "planned {}: {} points in {} shards (point i in shard i mod {}); next: uq-driver run-shard {} --shard K, then uq-driver merge {}",
+                s.name,
+                p.manifest.n_points,
+                p.shards,
+                p.shards,
+                out.display(),
+                out.display()
+            );
+            Ok(())
+        }
+        Command::RunShard {
+            dir,
+            shard,
+            threads,
+            allow_failures,
+            safety,
+        } => run_shard(&dir, shard, threads, allow_failures, &safety),
+        Command::Merge {
+            dir,
+            out,
+            allow_failures,
+            no_report,
+            yes,
+        } => {
+            let out = out.unwrap_or_else(|| dir.join("result"));
+            let opts = RunOptions {
+                allow_failures,
+                no_report,
+                yes,
+                ..RunOptions::default()
+            };
+            let r = shard::merge(&dir, &out, &opts)?;
+            if no_report {
+                println!(
+                    "merged {} points; results (no report): {}",
+                    r.summary.model_runs,
+                    out.join("summary.json").display()
+                );
+            } else {
+                println!(
+                    "merged {} points; report: {}",
+                    r.summary.model_runs,
+                    out.join("index.html").display()
+                );
+            }
+            Ok(())
+        }
+        Command::Slurm(args) => slurm(args),
+        Command::List => {
+            let mut o = std::io::stdout().lock();
+            let w = BUILTINS.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
+            for (name, text) in BUILTINS {
+                let s = Study::parse(text, name, None)?;
+                writeln!(o, "builtin:{name:<w$} {}", s.description)?;
+            }
+            Ok(())
+        }
+        Command::Show { name } => {
+            let spec = study_spec(&format!(
+                "builtin:{}",
+                name.strip_prefix("builtin:").unwrap_or(&name)
+            ))?;
+            let text = builtin(spec.strip_prefix("builtin:").unwrap_or(&spec))?;
+            std::io::stdout().lock().write_all(text.as_bytes())?;
+            Ok(())
+        }
+        Command::Inspect { fmu } => inspect(&fmu),
+        Command::Simulate(args) => simulate(args),
+        Command::Surrogate(cmd) => surrogate(cmd),
+        Command::Compare { dirs, out } => {
+            crate::report::compare::write(&dirs, &out)?;
+            println!(
+                "compared {} folders: {}",
+                dirs.len(),
+                out.join("index.html").display()
+            );
+            Ok(())
+        }
+        Command::Export { dir, runs, out } => {
+            anyhow::ensure!(runs, "say what to export: --runs (every run's time series)");
+            let out = out.unwrap_or_else(|| dir.join("runs"));
+            let e = crate::study::store::export::runs(&dir, &out)?;
+            println!(
+                "exported {} runs × {} times of {}: {} and {}",
+                e.runs,
+                e.times,
+                e.outputs.join(", "),
+                e.csv.display(),
+                e.npz.display()
+            );
+            Ok(())
+        }
+        Command::Worker => unreachable!("handled in main"),
+    }
+}
+
+/// `uq-driver run`.
+fn run(a: RunArgs) -> Result<()> {
+    let s = load_study(&a.study)?;
+    let mut opts = RunOptions {
+        threads: a.threads,
+        progress: std::io::stderr().is_terminal(),
+        progress_lines: !std::io::stderr().is_terminal(),
+        allow_failures: a.allow_failures,
+        fresh: a.fresh,
+        max_new_points: a.max_points,
+        yes: a.yes,
+        no_report: a.no_report,
+        ..RunOptions::default()
+    };
+    a.safety.apply(&mut opts)?;
+    let outcome = run_study(&s, &a.out, &opts).with_context(|| format!("study {}", s.origin))?;
+    match outcome {
+        Outcome::Study(r) => print_study(&r, &a.out, a.no_report),
+        Outcome::Suite(r) => print_suite(&r, &a.out),
+    }
+    Ok(())
+}

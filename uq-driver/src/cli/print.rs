@@ -2,10 +2,10 @@
 
 use std::path::Path;
 
-use uq_driver::report::units::with_unit;
-use uq_driver::results::numbers::{count, to_spread};
-use uq_driver::results::ScalarStats;
-use uq_driver::study::{StudyResult, SuiteResult};
+use crate::report::units::with_unit;
+use crate::results::numbers::{count, to_spread};
+use crate::results::ScalarStats;
+use crate::study::{StudyResult, SuiteResult};
 
 /// The result of `run` on the terminal: runs, wall time, the scalar quantities, warnings;
 /// where the results are (`index.html`, or the folder when `--no-report` wrote no page).
@@ -40,7 +40,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
             format!("report: {}", out.join("index.html").display())
         }
     );
-    let nominal = s.method.kind == "nominal";
+    let nominal = crate::uq::method::notes_of_kind(&s.method.kind).deterministic;
     for q in &r.quantities {
         let u = q.unit.as_deref();
         let v = |x: f64| with_unit(&six_digits(x), u);

@@ -6,22 +6,24 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::args::*;
-use uq_driver::fmu::{Fmu, VariableKind};
-use uq_driver::report::csv::push_shortest;
-use uq_driver::spec::{Experiment, FixedValue, InvalidExperiment};
-use uq_driver::study::{guard, runner, size};
-use uq_driver::uq::surrogate::Surrogate;
+use crate::fmu::{Fmu, VariableKind};
+use crate::report::csv::push_shortest;
+use crate::spec::{Experiment, FixedValue, InvalidExperiment};
+use crate::study::plan::size;
+use crate::study::run::{self as runner, guard};
+use crate::uq::surrogate::Surrogate;
 
 /// The file named by `--out`, or `None` for standard output (no `--out`, or `--out -`).
 fn out_path(out: Option<&Path>) -> Option<&Path> {
-    out.filter(|p| !uq_driver::out_file::is_stdout(p))
+    out.filter(|p| !out_file::is_stdout(p))
 }
 
-/// Writes `text` to `out` (by the rules of [`uq_driver::out_file`]), or to standard output.
+/// Writes `text` to `out` (by the rules of the `out-file` crate), or to standard output.
 pub(crate) fn emit(text: &str, out: Option<&Path>) -> Result<()> {
     match out_path(out) {
-        Some(p) => uq_driver::out_file::write(p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display())),
+        Some(p) => {
+            out_file::write(p, text.as_bytes()).with_context(|| format!("writing {}", p.display()))
+        }
         None => Ok(std::io::stdout().lock().write_all(text.as_bytes())?),
     }
 }
@@ -45,7 +47,7 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
             // Written as drawn: the memory does not grow with -n.
             match out_path(out.as_deref()) {
                 Some(p) => {
-                    let mut f = uq_driver::out_file::OutFile::create(p, 1 << 16)
+                    let mut f = out_file::OutFile::create(p, 1 << 16)
                         .with_context(|| format!("writing {}", p.display()))?;
                     s.write_sample_csv(n, seed, &times, &mut f, &p.display().to_string())?;
                     f.commit()
@@ -88,14 +90,14 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     };
     size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
-    uq_driver::study::interface::check_step_sizes(&fmu, &times)?;
+    crate::study::plan::interface::check_step_sizes(&fmu, &times)?;
     let params: Vec<(String, FixedValue)> = a
         .set
         .into_iter()
         .map(|(n, v)| (n, FixedValue::Text(v)))
         .collect();
     for (name, value) in &params {
-        if let Some(w) = uq_driver::study::ranges::value_warning(&fmu, name, value) {
+        if let Some(w) = crate::study::plan::ranges::value_warning(&fmu, name, value) {
             eprintln!("uq-driver: warning: {w}");
         }
     }
@@ -132,7 +134,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     let mut text = String::from("time");
     for n in &sim.names {
         text.push(',');
-        uq_driver::report::csv::push_field(&mut text, n);
+        crate::report::csv::push_field(&mut text, n);
     }
     text.push('\n');
     for (k, t) in sim.times.iter().enumerate() {
@@ -209,7 +211,7 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
         let (start, unit) = match &v.kind {
             VariableKind::Real { start, .. } => (
                 start.map(shortest),
-                uq_driver::report::units::unit_of(md, &v.name),
+                crate::report::units::unit_of(md, &v.name),
             ),
             VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
                 (start.map(|s| s.to_string()), None)
@@ -237,7 +239,7 @@ pub(crate) fn inspect(path: &Path) -> Result<()> {
 /// A number as the CSV files write it: plain between 1e-4 and 1e16, else in exponent form
 /// (`1e300`, not 301 digits).
 fn shortest(v: f64) -> String {
-    uq_driver::report::csv::shortest(v)
+    crate::report::csv::shortest(v)
 }
 
 /// A variable's description, after its declared `min`/`max` (`range [0.5, 1]`, an open end

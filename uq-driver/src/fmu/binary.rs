@@ -5,13 +5,12 @@
 //! The pointers stay valid as long as the [`FmuLibrary`] (which owns the `Library`) is alive;
 //! instances hold it in an `Arc`, so the library is unloaded after the last instance is freed.
 
-use std::ffi::{c_char, c_int, c_uint, c_void};
+use std::ffi::{c_char, c_int, c_uint, c_void, CStr};
 use std::path::{Path, PathBuf};
 
 use libloading::Library;
 
 use super::error::FmuError;
-use super::ffi::c_string;
 use super::logger::CallbackFunctions;
 
 /// `fmi2Component`.
@@ -302,6 +301,19 @@ fn open_library(path: &Path) -> Result<Library, libloading::Error> {
     unsafe { Library::new(path) }
 }
 
+/// Copies a C string returned by the FMU, `None` if null.
+///
+/// # Safety
+/// `ptr` must be null or point to a NUL-terminated string valid for the duration of the call.
+pub(crate) unsafe fn c_string(ptr: *const c_char) -> Option<String> {
+    if ptr.is_null() {
+        return None;
+    }
+    // SAFETY: non-null, and NUL-terminated and valid per this function's contract.
+    let s = unsafe { CStr::from_ptr(ptr) };
+    Some(s.to_string_lossy().into_owned())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -323,7 +335,7 @@ mod tests {
 
     #[test]
     fn an_fmu_needing_the_python_runtime_gets_a_hint_to_preload_it() {
-        // QA round 3, I-1: a pythonfmu 0.7.0 FMU's library does not link libpython.
+        // A pythonfmu 0.7.0 FMU's library does not link libpython.
         let reason = "/tmp/x/Osc.so: undefined symbol: _Py_NoneStruct".to_owned();
         let hinted = with_load_hint(reason.clone());
         assert!(

@@ -418,7 +418,7 @@ mod tests {
         assert!(text.contains("[Error] logStatusError: step size must be positive"));
     }
 
-    /// QA3 M-2: an FMU that logs only with loggingOn gave "the FMU logged nothing" and no way
+    /// An FMU that logs only with loggingOn gave "the FMU logged nothing" and no way
     /// out; the message names --fmu-logging unless logging was on.
     #[test]
     fn an_empty_log_names_fmu_logging_when_logging_was_off() {

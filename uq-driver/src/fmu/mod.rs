@@ -27,7 +27,7 @@
 //! # Ok(()) }
 //! ```
 //!
-//! [`crate::study::runner::simulate`] does all of this for one parameter point and a time grid.
+//! [`crate::study::run::simulate`] does all of this for one parameter point and a time grid.
 //!
 //! Every `Fmu::open` extracts and loads its own copy of the binary, and
 //! [`Fmu::private_copy`] loads another copy of an opened FMU's binary, so an FMU that keeps
@@ -39,9 +39,9 @@ mod binary;
 pub mod cleanup;
 pub mod description;
 mod error;
-mod ffi;
 mod instance;
 mod logger;
+mod value;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -56,6 +56,7 @@ pub use description::{
 };
 pub use error::{FmuError, LogMessage, Status};
 pub use instance::{FmuState, Instance, InstanceState, StatusKind};
+pub use value::FixedValue;
 
 /// An opened FMU: extracted, described and loaded, ready to instantiate.
 ///

@@ -37,7 +37,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::spec::FixedValue;
+use crate::fmu::FixedValue;
 
 /// Settings of a `hunting_speed` quantity (`[[qoi]] kind = "hunting_speed"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

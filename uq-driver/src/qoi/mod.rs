@@ -6,8 +6,10 @@
 //! - [`sperling`]: the Sperling ride index of an acceleration record;
 //! - [`kde`]: Gaussian kernel density estimates.
 
+#![forbid(unsafe_code)]
+
 pub mod critical_speed;
-mod evaluate;
+pub mod evaluate;
 pub mod hunting_speed;
 pub mod kde;
 pub mod scalar;

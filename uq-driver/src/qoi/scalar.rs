@@ -8,9 +8,6 @@ use serde::{Deserialize, Serialize};
 use crate::qoi::critical_speed::CriticalSpeedError;
 use crate::qoi::hunting_speed::HuntingSpeedSpec;
 use crate::qoi::sperling::{Direction, SperlingError, Statistic, Window};
-use crate::results::QuantityDefinition;
-
-pub use super::evaluate::{evaluate, Code};
 
 /// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
 /// `kind`).
@@ -534,7 +531,7 @@ impl QoiSpec {
     /// A warning when a Sperling quantity's `direction` contradicts the description of its
     /// signal (`description` gives a variable's modelDescription description): `lateral` on
     /// a signal described as vertical (and not lateral), or the reverse. The weighting
-    /// differs (QA5 M5: W 3.33 with the lateral weighting of a vertical acceleration, silently).
+    /// differs (W 3.33 with the lateral weighting of a vertical acceleration, silently).
     pub fn direction_warning(
         &self,
         description: &dyn Fn(&str) -> Option<String>,
@@ -574,9 +571,24 @@ impl QoiSpec {
     }
 }
 
+/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct QuantityDefinition {
+    /// `kind` of the `[[qoi]]` entry.
+    pub kind: String,
+    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
+    /// `window`, `statistic`).
+    pub settings: serde_json::Map<String, serde_json::Value>,
+    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
+    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
+    /// 1 s left out`.
+    pub text: String,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::qoi::evaluate::{evaluate, Code};
 
     #[test]
     fn direction_is_typed_with_vertical_default() {
@@ -606,7 +618,7 @@ mod tests {
         assert!(r.unwrap_err().to_string().contains("unknown variant"));
     }
 
-    /// QA5 M5: `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
+    /// `direction = "lateral"` on a vertical carbody acceleration gave a lateral W
     /// without a word.
     #[test]
     fn a_lateral_sperling_on_a_vertical_signal_is_warned_about() {
@@ -739,7 +751,7 @@ mod tests {
 
     #[test]
     fn a_one_letter_signal_is_described_after_its_name_not_inside_a_word() {
-        // QA round 3, H3: the description was put after the first "a" of the sentence, the
+        // The description was put after the first "a" of the sentence, the
         // one inside "peak": "pea (Acceleration q'')k-to-peak (max − min) of a over 0.5–2 s".
         let q: QoiSpec = toml::from_str(
             "kind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\nto = 2.0",

@@ -691,7 +691,7 @@ mod tests {
 
     #[test]
     fn a_deterministic_study_is_compared_by_its_value_without_a_std_or_density() {
-        // QA round 3 (report M4): a nominal study got a "±3σ" entry, a flat Std curve on a
+        // A nominal study got a "±3σ" entry, a flat Std curve on a
         // −1…1 axis, and its W dropped out of the PDF plot, which also left out the limits.
         let d = tempfile::tempdir().unwrap();
         let p = d.path();

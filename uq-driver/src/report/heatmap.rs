@@ -6,13 +6,12 @@
 //! cells (and cells missing from a short `z`) are transparent.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
 use super::svg::{c, finite_range, legend, legend_width, Axis, Frame, LegendEntry, Series};
 
 /// Where the colorbar's label sits right of the bar's tick labels (px).
 const BAR_LABEL_GAP: f64 = 14.0;
-use super::{escape_xml, write_bytes, ReportError};
+use super::escape_xml;
 
 /// A heat map `z[ix][iy]` over `x` (horizontal, e.g. time) and `y` (vertical, e.g. the grid
 /// of a density).
@@ -156,15 +155,6 @@ impl Heatmap {
         Ok(bytes)
     }
 
-    /// Writes the PNG of [`Self::to_png`] to `path`.
-    pub fn write_png(&self, path: &Path) -> Result<(), ReportError> {
-        let bytes = self.to_png().map_err(|source| ReportError::Png {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        write_bytes(path, &bytes)
-    }
-
     /// Renders the SVG frame (axes, colorbar, overlay) around an `<image>` with `href`
     /// `png_href` (a file name relative to the SVG, or a `data:` URI).
     pub fn to_svg(&self, png_href: &str) -> String {
@@ -275,24 +265,6 @@ impl Heatmap {
             c(ly),
             escape_xml(&self.colorbar_label)
         );
-    }
-
-    /// Writes [`Self::to_svg`] referencing the PNG file `png_file_name` (relative to the SVG;
-    /// write it with [`Self::write_png`]). Opened directly in a browser the SVG shows the
-    /// image, but SVGs shown through an HTML `<img>` may not load external files: for
-    /// `index.html` use [`Self::write_svg_embedded`] (or show the PNG itself).
-    pub fn write_svg(&self, path: &Path, png_file_name: &str) -> Result<(), ReportError> {
-        write_bytes(path, self.to_svg(png_file_name).as_bytes())
-    }
-
-    /// Writes a self-contained SVG with the PNG embedded as a base64 `data:` URI; it also
-    /// displays through an HTML `<img>`.
-    pub fn write_svg_embedded(&self, path: &Path) -> Result<(), ReportError> {
-        let bytes = self.to_png().map_err(|source| ReportError::Png {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        write_bytes(path, self.to_svg(&Self::data_uri(&bytes)).as_bytes())
     }
 
     /// A `data:` URI of PNG bytes, for [`Self::to_svg`] (a self-contained SVG).
@@ -520,7 +492,6 @@ mod tests {
 
     #[test]
     fn odd_input_still_gives_a_valid_png_and_svg() {
-        let dir = tempfile::tempdir().unwrap();
         let cases = [
             Heatmap::default(),
             Heatmap {
@@ -544,9 +515,7 @@ mod tests {
             },
         ];
         for (k, map) in cases.iter().enumerate() {
-            let path = dir.path().join(format!("h{k}.png"));
-            map.write_png(&path).unwrap();
-            let (info, _) = decode(&std::fs::read(&path).unwrap());
+            let (info, _) = decode(&map.to_png().unwrap());
             assert_eq!((info.width, info.height), map.png_size());
             let svg = map.to_svg("h.png");
             assert!(svg.starts_with("<svg "), "{k}");
@@ -605,10 +574,9 @@ mod tests {
 
     #[test]
     fn embedded_svg_carries_the_png() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("e.svg");
-        gaussian_map().write_svg_embedded(&path).unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
+        // As the study report embeds it.
+        let map = gaussian_map();
+        let svg = map.to_svg(&Heatmap::data_uri(&map.to_png().unwrap()));
         assert!(svg.contains("href=\"data:image/png;base64,iVBORw0KGgo"));
     }
 

@@ -185,7 +185,7 @@ mod tests {
 
     #[test]
     fn inputs_keep_the_digits_the_study_file_wrote() {
-        // QA round 3, M5: `mean = 0.1823e6, cov = 0.1` was shown as "mean 1.82e5, std 18230"
+        // `mean = 0.1823e6, cov = 0.1` was shown as "mean 1.82e5, std 18230"
         // (a digit dropped, two notations in one row).
         let k = param(Distribution::normal(0.1823e6, 0.1 * 0.1823e6).unwrap());
         assert_eq!(written(&k), "normal, mean 182300, std 18230 (cov 0.1)");

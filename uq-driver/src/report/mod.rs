@@ -16,9 +16,11 @@
 //! Plots never fail on odd data: empty series, NaN values and zero ranges still give a valid
 //! file. Only I/O (and, for CSV, inconsistent column lengths) produce a [`ReportError`].
 
+#![forbid(unsafe_code)]
+
 pub mod compare;
 pub mod csv;
-pub mod file_name;
+pub use crate::text::file_name;
 pub mod heatmap;
 pub mod html;
 pub mod inputs;
@@ -34,9 +36,7 @@ pub use csv::{write_columns, write_grid};
 pub use heatmap::Heatmap;
 pub use html::{ReportPage, Section, Table};
 pub use study::StudyReport;
-pub use svg::{
-    histogram_density, nice_ticks, palette, Band, BarChart, BarGroup, DensityPlot, LinePlot, Series,
-};
+pub use svg::{histogram_density, palette, Band, DensityPlot, LinePlot, Series};
 
 /// Errors of the report writers.
 #[derive(Debug, thiserror::Error)]
@@ -74,9 +74,9 @@ pub enum ReportError {
 }
 
 /// Writes `bytes` to `path`, attaching the path to any I/O error; never through a symbolic
-/// link, never half-written ([`crate::out_file`]).
+/// link, never half-written (the `out-file` crate).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
-    crate::out_file::write(path, bytes).map_err(|source| ReportError::Io {
+    out_file::write(path, bytes).map_err(|source| ReportError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -217,18 +217,19 @@ mod tests {
             ],
             log_scale: false,
         };
-        map.write_png(&dir.join("q_pdf.png")).unwrap();
-        map.write_svg(&dir.join("q_pdf.svg"), "q_pdf.png").unwrap();
-        map.write_svg_embedded(&dir.join("q_pdf_embedded.svg"))
-            .unwrap();
+        let png = map.to_png().unwrap();
+        write_bytes(&dir.join("q_pdf.png"), &png).unwrap();
+        write_bytes(&dir.join("q_pdf.svg"), map.to_svg("q_pdf.png").as_bytes()).unwrap();
+        let embedded = map.to_svg(&Heatmap::data_uri(&png));
+        write_bytes(&dir.join("q_pdf_embedded.svg"), embedded.as_bytes()).unwrap();
         let log_map = Heatmap {
             log_scale: true,
             title: "PDF of q over time (log colour)".into(),
             ..map.clone()
         };
-        log_map
-            .write_svg_embedded(&dir.join("q_pdf_log.svg"))
-            .unwrap();
+        let log_png = log_map.to_png().unwrap();
+        let log_svg = log_map.to_svg(&Heatmap::data_uri(&log_png));
+        write_bytes(&dir.join("q_pdf_log.svg"), log_svg.as_bytes()).unwrap();
 
         csv::write_columns(
             &dir.join("q_stats.csv"),

@@ -508,7 +508,7 @@ mod tests {
 
     #[test]
     fn intervals_read_to_their_own_resolution() {
-        // QA round 3, M8: four fixed decimals whatever the size ("115131.0736 [...]").
+        // Four fixed decimals whatever the size ("115131.0736 [...]").
         assert_eq!(
             with_ci(115131.0736, [115090.2, 115170.9]),
             "115\u{202f}131 [115\u{202f}090, 115\u{202f}171]"

@@ -81,8 +81,8 @@ fn find<'a>(quantities: &'a [ScalarStats], name: &str) -> Option<&'a ScalarStats
 }
 
 /// A probability in the table of variants: `0.3125`, or, when no draw exceeded, the 95 %
-/// upper bound with the count, `< 0.221 (0 of 12)`, as the variant's page gives it (QA5 L2:
-/// "0.0000" from 12 runs read as certainty).
+/// upper bound with the count, `< 0.221 (0 of 12)`, as the variant's page gives it
+/// ("0.0000" from 12 runs read as certainty).
 fn probability_cell(e: &ExceedanceCount) -> String {
     if e.exceeded == 0 && e.of > 0 {
         format!("< {} (0 of {})", sig(e.upper_95), group_digits(e.of))

@@ -178,7 +178,7 @@ mod tests {
 
     #[test]
     fn units_given_through_a_declared_type_are_resolved() {
-        // QA round 3, L-3: Modelica tools give most units through TypeDefinitions (e.g. the
+        // Modelica tools give most units through TypeDefinitions (e.g. the
         // Reference FMU BouncingBall's `v` with declaredType "Velocity"); they were not shown.
         let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="M" guid="g">

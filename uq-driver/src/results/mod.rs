@@ -4,10 +4,13 @@
 //! The field names of [`Summary`] and [`SuiteSummary`] are a public interface (they are the
 //! keys of `summary.json`): add fields, rename none.
 
+#![forbid(unsafe_code)]
+
 mod nested;
 pub mod numbers;
 
-use crate::report::file_name::stem;
+pub use crate::qoi::scalar::QuantityDefinition;
+use crate::text::file_name::stem;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
@@ -24,6 +27,7 @@ use crate::uq::random_inputs::Correlation;
 
 /// Statistics of one output variable over time.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct OutputStats {
     /// Variable name.
     pub name: String,
@@ -78,6 +82,7 @@ impl OutputStats {
 
 /// Statistics of one scalar quantity of interest.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct ScalarStats {
     /// Quantity name.
     pub name: String,
@@ -235,8 +240,8 @@ pub struct ExceedanceCount {
     pub outer_samples: Option<usize>,
     /// Counted over the draws of a chaos surrogate with the limit outside the range
     /// `[smallest, largest]` of the model runs: the probability rests on the chaos's
-    /// extrapolation alone, which its truncation-error estimate does not cover (QA round 4:
-    /// P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
+    /// extrapolation alone, which its truncation-error estimate does not cover
+    /// (P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub beyond_runs: Option<[f64; 2]>,
 }
@@ -248,7 +253,7 @@ impl ExceedanceCount {
     /// over the outer samples: 0.2–0.42)`.
     ///
     /// Nested studies used to print the Clopper–Pearson interval of the pooled runs, as if
-    /// they were independent: it held the true P in 3 of 30 seeds (found by QA).
+    /// they were independent: it held the true P in 3 of 30 seeds.
     pub fn describe(&self) -> String {
         self.describe_with(&|x: f64| x.to_string())
     }
@@ -300,7 +305,7 @@ impl ExceedanceCount {
         };
         if self.ci_kind == "outer_one_sided" && self.exceeded == self.of && self.of > 0 {
             // Nested: every outer sample exceeds; an unsampled one that does not is not ruled
-            // out (`0.05^(1/outer_samples)`, found by QA, qa5/rail H2: [1, 1] from 16 tracks).
+            // out (`0.05^(1/outer_samples)`, [1, 1] from 16 tracks).
             return format!(
                 "{head}: P = {} (95 % lower bound of P{kind}: {})",
                 sig(self.p),
@@ -348,20 +353,6 @@ pub fn sig(x: f64) -> String {
     } else {
         format!("{x:.2e}")
     }
-}
-
-/// How a scalar quantity is computed from each run (`definition` in `summary.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct QuantityDefinition {
-    /// `kind` of the `[[qoi]]` entry.
-    pub kind: String,
-    /// Every setting, defaults included (e.g. the Sperling index's `signal`, `segment`,
-    /// `window`, `statistic`).
-    pub settings: serde_json::Map<String, serde_json::Value>,
-    /// The same in words, e.g. `Sperling index of Zc_acc (<the FMU's description of it>),
-    /// vertical weighting, 5 s segments, no window, the largest segment W, 0.5–40 Hz, first
-    /// 1 s left out`.
-    pub text: String,
 }
 
 /// Mean and Std of an estimate against the work spent.
@@ -479,7 +470,7 @@ impl OutputSummary {
     }
 }
 
-/// The random parameters with the mean and Std of each (QA round 4: a truncated normal's own
+/// The random parameters with the mean and Std of each (a truncated normal's own
 /// moments, which the README promised in `summary.json`, were only on the page).
 fn parameters_with_moments<S: serde::Serializer>(
     parameters: &[RandomParameter],
@@ -502,6 +493,7 @@ fn parameters_with_moments<S: serde::Serializer>(
 
 /// `summary.json` of a study.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Summary {
     /// Study name.
     pub study: String,
@@ -613,6 +605,7 @@ pub struct VariantSummary {
 
 /// `summary.json` of a suite.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct SuiteSummary {
     /// Suite name.
     pub suite: String,

@@ -113,7 +113,7 @@ pub struct ConditionalTable {
 
 /// The conditional chaos of a quantity: the union of the multi-indices of every outer
 /// sample's basis (a sparse inner chaos keeps a different basis per outer sample), in graded
-/// order (total degree, then as [`crate::uq::pce::basis::MultiIndexSet::total_degree`] lists
+/// order (total degree, then as the chaos's total-degree set lists
 /// them), and per outer sample the coefficient of each (0 for a term its basis does not
 /// keep).
 pub type ConditionalChaos = (Vec<Vec<usize>>, Vec<Vec<f64>>);

@@ -154,7 +154,7 @@ mod tests {
 
     #[test]
     fn inputs_read_as_written_in_one_notation() {
-        // QA round 3, M5: `mean = 0.1823e6, cov = 0.1` read "mean 1.82e5, std 18230".
+        // `mean = 0.1823e6, cov = 0.1` read "mean 1.82e5, std 18230".
         assert_eq!(as_written(&[0.1823e6, 0.1 * 0.1823e6]), ["182300", "18230"]);
         assert_eq!(
             as_written(&[1773000.0, 0.1 * 1773000.0]),
@@ -173,7 +173,7 @@ mod tests {
 
     #[test]
     fn statistics_to_the_resolution_of_their_spread() {
-        // QA round 3, M8: "mean 115131.073578 N", "Std 43.224931 N".
+        // "mean 115131.073578 N", "Std 43.224931 N".
         assert_eq!(to_spread(115131.073578, 43.224931), "115\u{202f}131");
         assert_eq!(to_spread(43.224931, 43.224931), "43.2");
         assert_eq!(to_spread(0.035097011, 0.0045246), "0.0351");

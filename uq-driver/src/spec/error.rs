@@ -32,6 +32,7 @@ impl std::fmt::Display for Location {
 
 /// Errors in a study file.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum StudyError {
     /// The file could not be read.
     #[error("cannot read {}", path.display())]

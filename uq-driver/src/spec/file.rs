@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 use super::parameter::ParameterSpec;
-use super::value::FixedValue;
+use crate::fmu::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::galerkin::system::SystemSpec;
 use crate::uq::method::MethodSpec;

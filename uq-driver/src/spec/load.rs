@@ -246,7 +246,7 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
     // Their files: two names must not write the same one (checked before any run).
-    crate::report::file_name::check_distinct(&names).map_err(|m| cx.invalid(None, m))?;
+    crate::text::file_name::check_distinct(&names).map_err(|m| cx.invalid(None, m))?;
     Ok(())
 }
 

@@ -32,14 +32,16 @@
 //! in one place (`load.rs`) into a [`Study`]. Errors carry the origin and, where the
 //! file has them, the line and column.
 
+#![forbid(unsafe_code)]
+
 mod builtins;
 mod error;
 mod file;
 mod load;
 mod parameter;
 mod study;
-mod value;
 
+pub use crate::fmu::FixedValue;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{
@@ -49,7 +51,6 @@ pub use file::{
 pub use load::{fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};
 pub use study::{Study, Suite};
-pub use value::FixedValue;
 
 #[cfg(test)]
 mod tests;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use super::error::StudyError;
 use super::file::{Analysis, Experiment, PaperValue};
-use super::value::FixedValue;
+use crate::fmu::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;

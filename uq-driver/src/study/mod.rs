@@ -4,37 +4,31 @@
 //! [`run_study`] is the whole pipeline: study → the method's design → runs (parallel,
 //! resumable) → the method's estimates → statistics → report. An intrusive method solves its
 //! own system instead of running an FMU. A suite (a study with `[[variants]]`) runs each
-//! variant into a sub-folder and then writes a comparison ([`suite`]).
+//! variant into a sub-folder and then writes a comparison.
 
-pub mod analysis;
-mod batch;
-mod crash;
-pub mod export;
-mod fingerprint;
-pub mod guard;
-pub mod inputs;
-pub mod instances;
-pub mod interface;
-pub mod isolate;
-pub mod lock;
-pub mod nested;
+#![forbid(unsafe_code)]
+
+pub(crate) mod analysis;
 mod outcome;
-mod point;
-pub mod progress;
-pub mod ranges;
-pub mod runner;
-pub mod shard;
+pub(crate) mod plan;
+pub(crate) mod progress;
+pub(crate) mod run;
+pub(crate) mod shard;
 mod single;
-pub mod size;
-pub mod speed_runs;
-pub mod store;
-pub mod suite;
-mod worker_fmu;
+pub(crate) mod store;
+pub(crate) mod suite;
 
 use std::path::Path;
 
+pub use analysis::AnalysisError;
 pub use outcome::{Outcome, StudyResult, StudyRunError, SuiteResult};
-pub use runner::{RunError, RunOptions, RunOutcome};
+pub use plan::interface::{InterfaceError, VariableProblem};
+pub use plan::size::SizeError;
+pub use progress::{set_message_sink, Sink};
+pub use run::guard::install_process_guards;
+pub use run::{simulate, simulate_with, FailedPoint, PointError, RunError, RunOptions, Simulation};
+pub use store::lock::LockError;
+pub use store::StoreError;
 
 use crate::spec::Study;
 
@@ -43,7 +37,7 @@ use crate::spec::Study;
 ///
 /// Nothing is allocated, run or written (`out_dir` is not even created) before the study
 /// passes [`Study::check`] (the fields of a [`Study`] are public: they are checked again) and
-/// [`size::check`]: too large to run, it is refused; large, it needs `opts.yes`. An empty
+/// the size check: too large to run, it is refused; large, it needs `opts.yes`. An empty
 /// `out_dir` is refused ([`RunError::NoOutDir`]), as are options that do not fit together
 /// ([`RunError::Options`]).
 pub fn run_study(
@@ -56,8 +50,8 @@ pub fn run_study(
         return Err(RunError::NoOutDir.into());
     }
     opts.check()?;
-    size::check(study, out_dir, opts)?;
-    runner::prepare_out_dir(out_dir)?;
+    plan::size::check(study, out_dir, opts)?;
+    run::prepare_out_dir(out_dir)?;
     match &study.suite {
         Some(s) => suite::run(study, s, out_dir, opts).map(Outcome::Suite),
         None => single::run_single(study, out_dir, opts).map(|r| Outcome::Study(Box::new(r))),

@@ -1,14 +1,15 @@
 //! What running a study returns, and how it fails.
 
-use super::analysis::AnalysisError;
-use super::runner::RunError;
-use super::size::SizeError;
 use crate::report::ReportError;
 use crate::results::{OutputStats, ScalarStats, SuiteSummary, Summary};
+use crate::study::analysis::AnalysisError;
+use crate::study::plan::size::SizeError;
+use crate::study::run::RunError;
 use crate::uq::method::MethodError;
 
 /// Errors of a whole study run.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum StudyRunError {
     /// The study is not valid (its public fields were changed after [`Study::parse`]).
     ///
@@ -45,6 +46,7 @@ pub enum StudyRunError {
 
 /// What a finished study returns.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct StudyResult {
     /// The summary written to `summary.json`.
     pub summary: Summary,
@@ -59,6 +61,7 @@ pub struct StudyResult {
 
 /// What a finished suite returns.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct SuiteResult {
     /// The summary written to the suite's `summary.json`.
     pub summary: SuiteSummary,
@@ -68,6 +71,7 @@ pub struct SuiteResult {
 
 /// A study's or a suite's result.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub enum Outcome {
     /// One study.
     Study(Box<StudyResult>),

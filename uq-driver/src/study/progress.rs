@@ -10,11 +10,11 @@ use std::time::{Duration, Instant};
 
 /// Where the library's messages to the user go (notes and warnings printed as a study runs:
 /// "taking over a stale lock", "N points failed in an earlier run", a variant starting, …).
-type Sink = Box<dyn Fn(&str) + Send + Sync>;
+pub type Sink = Box<dyn Fn(&str) + Send + Sync>;
 static MESSAGES: RwLock<Option<Sink>> = RwLock::new(None);
 
 /// Sends the library's messages to `sink` (None: nowhere, the default). The command line
-/// prints them on stderr ([`print_messages`]); a host can log them, show them or drop them.
+/// prints them on stderr (`print_messages`); a host can log them, show them or drop them.
 /// Warnings that matter for the results are in `summary.warnings` as well.
 pub fn set_message_sink(sink: Option<Sink>) {
     *MESSAGES.write().unwrap_or_else(|e| e.into_inner()) = sink;
@@ -42,18 +42,6 @@ pub enum ProgressMode {
     Bar,
     /// A line now and then (a log file).
     Lines,
-}
-
-impl ProgressMode {
-    /// A bar when standard error is a terminal, else lines.
-    pub fn auto() -> ProgressMode {
-        use std::io::IsTerminal;
-        if std::io::stderr().is_terminal() {
-            ProgressMode::Bar
-        } else {
-            ProgressMode::Lines
-        }
-    }
 }
 
 /// Progress over `total` points.
@@ -201,7 +189,7 @@ mod tests {
         assert!(Progress::new(ProgressMode::Off, 10).lines.is_none());
     }
 
-    /// QA qa4/lib M1: library code printed notes to stderr unasked; they now go to the sink a
+    /// Library code printed notes to stderr unasked; they now go to the sink a
     /// host sets (the CLI: stderr), nowhere by default.
     #[test]
     fn library_messages_go_to_the_sink_that_is_set_and_nowhere_by_default() {

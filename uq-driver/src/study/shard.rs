@@ -17,13 +17,15 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::lock::FolderLock;
-use super::outcome::{StudyResult, StudyRunError};
-use super::ranges;
-use super::runner::{self, RunError, RunOptions, RunOutcome};
-use super::single::{finish, open_fmu};
-use super::store::{Manifest, Store, StoreError, StoredRuns};
 use crate::spec::Study;
+use crate::study::outcome::{StudyResult, StudyRunError};
+use crate::study::plan::fingerprint;
+use crate::study::plan::ranges;
+use crate::study::run::open_fmu;
+use crate::study::run::{self, RunError, RunOptions, RunOutcome};
+use crate::study::single::finish;
+use crate::study::store::lock::FolderLock;
+use crate::study::store::{Manifest, Store, StoreError, StoredRuns};
 use crate::uq::method::{Design, Evaluation, Sampling};
 
 /// Version of the plan layout.
@@ -136,9 +138,9 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     let fmu = open_fmu(&study)?;
     ranges::check_supports(&study, &fmu).map_err(RunError::from)?;
     for w in ranges::range_warnings(&study, &fmu, &design) {
-        super::progress::message(&format!("uq-driver: warning: {w}"));
+        crate::study::progress::message(&format!("uq-driver: warning: {w}"));
     }
-    let manifest = runner::manifest(&study, &fmu, &design)?;
+    let manifest = fingerprint::manifest(&study, &fmu, &design)?;
     let p = Plan {
         version: PLAN_VERSION,
         driver_version: env!("CARGO_PKG_VERSION").into(),
@@ -163,7 +165,7 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
             )));
         }
     }
-    crate::out_file::write(
+    out_file::write(
         &path,
         serde_json::to_string_pretty(&p).expect("json").as_bytes(),
     )
@@ -171,19 +173,19 @@ pub fn plan(study: &Study, shards: usize, dir: &Path) -> Result<Plan, ShardError
     let mut csv = String::from("index,shard");
     for par in &study.parameters {
         csv.push(',');
-        crate::report::csv::push_field(&mut csv, &par.name);
+        crate::text::csv::push_field(&mut csv, &par.name);
     }
     csv.push('\n');
     for (i, vals) in design.values.iter().enumerate() {
         csv.push_str(&format!("{i},{}", i % shards));
         for v in vals {
             csv.push(',');
-            crate::report::csv::push_shortest(&mut csv, *v);
+            crate::text::csv::push_shortest(&mut csv, *v);
         }
         csv.push('\n');
     }
     let dpath = dir.join("design.csv");
-    crate::out_file::write(&dpath, csv.as_bytes()).map_err(io(&dpath))?;
+    out_file::write(&dpath, csv.as_bytes()).map_err(io(&dpath))?;
     Ok(p)
 }
 
@@ -225,7 +227,7 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
     let study = plan_study(&p)?;
     let fmu = open_fmu(&study)?;
     let design = design(&study)?;
-    let now = runner::manifest(&study, &fmu, &design)?;
+    let now = fingerprint::manifest(&study, &fmu, &design)?;
     if now != p.manifest {
         return Err(ShardError::Shard(format!(
             "{}: the FMU or the study changed since the plan was written (SHA-256 now {}, planned {})",
@@ -239,8 +241,8 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
         ..opts.clone()
     };
     let sdir = dir.join("shards").join(k.to_string());
-    let outcome = runner::run_points(&study, &fmu, &design, &sdir, &opts)?;
-    runner::check_failures(
+    let outcome = run::run_points(&study, &fmu, &design, &sdir, &opts)?;
+    run::check_failures(
         &study,
         &design,
         outcome.runs.entries(),
@@ -259,7 +261,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     let design = design(&study)?;
     let n = design.len();
     // The analysis's memory, checked as `run` checks it (refused, or large: `--yes`).
-    super::size::check_runs(&study, n, opts).map_err(StudyRunError::from)?;
+    crate::study::plan::size::check_runs(&study, n, opts).map_err(StudyRunError::from)?;
     // Each shard's results, read in place: the merge holds no series in memory.
     let mut shard_runs: Vec<Option<StoredRuns>> = Vec::new();
     let mut owner: Vec<Option<usize>> = vec![None; n];
@@ -320,7 +322,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
         )));
     }
     // The merged store makes `out` look like (and resume like) a single-machine run.
-    runner::prepare_out_dir(out).map_err(StudyRunError::Run)?;
+    run::prepare_out_dir(out).map_err(StudyRunError::Run)?;
     let lock = FolderLock::acquire(out).map_err(|e| StudyRunError::Run(e.into()))?;
     let (store, mut runs) = Store::open_in_place(out, &p.manifest, true).map_err(RunError::from)?;
     for (i, k) in owner.iter().enumerate() {
@@ -335,7 +337,7 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     drop(shard_runs);
     let outcome = RunOutcome {
         runs,
-        lock: Some(lock),
+        _lock: Some(lock),
         n_new: 0,
         n_resumed: n,
         wall_time: 0.0,
@@ -372,7 +374,7 @@ pub fn write_sbatch(
     o: &SlurmOptions,
 ) -> Result<(PathBuf, PathBuf), ShardError> {
     let sdir = dir.join("slurm");
-    crate::out_file::sub_folder(&sdir).map_err(io(&sdir))?;
+    out_file::sub_folder(&sdir).map_err(io(&sdir))?;
     let dir = std::fs::canonicalize(dir).map_err(io(dir))?;
     if dir.to_string_lossy().contains(char::is_whitespace) {
         // #SBATCH lines are not parsed by a shell: a path with blanks cannot be written there.
@@ -414,8 +416,8 @@ pub fn write_sbatch(
         no_report = if o.no_report { " --no-report" } else { "" },
     );
     let (a, b) = (sdir.join("shard.sbatch"), sdir.join("merge.sbatch"));
-    crate::out_file::write(&a, shard.as_bytes()).map_err(io(&a))?;
-    crate::out_file::write(&b, merge.as_bytes()).map_err(io(&b))?;
+    out_file::write(&a, shard.as_bytes()).map_err(io(&a))?;
+    out_file::write(&b, merge.as_bytes()).map_err(io(&b))?;
     Ok((a, b))
 }
 
@@ -425,7 +427,7 @@ mod tests {
 
     #[test]
     fn the_array_job_runs_its_shards_with_the_options_given_to_slurm() {
-        // QA round 3: `slurm --isolate` (or --fresh-instances, --fmu-logging) planned shards
+        // `slurm --isolate` (or --fresh-instances, --fmu-logging) planned shards
         // that ran without them.
         let d = tempfile::tempdir().unwrap();
         let o = SlurmOptions {

@@ -5,13 +5,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use super::analysis::{self, Analysed, AnalysisError};
-use super::outcome::{StudyResult, StudyRunError};
-use super::progress;
-use super::ranges;
-use super::runner::{self, RunError, RunOptions, RunOutcome};
-use super::size;
-use super::store::{Entry, StoredRuns};
 use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
@@ -20,9 +13,16 @@ use crate::results::{
     ScalarStats, Summary, Timing, Versions,
 };
 use crate::spec::Study;
+use crate::study::analysis::{self, Analysed, AnalysisError};
+use crate::study::outcome::{StudyResult, StudyRunError};
+use crate::study::plan::ranges;
+use crate::study::plan::size;
+use crate::study::progress;
+use crate::study::run::{self, RunError, RunOptions, RunOutcome};
+use crate::study::store::{Entry, StoredRuns};
 use crate::uq::distributions::{Distribution, Germ};
 use crate::uq::method::{
-    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSpec, MethodSummary, Sampling,
+    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSummary, Sampling,
 };
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
@@ -40,7 +40,7 @@ pub(crate) fn run_single(
     match study.method().evaluation() {
         Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
         Evaluation::Sampling(method) => {
-            let fmu = open_fmu(study)?;
+            let fmu = run::open_fmu(study)?;
             ranges::check_supports(study, &fmu).map_err(RunError::from)?;
             let design = method.design(&study.random_inputs(), study.seed)?;
             if method.planned_runs_for(&study.parameters).is_none() {
@@ -60,7 +60,7 @@ pub(crate) fn run_single(
             for w in &early {
                 progress::message(&format!("uq-driver: warning: {w}"));
             }
-            let outcome = runner::run_points(study, &fmu, &design, out_dir, opts)?;
+            let outcome = run::run_points(study, &fmu, &design, out_dir, opts)?;
             let noted = outcome.warnings.len();
             let mut result = finish(study, method, &fmu, &design, outcome, out_dir, opts)?;
             // finish puts the same range warnings first in the summary's list, then those the
@@ -69,12 +69,6 @@ pub(crate) fn run_single(
             Ok(result)
         }
     }
-}
-
-/// Opens the study's FMU.
-pub(crate) fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
-    let path = study.fmu_path.as_deref().unwrap_or(Path::new(""));
-    Ok(Fmu::open(path)?)
 }
 
 /// Facts of a run for the summary.
@@ -149,7 +143,7 @@ pub(crate) fn finish(
 ) -> Result<StudyResult, StudyRunError> {
     let entries = outcome.runs.entries();
     let done = entries.iter().filter(|r| r.is_some()).count();
-    let failed = runner::check_failures(
+    let failed = run::check_failures(
         study,
         design,
         entries,
@@ -241,22 +235,21 @@ fn analyse(
     records: &StoredRuns,
     units: &BTreeMap<String, String>,
 ) -> Result<(Analysed, Vec<OutputSplit>, Vec<String>), AnalysisError> {
-    Ok(match &study.method {
-        MethodSpec::Nested(nested) => {
-            let n = super::nested::analyse(study, nested, design, records)?;
+    Ok(match study.method.nested() {
+        Some(nested) => {
+            let n = crate::study::analysis::nested::analyse(study, nested, design, records)?;
             (n.analysed, n.splits, n.warnings)
         }
-        _ => {
+        None => {
             let analysed = analysis::analyse_runs(study, method, design, records)?;
             // Inputs with an Askey family of their own that the design maps through the normal.
             let askey_hint =
                 design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);
             let mut warnings = analysis::chaos_gap_warnings(&analysed, askey_hint, units);
-            let no_estimate = matches!(study.method, MethodSpec::SparseGrid(_)).then_some(
-                "a sparse grid has one only at a level above 0 with nested rules; Beta and \
-                 Gamma inputs, and the gauss_* rules, are not nested",
-            );
-            warnings.extend(analysis::chaos_error_warnings(&analysed, no_estimate));
+            warnings.extend(analysis::chaos_error_warnings(
+                &analysed,
+                method.no_error_estimate(),
+            ));
             warnings.extend(correlated_sobol_warning(study, &analysed));
             warnings.extend(correlated_chaos_warning(study, &analysed));
             (analysed, Vec::new(), warnings)
@@ -266,7 +259,7 @@ fn analyse(
 
 /// With correlated inputs the Sobol' indices are those of the independent germs in study
 /// order (the Cholesky factor of the copula): the index of a parameter counts only its part
-/// independent of the parameters listed before it, so it changes with their order (QA: S of
+/// independent of the parameters listed before it, so it changes with their order (S of
 /// one input was 0.0006 in file order and 0.116 listed first). Said where indices are given.
 fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
     let correlated = study.correlation.is_some();
@@ -288,7 +281,7 @@ fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
 /// A chaos of correlated inputs that are not all normal expands the model composed with the
 /// Gaussian copula's map (each input `F⁻¹(Φ(·))` of a mix of germs), which can be far from a
 /// polynomial although the model is smooth; its own error estimate then understates its
-/// error (QA round 4: a lognormal and a gamma input at ρ = −0.5, LARS on 400 runs: Std +7.7 %
+/// error (a lognormal and a gamma input at ρ = −0.5, LARS on 400 runs: Std +7.7 %
 /// with a leave-one-out error of 0.55 %). Said where a chaos gives the statistics.
 fn correlated_chaos_warning(study: &Study, a: &Analysed) -> Option<String> {
     let correlation = study.correlation.as_ref()?;
@@ -423,7 +416,7 @@ fn write_surrogate(
 /// The design with the status of each point.
 /// `error`, after writing `points.csv` (every point's status and message) when points failed:
 /// a study that stops on its failures, or has too few successful runs to analyse, still says
-/// what happened to each point (QA round 3, L-2: before, only the store held the messages).
+/// what happened to each point (before, only the store held the messages).
 fn with_points_csv(
     study: &Study,
     design: &Design,

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use super::outcome::{StudyResult, StudyRunError, SuiteResult};
-use super::runner::RunOptions;
-use super::single::run_single;
 use crate::report::{self, suite::VariantResults};
 use crate::results::{SuiteSummary, VariantOutput, VariantSummary};
 use crate::spec::{Study, Suite};
+use crate::study::outcome::{StudyResult, StudyRunError, SuiteResult};
+use crate::study::run::RunOptions;
+use crate::study::single::run_single;
 
 /// Largest |a − b| over paired entries.
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
@@ -28,14 +28,14 @@ pub fn run(
 ) -> Result<SuiteResult, StudyRunError> {
     let mut results = Vec::new();
     for v in &suite.variants {
-        super::progress::message(&format!(
+        crate::study::progress::message(&format!(
             "{}: variant {} ({}) …",
             study.name,
             v.name,
             v.method().label(v.parameters.len())
         ));
         let folder = out_dir.join(&v.name);
-        crate::out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
+        out_file::sub_folder(&folder).map_err(|source| report::ReportError::Io {
             path: folder.clone(),
             source,
         })?;

@@ -5,10 +5,6 @@
 //! time step is contiguous. Per-column results are returned in column order.
 
 use nalgebra::DMatrix;
-use serde::{Deserialize, Serialize};
-
-/// Probabilities reported by [`ScalarSummary::from_samples`].
-pub const DEFAULT_QUANTILES: [f64; 7] = [0.01, 0.05, 0.25, 0.5, 0.75, 0.95, 0.99];
 
 /// Mean and unbiased (`M - 1`) standard deviation of `xs` by the corrected
 /// two-pass algorithm. `(NaN, NaN)` when empty; std NaN for one sample.
@@ -88,68 +84,6 @@ pub fn quantile(sorted: &[f64], p: f64) -> f64 {
     }
 }
 
-/// Sorted copy (NaN last, by `f64::total_cmp`).
-fn sorted_copy(xs: &[f64]) -> Vec<f64> {
-    let mut v = xs.to_vec();
-    v.sort_by(f64::total_cmp);
-    v
-}
-
-/// Type-7 quantiles of every column: `result[col][k]` is the quantile of
-/// probability `ps[k]` of column `col`.
-pub fn column_quantiles(values: &DMatrix<f64>, ps: &[f64]) -> Vec<Vec<f64>> {
-    values
-        .column_iter()
-        .map(|c| {
-            let s = sorted_copy(c.as_slice());
-            ps.iter().map(|&p| quantile(&s, p)).collect()
-        })
-        .collect()
-}
-
-/// Summary statistics of a scalar quantity of interest.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ScalarSummary {
-    /// Number of samples.
-    pub n: usize,
-    /// Sample mean.
-    pub mean: f64,
-    /// Unbiased sample standard deviation (NaN for fewer than 2 samples).
-    pub std: f64,
-    /// Standard error of the mean, `std / sqrt(n)`.
-    pub std_error_mean: f64,
-    /// Smallest sample.
-    pub min: f64,
-    /// Largest sample.
-    pub max: f64,
-    /// `(p, quantile)` pairs (type 7).
-    pub quantiles: Vec<(f64, f64)>,
-}
-
-impl ScalarSummary {
-    /// Summary with the quantiles of [`DEFAULT_QUANTILES`]. Values are NaN
-    /// for an empty sample.
-    pub fn from_samples(samples: &[f64]) -> Self {
-        Self::from_samples_with_quantiles(samples, &DEFAULT_QUANTILES)
-    }
-
-    /// Summary with the quantiles of the probabilities `ps`.
-    pub fn from_samples_with_quantiles(samples: &[f64], ps: &[f64]) -> Self {
-        let (mean, std) = mean_std(samples);
-        let sorted = sorted_copy(samples);
-        let n = samples.len();
-        ScalarSummary {
-            n,
-            mean,
-            std,
-            std_error_mean: std / (n as f64).sqrt(),
-            min: sorted.first().copied().unwrap_or(f64::NAN),
-            max: sorted.last().copied().unwrap_or(f64::NAN),
-            quantiles: ps.iter().map(|&p| (p, quantile(&sorted, p))).collect(),
-        }
-    }
-}
-
 /// Fraction of samples strictly above `limit` and its binomial standard
 /// error `sqrt(p (1 - p) / n)`. `(NaN, NaN)` for no samples. Note that the
 /// standard error is 0 when no sample exceeds: then `p < 3/n` at 95 %
@@ -211,7 +145,6 @@ mod tests {
         assert!(std.iter().all(|s| s.is_nan()));
         let (mean, _) = sample_mean_std(&DMatrix::zeros(0, 2));
         assert!(mean.iter().all(|m| m.is_nan()));
-        assert!(column_quantiles(&DMatrix::zeros(0, 1), &[0.5])[0][0].is_nan());
     }
 
     #[test]
@@ -242,29 +175,6 @@ mod tests {
         assert!(quantile(&[], 0.5).is_nan());
         assert!(quantile(&s, 1.5).is_nan());
         assert!(quantile(&s, f64::NAN).is_nan());
-        let m = DMatrix::from_fn(5, 2, |r, c| if c == 0 { 5.0 - r as f64 } else { r as f64 });
-        let q = column_quantiles(&m, &[0.1, 0.5]);
-        assert_eq!(q.len(), 2);
-        assert!((q[0][0] - 1.4).abs() < 1e-15 && q[0][1] == 3.0);
-        assert!((q[1][0] - 0.4).abs() < 1e-15 && q[1][1] == 2.0);
-    }
-
-    #[test]
-    fn scalar_summary() {
-        let xs: Vec<f64> = (1..=101).map(f64::from).collect();
-        let s = ScalarSummary::from_samples(&xs);
-        assert_eq!(s.n, 101);
-        assert_eq!(s.mean, 51.0);
-        assert_eq!(s.min, 1.0);
-        assert_eq!(s.max, 101.0);
-        assert!((s.std_error_mean - s.std / 101f64.sqrt()).abs() < 1e-15);
-        assert_eq!(s.quantiles[3], (0.5, 51.0));
-        assert_eq!(s.quantiles[0], (0.01, 2.0));
-        let json = serde_json::to_string(&s).unwrap();
-        assert!(json.contains("\"std_error_mean\""));
-        let e = ScalarSummary::from_samples(&[]);
-        assert_eq!(e.n, 0);
-        assert!(e.mean.is_nan() && e.min.is_nan());
     }
 
     #[test]

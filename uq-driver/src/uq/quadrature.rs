@@ -245,18 +245,6 @@ pub struct TensorGrid {
     pub weights: Vec<f64>,
 }
 
-impl TensorGrid {
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.points.len()
-    }
-
-    /// Whether the grid has no points.
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-}
-
 /// Tensor product of probabilists' Gauss–Hermite rules with
 /// `nodes_per_dim[j]` nodes in dimension `j` (see [`TensorGrid`] for the
 /// order of the points). Exact for products of polynomials of degree up to
@@ -504,7 +492,7 @@ mod tests {
     fn tensor_grid_order_last_dimension_fastest() {
         let g = tensor_grid(&[2, 3]).unwrap();
         let (x3, w3) = gauss_hermite(3).unwrap();
-        assert_eq!(g.len(), 6);
+        assert_eq!(g.points.len(), 6);
         let expected = [
             [-1.0, x3[0]],
             [-1.0, x3[1]],

@@ -13,7 +13,7 @@ use std::path::Path;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use crate::report::csv::{push_shortest, shortest};
+use crate::text::csv::{push_shortest, shortest};
 use crate::uq::distributions::{Distribution, Germ, RandomParameter};
 use crate::uq::method::ChaosError;
 use crate::uq::pce::{germ_draw, germ_draws, Basis, Family, MultiIndexSet, Pce};
@@ -485,14 +485,14 @@ impl Surrogate {
 
     /// `eval` as CSV: `name,time,value`, one row per output and time, then one per quantity
     /// (empty time). Numbers as every CSV of the driver writes them
-    /// ([`crate::report::csv::push_shortest`]).
+    /// (the shortest round-trip form of every CSV of the driver).
     pub fn eval_csv(&self, x: &[f64]) -> String {
         let v = self.eval(x);
         let mut text = String::from("name,time,value\n");
         for (o, vals) in self.file.outputs.iter().zip(&v.outputs) {
             let times = o.times.as_deref().unwrap_or(&[]);
             for (t, y) in times.iter().zip(vals) {
-                crate::report::csv::push_field(&mut text, &o.name);
+                crate::text::csv::push_field(&mut text, &o.name);
                 text.push(',');
                 push_shortest(&mut text, *t);
                 text.push(',');
@@ -501,7 +501,7 @@ impl Surrogate {
             }
         }
         for (q, y) in self.file.quantities.iter().zip(&v.quantities) {
-            crate::report::csv::push_field(&mut text, &q.name);
+            crate::text::csv::push_field(&mut text, &q.name);
             text.push_str(",,");
             push_shortest(&mut text, *y);
             text.push('\n');
@@ -590,7 +590,7 @@ impl Surrogate {
         header.extend(picks.iter().map(|p| p.2.clone()));
         let mut text = String::new();
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
-        crate::report::csv::push_header(&mut text, &header);
+        crate::text::csv::push_header(&mut text, &header);
         let families: Vec<Family> = self.file.inputs.iter().map(|i| i.family).collect();
         let laws: Vec<_> = families.iter().map(Family::law).collect();
         let mut t = vec![0.0; families.len()];
@@ -629,7 +629,7 @@ impl Surrogate {
     }
 
     /// `n` random points of the inputs' joint law with the surrogate's values there: point
-    /// `i` comes from the stream `(seed, i)` only ([`germ_draws`]).
+    /// `i` comes from the stream `(seed, i)` only (`germ_draws`).
     pub fn sample(&self, n: usize, seed: u64) -> Vec<(Vec<f64>, SurrogateValues)> {
         let families: Vec<Family> = self.file.inputs.iter().map(|i| i.family).collect();
         germ_draws(&families, n, seed)

@@ -1,8 +1,6 @@
 //! Analytic UQ benchmarks and their references, written independently of the code under
 //! test (closed forms, or tensor Gauss quadratures whose nodes are computed here by
 //! Golub–Welsch): the Ishigami function, the borehole function, the Sobol' g-function.
-//! Include with `#[path = "support/benchmarks.rs"] mod benchmarks;`.
-#![allow(dead_code)] // each test crate uses a part of it
 
 use std::f64::consts::PI;
 

@@ -1,4 +1,4 @@
-//! The check of a refusal shared by the size tests.
+//! The check of a refusal (of a study too large, a grid too fine, ...).
 
 use std::process::Output;
 

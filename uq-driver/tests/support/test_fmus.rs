@@ -1,24 +1,20 @@
-//! The C test FMUs of `uq-driver/tests/fmus/` (Functions, Features; see the README there), built
-//! for Rust integration tests. Include it in a test crate with
+//! The C test FMUs of `uq-driver/tests/fmus/` (Functions, Features, Once; see the README there),
+//! built for the Rust integration tests:
 //!
 //! ```ignore
-//! #[path = "support/test_fmus.rs"]
-//! mod test_fmus;
-//!
 //! let Some(fmu) = test_fmus::test_fmu("Functions") else { return }; // printed SKIPPED
 //! ```
 //!
 //! Each folder of `tests/fmus/` with a `modelDescription.xml` is one FMU: its `*.c` files and
 //! `common/*.c` are compiled with `$CC` (default `cc`) against the FMI 2.0 headers that fmpy ships
-//! (`$FMI2_HEADERS`, else `../.venv/lib/python3*/site-packages/fmpy/c-code`, as `fmu_import.rs`
-//! finds them), and packed with the zip crate as `<CARGO_TARGET_TMPDIR>/test-fmus/<modelName>.fmu`
+//! (`$FMI2_HEADERS`, else `../.venv/lib/python3*/site-packages/fmpy/c-code`), and packed with the
+//! zip crate as `<CARGO_TARGET_TMPDIR>/test-fmus/<modelName>.fmu`
 //! (`binaries/linux64/<modelIdentifier>.so`, `resources/`), the same way as
-//! `tests/fmus/build.py` does for pytest. Built once per test binary; files are written under a
-//! private name and renamed, so concurrent test binaries never see a partial file.
+//! `tests/fmus/build.py` does for pytest. Built once per test process; files are written under a
+//! private name and renamed, so concurrent test processes never see a partial file.
 //!
 //! Without a compiler or headers, `test_fmu` prints why and returns `None`, unless `CI` is set:
 //! then it panics.
-#![allow(dead_code)] // each test crate uses a part of it
 
 use std::collections::BTreeMap;
 use std::fs;
@@ -65,13 +61,19 @@ pub fn test_fmu(model_name: &str) -> Option<PathBuf> {
 /// Every test FMU by model name, or `None` as for [`test_fmu`].
 pub fn built() -> Option<&'static BTreeMap<String, PathBuf>> {
     static BUILT: OnceLock<Result<BTreeMap<String, PathBuf>, String>> = OnceLock::new();
-    match BUILT.get_or_init(build_all) {
+    available("C test FMUs", BUILT.get_or_init(build_all))
+}
+
+/// What was built (`what`, for the messages), or `None` with the reason printed when it could
+/// not be built outside CI; under CI (`CI` set) that is a failure.
+pub fn available<T>(what: &str, built: &'static Result<T, String>) -> Option<&'static T> {
+    match built {
         Ok(built) => Some(built),
         Err(reason) if std::env::var_os("CI").is_some() => {
-            panic!("the C test FMUs are required in CI: {reason}")
+            panic!("the {what} could not be built, and CI requires them: {reason}")
         }
         Err(reason) => {
-            eprintln!("SKIPPED (C test FMUs unavailable): {reason}");
+            eprintln!("SKIPPED ({what} unavailable): {reason}");
             None
         }
     }

@@ -1,58 +1,27 @@
 //! The wheel of the paper's §3 (m q'' + c q' + k q = 0, m = 10, q(0) = 0.1, K ~ N(100, 10²),
 //! C ~ N(20, 2²)) solved independently of the code under test: the closed-form response
 //! integrated over (K, C) on a 40 × 40 Gauss–Hermite grid whose nodes are computed here
-//! (Golub–Welsch). Include it with
-//!
-//! ```ignore
-//! #[path = "support/wheel.rs"]
-//! mod wheel;
-//! ```
-#![allow(dead_code)] // each test crate uses a part of it
+//! (Golub–Welsch, `benchmarks.rs`).
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{DMatrix, SymmetricEigen};
-
-/// The FMU folder: `$RAILUQ_FMU_DIR`, else `target/fmu`.
-pub fn fmu_dir() -> PathBuf {
-    std::env::var_os("RAILUQ_FMU_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
-}
+use super::benchmarks::gauss_hermite;
+use super::csv::Csv;
 
 /// `Wheel.fmu` (panics with a hint when it has not been built).
 pub fn wheel_fmu() -> PathBuf {
-    let p = fmu_dir().join("Wheel.fmu");
-    assert!(
-        p.is_file(),
-        "{} is missing: run `make fmu` first",
-        p.display()
-    );
-    p
+    super::built_fmu("Wheel")
 }
 
 /// The wheel's time grid in the paper: 0–5 s, step 0.01 s.
 pub const EXPERIMENT: &str = "start = 0.0\nstop = 5.0\nstep = 0.01";
 
-/// A study of the wheel (K ~ N(100, 10²), C ~ N(20, 2²) written as `cov = 0.1`, output `q`)
-/// with the `[experiment]` keys `experiment`, the `[method]` keys `method` and `extra` at the
-/// end, written to `DIR/<file>.toml`.
-pub fn write_study(
-    dir: &Path,
-    file: &str,
-    name: &str,
-    seed: u64,
-    experiment: &str,
-    method: &str,
-    extra: &str,
-) -> PathBuf {
-    let text = format!(
-        r#"name = "{name}"
-fmu = "{fmu}"
-seed = {seed}
-[experiment]
-{experiment}
-[method]
+/// The text of a study of the wheel (K ~ N(100, 10²), C ~ N(20, 2²) written as `cov = 0.1`,
+/// output `q`) with the `[experiment]` keys `experiment`, the `[method]` keys `method` and
+/// `extra` at the end.
+pub fn study_text(name: &str, seed: u64, experiment: &str, method: &str, extra: &str) -> String {
+    format!(
+        r#"{head}[method]
 {method}
 [[parameters]]
 name = "K"
@@ -66,31 +35,24 @@ cov = 0.1
 variables = ["q"]
 {extra}
 "#,
-        fmu = wheel_fmu().display()
-    );
-    let p = dir.join(format!("{file}.toml"));
-    std::fs::write(&p, text).unwrap();
-    p
+        head = super::study_head(name, &wheel_fmu(), seed, experiment)
+    )
 }
 
-/// Probabilists' Gauss–Hermite rule by Golub–Welsch (weights normalised to 1).
-pub fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let j = DMatrix::from_fn(n, n, |i, k| {
-        if k == i + 1 || i == k + 1 {
-            (i.max(k) as f64).sqrt()
-        } else {
-            0.0
-        }
-    });
-    let e = SymmetricEigen::new(j);
-    let mut pairs: Vec<(f64, f64)> = (0..n)
-        .map(|i| (e.eigenvalues[i], e.eigenvectors[(0, i)].powi(2)))
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let s: f64 = pairs.iter().map(|p| p.1).sum();
-    (
-        pairs.iter().map(|p| p.0).collect(),
-        pairs.iter().map(|p| p.1 / s).collect(),
+/// [`study_text`] written to `DIR/<file>.toml`.
+pub fn write_study(
+    dir: &Path,
+    file: &str,
+    name: &str,
+    seed: u64,
+    experiment: &str,
+    method: &str,
+    extra: &str,
+) -> PathBuf {
+    super::write_toml(
+        dir,
+        file,
+        &study_text(name, seed, experiment, method, extra),
     )
 }
 
@@ -161,39 +123,7 @@ pub fn reference_sobol(t: f64) -> ([f64; 2], [f64; 2]) {
     ([sk, sc], [1.0 - sc, 1.0 - sk])
 }
 
-/// A CSV file of numbers with a header.
-pub struct Csv {
-    /// Column names.
-    pub header: Vec<String>,
-    /// Rows.
-    pub rows: Vec<Vec<f64>>,
-}
-
-/// Reads a CSV file of numbers.
+/// A CSV file of numbers with a header (every field must be a number).
 pub fn read_csv(path: &Path) -> Csv {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
-        .collect();
-    Csv { header, rows }
-}
-
-impl Csv {
-    /// Column `col` at time `t` (first column).
-    pub fn at(&self, t: f64, col: &str) -> f64 {
-        let c = self
-            .header
-            .iter()
-            .position(|h| h == col)
-            .unwrap_or_else(|| panic!("no column {col} in {:?}", self.header));
-        let r = self.rows.iter().find(|r| (r[0] - t).abs() < 1e-9).unwrap();
-        r[c]
-    }
+    Csv::read(path).numeric()
 }

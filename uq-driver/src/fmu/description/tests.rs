@@ -403,7 +403,7 @@ fn byte_order_mark_is_accepted() {
     assert!(ModelDescription::parse(&bytes).is_ok());
 }
 
-/// QA F4: the `min`/`max` of an Enumeration variable are read, so that a fixed value outside
+/// The `min`/`max` of an Enumeration variable are read, so that a fixed value outside
 /// them is refused before any run (as for an Integer).
 #[test]
 fn enumeration_min_and_max_are_read() {

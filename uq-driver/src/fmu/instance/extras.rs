@@ -5,9 +5,9 @@ use std::ffi::{c_char, c_int};
 use std::ptr;
 
 use super::{same_len, FmuState, Instance, InstanceState, StatusKind};
+use crate::fmu::binary::c_string;
 use crate::fmu::binary::{RawStatus, StatePtr};
 use crate::fmu::error::{FmuError, Status};
-use crate::fmu::ffi::c_string;
 use crate::fmu::logger::LogSink;
 
 impl Instance {

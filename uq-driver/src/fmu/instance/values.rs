@@ -5,9 +5,9 @@ use std::ffi::{c_char, c_int};
 use std::ptr;
 
 use super::{c_string_arg, same_len, Instance, InstanceState};
+use crate::fmu::binary::c_string;
 use crate::fmu::description::ScalarVariable;
 use crate::fmu::error::FmuError;
-use crate::fmu::ffi::c_string;
 
 impl Instance {
     // ------------------------------------------------------------------------------------------

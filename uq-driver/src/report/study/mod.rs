@@ -257,7 +257,7 @@ fn variant_of(s: &Summary) -> Option<&str> {
 
 /// A nominal study: one deterministic run at the parameters' means.
 fn is_nominal(s: &Summary) -> bool {
-    s.method.kind == "nominal"
+    crate::uq::method::notes_of_kind(&s.method.kind).deterministic
 }
 
 /// Markdown code spans of a message (`order`) as quotes (‘order’): the page is not Markdown.
@@ -423,20 +423,19 @@ fn output_section(
 
 /// What the convergence plot's x axis is, in words that fit the method `kind`.
 fn convergence_axis(c: &results::Convergence, kind: &str) -> String {
+    let notes = crate::uq::method::notes_of_kind(kind);
     if c.axis == "runs" {
-        let lhs = if kind == "lhs" {
-            "; for a Latin hypercube the first n points are not a Latin hypercube themselves"
-        } else {
-            ""
-        };
-        format!("the number of runs (running estimates over the first n runs in design order{lhs})")
+        let note = notes
+            .runs_axis
+            .map(|n| format!("; {n}"))
+            .unwrap_or_default();
+        format!(
+            "the number of runs (running estimates over the first n runs in design order{note})"
+        )
     } else {
-        let truncation = if kind == "scm" {
-            "each term is projected on its own, so the truncation is the lower-order chaos of \
-             the same runs"
-        } else {
-            "the chaos with its higher-order terms dropped, not computed again"
-        };
+        let truncation = notes
+            .truncation
+            .unwrap_or("the chaos with its higher-order terms dropped, not computed again");
         format!(
             "the total order of the chaos: the Std of the terms of each order alone (a fast \
              decay means the expansion has converged) and of the expansion truncated there \
@@ -665,7 +664,7 @@ mod tests {
 
     #[test]
     fn warnings_on_the_page_have_no_markdown_backticks() {
-        // QA round 3, L5: "raise `order` (below `nodes`)" was shown with its backticks.
+        // "raise `order` (below `nodes`)" was shown with its backticks.
         assert_eq!(
             plain_quotes("raise `order` (below `nodes`) or `nodes`"),
             "raise ‘order’ (below ‘nodes’) or ‘nodes’"

@@ -269,11 +269,12 @@ fn format_linear_labels(ticks: &[f64], step: Step) -> Vec<String> {
         .collect()
 }
 
-/// Tick positions with a 1-2-5 step covering `[lo, hi]` with at most `max_intervals`
+/// (Tests) Tick positions with a 1-2-5 step covering `[lo, hi]` with at most `max_intervals`
 /// intervals (at least 1), e.g. `(0, 5, 6)` → 0, 1, …, 5 and `(0, 0.1, 6)` → 0, 0.02, …, 0.1.
 /// Ticks are the nearest doubles to the decimal values. Non-finite bounds or a zero-width
 /// range give the bounds themselves (deduplicated, finite only).
-pub fn nice_ticks(lo: f64, hi: f64, max_intervals: usize) -> Vec<f64> {
+#[cfg(test)]
+pub(crate) fn nice_ticks(lo: f64, hi: f64, max_intervals: usize) -> Vec<f64> {
     nice_step(lo, hi, max_intervals)
         .map(|s| s.ticks(lo.min(hi), lo.max(hi)))
         .unwrap_or_else(|| {

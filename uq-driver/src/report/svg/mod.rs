@@ -15,7 +15,8 @@ mod frame;
 #[cfg(test)]
 mod tests;
 
-pub use axis::nice_ticks;
+#[cfg(test)]
+pub(crate) use axis::nice_ticks;
 pub(crate) use axis::{finite_range, Axis};
 pub(crate) use frame::{c, legend, legend_width, Frame, LegendEntry};
 

@@ -352,7 +352,7 @@ fn density_markers_beyond_the_data_are_arrows_not_a_squashed_plot() {
     assert!(svg.contains(">2.5</text>") && !svg.contains(">3.0</text>"));
 }
 
-/// QA3 L1: eight limits get eight colours (the palette wrapped after three), and a limit
+/// Eight limits get eight colours (the palette wrapped after three), and a limit
 /// beyond the plotted range has an arrow glyph in the legend, not a dashed line.
 #[test]
 fn limit_markers_have_their_own_colours_and_arrow_glyphs() {
@@ -381,7 +381,7 @@ fn limit_markers_have_their_own_colours_and_arrow_glyphs() {
             "no arrow glyph of limit {i}: {legend}"
         );
     }
-    // QA3 M10: the density axis in the inverse unit.
+    // The density axis in the inverse unit.
     assert!(svg.contains("probability density [s2/m]"), "{svg}");
 }
 
@@ -393,7 +393,7 @@ fn density_axis_labels_carry_the_inverse_unit() {
     assert_eq!(density_label("x"), "probability density");
 }
 
-/// QA3 L2: legend swatches are drawn with the opacity of what they stand for.
+/// Legend swatches are drawn with the opacity of what they stand for.
 #[test]
 fn legend_swatches_match_bars_and_bands() {
     let chart = BarChart {
@@ -420,7 +420,7 @@ fn legend_swatches_match_bars_and_bands() {
     assert!(legend.contains("fill-opacity=\"0.75\""), "{legend}");
 }
 
-/// QA3 M6: an axis of orders has whole-number ticks only, and dots mark every point.
+/// An axis of orders has whole-number ticks only, and dots mark every point.
 #[test]
 fn integer_axis_and_markers() {
     let axis = Axis::integers(Some((1.0, 2.0)));

@@ -1,5 +1,5 @@
 //! The analysis of a time series in blocks of time columns, so that the runs of an output
-//! need not fit in memory (issue 12).
+//! need not fit in memory.
 //!
 //! Every estimator works column by column, so an output is estimated on `n × B` blocks of
 //! its runs (read from the results store) and the per-column results are concatenated
@@ -355,7 +355,7 @@ mod tests {
         assert_eq!(whole.picked(), tasks.picked());
     }
 
-    /// QA3 H1: a two-column event between evenly spaced columns is among the picked
+    /// A two-column event between evenly spaced columns is among the picked
     /// columns (the extremes of its quantiles, mean and Std), whatever the blocks.
     #[test]
     fn picked_columns_catch_a_short_event_whatever_the_blocks() {

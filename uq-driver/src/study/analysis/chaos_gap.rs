@@ -75,7 +75,7 @@ fn resolved(std: &[f64]) -> impl Fn(f64) -> bool {
 /// relative to the variance; not SCM's `order_difference`) exceeds [`CHAOS_ERROR`] at some time (where
 /// the Std is above 1e-3 of its largest) or for a quantity: its mean, Std, quantiles,
 /// P(q > limit) and Sobol' indices may then be far off, and any interval printed with them
-/// covers only the sampling of the chaos, not this error (found by QA: a 30-input G function
+/// covers only the sampling of the chaos, not this error (a 30-input G function
 /// at level 2 gave a mean of 0.013 against 1 with a level difference of 1.45 and no warning).
 /// Sparse grids whose rules are not all nested have no estimate: `no_estimate` names why.
 pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> Vec<String> {
@@ -162,7 +162,7 @@ fn error_warning(name: &str, at: &str, kind: &str, value: f64) -> String {
 
 /// The warning of a collocation chaos whose terms of the top order hold `share` of its
 /// variance (`order_difference`; `at`: where): either the model is a polynomial of that order,
-/// or the chaos has not converged. QA round 4: exp(x) on 4 nodes had 7 % there and gave
+/// or the chaos has not converged. exp(x) on 4 nodes had 7 % there and gave
 /// P(q > limit) = 3.7e-4 for a true 1e-3, and a negative 0.1 % quantile of a positive
 /// quantity, with no warning.
 fn top_order_warning(name: &str, at: &str, share: f64) -> String {

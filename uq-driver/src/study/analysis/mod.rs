@@ -13,13 +13,14 @@ mod chaos_gap;
 mod columns;
 mod error;
 mod exceedance;
+pub mod nested;
 mod runs;
 mod surrogate;
 
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
-pub use exceedance::{clopper_pearson, exceedance_count, nest_exceedance_count};
+pub use exceedance::{exceedance_count, nest_exceedance_count};
 
 use blocks::SeriesColumns;
 use columns::{column, Column};

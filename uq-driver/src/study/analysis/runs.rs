@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use super::AnalysisError;
-use crate::qoi::scalar::Code;
+use crate::qoi::evaluate::Code;
 use crate::study::store::{StoredRuns, Values};
 
 /// Runs read by one task of [`Runs::block`].

@@ -1,7 +1,7 @@
 //! The byte format of `records.bin`: framing, checksums, and a reader that resynchronises
 //! after damage. Every function here accepts any input without panicking.
 //!
-//! Format 2 (written since issue 12), all integers little endian:
+//! Format 2 (written since format 2), all integers little endian:
 //!
 //! ```text
 //! magic F5 52 51 32 | index u64 | kind u8 | length u64 | header crc32 | payload | record crc32
@@ -15,7 +15,7 @@
 //! 0xF5 never occurs in UTF-8, so a failure message cannot contain a record start; f64 data
 //! can, by chance, but a false start also needs two matching CRC-32s.
 //!
-//! Format 1 (before issue 12): `"REC1" | index u64 | kind u8 | length u64 | payload | FNV-1a
+//! Format 1 (the first): `"REC1" | index u64 | kind u8 | length u64 | payload | FNV-1a
 //! u64` over index, kind and payload. It is only read, to convert an old store.
 
 use std::ops::Range;
@@ -66,8 +66,9 @@ pub struct Decoded {
 }
 
 impl Decoded {
-    /// End of the last valid record (0 if there is none).
-    pub fn valid_end(&self) -> usize {
+    /// End of the last valid record (0 if there is none). Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn valid_end(&self) -> usize {
         self.records.last().map_or(0, |(_, _, r)| r.end)
     }
 }
@@ -347,7 +348,7 @@ pub fn detect_format(bytes: &[u8]) -> Format {
     Format::V2
 }
 
-/// Decodes a store file of either format (see [`detect_format`]).
+/// Decodes a store file of either format (see `detect_format`).
 pub fn decode(bytes: &[u8], n_values: usize) -> (Format, Decoded) {
     let format = detect_format(bytes);
     (format, decode_format(bytes, n_values, format))

@@ -1,5 +1,5 @@
 //! The finished points of a study, their values left in the store file: only the position
-//! of each point's values is held, so the runs of a study need not fit in memory (issue 12).
+//! of each point's values is held, so the runs of a study need not fit in memory.
 //! The analysis reads the values it needs, a block of time columns at a time
 //! ([`Values::read_into`], positioned reads of the file: they go through the page cache and
 //! count in no process's memory).
@@ -9,7 +9,9 @@ use std::ops::Range;
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-use super::format::{self, Format, Slot};
+use super::format::Slot;
+#[cfg(test)]
+use super::format::{self, Format};
 use super::{Record, StoreError};
 
 /// The result of one point, its values left in the file.
@@ -36,7 +38,8 @@ impl Entry {
 enum Source {
     /// The store file (read with positioned reads).
     File(File, PathBuf),
-    /// Bytes in memory (records built in memory).
+    /// Bytes in memory (records built in memory, [`StoredRuns::from_records`]: the tests).
+    #[cfg(test)]
     Bytes(Vec<u8>),
 }
 
@@ -68,8 +71,9 @@ impl StoredRuns {
         })
     }
 
-    /// The same from records in memory (one per point of a design).
-    pub fn from_records(records: &[Option<Record>], n_values: usize) -> StoredRuns {
+    /// The same from records in memory (one per point of a design). Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn from_records(records: &[Option<Record>], n_values: usize) -> StoredRuns {
         let mut bytes = Vec::new();
         for (i, r) in records.iter().enumerate() {
             if let Some(r) = r {
@@ -96,16 +100,6 @@ impl StoredRuns {
     /// Points of the design.
     pub fn len(&self) -> usize {
         self.entries.len()
-    }
-
-    /// Whether the design has no point.
-    pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
-    }
-
-    /// Values per successful point.
-    pub fn n_values(&self) -> usize {
-        self.n_values
     }
 
     /// The result of every point (`None`: not run).
@@ -163,6 +157,7 @@ impl Values<'_> {
             "values out of range"
         );
         match self.source {
+            #[cfg(test)]
             Source::Bytes(v) => decode_into(&v[a..b], out),
             Source::File(f, path) => {
                 // Straight into the f64 memory (the file is little endian, like the target
@@ -189,6 +184,7 @@ impl Values<'_> {
 /// The most bytes read at once (1 MiB).
 const READ_PIECE: usize = 1 << 20;
 
+#[cfg(test)]
 fn decode_into(bytes: &[u8], out: &mut [f64]) {
     for (o, c) in out.iter_mut().zip(bytes.chunks_exact(8)) {
         *o = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));

@@ -1,7 +1,7 @@
 //! Support, moments, density, CDF, survival function and quantile of every family.
 
 use super::shapes::Shape;
-use super::truncated::Trunc;
+use super::truncated::{clamp_to, Trunc};
 use super::Distribution;
 use crate::uq::special::{norm_cdf, norm_isf, norm_pdf, norm_ppf, norm_sf};
 
@@ -281,16 +281,5 @@ impl Distribution {
                 unreachable!("shapes handled above")
             }
         }
-    }
-}
-
-/// `x` limited to `[lo, hi]`, NaN kept; unlike `f64::clamp` it never panics (`lo > hi` or a
-/// NaN bound, possible for a `Distribution` built as a struct literal and not validated:
-/// the result is then meaningless, but the host is not brought down).
-pub(super) fn clamp_to(x: f64, lo: f64, hi: f64) -> f64 {
-    if x.is_nan() {
-        x
-    } else {
-        x.max(lo).min(hi)
     }
 }

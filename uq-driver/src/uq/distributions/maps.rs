@@ -2,7 +2,7 @@
 //! the isoprobabilistic map from the standard normal, the quantile from the unit interval,
 //! the affine map from the input's Askey germ, and their inverses.
 
-use super::functions::clamp_to;
+use super::truncated::clamp_to;
 use super::{Distribution, Germ};
 use crate::uq::special::{norm_cdf, norm_isf, norm_ppf, norm_sf};
 

@@ -353,7 +353,7 @@ fn serde_of_the_new_families() {
     }
 }
 
-/// QA qa4/lib H3: `Distribution::Uniform { low: 1, high: 0 }.inverse_cdf(0.5)` and the
+/// `Distribution::Uniform { low: 1, high: 0 }.inverse_cdf(0.5)` and the
 /// integer uniform with `low > high` or the full i64 range panicked (`min > max` in
 /// `f64::clamp`, an i64 overflow) instead of giving a meaningless value; `validate` is where
 /// they are refused.

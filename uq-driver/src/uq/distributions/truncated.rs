@@ -3,7 +3,6 @@
 
 use std::sync::OnceLock;
 
-use super::functions::clamp_to;
 use crate::uq::quadrature::gauss_legendre;
 use crate::uq::special::{norm_cdf, norm_isf, norm_pdf, norm_ppf, norm_sf};
 
@@ -183,4 +182,15 @@ fn legendre_24() -> (&'static [f64], &'static [f64]) {
     static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
     let rule = RULE.get_or_init(|| gauss_legendre(24).unwrap_or_default());
     (&rule.0, &rule.1)
+}
+
+/// `x` limited to `[lo, hi]`, NaN kept; unlike `f64::clamp` it never panics (`lo > hi` or a
+/// NaN bound, possible for a `Distribution` built as a struct literal and not validated:
+/// the result is then meaningless, but the host is not brought down).
+pub(super) fn clamp_to(x: f64, lo: f64, hi: f64) -> f64 {
+    if x.is_nan() {
+        x
+    } else {
+        x.max(lo).min(hi)
+    }
 }

@@ -44,8 +44,10 @@ impl Affine {
         }
     }
 
-    /// Evaluates A(ξ).
-    pub fn at(&self, xi: &[f64]) -> DMatrix<f64> {
+    /// Evaluates A(ξ). Serves the tests (their realisation-by-realisation reference
+    /// solve).
+    #[cfg(test)]
+    pub(crate) fn at(&self, xi: &[f64]) -> DMatrix<f64> {
         let mut a = self.mean.clone();
         for (l, m) in &self.terms {
             a += m * xi[*l];
@@ -59,7 +61,9 @@ impl Affine {
 pub enum Waveform {
     /// 1.
     Constant,
-    /// sin(ω t + φ), ω in rad/s.
+    /// sin(ω t + φ), ω in rad/s. Only the tests build one (a time-dependent load for the
+    /// solver); the models solved here have constant loads.
+    #[cfg(test)]
     Sine {
         /// Angular frequency (rad/s).
         omega: f64,
@@ -69,9 +73,11 @@ pub enum Waveform {
 }
 
 impl Waveform {
-    fn at(&self, t: f64) -> f64 {
+    /// The value at time `t` (read by the tests' sine only: a constant load has none).
+    fn at(&self, #[cfg_attr(not(test), allow(unused_variables))] t: f64) -> f64 {
         match self {
             Waveform::Constant => 1.0,
+            #[cfg(test)]
             Waveform::Sine { omega, phase } => (omega * t + phase).sin(),
         }
     }

@@ -11,12 +11,13 @@
 //! solved by bisection. Both matrices must be positive definite (Cholesky); the error
 //! names the offending matrix.
 //!
-//! Designs and chaos are built in the *independent* standard space `U ~ N(0, I)`:
-//! [`GaussianCopula::to_physical`] maps `u -> z = L u -> x`, with `R_z = L L^T`.
+//! Designs and chaos are built in the *independent* standard space `U ~ N(0, I)`: the map
+//! `u -> z = L u -> x`, with `R_z = L L^T`, is that of
+//! [`RandomInputs::to_physical`](crate::uq::RandomInputs::to_physical).
 
-use nalgebra::{Cholesky, DMatrix, DVector};
+use nalgebra::{Cholesky, DMatrix};
 
-use crate::uq::distributions::{Distribution, Germ};
+use crate::uq::distributions::Distribution;
 use crate::uq::pce::askey::Family;
 
 /// Number of Gauss–Hermite nodes for the Mehler coefficients.
@@ -24,20 +25,15 @@ const GH_NODES: usize = 160;
 /// Number of Mehler terms.
 const MEHLER_TERMS: usize = 100;
 
-/// A marginal known through its isoprobabilistic map to the standard normal.
+/// A marginal known through its isoprobabilistic map from the standard normal.
 pub trait NormalMapped: Send + Sync {
     /// `x = F^-1(Phi(z))`: the physical value of standard-normal `z`.
     fn physical(&self, z: f64) -> f64;
-    /// `z = Phi^-1(F(x))`: the standard-normal value of physical `x`.
-    fn normal(&self, x: f64) -> f64;
 }
 
 impl NormalMapped for Distribution {
     fn physical(&self, z: f64) -> f64 {
         Distribution::from_standard_normal(self, z)
-    }
-    fn normal(&self, x: f64) -> f64 {
-        self.to_germ(Germ::Normal, x)
     }
 }
 
@@ -118,8 +114,10 @@ fn rho_x(a: &Mehler, b: &Mehler, rz: f64) -> f64 {
 }
 
 /// The range of Pearson correlations reachable by a Gaussian copula of two marginals
-/// (`rho_z = -1` and `+1`).
-pub fn attainable_range(a: &dyn NormalMapped, b: &dyn NormalMapped) -> (f64, f64) {
+/// (at `rho_z = -1` and `+1`; [`GaussianCopula::new`] refuses a correlation outside it).
+/// Serves the tests.
+#[cfg(test)]
+pub(crate) fn attainable_range(a: &dyn NormalMapped, b: &dyn NormalMapped) -> (f64, f64) {
     let nodes = Family::Hermite.gauss(GH_NODES).expect("fixed node count");
     let (ma, mb) = (mehler(a, &nodes), mehler(b, &nodes));
     (rho_x(&ma, &mb, -1.0), rho_x(&ma, &mb, 1.0))
@@ -154,8 +152,11 @@ fn solve_pair(a: &Mehler, b: &Mehler, target: f64, i: usize, j: usize) -> Result
     Ok(0.5 * (l + h))
 }
 
-/// The normal-space correlation giving Pearson correlation `rho` between two marginals.
-pub fn nataf_normal_correlation(
+/// The normal-space correlation giving Pearson correlation `rho` between two marginals: what
+/// [`GaussianCopula::new`] solves for each pair. Serves the tests, which check the solve on
+/// pairs with closed forms.
+#[cfg(test)]
+pub(crate) fn nataf_normal_correlation(
     a: &dyn NormalMapped,
     b: &dyn NormalMapped,
     rho: f64,
@@ -255,11 +256,6 @@ impl GaussianCopula {
         })
     }
 
-    /// Dimension.
-    pub fn dim(&self) -> usize {
-        self.marginals.len()
-    }
-
     /// The solved normal-space correlation `R_z`.
     pub fn normal_correlation(&self) -> &DMatrix<f64> {
         &self.normal_corr
@@ -270,9 +266,12 @@ impl GaussianCopula {
         &self.chol
     }
 
-    /// Physical values of independent standard normals `u`: `x_i = g_i((L u)_i)`.
-    pub fn to_physical(&self, u: &[f64]) -> Vec<f64> {
-        let z = &self.chol * DVector::from_column_slice(u);
+    /// Physical values of independent standard normals `u`: `x_i = g_i((L u)_i)`. Serves
+    /// the tests (the studies map through
+    /// [`RandomInputs::to_physical`](crate::uq::RandomInputs::to_physical)).
+    #[cfg(test)]
+    pub(crate) fn to_physical(&self, u: &[f64]) -> Vec<f64> {
+        let z = &self.chol * nalgebra::DVector::from_column_slice(u);
         z.iter()
             .zip(&self.marginals)
             .map(|(&zi, m)| m.physical(zi))
@@ -280,10 +279,15 @@ impl GaussianCopula {
     }
 
     /// Independent standard normals of physical values `x` (inverse of `to_physical`).
-    pub fn to_independent(&self, x: &[f64]) -> Vec<f64> {
-        let z = DVector::from_iterator(
+    /// Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn to_independent(&self, x: &[f64]) -> Vec<f64> {
+        use crate::uq::distributions::Germ;
+        let z = nalgebra::DVector::from_iterator(
             x.len(),
-            x.iter().zip(&self.marginals).map(|(&xi, m)| m.normal(xi)),
+            x.iter()
+                .zip(&self.marginals)
+                .map(|(&xi, m)| m.to_germ(Germ::Normal, xi)),
         );
         let u = self
             .chol
@@ -305,9 +309,6 @@ mod tests {
     impl NormalMapped for LogN {
         fn physical(&self, z: f64) -> f64 {
             (self.0 + self.1 * z).exp()
-        }
-        fn normal(&self, x: f64) -> f64 {
-            (x.ln() - self.0) / self.1
         }
     }
 

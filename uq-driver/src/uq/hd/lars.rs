@@ -1,14 +1,13 @@
 //! Sparse regression: least-angle regression (Efron, Hastie, Johnstone & Tibshirani,
-//! Ann. Stat. 32, 2004) and orthogonal matching pursuit, with the basis chosen by the
-//! corrected leave-one-out error ("hybrid LARS", Blatman & Sudret, J. Comput. Phys. 230,
-//! 2011).
+//! Ann. Stat. 32, 2004), with the basis chosen by the corrected leave-one-out error
+//! ("hybrid LARS", Blatman & Sudret, J. Comput. Phys. 230, 2011).
 //!
-//! The path algorithms return the nested sequence of active sets `A_1 ⊂ A_2 ⊂ ...` (column
-//! indices of the design). [`select_by_loo`] refits each by ordinary least squares
-//! (see [`super::regression`]) — with the constant column always included when one is
-//! given — and keeps the set of smallest corrected relative LOO error.
+//! The path algorithm returns the nested sequence of active sets `A_1 ⊂ A_2 ⊂ ...` (column
+//! indices of the design). Each is refitted by ordinary least squares (see
+//! [`super::regression`]) — with the constant column always included when one is given —
+//! and the set of smallest corrected relative LOO error is kept.
 //!
-//! The paths work on the non-constant columns, centred and scaled to unit norm, and on
+//! The path works on the non-constant columns, centred and scaled to unit norm, and on
 //! the centred response (the constant plays the intercept). They stop when every column
 //! is active, when `N - 2` columns are active (the refit needs `N > P`), when the
 //! remaining correlation vanishes, or when the active Gram matrix becomes singular.
@@ -16,7 +15,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 use super::regression::{columns, LeastSquares, LeastSquaresFit, RegressionError};
 
@@ -25,8 +24,6 @@ use super::regression::{columns, LeastSquares, LeastSquaresFit, RegressionError}
 pub enum PathKind {
     /// Least-angle regression.
     Lars,
-    /// Orthogonal matching pursuit.
-    Omp,
 }
 
 /// The selected sparse model.
@@ -41,8 +38,10 @@ pub struct SparseFit {
 }
 
 impl SparseFit {
-    /// Coefficients scattered to a full vector of `ncols` entries (zeros elsewhere).
-    pub fn full_coefficients(&self, ncols: usize) -> Vec<f64> {
+    /// Coefficients scattered to a full vector of `ncols` entries (zeros elsewhere). Serves
+    /// the tests.
+    #[cfg(test)]
+    pub(crate) fn full_coefficients(&self, ncols: usize) -> Vec<f64> {
         let mut c = vec![0.0; ncols];
         for (&j, &v) in self.columns.iter().zip(&self.fit.coeffs) {
             c[j] = v;
@@ -71,7 +70,7 @@ fn standardize(psi: &DMatrix<f64>, constant: Option<usize>) -> (DMatrix<f64>, Ve
 
 /// What the paths need of a design, whatever the response: the standardised columns, their
 /// transpose, their Gram matrix and squared norms. Computed once for any number of responses
-/// on the same design (the paths are then those of [`lars_path`] and [`omp_path`], bit for
+/// on the same design (the path is then that of the design prepared per response, bit for
 /// bit: the same operations on the same numbers). A row of the Gram matrix is computed the
 /// first time its column enters a path: a path reads only the rows of its active columns.
 #[derive(Clone, Debug)]
@@ -191,8 +190,10 @@ impl ActiveSet {
     }
 }
 
-/// The LARS sequence of active sets (design column indices, constant excluded).
-pub fn lars_path(
+/// The LARS sequence of active sets (design column indices, constant excluded). Serves the
+/// tests ([`lars_path_on`] with the design prepared for this response alone).
+#[cfg(test)]
+pub(crate) fn lars_path(
     psi: &DMatrix<f64>,
     y: &[f64],
     constant: Option<usize>,
@@ -201,7 +202,8 @@ pub fn lars_path(
     lars_path_on(&PathDesign::new(psi, constant), y, max_active)
 }
 
-/// [`lars_path`] on a prepared design.
+/// The LARS sequence of active sets (design column indices, constant excluded) on a prepared
+/// design.
 pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
     use kernels::{combine_columns, mat_vec};
     let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
@@ -270,57 +272,6 @@ pub fn lars_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Ve
             }
             _ => break,
         }
-    }
-    path
-}
-
-/// The orthogonal matching pursuit sequence of active sets (constant excluded).
-pub fn omp_path(
-    psi: &DMatrix<f64>,
-    y: &[f64],
-    constant: Option<usize>,
-    max_active: usize,
-) -> Vec<Vec<usize>> {
-    omp_path_on(&PathDesign::new(psi, constant), y, max_active)
-}
-
-/// [`omp_path`] on a prepared design.
-pub fn omp_path_on(design: &PathDesign, y: &[f64], max_active: usize) -> Vec<Vec<usize>> {
-    let (x, xt, idx, constant) = (&design.x, &design.xt, &design.idx, design.constant);
-    let (n, m) = x.shape();
-    let ym = if constant.is_some() {
-        y.iter().sum::<f64>() / n as f64
-    } else {
-        0.0
-    };
-    let yc = DVector::from_iterator(n, y.iter().map(|v| v - ym));
-    let limit = max_active.min(m).min(n.saturating_sub(2));
-    let mut r = yc.clone();
-    let mut active: Vec<usize> = Vec::new();
-    let mut in_active = vec![false; m];
-    let mut path = Vec::new();
-    while active.len() < limit {
-        let c = xt * &r;
-        let best = (0..m)
-            .filter(|&j| !in_active[j])
-            .max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()));
-        let Some(j) = best else { break };
-        if c[j].abs() <= 1e-13 * yc.norm().max(1e-300) {
-            break;
-        }
-        active.push(j);
-        in_active[j] = true;
-        let xa = DMatrix::from_fn(n, active.len(), |i, k| x[(i, active[k])]);
-        let qr = xa.clone().qr();
-        let rr = qr.r();
-        if (0..active.len()).any(|k| rr[(k, k)].abs() < 1e-12) {
-            break;
-        }
-        let coef = rr
-            .solve_upper_triangular(&(qr.q().transpose() * &yc))
-            .expect("checked diagonal");
-        r = &yc - &xa * coef;
-        path.push(active.iter().map(|&k| idx[k]).collect());
     }
     path
 }
@@ -424,9 +375,10 @@ pub fn nested_loo_errors(psi: &DMatrix<f64>, y: &[f64], order: &[usize]) -> Vec<
 /// Refits each active set of `path` (plus the constant column, if any) by least squares
 /// and keeps the smallest corrected relative LOO error. The empty model (constant only)
 /// is a candidate when a constant is given. The path's sets must be nested, each adding
-/// one column (as LARS and OMP produce); the errors come from [`nested_loo_errors`] and
-/// the chosen set is refitted once.
-pub fn select_by_loo(
+/// one column (as LARS produces); the errors come from [`nested_loo_errors`] and
+/// the chosen set is refitted once. Serves the tests (the fit without a cache).
+#[cfg(test)]
+pub(crate) fn select_by_loo(
     psi: &DMatrix<f64>,
     y: &[f64],
     constant: Option<usize>,
@@ -435,9 +387,13 @@ pub fn select_by_loo(
     select_by_loo_cached(psi, y, constant, path, None)
 }
 
-/// [`select_by_loo`] taking the factorisation of the chosen columns from `cache` when
-/// another response chose the same ones (the same numbers: the factorisation depends on
-/// the columns only).
+/// Refits each active set of `path` (plus the constant column, if any) by least squares
+/// and keeps the smallest corrected relative LOO error. The empty model (constant only)
+/// is a candidate when a constant is given. The path's sets must be nested, each adding
+/// one column (as LARS produces); the errors come from [`nested_loo_errors`] and
+/// the chosen set is refitted once, its factorisation taken from `cache` when another
+/// response chose the same columns (the same numbers: the factorisation depends on the
+/// columns only).
 fn select_by_loo_cached(
     psi: &DMatrix<f64>,
     y: &[f64],
@@ -522,8 +478,10 @@ impl SupportCache {
     }
 }
 
-/// Hybrid sparse regression: the `kind` path, then selection by corrected LOO.
-pub fn sparse_regression(
+/// Hybrid sparse regression: the `kind` path, then selection by corrected LOO. Serves the
+/// tests ([`sparse_regression_on`] with the design prepared for this response alone).
+#[cfg(test)]
+pub(crate) fn sparse_regression(
     psi: &DMatrix<f64>,
     y: &[f64],
     constant: Option<usize>,
@@ -533,9 +491,9 @@ pub fn sparse_regression(
     sparse_regression_on(&design, psi, y, kind, None)
 }
 
-/// [`sparse_regression`] on a prepared design (`design` must be that of `psi`), with the
-/// refits shared through `cache` if given: the same fit, bit for bit, for any number of
-/// responses on one design.
+/// Hybrid sparse regression on a prepared design (`design` must be that of `psi`): the
+/// `kind` path, then selection by corrected LOO, with the refits shared through `cache` if
+/// given: the same fit, bit for bit, for any number of responses on one design.
 pub fn sparse_regression_on(
     design: &PathDesign,
     psi: &DMatrix<f64>,
@@ -551,7 +509,6 @@ pub fn sparse_regression_on(
     }
     let path = match kind {
         PathKind::Lars => lars_path_on(design, y, usize::MAX),
-        PathKind::Omp => omp_path_on(design, y, usize::MAX),
     };
     select_by_loo_cached(psi, y, design.constant, &path, cache)
 }
@@ -570,6 +527,7 @@ mod tests {
     use crate::uq::pce::askey::Family;
     use crate::uq::pce::basis::{Basis, MultiIndexSet};
     use crate::uq::rng::{standard_normal, stream, uniform_open01};
+    use nalgebra::DVector;
 
     #[test]
     fn lars_on_an_orthonormal_design_enters_by_decreasing_correlation() {
@@ -626,21 +584,15 @@ mod tests {
     #[test]
     fn hybrid_lars_recovers_an_exactly_sparse_chaos_from_fewer_samples_than_terms() {
         let (psi, y, truth) = sparse_problem(80);
-        for kind in [PathKind::Lars, PathKind::Omp] {
-            let fit = sparse_regression(&psi, &y, Some(0), kind).unwrap();
-            let mut want: Vec<usize> = truth.iter().map(|t| t.0).collect();
-            want.sort_unstable();
-            assert_eq!(fit.columns, want, "{kind:?}");
-            let full = fit.full_coefficients(psi.ncols());
-            for &(k, c) in &truth {
-                assert!(
-                    (full[k] - c).abs() < 1e-10,
-                    "{kind:?}: term {k}: {}",
-                    full[k]
-                );
-            }
-            assert!(fit.fit.corrected_relative_loo() < 1e-20);
+        let fit = sparse_regression(&psi, &y, Some(0), PathKind::Lars).unwrap();
+        let mut want: Vec<usize> = truth.iter().map(|t| t.0).collect();
+        want.sort_unstable();
+        assert_eq!(fit.columns, want);
+        let full = fit.full_coefficients(psi.ncols());
+        for &(k, c) in &truth {
+            assert!((full[k] - c).abs() < 1e-10, "term {k}: {}", full[k]);
         }
+        assert!(fit.fit.corrected_relative_loo() < 1e-20);
         // The full fit is refused: 80 samples for 286 terms.
         assert!(matches!(
             least_squares(&psi, &y),

@@ -1,7 +1,7 @@
 //! Linear combinations of columns for the LARS path, summed in the same order and with
 //! the same roundings as nalgebra's matrix-vector product and `axpy` (so the path stays
 //! the same, bit for bit), but a block of rows at a time in registers instead of one
-//! pass over the output per column (issue 15). The products and the Gram-Schmidt step are
+//! pass over the output per column. The products and the Gram-Schmidt step are
 //! also compiled for AVX2 and AVX-512 and chosen at run time: the same operations lane by
 //! lane (no fused multiply-add), so the same bits on every machine.
 

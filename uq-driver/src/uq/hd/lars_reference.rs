@@ -1,5 +1,5 @@
 //! The LARS path as it was before the design was prepared once for every response
-//! (issue 15): standardisation, transposes and Gram entries recomputed for each response.
+//!: standardisation, transposes and Gram entries recomputed for each response.
 //! Kept for the tests, which pin the prepared path to it bit for bit; likewise the nested
 //! leave-one-out errors as they were before the Gram-Schmidt steps were fused and kept in
 //! flat buffers.

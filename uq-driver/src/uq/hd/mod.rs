@@ -1,4 +1,4 @@
-//! High-dimensional UQ building blocks (issue 11): pure numerics, no FMU.
+//! High-dimensional UQ building blocks: pure numerics, no FMU.
 //!
 //! One concept per module (the Askey families and the orthonormal bases over multi-index
 //! sets are in [`crate::uq::pce`]; the input families in [`crate::uq::distributions`]):
@@ -9,7 +9,7 @@
 //! - [`copula`]: the Gaussian (Nataf) copula for correlated inputs;
 //! - [`sobol_seq`]: Sobol' points (Joe–Kuo direction numbers) with Owen scrambling;
 //! - [`regression`]: least squares with the closed-form leave-one-out error;
-//! - [`lars`]: least-angle regression with hybrid LOO basis selection, and OMP;
+//! - [`lars`]: least-angle regression with hybrid LOO basis selection;
 //! - [`sparse_chaos`]: regression chaos (full or sparse) with degree adaptivity by LOO;
 //! - [`sensitivity`]: pick-freeze Sobol' estimators (Saltelli / Jansen) with bootstrap,
 //!   and replicated-design estimators.

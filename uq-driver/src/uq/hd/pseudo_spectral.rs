@@ -6,8 +6,8 @@
 //! `2 p_i <= exactness_i`. Each such projection is exact on its own space; the
 //! coefficients are then combined with the combination coefficients. For a downward
 //! closed level set the result reproduces *every* polynomial in the union of the tensor
-//! spaces exactly, whereas projecting with the merged Smolyak weights
-//! ([`smolyak_weight_projection`]) aliases (shown in the tests).
+//! spaces exactly, whereas projecting with the merged Smolyak weights aliases (shown in the
+//! tests).
 //!
 //! The basis is orthonormal on the rules' germs: Hermite for Genz–Keister /
 //! Gauss–Hermite dimensions, Legendre for Clenshaw–Curtis / Gauss–Patterson /
@@ -134,8 +134,10 @@ pub fn sparse_pseudo_spectral(
 }
 
 /// The direct projection `c_alpha = sum_j w_j f(x_j) Psi_alpha(x_j)` with the merged
-/// Smolyak weights, onto the given set (for comparison only: it aliases).
-pub fn smolyak_weight_projection(
+/// Smolyak weights, onto the given set. Serves the tests, which compare it with
+/// [`sparse_pseudo_spectral`]: it aliases.
+#[cfg(test)]
+pub(crate) fn smolyak_weight_projection(
     grid: &SparseGrid,
     values: &DMatrix<f64>,
     set: &MultiIndexSet,
@@ -156,13 +158,9 @@ pub fn smolyak_weight_projection(
     Ok(psi.transpose() * wf)
 }
 
-/// Truncation-error estimate from two nested levels: the projections on `grid` (with
-/// `values`) and on the coarser level set `coarse` (its points must be among the grid's,
-/// as for nested rules and `coarse` a subset of the grid's level set; no new model runs)
-/// are compared. Returns, per output, `sum_alpha (c_fine - c_coarse)^2 / Var_fine` — the
-/// relative mean-square difference of the two chaoses (a pessimistic estimate of the
-/// coarse chaos's error, a usual stand-in for the fine one's).
-pub fn level_difference(
+/// [`level_difference_from`], projecting the fine chaos itself. Serves the tests.
+#[cfg(test)]
+pub(crate) fn level_difference(
     grid: &SparseGrid,
     values: &DMatrix<f64>,
     coarse: &LevelSet,
@@ -171,8 +169,13 @@ pub fn level_difference(
     level_difference_from(&fine, grid, values, coarse)
 }
 
-/// [`level_difference`] with the fine chaos already projected (`fine`, from `grid` and
-/// `values`).
+/// Truncation-error estimate from two nested levels: the projections on `grid` (with
+/// `values`; `fine`, already projected from them) and on the coarser level set `coarse` (its
+/// points must be among the grid's, as for nested rules and `coarse` a subset of the grid's
+/// level set; no new model runs) are compared. Returns, per output,
+/// `sum_alpha (c_fine - c_coarse)^2 / Var_fine` — the relative mean-square difference of the
+/// two chaoses (a pessimistic estimate of the coarse chaos's error, a usual stand-in for the
+/// fine one's).
 pub fn level_difference_from(
     fine: &Pce,
     grid: &SparseGrid,

@@ -61,8 +61,10 @@ pub struct LeastSquaresFit {
 
 impl LeastSquaresFit {
     /// Relative LOO error `loo_mse / Var(y)` (infinite when `Var(y) = 0` and the
-    /// error is not).
-    pub fn relative_loo(&self) -> f64 {
+    /// error is not). Serves the tests (the fits are compared by
+    /// [`LeastSquaresFit::corrected_relative_loo`]).
+    #[cfg(test)]
+    pub(crate) fn relative_loo(&self) -> f64 {
         relative(self.loo_mse, self.response_var, self.negligible_var)
     }
 
@@ -105,8 +107,13 @@ pub fn sample_variance(y: &[f64]) -> f64 {
     y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1) as f64
 }
 
-/// Least-squares fit of `y` on the columns of `psi` with LOO errors.
-pub fn least_squares(psi: &DMatrix<f64>, y: &[f64]) -> Result<LeastSquaresFit, RegressionError> {
+/// Least-squares fit of `y` on the columns of `psi` with LOO errors: [`LeastSquares`] for one
+/// response. Serves the tests (the studies factor a design once for all its responses).
+#[cfg(test)]
+pub(crate) fn least_squares(
+    psi: &DMatrix<f64>,
+    y: &[f64],
+) -> Result<LeastSquaresFit, RegressionError> {
     LeastSquares::new(psi)?.fit(y)
 }
 

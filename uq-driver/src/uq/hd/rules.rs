@@ -71,7 +71,8 @@ pub struct Rule1d {
     pub exactness: usize,
 }
 
-/// A row of a rule's table.
+/// A row of a rule's table ([`RuleKind::table`], which serves the tests).
+#[cfg(test)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LevelInfo {
     /// Level (from 0).
@@ -203,8 +204,9 @@ impl RuleKind {
         })
     }
 
-    /// The table (level, points, exactness) for levels `0..=max_level`.
-    pub fn table(&self, max_level: usize) -> Vec<LevelInfo> {
+    /// The table (level, points, exactness) for levels `0..=max_level`. Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn table(&self, max_level: usize) -> Vec<LevelInfo> {
         (0..=max_level.min(self.max_level()))
             .map(|level| LevelInfo {
                 level,

@@ -148,7 +148,7 @@ pub fn pick_freeze(values: &[f64], n: usize, d: usize) -> Result<SobolIndices, S
     Ok(estimate_rows(values, n, d, &rows))
 }
 
-/// [`pick_freeze`] with bootstrap percentile intervals at `level` (e.g. 0.95) from
+/// `pick_freeze` with bootstrap percentile intervals at `level` (e.g. 0.95) from
 /// `resamples` resamples seeded by `seed`.
 pub fn pick_freeze_bootstrap(
     values: &[f64],
@@ -394,13 +394,6 @@ pub fn replicate_summary(estimates: &[f64]) -> ReplicateSummary {
         std_error,
         replicates: r,
     }
-}
-
-/// Splits `values` laid out replicate by replicate (`R` blocks of `n`) and applies
-/// `statistic` to each block, returning the replicate summary.
-pub fn replicated(values: &[f64], n: usize, statistic: impl Fn(&[f64]) -> f64) -> ReplicateSummary {
-    let est: Vec<f64> = values.chunks(n.max(1)).map(statistic).collect();
-    replicate_summary(&est)
 }
 
 #[cfg(test)]
@@ -722,10 +715,5 @@ mod tests {
         assert_eq!(s.mean, 2.5);
         // sd = sqrt(5/3), se = sd / 2.
         assert!((s.std_error - (5.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-15);
-        let r = replicated(&[1.0, 3.0, 2.0, 4.0, 3.0, 5.0], 2, |b| {
-            b.iter().sum::<f64>() / 2.0
-        });
-        assert_eq!(r.replicates, 3);
-        assert_eq!(r.mean, 3.0);
     }
 }

@@ -26,7 +26,9 @@ pub const MAX_SPARSE_POINTS: usize = 5_000_000;
 /// Errors of the level sets and sparse grids.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SmolyakError {
-    /// The level set is not downward closed.
+    /// The level set is not downward closed (refused by [`LevelSet::from_levels`], which
+    /// serves the tests).
+    #[cfg(test)]
     #[error("level set is not downward closed: {missing:?} (below {member:?}) is missing")]
     NotDownwardClosed {
         /// A member.
@@ -103,8 +105,10 @@ impl LevelSet {
         Ok(LevelSet { dim, levels: out })
     }
 
-    /// A general set; refused unless downward closed.
-    pub fn from_levels(dim: usize, levels: Vec<Vec<usize>>) -> Result<Self, SmolyakError> {
+    /// A general set; refused unless downward closed. Serves the tests (the studies build
+    /// [`LevelSet::total`] and [`LevelSet::weighted`] sets).
+    #[cfg(test)]
+    pub(crate) fn from_levels(dim: usize, levels: Vec<Vec<usize>>) -> Result<Self, SmolyakError> {
         if dim == 0 {
             return Err(SmolyakError::Dimension(vec![], 0));
         }
@@ -135,11 +139,6 @@ impl LevelSet {
     /// Dimension.
     pub fn dim(&self) -> usize {
         self.dim
-    }
-
-    /// The members.
-    pub fn levels(&self) -> &[Vec<usize>] {
-        &self.levels
     }
 
     /// The non-zero combination coefficients `(l, c_l)`, in the set's order.
@@ -289,20 +288,22 @@ impl SparseGrid {
         self.points.len()
     }
 
-    /// Whether the grid is empty.
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-
-    /// `sum_j w_j f_j` for values at the merged points.
-    pub fn integrate(&self, values: &[f64]) -> f64 {
+    /// `sum_j w_j f_j` for values at the merged points. Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn integrate(&self, values: &[f64]) -> f64 {
         self.weights.iter().zip(values).map(|(w, v)| w * v).sum()
     }
 }
 
 /// Number of merged points of the isotropic sparse grid of `level` in `dim` dimensions
-/// with one rule in every dimension (builds the grid).
-pub fn sparse_grid_size(rule: RuleKind, dim: usize, level: usize) -> Result<usize, SmolyakError> {
+/// with one rule in every dimension (builds the grid). Serves the tests (the studies count
+/// with [`total_level_size`], without building the grid).
+#[cfg(test)]
+pub(crate) fn sparse_grid_size(
+    rule: RuleKind,
+    dim: usize,
+    level: usize,
+) -> Result<usize, SmolyakError> {
     let set = LevelSet::total(dim, level)?;
     Ok(SparseGrid::new(&vec![rule; dim], &set)?.len())
 }
@@ -345,7 +346,7 @@ mod tests {
         let (d, big_l) = (3, 4);
         let set = LevelSet::total(d, big_l).unwrap();
         let comb = set.combination();
-        for l in set.levels() {
+        for l in &set.levels {
             let s: usize = l.iter().sum();
             let k = big_l - s;
             let want: i64 = if k < d {
@@ -489,7 +490,7 @@ mod tests {
             };
             assert_eq!(*c, want, "{l:?}");
         }
-        assert_eq!(comb.len(), set.levels().len());
+        assert_eq!(comb.len(), set.levels.len());
         let grid = SparseGrid::new(&[RuleKind::ClenshawCurtis; 40], &set).unwrap();
         // 1 + 2 d (level 1) + 2 d (level 2 new nodes) + 4 C(d, 2) (pairs).
         assert_eq!(grid.len(), 1 + 4 * 40 + 4 * 40 * 39 / 2);
@@ -518,7 +519,7 @@ mod tests {
             Err(SmolyakError::Rule(RuleError::LevelTooHigh { .. }))
         ));
         let w = LevelSet::weighted(&[1.0, 2.0], 4.0).unwrap();
-        assert!(w.levels().iter().all(|l| l[0] + 2 * l[1] <= 4));
-        assert_eq!(w.levels().len(), 5 + 3 + 1);
+        assert!(w.levels.iter().all(|l| l[0] + 2 * l[1] <= 4));
+        assert_eq!(w.levels.len(), 5 + 3 + 1);
     }
 }

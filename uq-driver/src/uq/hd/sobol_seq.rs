@@ -42,7 +42,6 @@ pub enum SobolError {
 /// A Sobol' sequence, optionally scrambled.
 #[derive(Clone, Debug)]
 pub struct Sobol {
-    dim: usize,
     /// `dirs[j][k]` = V_{k+1} of dimension j.
     dirs: Vec<[u32; BITS]>,
     /// Scrambling key per dimension (`None`: unscrambled).
@@ -113,7 +112,6 @@ impl Sobol {
             return Err(SobolError::Dimension(dim));
         }
         Ok(Sobol {
-            dim,
             dirs: direction_numbers(dim),
             keys: None,
         })
@@ -125,11 +123,6 @@ impl Sobol {
         let mut rng = stream(seed, replicate);
         s.keys = Some((0..dim).map(|_| rng.next_u64()).collect());
         Ok(s)
-    }
-
-    /// Dimension.
-    pub fn dim(&self) -> usize {
-        self.dim
     }
 
     /// The 32-bit integer coordinates of unscrambled point `index`.
@@ -149,8 +142,10 @@ impl Sobol {
             .collect()
     }
 
-    /// Point `index` (from 0) in `[0, 1)^dim` (scrambled: in `(0, 1)^dim`).
-    pub fn point(&self, index: u64) -> Result<Vec<f64>, SobolError> {
+    /// Point `index` (from 0) in `[0, 1)^dim` (scrambled: in `(0, 1)^dim`), computed directly.
+    /// Serves the tests: the reference for the recurrence of [`Sobol::points`].
+    #[cfg(test)]
+    pub(crate) fn point(&self, index: u64) -> Result<Vec<f64>, SobolError> {
         if index >= 1u64 << BITS {
             return Err(SobolError::TooMany(index));
         }

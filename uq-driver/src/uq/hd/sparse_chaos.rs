@@ -1,7 +1,6 @@
 //! Regression chaos with degree adaptivity: for each total degree `p` in a range, the
-//! hyperbolic (q-norm) basis of that degree is fitted by hybrid LARS / OMP (sparse) or
-//! by least squares (full), and the degree with the smallest corrected relative
-//! leave-one-out error is kept (as UQLab and OpenTURNS do). Scanning stops after two
+//! hyperbolic (q-norm) basis of that degree is fitted by hybrid LARS (sparse), and the
+//! degree with the smallest corrected relative leave-one-out error is kept (as UQLab and OpenTURNS do). Scanning stops after two
 //! degrees in a row without improvement.
 //!
 //! Points are given in germ space (see [`crate::uq::pce::askey`]): one coordinate per input, in
@@ -13,7 +12,7 @@ use std::sync::{Arc, OnceLock};
 use nalgebra::DMatrix;
 
 use super::lars::{sparse_regression_on, PathDesign, PathKind, SupportCache};
-use super::regression::{least_squares, RegressionError};
+use super::regression::RegressionError;
 use crate::uq::pce::askey::Family;
 use crate::uq::pce::basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
 use crate::uq::pce::{Pce, PceError};
@@ -38,8 +37,6 @@ pub enum ChaosFitError {
 /// How the coefficients are fitted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FitKind {
-    /// Ordinary least squares on the whole truncated basis.
-    Full,
     /// Sparse: the path algorithm, then selection by corrected LOO.
     Sparse(PathKind),
 }
@@ -64,8 +61,9 @@ impl ChaosFit {
         self.pce.stats(0)
     }
 
-    /// Evaluates the chaos at a germ point.
-    pub fn eval(&self, t: &[f64]) -> f64 {
+    /// Evaluates the chaos at a germ point. Serves the tests.
+    #[cfg(test)]
+    pub(crate) fn eval(&self, t: &[f64]) -> f64 {
         self.pce.eval_column(0, t)
     }
 }
@@ -123,30 +121,22 @@ impl Candidates {
 
     /// Fits `y` (one value per point): each degree in turn, keeping the smallest corrected
     /// relative LOO error; stops after two degrees in a row without improvement, or at the
-    /// first degree a full fit cannot determine (the error of the first degree is returned
-    /// when none fits).
+    /// first degree that cannot be fitted (the error of the first degree is returned when
+    /// none fits).
     pub fn fit(&self, y: &[f64], kind: FitKind) -> Result<ChaosFit, ChaosFitError> {
         let mut best: Option<ChaosFit> = None;
         let mut tried = Vec::new();
         let mut first_err = None;
         let mut worse = 0;
+        let FitKind::Sparse(path) = kind;
         for ((p, basis, psi), (design, cache)) in self.levels.iter().zip(&self.sparse) {
-            let result = match kind {
-                FitKind::Full => least_squares(psi, y).map(|f| {
-                    let loo = f.corrected_relative_loo();
-                    (basis.clone(), f.coeffs, loo)
-                }),
-                FitKind::Sparse(path) => {
-                    let design = design.get_or_init(|| PathDesign::new(psi, Some(0)));
-                    sparse_regression_on(design, psi, y, path, Some(cache))
-                }
-                .map(|f| {
-                    let loo = f.fit.corrected_relative_loo();
-                    let sub = basis.set().select(&f.columns).expect("distinct columns");
-                    let b = Basis::new(self.families.clone(), sub).expect("same families");
-                    (b, f.fit.coeffs, loo)
-                }),
-            };
+            let design = design.get_or_init(|| PathDesign::new(psi, Some(0)));
+            let result = sparse_regression_on(design, psi, y, path, Some(cache)).map(|f| {
+                let loo = f.fit.corrected_relative_loo();
+                let sub = basis.set().select(&f.columns).expect("distinct columns");
+                let b = Basis::new(self.families.clone(), sub).expect("same families");
+                (b, f.fit.coeffs, loo)
+            });
             let (b, coeffs, loo) = match result {
                 Ok(r) => r,
                 Err(e) => {
@@ -204,31 +194,12 @@ mod tests {
             .iter()
             .map(|t| t[0].powi(3) - 2.0 * t[0] * t[1] + 0.5 * t[1] * t[1])
             .collect();
-        for kind in [FitKind::Full, FitKind::Sparse(PathKind::Lars)] {
-            let fit = fit_chaos(&[Family::Legendre; 2], &pts, &y, 1..=6, 1.0, kind).unwrap();
-            assert_eq!(fit.degree, 3, "{kind:?}: {:?}", fit.tried);
-            assert!(fit.loo < 1e-20);
-            // Mean: E[t1^3] - 2 E[t1 t2] + 0.5 E[t2^2] = 1/6.
-            assert!((fit.stats().mean - 1.0 / 6.0).abs() < 1e-13);
-            assert!((fit.eval(&[0.3, -0.4]) - (0.027 + 0.24 + 0.08)).abs() < 1e-12);
-        }
-    }
-
-    #[test]
-    fn too_few_points_for_a_full_fit_is_an_error() {
-        let pts = vec![vec![0.1, 0.2], vec![0.3, -0.5], vec![-0.2, 0.9]];
-        let err = fit_chaos(
-            &[Family::Legendre; 2],
-            &pts,
-            &[1.0, 2.0, 3.0],
-            3..=3,
-            1.0,
-            FitKind::Full,
-        )
-        .unwrap_err();
-        assert!(matches!(
-            err,
-            ChaosFitError::Regression(RegressionError::Underdetermined { .. })
-        ));
+        let kind = FitKind::Sparse(PathKind::Lars);
+        let fit = fit_chaos(&[Family::Legendre; 2], &pts, &y, 1..=6, 1.0, kind).unwrap();
+        assert_eq!(fit.degree, 3, "{:?}", fit.tried);
+        assert!(fit.loo < 1e-20);
+        // Mean: E[t1^3] - 2 E[t1 t2] + 0.5 E[t2^2] = 1/6.
+        assert!((fit.stats().mean - 1.0 / 6.0).abs() < 1e-13);
+        assert!((fit.eval(&[0.3, -0.4]) - (0.027 + 0.24 + 0.08)).abs() < 1e-12);
     }
 }

@@ -190,7 +190,7 @@ mod tests {
         assert!(u.warnings.is_empty());
     }
 
-    /// QA F3: the "positive-mean Gaussian" warning fired for uniform [−1, 2], a normal truncated
+    /// The "positive-mean Gaussian" warning fired for uniform [−1, 2], a normal truncated
     /// at −0.5 and integers −2..5, whose declared support includes x <= 0 by the user's choice.
     #[test]
     fn sign_warning_only_for_normal_inputs_not_for_families_whose_support_includes_zero() {

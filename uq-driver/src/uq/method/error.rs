@@ -14,6 +14,7 @@ pub struct InvalidSettings(pub String);
 
 /// Failures of designs and estimators.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum MethodError {
     /// A quadrature rule could not be built.
     #[error(transparent)]

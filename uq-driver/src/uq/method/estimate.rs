@@ -389,7 +389,7 @@ mod replicate_tests {
         assert!(e.std_error_mean.unwrap()[0].is_nan());
     }
 
-    /// QA F5: where a column has no variance (a fixed initial state at t = 0, a constant
+    /// Where a column has no variance (a fixed initial state at t = 0, a constant
     /// output) its indices are 0/0; they were written as exact 0 with a [0, 0] interval.
     #[test]
     fn sobol_indices_without_variance_are_nan_and_the_whole_series_skips_them() {

@@ -39,6 +39,8 @@ fn replicate_seed(seed: u64, r: usize) -> u64 {
 
 impl UnitCubeSample for Lhs {
     const KIND: &'static str = "lhs";
+    const RUNS_AXIS: Option<&'static str> =
+        Some("for a Latin hypercube the first n points are not a Latin hypercube themselves");
 
     fn samples(&self) -> usize {
         self.samples

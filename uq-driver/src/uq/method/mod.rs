@@ -45,14 +45,26 @@ pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
 pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
-    details, Evaluation, Intrusive, Method, MethodSummary, Problem, Sampling, Solution,
+    details, hyperbolic_terms, ChaosFit, Evaluation, Intrusive, KindNotes, Method, MethodSummary,
+    Problem, Sampling, Solution,
 };
 
-/// Declares the method modules and the `[method]` table: one line per method.
+// The method modules: declared here, not by the macro below, so that rustfmt reaches them.
+pub mod lhs;
+pub mod mc;
+pub mod nested;
+pub mod nominal;
+pub mod pce_regression;
+pub mod qmc;
+pub mod scm;
+pub mod sgm;
+pub mod sobol_sampling;
+pub mod sparse_grid;
+
+/// Builds the `[method]` table from the list of methods: one line per method, `module::Type`,
+/// the module's name being the `kind` of study files.
 macro_rules! methods {
     ($($module:ident :: $Type:ident),* $(,)?) => {
-        $(pub mod $module;)*
-
         /// The `[method]` table of a study: `kind` names the method (the type's name in
         /// snake_case), the other keys are its settings.
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -70,6 +82,22 @@ macro_rules! methods {
                 match self {
                     $(MethodSpec::$Type(m) => m,)*
                 }
+            }
+
+            /// The method these settings select, to be completed (files, levels).
+            pub fn method_mut(&mut self) -> &mut dyn Method {
+                match self {
+                    $(MethodSpec::$Type(m) => m,)*
+                }
+            }
+        }
+
+        /// What the report and the terminal say of the results of the method `kind` (as a
+        /// `summary.json` names it); nothing in particular for a kind this build does not know.
+        pub fn notes_of_kind(kind: &str) -> KindNotes {
+            match kind {
+                $(stringify!($module) => <$module::$Type as Method>::notes(),)*
+                _ => KindNotes::default(),
             }
         }
     };
@@ -92,32 +120,21 @@ impl MethodSpec {
     /// Resolves the files a method's settings name (e.g. a points file) against `base`,
     /// the study file's folder, and records what must enter the study's hash.
     pub fn resolve_files(&mut self, base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
+        self.method_mut().resolve_files(base)
+    }
+
+    /// The two-level settings of a nested study, whose analysis is its own.
+    pub fn nested(&self) -> Option<&nested::Nested> {
         match self {
-            MethodSpec::PceRegression(m) => m.resolve_points(base),
-            MethodSpec::Nested(m) => {
-                m.outer.resolve_files(base)?;
-                m.inner.resolve_files(base)
-            }
-            _ => Ok(()),
+            MethodSpec::Nested(n) => Some(n),
+            _ => None,
         }
     }
 
     /// Takes the parameters marked `level = "outer"` (names, study order): a nested study
     /// draws them in its outer design; any other method refuses them.
     pub fn set_levels(&mut self, outer: &[String]) -> Result<(), InvalidSettings> {
-        match self {
-            MethodSpec::Nested(m) => {
-                m.outer_parameters = outer.to_vec();
-                Ok(())
-            }
-            _ if outer.is_empty() => Ok(()),
-            other => Err(InvalidSettings(format!(
-                "parameter '{}' has level = \"outer\", which only a nested study \
-                 ([method] kind = \"nested\") has; {} draws every parameter in one design",
-                outer[0],
-                other.method().kind()
-            ))),
-        }
+        self.method_mut().set_outer_parameters(outer)
     }
 }
 
@@ -316,7 +333,7 @@ mod tests {
         toml::from_str(text).unwrap()
     }
 
-    /// QA qa4/lib H3/H4: `SobolSampling::estimate` with `data` three rows short of `rows`
+    /// `SobolSampling::estimate` with `data` three rows short of `rows`
     /// panicked (range end index out of range); `Lhs::estimate` with three rows too many or
     /// too few, and `Scm::estimate` with rows that are not design indices, returned `Ok`
     /// with wrong numbers.
@@ -365,7 +382,7 @@ mod tests {
         }
     }
 
-    /// QA qa4/lib H3: `SobolSampling { base: Mc, bootstrap: Some(50), confidence: 2.0 }`
+    /// `SobolSampling { base: Mc, bootstrap: Some(50), confidence: 2.0 }`
     /// panicked in `estimate` (`partition_at_index`); only `validate` refused it, which
     /// `design` and `estimate` did not call.
     #[test]
@@ -401,7 +418,7 @@ mod tests {
         }
     }
 
-    /// QA qa4/lib H4: `Scm` on an `integer_uniform` input returned `Ok` with std 0.577 (true
+    /// `Scm` on an `integer_uniform` input returned `Ok` with std 0.577 (true
     /// 0.816): only `validate` refused a discrete input for a chaos, not `design`/`estimate`.
     #[test]
     fn chaos_methods_refuse_a_discrete_input_in_design_and_estimate() {
@@ -449,7 +466,7 @@ mod tests {
         m.design(&discrete, 1).unwrap();
     }
 
-    /// QA qa4/lib H3: a `Distribution` struct literal with `low > high` reached the
+    /// A `Distribution` struct literal with `low > high` reached the
     /// quantile and panicked (`min > max`); the designs now refuse it with a typed error.
     #[test]
     fn designs_refuse_an_invalid_distribution_literal() {

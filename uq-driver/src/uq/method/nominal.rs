@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -40,13 +40,19 @@ impl Method for Nominal {
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Sampling(self)
     }
+
+    fn notes() -> KindNotes {
+        KindNotes {
+            deterministic: true,
+            ..KindNotes::default()
+        }
+    }
 }
 
 impl Sampling for Nominal {
     /// One point of weight 1 at the parameters' means (a discrete input at the value of
     /// its support nearest to its mean, [`crate::uq::Distribution::nominal`]).
-    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         Ok(Design {
             germ: Germ::Normal,
             points: vec![vec![0.0; inputs.len()]],
@@ -58,13 +64,12 @@ impl Sampling for Nominal {
     }
 
     /// The run's values, Std 0.
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         Ok(Estimate::from_quadrature(
             data,
             design.complete_weights(rows)?,

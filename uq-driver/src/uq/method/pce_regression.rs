@@ -21,14 +21,16 @@ use super::chaos::{continuous_inputs, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
-use super::traits::{check_design, check_estimate, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::Germ;
+use super::traits::{
+    hyperbolic_terms, ChaosFit, Evaluation, Method, MethodSummary, Problem, Sampling,
+};
+use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::hd::lars::PathKind;
 use crate::uq::hd::regression::LeastSquares;
 use crate::uq::hd::sobol_seq::Sobol;
 use crate::uq::hd::sparse_chaos::{Candidates, FitKind};
-use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce};
+use crate::uq::random_inputs::RandomInputs;
 use crate::uq::sampling;
 
 /// Highest chaos order accepted.
@@ -96,9 +98,8 @@ impl PceRegression {
                 path = b.join(path);
             }
         }
-        let bytes = std::fs::read(&path).map_err(|e| {
-            InvalidSettings(format!("points file {}: {e}", path.display()))
-        })?;
+        let bytes = std::fs::read(&path)
+            .map_err(|e| InvalidSettings(format!("points file {}: {e}", path.display())))?;
         use sha2::Digest;
         self.points_sha256 = Some(format!("{:x}", sha2::Sha256::digest(&bytes)));
         self.points = Some(path.display().to_string());
@@ -247,6 +248,10 @@ impl Method for PceRegression {
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Sampling(self)
     }
+
+    fn resolve_files(&mut self, base: Option<&Path>) -> Result<(), InvalidSettings> {
+        self.resolve_points(base)
+    }
 }
 
 fn under_determined(n: usize, terms: usize, m: &PceRegression) -> InvalidSettings {
@@ -261,8 +266,7 @@ fn under_determined(n: usize, terms: usize, m: &PceRegression) -> InvalidSetting
 impl Sampling for PceRegression {
     /// The random design mapped to the chaos germs (one uniform per coordinate through the
     /// germ law's quantile), or the points file.
-    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         if let Some(path) = &self.points {
             return self.file_design(path, inputs);
         }
@@ -298,15 +302,16 @@ impl Sampling for PceRegression {
     }
 
     /// The chaos of every column at the runs that gave a value (`rows`).
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         let families = design.families().ok_or_else(|| {
-            MethodError::Invalid(InvalidSettings("regression chaos needs a chaos germ".into()))
+            MethodError::Invalid(InvalidSettings(
+                "regression chaos needs a chaos germ".into(),
+            ))
         })?;
         let points: Vec<Vec<f64>> = rows.iter().map(|&r| design.points[r].clone()).collect();
         let columns: Vec<Vec<f64>> = (0..data.ncols())
@@ -329,6 +334,22 @@ impl Sampling for PceRegression {
 
     fn min_runs(&self) -> usize {
         3
+    }
+
+    fn chaos_fit(&self, parameters: &[RandomParameter]) -> Option<ChaosFit> {
+        let dim = parameters.len();
+        Some(if self.sparse {
+            ChaosFit::Lars {
+                candidates: (1..=self.order)
+                    .map(|p| hyperbolic_terms(dim, p, self.q_norm))
+                    .sum(),
+                largest: hyperbolic_terms(dim, self.order, self.q_norm),
+            }
+        } else {
+            ChaosFit::LeastSquares {
+                terms: hyperbolic_terms(dim, self.order, self.q_norm),
+            }
+        })
     }
 }
 

@@ -1,5 +1,5 @@
 //! Quasi-Monte Carlo: `replicates` independent Owen-scrambled Sobol' sequences (Joe–Kuo
-//! direction numbers, [`crate::uq::hd::sobol_seq`]) of `samples` points each, mapped through
+//! direction numbers, `uq::hd::sobol_seq`) of `samples` points each, mapped through
 //! each input's quantile function.
 //!
 //! Replicate `r` is the scrambling keyed by `(seed, r)`: its dimension `j` takes the `j`-th
@@ -76,7 +76,8 @@ impl UnitCubeSample for Qmc {
         replicate: Option<usize>,
     ) -> Result<Vec<Vec<f64>>, MethodError> {
         let r = replicate.unwrap_or(0) as u64;
-        let invalid = |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
+        let invalid =
+            |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
         Sobol::scrambled(d, seed, r)
             .map_err(invalid)?
             .points(0, n)

@@ -15,9 +15,7 @@ use rayon::prelude::*;
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{
-    check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling,
-};
+use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -31,6 +29,9 @@ pub(crate) const SE_MONTE_CARLO: &str = "Monte Carlo: std / sqrt(samples)";
 pub(crate) trait UnitCubeSample: std::fmt::Debug + Send + Sync {
     /// `kind` in study files.
     const KIND: &'static str;
+
+    /// Said of a convergence plot over the number of runs ([`KindNotes::runs_axis`]).
+    const RUNS_AXIS: Option<&'static str> = None;
 
     /// Number of points (of each replicate).
     fn samples(&self) -> usize;
@@ -111,12 +112,18 @@ impl<T: UnitCubeSample> Method for T {
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Sampling(self)
     }
+
+    fn notes() -> KindNotes {
+        KindNotes {
+            runs_axis: T::RUNS_AXIS,
+            ..KindNotes::default()
+        }
+    }
 }
 
 impl<T: UnitCubeSample> Sampling for T {
     /// Replicate by replicate (point `i` in replicate `i / samples`).
-    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         let (n, d) = (self.samples(), inputs.len());
         let points = match self.replicates() {
             None => self.block(n, d, seed, None)?,
@@ -134,13 +141,12 @@ impl<T: UnitCubeSample> Sampling for T {
     }
 
     /// Any subset of the points is a valid (smaller) sample: failed points may be left out.
-    fn estimate(
+    fn make_estimate(
         &self,
-        design: &Design,
+        _design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         Ok(match self.replicates() {
             None => Estimate::from_sample(data),
             Some(_) => Estimate::from_replicates(data, rows, self.samples()),

@@ -17,11 +17,11 @@ use super::chaos::{continuous_inputs, order_difference, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
-use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
-use crate::uq::distributions::Germ;
-use crate::uq::random_inputs::RandomInputs;
+use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
+use crate::uq::random_inputs::RandomInputs;
 
 /// Most nodes per dimension.
 const MAX_NODES: usize = 64;
@@ -99,12 +99,32 @@ impl Method for Scm {
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Sampling(self)
     }
+
+    /// SCM follows each input's Askey family since `chaos` became one of its keys: where that
+    /// changes the design (an input with a non-Hermite germ) the hash says so, so that a store
+    /// of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
+    fn hash_entry(
+        &self,
+        parameters: &[RandomParameter],
+    ) -> Option<(&'static str, serde_json::Value)> {
+        (self.chaos == ChaosBasis::Askey && ChaosBasis::some_own_family(parameters))
+            .then(|| ("scm_germ", serde_json::json!("askey")))
+    }
+
+    fn notes() -> KindNotes {
+        KindNotes {
+            truncation: Some(
+                "each term is projected on its own, so the truncation is the lower-order chaos \
+                 of the same runs",
+            ),
+            ..KindNotes::default()
+        }
+    }
 }
 
 impl Sampling for Scm {
     /// The tensor grid, last parameter varying fastest; weights sum to one.
-    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         let families = self.chaos.families(inputs);
         if families.iter().all(|f| *f == Family::Hermite) {
             // Every input through the normal map: the Gauss–Hermite grid.
@@ -139,13 +159,12 @@ impl Sampling for Scm {
     }
 
     /// Needs every node: a missing weighted node would bias every moment.
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
         let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
@@ -153,13 +172,7 @@ impl Sampling for Scm {
             MethodError::Invalid(InvalidSettings("scm needs a chaos germ".into()))
         })?;
         let basis = Basis::new(families, set).map_err(PceError::from)?;
-        let pce = Pce::project(
-            basis,
-            &design.points,
-            weights,
-            data,
-            &vec![self.nodes; dim],
-        )?;
+        let pce = Pce::project(basis, &design.points, weights, data, &vec![self.nodes; dim])?;
         let mut estimate = Estimate::from_quadrature(data, weights);
         estimate.std_chaos = Some(pce.std());
         estimate.chaos_error = order_difference(&pce);

@@ -1,14 +1,16 @@
 //! The stochastic Galerkin method on a linear second-order system given in the study file
 //! (`[system]`): `M q'' + C q' + K q = f`, each matrix (and q0, v0) affine in the Gaussian
 //! parameters, `A = A_given + Σ_j p_j · D_j`. The Galerkin system itself is in
-//! [`crate::uq::galerkin`]; this module reads the `[system]` table, checks it against the
+//! `uq::galerkin`; this module reads the `[system]` table, checks it against the
 //! study, solves, and returns the chaos of every output over time.
 
 use serde::{Deserialize, Serialize};
 
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{details, Evaluation, Intrusive, Method, MethodSummary, Problem, Solution};
+use super::traits::{
+    details, Evaluation, Intrusive, KindNotes, Method, MethodSummary, Problem, Solution,
+};
 use crate::uq::galerkin::system::{linear_system, output_dof, SystemSpec};
 use crate::uq::galerkin::{Definiteness, GalerkinSystem};
 
@@ -24,12 +26,15 @@ pub struct Sgm {
 }
 
 fn system<'a>(problem: &Problem<'a>) -> Result<&'a SystemSpec, InvalidSettings> {
-    problem.system.ok_or_else(|| {
-        InvalidSettings("method sgm needs a [system] (matrices M, C, K, q0)".into())
-    })
+    problem
+        .system
+        .ok_or_else(|| InvalidSettings("method sgm needs a [system] (matrices M, C, K, q0)".into()))
 }
 
-fn output_dofs(sys: &SystemSpec, outputs: &[String]) -> Result<Vec<(usize, bool)>, InvalidSettings> {
+fn output_dofs(
+    sys: &SystemSpec,
+    outputs: &[String],
+) -> Result<Vec<(usize, bool)>, InvalidSettings> {
     outputs
         .iter()
         .map(|o| {
@@ -97,6 +102,13 @@ impl Method for Sgm {
 
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Intrusive(self)
+    }
+
+    fn notes() -> KindNotes {
+        KindNotes {
+            name: Some("an SGM study"),
+            ..KindNotes::default()
+        }
     }
 }
 

@@ -11,7 +11,7 @@
 //!   `k / (samples / R)`;
 //! - `"mc"`: Monte Carlo; `"lhs"`: a Latin hypercube (one design of `samples` points).
 //!
-//! Estimators ([`crate::uq::hd::sensitivity`]): first order by Saltelli (2010), total by
+//! Estimators (`uq::hd::sensitivity`): first order by Saltelli (2010), total by
 //! Jansen (1999), normalised by the variance of the `2 × samples` values of `A` and `B`, on
 //! the values less their mean over `A` and `B` (same expectation; centring cuts the variance
 //! of the first-order estimator when the mean is large against the spread), always on all
@@ -19,7 +19,7 @@
 //! - base `qmc`: from the spread of the R replicate estimates (each replicate's rows alone),
 //!   `estimate ± t_{R-1, (1 + confidence)/2} sd_R / sqrt(R)`. The rows of one scrambled net
 //!   are not independent: a bootstrap over them missed the indices of the Morris function in
-//!   every seed (QA2 F1), since the error of one net depends on its scrambling;
+//!   every seed, since the error of one net depends on its scrambling;
 //! - bases `mc` and `lhs`: percentile bootstrap from `bootstrap` resamples of the rows (the
 //!   same resampled rows for every column; resample `k` from the ChaCha20 stream
 //!   `(0x5eed_b007, k)`, so the intervals are reproducible).
@@ -45,7 +45,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::qmc::{check_sobol_points, Qmc, DEFAULT_REPLICATES};
 use super::sample::UnitCubeSample;
-use super::traits::{check_design, check_estimate, DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::random_inputs::RandomInputs;
@@ -179,10 +179,7 @@ impl Method for SobolSampling {
             d.insert("bootstrap".into(), self.bootstrap_resamples().into());
         }
         d.insert("confidence".into(), self.confidence.into());
-        d.insert(
-            "runs".into(),
-            (self.samples.saturating_mul(dim + 2)).into(),
-        );
+        d.insert("runs".into(), (self.samples.saturating_mul(dim + 2)).into());
         let estimators = match self.base {
             Base::Qmc => {
                 "first order: Saltelli (2010); total: Jansen (1999); on all rows; intervals \
@@ -301,8 +298,7 @@ impl SobolSampling {
 impl Sampling for SobolSampling {
     /// In the independent uniform space (with correlated inputs the indices are those of the
     /// independent germs, one per input in study order, as for a chaos).
-    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         let d = inputs.len();
         let base = self.base_points(d, seed)?;
         let (a, b): (Vec<Vec<f64>>, Vec<Vec<f64>>) = base
@@ -321,13 +317,12 @@ impl Sampling for SobolSampling {
         Ok(design)
     }
 
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         let n = self.samples;
         let d = design.points.first().map_or(0, Vec::len);
         let blocks = PickFreezeRows::new(n, d, rows);
@@ -356,7 +351,13 @@ impl Sampling for SobolSampling {
         let d = design.points.first().map_or(0, Vec::len);
         let blocks = PickFreezeRows::new(self.samples, d, rows);
         let b: Vec<usize> = blocks.block_rows(1).collect();
-        Some(blocks.block_rows(0).zip(b).flat_map(|(a, b)| [a, b]).collect())
+        Some(
+            blocks
+                .block_rows(0)
+                .zip(b)
+                .flat_map(|(a, b)| [a, b])
+                .collect(),
+        )
     }
 
     fn planned_runs(&self, dim: usize) -> Option<f64> {
@@ -365,6 +366,10 @@ impl Sampling for SobolSampling {
 
     fn draws_from_chaos(&self) -> bool {
         false
+    }
+
+    fn estimates_sobol(&self) -> bool {
+        true
     }
 }
 
@@ -698,13 +703,17 @@ mod tests {
         let some = |i: usize| !(base_row(i) < 63 || (320..384).contains(&base_row(i)));
         let s = estimate(&some, &m).unwrap().sobol.unwrap();
         let ci = s.intervals.unwrap();
-        assert!(ci.total[0].iter().all(|&(lo, hi)| lo.is_finite() && hi.is_finite()));
+        assert!(ci.total[0]
+            .iter()
+            .all(|&(lo, hi)| lo.is_finite() && hi.is_finite()));
         // Only replicate 2 left: indices, but no spread, so NaN intervals (not a panic).
         let one = |i: usize| (128..192).contains(&base_row(i));
         let s = estimate(&one, &m).unwrap().sobol.unwrap();
         assert!(s.first[0][0].is_finite());
         let ci = s.intervals.unwrap();
-        assert!(ci.first[0].iter().all(|&(lo, hi)| lo.is_nan() && hi.is_nan()));
+        assert!(ci.first[0]
+            .iter()
+            .all(|&(lo, hi)| lo.is_nan() && hi.is_nan()));
         // Too few complete rows is an error, not a panic.
         assert!(estimate(&|i| base_row(i) < 1, &m).is_err());
         // `bootstrap = 0`: no intervals for the other bases.
@@ -762,7 +771,10 @@ mod tests {
                 covered += 1;
             }
         }
-        assert!(covered >= 16, "the interval covered the mean in {covered} of 20 seeds");
+        assert!(
+            covered >= 16,
+            "the interval covered the mean in {covered} of 20 seeds"
+        );
         // The other bases keep the Monte Carlo formula.
         let lhs = SobolSampling {
             base: Base::Lhs,
@@ -911,18 +923,27 @@ mod tests {
         assert_eq!(err("samples = 64"), Ok(()));
         assert_eq!(err("samples = 12\nreplicates = 3"), Ok(()));
         let e = err("samples = 64\nreplicates = 1").unwrap_err();
-        assert!(e.contains("`replicates` = 1") && e.contains("at least 2"), "{e}");
+        assert!(
+            e.contains("`replicates` = 1") && e.contains("at least 2"),
+            "{e}"
+        );
         let e = err("samples = 100").unwrap_err();
         assert!(e.contains("not a multiple of `replicates` = 8"), "{e}");
         assert!(e.contains("samples = 128"), "{e}");
         let e = err("samples = 96").unwrap_err();
-        assert!(e.contains("96 / 8 = 12") && e.contains("power of two"), "{e}");
+        assert!(
+            e.contains("96 / 8 = 12") && e.contains("power of two"),
+            "{e}"
+        );
         assert!(e.contains("samples = 64 or 128"), "{e}");
         let e = err("samples = 8").unwrap_err();
         assert!(e.contains("8 / 8 = 1") && e.contains("samples = 16"), "{e}");
         assert_eq!(err("samples = 96\nreplicates = 3"), Ok(()));
         let e = err("samples = 64\nbase = \"mc\"\nreplicates = 4").unwrap_err();
-        assert!(e.contains("`replicates` = 4 applies to base = \"qmc\" only"), "{e}");
+        assert!(
+            e.contains("`replicates` = 4 applies to base = \"qmc\" only"),
+            "{e}"
+        );
         assert!(e.contains("base = \"mc\""), "{e}");
         // `bootstrap` on a qmc base is not used: said so in the design's warnings.
         let m: SobolSampling = toml::from_str("samples = 16\nbootstrap = 50").unwrap();

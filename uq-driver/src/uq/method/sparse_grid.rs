@@ -23,13 +23,13 @@ use super::chaos::{continuous_inputs, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
-use super::traits::{check_design, check_estimate, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{ChaosFit, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
 use crate::uq::hd::smolyak::{total_level_size as count, GridSize, LevelSet, SparseGrid as Grid};
-use crate::uq::random_inputs::RandomInputs;
 use crate::uq::pce::Family;
+use crate::uq::random_inputs::RandomInputs;
 
 /// Most points of a sparse grid accepted here.
 const MAX_POINTS: usize = 1_000_000;
@@ -204,8 +204,7 @@ impl Method for SparseGrid {
 impl Sampling for SparseGrid {
     /// The merged nodes of the sparse grid in the inputs' germs, with the (possibly
     /// negative) combined weights.
-    fn design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
-        check_design(self, inputs)?;
+    fn make_design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
         let families = self.families(inputs);
         let grid = self.grid(&families)?;
         let germ = self.chaos.germ();
@@ -220,13 +219,12 @@ impl Sampling for SparseGrid {
 
     /// Needs every node (weighted design). The chaos of every column by the sparse
     /// pseudo-spectral projection; the level difference when the rules are nested.
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
         design.complete_weights(rows)?;
         let families = design.families().ok_or_else(|| {
             MethodError::Invalid(InvalidSettings("a sparse grid needs a chaos germ".into()))
@@ -263,6 +261,17 @@ impl Sampling for SparseGrid {
     /// The grid's points, counted without building it.
     fn planned_runs_for(&self, parameters: &[RandomParameter]) -> Option<f64> {
         self.size(parameters).ok().map(|s| s.points)
+    }
+
+    fn chaos_fit(&self, parameters: &[RandomParameter]) -> Option<ChaosFit> {
+        self.size(parameters).ok().map(ChaosFit::Projection)
+    }
+
+    fn no_error_estimate(&self) -> Option<&'static str> {
+        Some(
+            "a sparse grid has one only at a level above 0 with nested rules; Beta and \
+             Gamma inputs, and the gauss_* rules, are not nested",
+        )
     }
 }
 
@@ -309,8 +318,10 @@ mod tests {
         assert_eq!(cc.rules(&fams)[1], RuleKind::ClenshawCurtis);
         assert_eq!(cc.rules(&fams)[0], RuleKind::GenzKeister);
         let h = method("level = 2\nchaos = \"hermite\"");
-        assert!(h.rules(&h.families(&inputs(vec![Distribution::uniform(0.0, 1.0).unwrap()])))
-            == vec![RuleKind::GenzKeister]);
+        assert!(
+            h.rules(&h.families(&inputs(vec![Distribution::uniform(0.0, 1.0).unwrap()])))
+                == vec![RuleKind::GenzKeister]
+        );
     }
 
     #[test]
@@ -340,7 +351,9 @@ mod tests {
         let err = e.chaos_error.unwrap();
         assert_eq!(err.kind, ChaosErrorKind::LevelDifference);
         assert!(err.values[0] < 1e-24, "{:?}", err.values);
-        assert!(m.estimate(&d, &rows[1..], &data.rows(1, d.len() - 1).into_owned()).is_err());
+        assert!(m
+            .estimate(&d, &rows[1..], &data.rows(1, d.len() - 1).into_owned())
+            .is_err());
     }
 
     #[test]
@@ -359,7 +372,10 @@ mod tests {
         let gammas = vec![Distribution::gamma(3.0, 0.5).unwrap(); 4];
         let betas = vec![Distribution::beta(2.0, 5.0, 0.0, 1.0).unwrap(); 3];
         for (ds, rules) in [
-            (mixed.clone(), vec!["", "rule = \"gauss_hermite\"", "rule = \"clenshaw_curtis\""]),
+            (
+                mixed.clone(),
+                vec!["", "rule = \"gauss_hermite\"", "rule = \"clenshaw_curtis\""],
+            ),
             (mixed[..3].to_vec(), vec!["rule = \"gauss_legendre\""]),
             (gammas, vec![""]),
             (betas, vec![""]),
@@ -404,7 +420,13 @@ mod tests {
     fn a_misplaced_rule_is_named_as_the_study_file_spells_it() {
         // README audit F8: messages named rules `ClenshawCurtis`, which no study file takes.
         use RuleName::*;
-        for r in [GenzKeister, GaussHermite, GaussPatterson, ClenshawCurtis, GaussLegendre] {
+        for r in [
+            GenzKeister,
+            GaussHermite,
+            GaussPatterson,
+            ClenshawCurtis,
+            GaussLegendre,
+        ] {
             let spelt = serde_json::to_string(&r).unwrap();
             assert_eq!(spelt, format!("\"{}\"", r.file_name()));
         }

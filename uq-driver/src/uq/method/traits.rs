@@ -49,7 +49,7 @@ impl<'a> Problem<'a> {
 /// and the method's settings fit these inputs ([`Method::validate`] on
 /// [`Problem::of_inputs`]: e.g. a chaos refuses a discrete input, `confidence` must be in
 /// (0, 1)).
-pub(crate) fn check_design(method: &dyn Method, inputs: &RandomInputs) -> Result<(), MethodError> {
+fn check_design<M: Method + ?Sized>(method: &M, inputs: &RandomInputs) -> Result<(), MethodError> {
     for p in &inputs.parameters {
         p.distribution
             .validate()
@@ -65,8 +65,8 @@ pub(crate) fn check_design(method: &dyn Method, inputs: &RandomInputs) -> Result
 /// What every [`Sampling::estimate`] checks before it estimates: the design's inputs and
 /// the settings as [`check_design`] does (the settings may have changed since the design
 /// was built), and that the results fit the design ([`Design::check_results`]).
-pub(crate) fn check_estimate(
-    method: &dyn Method,
+fn check_estimate<M: Method + ?Sized>(
+    method: &M,
     design: &Design,
     rows: &[usize],
     data: &DMatrix<f64>,
@@ -139,10 +139,66 @@ pub trait Method: std::fmt::Debug + Send + Sync {
 
     /// Whether the method runs the model at a design or solves its own system.
     fn evaluation(&self) -> Evaluation<'_>;
+
+    /// What besides its settings makes the results of this method on `parameters` differ,
+    /// as an entry of the study's hash (so that a store of another design is not resumed).
+    fn hash_entry(
+        &self,
+        _parameters: &[RandomParameter],
+    ) -> Option<(&'static str, serde_json::Value)> {
+        None
+    }
+
+    /// Resolves the files the settings name (e.g. a points file) against `base`, the study
+    /// file's folder.
+    fn resolve_files(&mut self, _base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
+        Ok(())
+    }
+
+    /// Takes the parameters marked `level = "outer"` (names, study order): only a nested
+    /// study has two levels; any other method refuses them.
+    fn set_outer_parameters(&mut self, outer: &[String]) -> Result<(), InvalidSettings> {
+        match outer.first() {
+            None => Ok(()),
+            Some(name) => Err(InvalidSettings(format!(
+                "parameter '{name}' has level = \"outer\", which only a nested study \
+                 ([method] kind = \"nested\") has; {} draws every parameter in one design",
+                self.kind()
+            ))),
+        }
+    }
+
+    /// What the report and the terminal say of this method's results (by `kind`, for a
+    /// `summary.json` read back: see [`notes_of_kind`](crate::uq::method::notes_of_kind)).
+    fn notes() -> KindNotes
+    where
+        Self: Sized,
+    {
+        KindNotes::default()
+    }
+}
+
+/// What the report and the terminal say of a method's results.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct KindNotes {
+    /// One deterministic run (no spread, no statistics).
+    pub deterministic: bool,
+    /// Said of a convergence plot over the number of runs (e.g. that the first n points of
+    /// a Latin hypercube are not a Latin hypercube).
+    pub runs_axis: Option<&'static str>,
+    /// Said of a convergence plot over the chaos order: how the truncated chaos is obtained.
+    pub truncation: Option<&'static str>,
+    /// The method's name in a sentence ("an SGM study").
+    pub name: Option<&'static str>,
 }
 
 /// A method that runs the model at the points of a design.
-pub trait Sampling {
+///
+/// A method implements [`Sampling::make_design`] and [`Sampling::make_estimate`]; callers
+/// call [`Sampling::design`] and [`Sampling::estimate`], which run the checks every method
+/// shares first (valid inputs, settings that fit them, results that fit the design), so
+/// that no method can skip them.
+pub trait Sampling: Method {
     /// The design for `inputs` (deterministic in `seed`): points in an independent standard
     /// space mapped to physical values by [`Design::mapped`], which honours the inputs'
     /// correlation.
@@ -151,7 +207,10 @@ pub trait Sampling {
     /// ([`MethodError::InvalidInput`]) and that the settings fit the inputs
     /// ([`Method::validate`] on [`Problem::of_inputs`], [`MethodError::Invalid`]); no need to
     /// call `validate` first.
-    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError>;
+    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+        check_design(self, inputs)?;
+        self.make_design(inputs, seed)
+    }
 
     /// Estimates from the results `data` (one row per entry of `rows`, the design indices of
     /// the points that gave a value; one column per time step or quantity).
@@ -160,6 +219,22 @@ pub trait Sampling {
     /// ([`MethodError::ResultsMismatch`] otherwise); the settings are checked as in
     /// [`Sampling::design`].
     fn estimate(
+        &self,
+        design: &Design,
+        rows: &[usize],
+        data: &DMatrix<f64>,
+    ) -> Result<Estimate, MethodError> {
+        check_estimate(self, design, rows, data)?;
+        self.make_estimate(design, rows, data)
+    }
+
+    /// The method's own design, called by [`Sampling::design`] once the inputs and the
+    /// settings have passed the shared checks.
+    fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError>;
+
+    /// The method's own estimator, called by [`Sampling::estimate`] once the inputs, the
+    /// settings and the shape of the results have passed the shared checks.
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
@@ -198,6 +273,58 @@ pub trait Sampling {
     fn draws_from_chaos(&self) -> bool {
         true
     }
+
+    /// Whether the estimates carry Sobol' indices over time (counted in the memory estimate).
+    fn estimates_sobol(&self) -> bool {
+        self.draws_from_chaos()
+    }
+
+    /// The size of the chaos the estimator fits, for a method whose arrays grow with the
+    /// chaos's terms (counted in the memory estimate before anything is built); `None` for the
+    /// others, and when the sizes cannot be known (the method's own checks then refuse).
+    fn chaos_fit(&self, _parameters: &[RandomParameter]) -> Option<ChaosFit> {
+        None
+    }
+
+    /// Whether the estimator needs the whole series of an output at once, not a block of
+    /// columns at a time (a nested study: its outer samples' inner estimates).
+    fn whole_series(&self) -> bool {
+        false
+    }
+
+    /// Why the chaos has no truncation-error estimate, where the method can have none.
+    fn no_error_estimate(&self) -> Option<&'static str> {
+        None
+    }
+}
+
+/// The size of the chaos a method's estimator fits (see [`Sampling::chaos_fit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ChaosFit {
+    /// Regression with least-angle regression (`pce_regression`, `sparse = true`): the
+    /// candidates of all the degrees tried (`sum_p m_p`) and of the highest (`m_order`).
+    Lars {
+        /// `sum_p m_p`, `p = 1..=order`.
+        candidates: f64,
+        /// `m_order`.
+        largest: f64,
+    },
+    /// Least squares on a fixed basis (`pce_regression`, `sparse = false`): its terms.
+    LeastSquares {
+        /// Terms.
+        terms: f64,
+    },
+    /// Sparse pseudo-spectral projection (`sparse_grid`): the grid's counted sizes.
+    Projection(crate::uq::hd::smolyak::GridSize),
+}
+
+/// Terms of the hyperbolic (q-norm) truncation `{k : sum_i k_i^q <= order^q}` in `dim`
+/// dimensions (the set of `MultiIndexSet::hyperbolic`), counted without building it: over
+/// the non-increasing lists of non-zero degrees within the bound, the ways of placing them
+/// among the dimensions. `q = 1` gives `C(dim + order, order)`.
+pub fn hyperbolic_terms(dim: usize, order: usize, q: f64) -> f64 {
+    // Beyond 1e10 terms any estimate is refused: counting further would only take time.
+    crate::uq::pce::MultiIndexSet::hyperbolic_count_upto(dim, order, q, 1e10)
 }
 
 /// A method that solves a projected (intrusive) system instead of running the model.

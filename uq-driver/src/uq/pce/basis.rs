@@ -148,7 +148,7 @@ impl MultiIndexSet {
         if !(q > 0.0 && q <= 1.0) {
             return Err(BasisError::BadQ(q));
         }
-        // Counted first: a set over the limit is refused before it is built (QA: 30 inputs
+        // Counted first: a set over the limit is refused before it is built (30 inputs
         // at order 7 took 2.3 s and 1.4 GB to reach the limit by enumeration).
         if Self::hyperbolic_count_upto(dim, order, q, MAX_TERMS as f64) > MAX_TERMS as f64 {
             return Err(BasisError::TooLarge(MAX_TERMS));
@@ -416,7 +416,7 @@ mod tests {
 
     #[test]
     fn a_basis_over_the_term_limit_is_refused_from_its_count_before_it_is_built() {
-        // QA: 30 inputs at order 7 (C(37, 7) = 10 295 472 terms) took 2.3 s and 1.4 GB of
+        // 30 inputs at order 7 (C(37, 7) = 10 295 472 terms) took 2.3 s and 1.4 GB of
         // enumeration to reach the limit; the count refuses it at once, and a huge order is
         // counted only up to the limit.
         assert_eq!(

@@ -1,7 +1,12 @@
-//! Probabilists' Hermite polynomials: values, exact norms `n!` and Galerkin triple products.
+//! Probabilists' Hermite polynomials: exact norms `n!` and Galerkin triple products (and, for
+//! the tests, their values).
 
 /// Probabilists' Hermite polynomial `He_n(x)` by the three-term recurrence.
-pub fn hermite_he(n: usize, x: f64) -> f64 {
+///
+/// Serves the tests: the reference the chaos's Hermite basis, norms and triple products are
+/// checked against.
+#[cfg(test)]
+pub(crate) fn hermite_he(n: usize, x: f64) -> f64 {
     let (mut prev, mut cur) = (0.0, 1.0);
     for k in 0..n {
         let next = x * cur - k as f64 * prev;
@@ -9,22 +14,6 @@ pub fn hermite_he(n: usize, x: f64) -> f64 {
         cur = next;
     }
     cur
-}
-
-/// All `He_0(x), ..., He_{n_max}(x)` into `out[0..=n_max]` (only the first
-/// `out.len()` values if `out` is shorter).
-pub fn hermite_all(n_max: usize, x: f64, out: &mut [f64]) {
-    let m = out.len().min(n_max.saturating_add(1));
-    if m == 0 {
-        return;
-    }
-    out[0] = 1.0;
-    if m > 1 {
-        out[1] = x;
-    }
-    for k in 1..m.saturating_sub(1) {
-        out[k + 1] = x * out[k] - k as f64 * out[k - 1];
-    }
 }
 
 /// `n!` as an integer while it fits in a `u128` (n <= 34).

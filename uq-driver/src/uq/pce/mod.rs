@@ -28,7 +28,9 @@ use nalgebra::DMatrix;
 
 pub use askey::Family;
 pub use basis::{Basis, BasisError, ChaosStats, MultiIndexSet};
-pub use hermite::{hermite_all, hermite_he, hermite_norm_sq, hermite_triple};
+#[cfg(test)]
+pub(crate) use hermite::hermite_he;
+pub use hermite::{hermite_norm_sq, hermite_triple};
 
 use crate::uq::rng;
 use crate::uq::Distribution;

@@ -249,7 +249,7 @@ mod tests {
     #[test]
     fn the_counts_of_large_grids_are_instant() {
         // 30 uniform inputs, Gauss–Patterson: nested, Σ_{|l| <= L} Π new(l_i) with
-        // new = 1, 2, 4, 8, 16, 32 (the QA's count for level 5: 9 600 513 points).
+        // new = 1, 2, 4, 8, 16, 32 (the count for level 5: 9 600 513 points).
         let rules = vec![RuleKind::GaussPatterson; 30];
         fn nested(new: &[f64], d: usize, budget: usize) -> f64 {
             if d == 0 {

@@ -102,8 +102,8 @@ impl Conditional {
     /// of the mean): since `E[Σ (y − ȳ)²] = n σ² − n Var(ȳ)` for any design whose points each
     /// follow the inputs' law, this is unbiased whenever `se²` is. For Monte Carlo
     /// (`se² = s²/n`) it is `s²` itself; for a replicated quasi-Monte Carlo design, whose
-    /// mean varies far less than `σ²/n`, it drops the `n/(n − 1)` excess of `s²` (found by QA:
-    /// inner designs of 16 runs gave 2.48 ± 0.05 for a true 2.33). A Latin hypercube's `se²`
+    /// mean varies far less than `σ²/n`, it drops the `n/(n − 1)` excess of `s²`
+    /// (inner designs of 16 runs gave 2.48 ± 0.05 for a true 2.33). A Latin hypercube's `se²`
     /// is the Monte Carlo one, an upper bound, so its `v` stays `s²`, at most `n/(n − 1)`
     /// high. Quadrature and chaos estimates (no `se²`) keep their own variance.
     pub fn column(&self, col: usize) -> Conditionals {
@@ -194,7 +194,9 @@ impl Nested {
         }
         for n in &self.outer_parameters {
             if !inputs.iter().any(|p| &p.name == n) {
-                return Err(InvalidSettings(format!("outer parameter '{n}' is not random")));
+                return Err(InvalidSettings(format!(
+                    "outer parameter '{n}' is not random"
+                )));
             }
         }
         let (outer, inner): (Vec<usize>, Vec<usize>) =
@@ -384,8 +386,7 @@ impl Method for Nested {
             map.insert("kind".into(), ms.kind.into());
             serde_json::Value::Object(map)
         };
-        s.details
-            .insert("outer".into(), sub(&self.outer, d_outer));
+        s.details.insert("outer".into(), sub(&self.outer, d_outer));
         s.details
             .insert("inner".into(), sub(&self.inner, dim - d_outer));
         s.details.insert(
@@ -418,12 +419,30 @@ impl Method for Nested {
     fn evaluation(&self) -> Evaluation<'_> {
         Evaluation::Sampling(self)
     }
+
+    /// The inner method's entry: it draws the designs the runs come from.
+    fn hash_entry(
+        &self,
+        parameters: &[RandomParameter],
+    ) -> Option<(&'static str, serde_json::Value)> {
+        self.inner.method().hash_entry(parameters)
+    }
+
+    fn resolve_files(&mut self, base: Option<&std::path::Path>) -> Result<(), InvalidSettings> {
+        self.outer.method_mut().resolve_files(base)?;
+        self.inner.method_mut().resolve_files(base)
+    }
+
+    fn set_outer_parameters(&mut self, outer: &[String]) -> Result<(), InvalidSettings> {
+        self.outer_parameters = outer.to_vec();
+        Ok(())
+    }
 }
 
 impl Sampling for Nested {
     /// The outer design, and per outer sample `k` the inner design seeded by
     /// [`Nested::inner_seed`]`(seed, k)`; point `k · n_inner + i` in study order.
-    fn design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+    fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
         let levels = self.levels(inputs)?;
         let outer = self.outer_method()?.design(&levels.outer_inputs, seed)?;
         let inner_method = self.inner_method()?;
@@ -475,14 +494,12 @@ impl Sampling for Nested {
 
     /// The marginal mean (its standard error from the spread of the conditional means over
     /// the outer samples) and the marginal Std (from the corrected variance split).
-    fn estimate(
+    fn make_estimate(
         &self,
         design: &Design,
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        // The inner designs' inputs and the settings are checked by the methods they call.
-        design.check_results(rows, data)?;
         let blocks = self.blocks(design)?;
         let cond = self.conditional(&blocks, rows, data)?;
         marginal(&cond, data.ncols())
@@ -490,6 +507,33 @@ impl Sampling for Nested {
 
     fn min_runs(&self) -> usize {
         2 * self.inner_method().map_or(2, |m| m.min_runs())
+    }
+
+    /// Outer samples × inner points, each level's count from its own method over its own
+    /// parameters (`None` where either level only knows at the design).
+    fn planned_runs_for(&self, parameters: &[RandomParameter]) -> Option<f64> {
+        let (outer, inner): (Vec<_>, Vec<_>) = parameters
+            .iter()
+            .cloned()
+            .partition(|p| self.outer_parameters.contains(&p.name));
+        let count = |spec: &MethodSpec, params: &[RandomParameter]| match spec.method().evaluation()
+        {
+            Evaluation::Sampling(m) => m.planned_runs_for(params),
+            Evaluation::Intrusive(_) => None,
+        };
+        Some(count(&self.outer, &outer)? * count(&self.inner, &inner)?)
+    }
+
+    /// The estimates are the inner method's, per outer sample.
+    fn draws_from_chaos(&self) -> bool {
+        match self.inner.method().evaluation() {
+            Evaluation::Sampling(m) => m.draws_from_chaos(),
+            Evaluation::Intrusive(_) => true,
+        }
+    }
+
+    fn whole_series(&self) -> bool {
+        true
     }
 }
 

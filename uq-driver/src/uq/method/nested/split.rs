@@ -139,7 +139,12 @@ pub struct Intervals {
 /// Bootstrap intervals of the split of `c` and of the means of the conditional exceedance
 /// probabilities `exceedance[l][k]` (one list per limit, aligned with `c`): `resamples`
 /// resamples of the outer samples, resample `b` drawn from the stream `(seed, b)`.
-pub fn bootstrap(c: &Conditionals, exceedance: &[Vec<f64>], resamples: usize, seed: u64) -> Intervals {
+pub fn bootstrap(
+    c: &Conditionals,
+    exceedance: &[Vec<f64>],
+    resamples: usize,
+    seed: u64,
+) -> Intervals {
     let n = c.len();
     let mut stats: Vec<Vec<f64>> = vec![Vec::with_capacity(resamples); 4 + exceedance.len()];
     let mut idx = vec![0usize; n];
@@ -207,7 +212,7 @@ pub fn student_t(values: &[f64]) -> Option<[f64; 2]> {
 
 /// The interval of the mean of `values` over the outer samples from its percentile
 /// bootstrap `boot`: the Student-t interval instead where that is wider (a bootstrap over
-/// few outer samples is too narrow: QA found half the t width with 4 of them), with its
+/// few outer samples is too narrow: it was found half the t width with 4 of them), with its
 /// [`kind`].
 pub fn mean_interval(values: &[f64], boot: [f64; 2]) -> ([f64; 2], &'static str) {
     match student_t(values) {
@@ -283,7 +288,9 @@ mod tests {
         for k in 0..outer {
             let mut r = rng::stream(11, k);
             let mu = rng::standard_normal(&mut r);
-            let ys: Vec<f64> = (0..n).map(|_| mu + 2.0 * rng::standard_normal(&mut r)).collect();
+            let ys: Vec<f64> = (0..n)
+                .map(|_| mu + 2.0 * rng::standard_normal(&mut r))
+                .collect();
             let m = ys.iter().sum::<f64>() / n as f64;
             let v = ys.iter().map(|y| (y - m).powi(2)).sum::<f64>() / (n - 1) as f64;
             c.mean.push(m);
@@ -291,7 +298,11 @@ mod tests {
             c.se2.push(v / n as f64);
         }
         let s = Split::all(&c);
-        assert!((s.var_outer_plugin - 1.8).abs() < 0.1, "{}", s.var_outer_plugin);
+        assert!(
+            (s.var_outer_plugin - 1.8).abs() < 0.1,
+            "{}",
+            s.var_outer_plugin
+        );
         assert!((s.var_outer - 1.0).abs() < 0.1, "{}", s.var_outer);
         assert!((s.var_inner - 4.0).abs() < 0.15, "{}", s.var_inner);
         let ci = bootstrap(&c, &[], 500, 3);
@@ -315,11 +326,14 @@ mod tests {
 
     #[test]
     fn few_outer_samples_get_at_least_a_student_t_interval() {
-        // QA round qa5/rail H2: 4 outer samples, bootstrap half as wide as Student's t.
+        // 4 outer samples, bootstrap half as wide as Student's t.
         let v = [2.9, 3.0, 3.05, 3.15];
         let t = student_t(&v).unwrap();
         // t(0.975, 3) = 3.182446; sd = 0.104083; half = 0.165613.
-        assert!((t[1] - t[0] - 2.0 * 3.182446 * 0.104083 / 2.0).abs() < 1e-5, "{t:?}");
+        assert!(
+            (t[1] - t[0] - 2.0 * 3.182446 * 0.104083 / 2.0).abs() < 1e-5,
+            "{t:?}"
+        );
         let (ci, k) = mean_interval(&v, [2.97, 3.08]);
         assert_eq!((ci, k), (t, kind::STUDENT_T));
         let (ci, k) = mean_interval(&v, [2.0, 4.0]);
@@ -331,7 +345,7 @@ mod tests {
 
     #[test]
     fn every_outer_sample_exceeding_gives_a_one_sided_lower_bound_not_one() {
-        // QA round qa5/rail H2: 16 tracks all with P = 1 gave [1, 1].
+        // 16 tracks all with P = 1 gave [1, 1].
         let (ci, k) = exceedance_interval(&[1.0; 16], [1.0, 1.0]);
         assert_eq!(k, kind::ONE_SIDED);
         assert!((ci[0] - 0.05f64.powf(1.0 / 16.0)).abs() < 1e-15 && ci[1] == 1.0);

@@ -44,7 +44,10 @@ fn run(n: &Nested, seed: u64) -> (Design, DMatrix<f64>) {
 
 #[test]
 fn the_design_is_the_product_of_the_outer_design_and_one_inner_design_per_outer_sample() {
-    let n = nested("{ kind = \"mc\", samples = 5 }", "{ kind = \"mc\", samples = 4 }");
+    let n = nested(
+        "{ kind = \"mc\", samples = 5 }",
+        "{ kind = \"mc\", samples = 4 }",
+    );
     let design = n.design(&inputs(), 7).unwrap();
     assert_eq!(design.len(), 20);
     assert!(design.weights.is_none());
@@ -68,7 +71,10 @@ fn the_design_is_the_product_of_the_outer_design_and_one_inner_design_per_outer_
     assert_eq!(blocks.inner_len, 4);
     assert_eq!(blocks.outer_values.len(), 5);
     assert_eq!(blocks.outer_values[3], vec![outer[3]]);
-    assert_eq!(blocks.inner[3].values[2], vec![design.values[14][0], design.values[14][2]]);
+    assert_eq!(
+        blocks.inner[3].values[2],
+        vec![design.values[14][0], design.values[14][2]]
+    );
     assert_eq!(n.label(3), "nested mc 5 × mc 4");
 }
 
@@ -86,7 +92,10 @@ fn mc_design(samples: usize, seed: u64) -> Vec<f64> {
 
 #[test]
 fn a_collocation_inner_design_gives_exact_conditional_moments_and_weights() {
-    let n = nested("{ kind = \"lhs\", samples = 4 }", "{ kind = \"scm\", nodes = 3 }");
+    let n = nested(
+        "{ kind = \"lhs\", samples = 4 }",
+        "{ kind = \"scm\", nodes = 3 }",
+    );
     let (design, data) = run(&n, 1);
     assert_eq!(design.len(), 36);
     assert_eq!(design.germ, Germ::Normal);
@@ -128,12 +137,19 @@ fn the_split_of_an_additive_model_matches_the_closed_form() {
         assert!((fo - exact_outer).abs() < tolerance, "{inner}: {fo}");
         assert!((fi + fo - 1.0).abs() < 1e-12);
         let ci = bootstrap(&c, &[], 400, 5);
-        assert!(ci.outer[0] < exact_outer && exact_outer < ci.outer[1], "{inner}: {ci:?}");
+        assert!(
+            ci.outer[0] < exact_outer && exact_outer < ci.outer[1],
+            "{inner}: {ci:?}"
+        );
         let e = n.estimate(&design, &rows, &data).unwrap();
         assert!((e.std[0] - s.std()).abs() < 1e-15);
         assert!((e.mean[0] - 2.0).abs() < 4.0 * e.std_error_mean.as_ref().unwrap()[0]);
         if inner.contains("mc") {
-            assert!(s.correction > 0.3 && s.correction < 0.45, "{}", s.correction);
+            assert!(
+                s.correction > 0.3 && s.correction < 0.45,
+                "{}",
+                s.correction
+            );
         } else {
             assert_eq!(s.correction, 0.0);
         }
@@ -142,7 +158,10 @@ fn the_split_of_an_additive_model_matches_the_closed_form() {
 
 #[test]
 fn failed_runs_of_a_sampled_inner_design_are_left_out() {
-    let n = nested("{ kind = \"mc\", samples = 3 }", "{ kind = \"mc\", samples = 3 }");
+    let n = nested(
+        "{ kind = \"mc\", samples = 3 }",
+        "{ kind = \"mc\", samples = 3 }",
+    );
     let (_, data) = run(&n, 2);
     let design = n.design(&inputs(), 2).unwrap();
     let blocks = n.blocks(&design).unwrap();
@@ -172,10 +191,19 @@ fn levels_and_kinds_are_checked() {
     };
     fn nested_validate(p: &Problem) -> Vec<String> {
         [
-            ("{ kind = \"scm\", nodes = 3 }", "{ kind = \"mc\", samples = 4 }"),
+            (
+                "{ kind = \"scm\", nodes = 3 }",
+                "{ kind = \"mc\", samples = 4 }",
+            ),
             ("{ kind = \"mc\", samples = 4 }", "{ kind = \"nominal\" }"),
-            ("{ kind = \"mc\", samples = 4 }", "{ kind = \"scm\", nodes = 3 }"),
-            ("{ kind = \"mc\", samples = 1 }", "{ kind = \"mc\", samples = 4 }"),
+            (
+                "{ kind = \"mc\", samples = 4 }",
+                "{ kind = \"scm\", nodes = 3 }",
+            ),
+            (
+                "{ kind = \"mc\", samples = 1 }",
+                "{ kind = \"mc\", samples = 4 }",
+            ),
         ]
         .iter()
         .map(|(o, i)| {
@@ -188,15 +216,26 @@ fn levels_and_kinds_are_checked() {
     }
     let params = inputs().parameters;
     let errors = problem(&params);
-    assert!(errors[0].contains("outer design must be one of mc, lhs, qmc"), "{}", errors[0]);
+    assert!(
+        errors[0].contains("outer design must be one of mc, lhs, qmc"),
+        "{}",
+        errors[0]
+    );
     assert!(errors[1].contains("not nominal"), "{}", errors[1]);
     assert_eq!(errors[2], "");
-    assert!(errors[3].starts_with("outer: `samples` must be at least 2"), "{}", errors[3]);
+    assert!(
+        errors[3].starts_with("outer: `samples` must be at least 2"),
+        "{}",
+        errors[3]
+    );
     // A discrete input is fine outside the chaos level, refused inside it.
     let mut p = params.clone();
     p[1].distribution = Distribution::integer_uniform(1, 100).unwrap();
     assert_eq!(problem(&p)[2], "");
-    let mut n = nested("{ kind = \"mc\", samples = 4 }", "{ kind = \"scm\", nodes = 3 }");
+    let mut n = nested(
+        "{ kind = \"mc\", samples = 4 }",
+        "{ kind = \"scm\", nodes = 3 }",
+    );
     n.outer_parameters = vec!["x1".into()];
     let mut q = params.clone();
     q[1].distribution = Distribution::integer_uniform(1, 100).unwrap();
@@ -209,19 +248,33 @@ fn levels_and_kinds_are_checked() {
         system: None,
     };
     let e = n.validate(&pr).unwrap_err().to_string();
-    assert!(e.starts_with("inner: 'u' is an integer_uniform input"), "{e}");
+    assert!(
+        e.starts_with("inner: 'u' is an integer_uniform input"),
+        "{e}"
+    );
     // No outer parameter, or no inner one.
     n.outer_parameters.clear();
-    assert!(n.validate(&pr).unwrap_err().to_string().contains("level = \"outer\""));
+    assert!(n
+        .validate(&pr)
+        .unwrap_err()
+        .to_string()
+        .contains("level = \"outer\""));
     n.outer_parameters = vec!["x1".into(), "u".into(), "x2".into()];
-    assert!(n.validate(&pr).unwrap_err().to_string().contains("every parameter is outer"));
+    assert!(n
+        .validate(&pr)
+        .unwrap_err()
+        .to_string()
+        .contains("every parameter is outer"));
     // A correlation across the levels.
     let pairs = vec![CorrelationPair {
         between: ["x1".into(), "u".into()],
         rho: 0.5,
     }];
     let corr = Correlation::new(&params, pairs).unwrap().unwrap();
-    let n = nested("{ kind = \"mc\", samples = 4 }", "{ kind = \"mc\", samples = 4 }");
+    let n = nested(
+        "{ kind = \"mc\", samples = 4 }",
+        "{ kind = \"mc\", samples = 4 }",
+    );
     let pr = Problem {
         parameters: &params,
         correlation: Some(&corr),
@@ -246,7 +299,10 @@ fn a_correlation_within_a_level_reaches_the_inner_designs() {
         parameters: params,
         correlation: corr,
     };
-    let n = nested("{ kind = \"mc\", samples = 2 }", "{ kind = \"mc\", samples = 4000 }");
+    let n = nested(
+        "{ kind = \"mc\", samples = 2 }",
+        "{ kind = \"mc\", samples = 4000 }",
+    );
     let design = n.design(&inputs, 4).unwrap();
     let (a, b): (Vec<f64>, Vec<f64>) = design.values[..4000].iter().map(|v| (v[0], v[2])).unzip();
     let r = a.iter().zip(&b).map(|(x, y)| x * y).sum::<f64>() / 4000.0;
@@ -265,7 +321,10 @@ fn counts(values: impl Iterator<Item = f64>, low: i64, high: i64) -> Vec<usize> 
     let mut c = vec![0usize; (high - low + 1) as usize];
     for v in values {
         assert_eq!(v, v.round(), "{v} is not an integer");
-        assert!(v >= low as f64 && v <= high as f64, "{v} outside {low}..={high}");
+        assert!(
+            v >= low as f64 && v <= high as f64,
+            "{v} outside {low}..={high}"
+        );
         c[(v as i64 - low) as usize] += 1;
     }
     c
@@ -298,7 +357,10 @@ fn integer_uniform_covers_its_range_uniformly_in_every_sampling_design() {
         assert_ne!(m.design(&inputs, 22).unwrap().values, d.values, "{kind}");
     }
     // And in the outer design of a nested study.
-    let mut n = nested("{ kind = \"mc\", samples = 6000 }", "{ kind = \"mc\", samples = 2 }");
+    let mut n = nested(
+        "{ kind = \"mc\", samples = 6000 }",
+        "{ kind = \"mc\", samples = 2 }",
+    );
     n.outer_parameters = vec!["s".into()];
     let d = n.design(&inputs, 5).unwrap();
     let c = counts(d.values.iter().step_by(2).map(|v| v[0]), low, high);
@@ -308,7 +370,7 @@ fn integer_uniform_covers_its_range_uniformly_in_every_sampling_design() {
 
 #[test]
 fn small_quasi_monte_carlo_inner_designs_give_unbiased_conditional_variances() {
-    // QA round 4: the conditional variance of an inner design of 16 scrambled Sobol' points
+    // The conditional variance of an inner design of 16 scrambled Sobol' points
     // was its sample variance, whose divisor n − 1 overstates σ² by n/(n − 1) when the
     // design's mean hardly varies (2.48 ± 0.05 for a true 2.33). The inner variance of
     // y = x1 + x2² + u is 1 + 2 = 3 at every u.

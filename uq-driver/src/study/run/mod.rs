@@ -1,0 +1,334 @@
+//! Running a study's points: the one place that runs them. The options ([`options`]), the
+//! errors ([`error`]), the output folder (its lock, its store and the in-process time limit)
+//! and the failure policy are here; a batch of points runs in [`batch`] (one FMU instance per
+//! worker, reused through `fmi2Reset` once the reset self-check has passed: [`instances`]),
+//! one point in [`point`], or each in a worker process ([`isolate`]); [`guard`] keeps what
+//! the process must know of a study in progress.
+
+pub mod batch;
+pub mod error;
+pub mod guard;
+pub mod instances;
+pub mod isolate;
+pub mod options;
+pub mod point;
+pub mod worker_fmu;
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use crate::fmu::Fmu;
+use crate::spec::Study;
+use crate::study::plan::fingerprint;
+use crate::study::progress::{Progress, ProgressMode};
+use crate::study::store::lock::FolderLock;
+use crate::study::store::{Entry, Store, StoreError, StoredRuns};
+use crate::uq::method::Design;
+use batch::{Batch, Notes};
+pub use error::{FailedPoint, PointError, RunError};
+use guard::StudyGuard;
+use instances::InstancePolicy;
+use isolate::{IsolateOptions, WorkerPool};
+pub use options::RunOptions;
+pub use point::{simulate, simulate_with, Simulation};
+use worker_fmu::WorkerFmus;
+
+/// What a run produced: every point's record, in design order, read in place from the
+/// results store (the series of the runs are not held in memory).
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// Records by point index (all present unless stopped early).
+    pub runs: StoredRuns,
+    /// The output folder's lock, held while the records are read (None: not locked).
+    pub _lock: Option<FolderLock>,
+    /// Points run in this invocation.
+    pub n_new: usize,
+    /// Points found finished in the store.
+    pub n_resumed: usize,
+    /// Wall time of this invocation (s).
+    pub wall_time: f64,
+    /// Threads used.
+    pub threads: usize,
+    /// SHA-256 of the FMU.
+    pub fmu_sha256: String,
+    /// Warnings of the runs (printed when they arose): a failed reset self-check or
+    /// `fmi2Reset`, for `summary.json`.
+    pub warnings: Vec<String>,
+}
+
+/// Runs every point of `design` not yet in the store of `out_dir` (with
+/// [`RunOptions::retry_failed`], also the points that failed before), holding the folder's
+/// lock ([`FolderLock`]) meanwhile.
+pub fn run_points(
+    study: &Study,
+    fmu: &Fmu,
+    design: &Design,
+    out_dir: &Path,
+    opts: &RunOptions,
+) -> Result<RunOutcome, RunError> {
+    opts.check()?;
+    if let Some(&bad) = opts
+        .points
+        .as_ref()
+        .and_then(|p| p.iter().find(|&&i| i >= design.len()))
+    {
+        return Err(RunError::Options(format!(
+            "RunOptions::points names point {bad}, but the design has {} points (0 to {})",
+            design.len(),
+            design.len().saturating_sub(1)
+        )));
+    }
+    let started = Instant::now();
+    let manifest = fingerprint::manifest(study, fmu, design)?;
+    prepare_out_dir(out_dir)?;
+    let lock = FolderLock::acquire(out_dir)?;
+    if let Some(previous) = lock.taken_over() {
+        crate::study::progress::message(&format!(
+            "note: {} was locked by a run that is no longer running ({previous}); taking it over",
+            out_dir.display()
+        ));
+    }
+    let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
+    let records = runs.entries();
+    if let Some(note) = store.recovery().summary() {
+        crate::study::progress::message(&format!("warning: {note}"));
+    }
+    let wanted: Vec<usize> = match &opts.points {
+        Some(p) => p.clone(),
+        None => (0..design.len()).collect(),
+    };
+    let failed_before = wanted
+        .iter()
+        .filter(|&&i| matches!(records[i], Some(Entry::Failed(_))))
+        .count();
+    if failed_before > 0 && !opts.retry_failed {
+        crate::study::progress::message(&format!(
+            "note: {failed_before} point{} failed in an earlier run and {} not run again \
+             (--retry-failed, RunOptions::retry_failed, runs {} again)",
+            if failed_before == 1 { "" } else { "s" },
+            if failed_before == 1 { "is" } else { "are" },
+            if failed_before == 1 { "it" } else { "them" },
+        ));
+    }
+    let missing: Vec<usize> = wanted
+        .iter()
+        .copied()
+        .filter(|&i| match records[i] {
+            None => true,
+            Some(Entry::Failed(_)) => opts.retry_failed,
+            Some(Entry::Ok(_)) => false,
+        })
+        .collect();
+    let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(RunError::Pool)?;
+    let iface = crate::study::plan::resolve::interface(study, fmu)?;
+    iface.check_design(fmu, &design.values)?;
+    let times = study.times();
+    crate::study::plan::interface::check_step_sizes(fmu, &times)?;
+    let policy = InstancePolicy {
+        reuse: false,
+        logging_on: opts.fmu_logging,
+    };
+    let workers = opts.isolate.as_ref().map(|exe| {
+        WorkerPool::new(
+            IsolateOptions {
+                exe: exe.clone(),
+                timeout: opts.timeout_per_run,
+            },
+            &isolate::setup(fmu, &iface, &times, policy),
+        )
+    });
+    let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
+    let batch = Batch {
+        fmus: WorkerFmus::new(fmu, threads),
+        iface,
+        study,
+        design,
+        times,
+        store: &store,
+        stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
+        max_new: opts.max_new_points,
+        workers,
+        guard: &guard,
+        policy,
+        check_reset: !opts.fresh_instances && missing.len() >= 2,
+        notes: Notes::default(),
+    };
+    let mode = match (opts.progress, opts.progress_lines) {
+        (true, _) => ProgressMode::Bar,
+        (false, true) => ProgressMode::Lines,
+        _ => ProgressMode::Off,
+    };
+    let progress = Progress::new(mode, missing.len());
+    let done = AtomicBool::new(false);
+    let new = std::thread::scope(|scope| {
+        // In-process, only with the process guards (checked by `opts.check()` above).
+        if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
+            let (guard, done) = (&guard, &done);
+            scope.spawn(move || watchdog(guard, limit, done));
+        }
+        let new = pool.install(|| batch.run(&missing, &progress));
+        done.store(true, Ordering::Release);
+        new
+    })?;
+    progress.finish();
+    let warnings = batch.notes.into_warnings();
+    let n_new = new.len();
+    for (i, e) in new {
+        runs.set(i, e);
+    }
+    Ok(RunOutcome {
+        runs,
+        _lock: Some(lock),
+        n_new,
+        n_resumed: wanted.len() - missing.len(),
+        wall_time: started.elapsed().as_secs_f64(),
+        threads,
+        fmu_sha256: manifest.fmu_sha256,
+        warnings,
+    })
+}
+
+/// Opens the study's FMU.
+pub fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
+    let path = study.fmu_path.as_deref().unwrap_or(Path::new(""));
+    Ok(Fmu::open(path)?)
+}
+
+/// Creates the output folder, or checks that the existing path is one.
+pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.as_os_str().is_empty() {
+        return Err(RunError::NoOutDir);
+    }
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotAFolder(dir.to_path_buf()));
+    }
+    std::fs::create_dir_all(dir).map_err(|source| {
+        RunError::Store(StoreError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })
+    })
+}
+
+/// In-process runs cannot be interrupted: when one outlives `limit`, name it and end the
+/// process (the store keeps every finished point).
+fn watchdog(guard: &StudyGuard, limit: Duration, done: &AtomicBool) {
+    let tick = (limit / 10).clamp(Duration::from_millis(10), Duration::from_millis(250));
+    while !done.load(Ordering::Acquire) {
+        std::thread::sleep(tick);
+        let overdue = guard.overdue(limit);
+        if overdue.is_empty() {
+            continue;
+        }
+        let points: Vec<String> = overdue
+            .iter()
+            .map(|(p, v, t)| format!("point {p} ({v}) has run for {:.1} s", t.as_secs_f64()))
+            .collect();
+        guard::exit_now(
+            guard::EXIT_FAILURE,
+            &format!(
+                "uq-driver: error: {}, longer than --timeout-per-run {} s. An FMU call cannot be \
+                 interrupted inside this process, so the study stops here; finished points are \
+                 kept in the results store. Run again with --isolate to have such runs killed \
+                 and marked failed while the study goes on.",
+                points.join("; "),
+                limit.as_secs_f64()
+            ),
+        );
+    }
+}
+
+/// The number of failed points; an error naming the first when failures are not allowed
+/// (or the design is weighted: dropping a weighted point would bias every moment silently),
+/// with how many of the `points` (None: every point) were not run (the study stops at the
+/// first failure).
+pub fn check_failures(
+    study: &Study,
+    design: &Design,
+    records: &[Option<Entry>],
+    allow: bool,
+    points: Option<&[usize]>,
+) -> Result<usize, RunError> {
+    let failed: Vec<(usize, &String)> = records
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| match r {
+            Some(Entry::Failed(m)) => Some((i, m)),
+            _ => None,
+        })
+        .collect();
+    let Some(&(index, message)) = failed.first() else {
+        return Ok(0);
+    };
+    if allow && !design.is_weighted() {
+        return Ok(failed.len());
+    }
+    let parameters = study
+        .parameters
+        .iter()
+        .zip(&design.values[index])
+        .map(|(p, v)| (p.name.clone(), *v))
+        .collect();
+    let wanted: Vec<usize> = match points {
+        Some(p) => p.iter().copied().filter(|&i| i < records.len()).collect(),
+        None => (0..records.len()).collect(),
+    };
+    Err(RunError::PointsFailed {
+        failed: failed.len(),
+        total: wanted.len(),
+        not_run: wanted.iter().filter(|&&i| records[i].is_none()).count(),
+        first: FailedPoint {
+            index,
+            parameters,
+            message: message.clone(),
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A study stopped at its first failures said "2 of 200 points failed" although
+    /// 103 of them fail; the points not started are not counted as successes.
+    #[test]
+    fn failure_message_says_the_study_stopped_and_how_many_points_were_not_started() {
+        let first = FailedPoint {
+            index: 4,
+            parameters: vec![("K".into(), 1.5)],
+            message: "NaN".into(),
+        };
+        let err = |failed, not_run| {
+            RunError::PointsFailed {
+                failed,
+                total: 200,
+                not_run,
+                first: first.clone(),
+            }
+            .to_string()
+        };
+        let one = err(1, 197);
+        assert!(
+            one.starts_with(
+                "stopped at the first failure of 200 points (runs not started: 197; how many \
+                 of those would fail is not known); first: point 4 with K = 1.5: NaN."
+            ),
+            "{one}"
+        );
+        let two = err(2, 150);
+        assert!(
+            two.starts_with(
+                "stopped after the first 2 failures of 200 points (runs not started: 150;"
+            ),
+            "{two}"
+        );
+        assert!(!two.contains("2 of 200 points failed"));
+        // Every point run: the count is the whole truth.
+        assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
+    }
+}

@@ -1,0 +1,177 @@
+//! How to run a study: the options of `run`, `run-shard` and `merge` as a library takes them.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use super::error::RunError;
+use super::guard;
+use crate::spec::Study;
+
+/// How to run a study. Built from [`RunOptions::default`] (all cores, resume, a report) with
+/// the `with_*` methods, or by setting fields on a default value:
+///
+/// ```
+/// use uq_driver::study::RunOptions;
+/// let opts = RunOptions::default().with_threads(2).with_no_report(true).with_fresh(true);
+/// assert_eq!(opts.threads, Some(2));
+/// ```
+#[derive(Clone, Debug, Default)]
+#[non_exhaustive]
+pub struct RunOptions {
+    /// Worker threads of the model runs (None: all cores; 0 is refused).
+    pub threads: Option<usize>,
+    /// Show a progress bar (on a terminal).
+    pub progress: bool,
+    /// Print progress lines (when the output is a log file, not a terminal); ignored when
+    /// `progress` is set.
+    pub progress_lines: bool,
+    /// Unweighted designs: continue past failed points (overrides the study file when true).
+    pub allow_failures: bool,
+    /// Discard earlier results in the output folder.
+    pub fresh: bool,
+    /// Stop after this many newly finished points (for tests of interruption).
+    pub max_new_points: Option<usize>,
+    /// Run only these points of the design (a shard); None: all. A point outside the design
+    /// is refused ([`RunError::Options`]).
+    pub points: Option<Vec<usize>>,
+    /// Write the CSV files and `summary.json` only: no plots, no `index.html`.
+    pub no_report: bool,
+    /// Run the points that failed in an earlier run again (`--retry-failed`).
+    pub retry_failed: bool,
+    /// `--isolate`: run each point in a worker process started from this uq-driver executable
+    /// (the `uq-driver worker` protocol); None: in-process.
+    pub isolate: Option<PathBuf>,
+    /// `--timeout-per-run`: with `isolate` a longer run is killed and fails its point.
+    /// In-process an FMU call cannot be interrupted, so a longer run ends the whole process
+    /// after naming the point: allowed only after [`guard::install_process_guards`] (the
+    /// command line's choice), refused with [`RunError::Options`] otherwise.
+    pub timeout_per_run: Option<Duration>,
+    /// Start a large study without asking (`--yes`; see the size checks of a study).
+    pub yes: bool,
+    /// `--fresh-instances`: every run on a fresh FMU instance, never reused through
+    /// `fmi2Reset` (and no reset self-check).
+    pub fresh_instances: bool,
+    /// `--fmu-logging`: instantiate with `loggingOn = true` (the FMU's messages are kept with
+    /// failed points, capped, not printed).
+    pub fmu_logging: bool,
+}
+
+impl RunOptions {
+    /// Worker threads of the model runs (at least 1; the default is all cores).
+    pub fn with_threads(mut self, v: usize) -> Self {
+        self.threads = Some(v);
+        self
+    }
+
+    /// Shows a progress bar (on a terminal).
+    pub fn with_progress(mut self, v: bool) -> Self {
+        self.progress = v;
+        self
+    }
+
+    /// Prints progress lines (for a log file).
+    pub fn with_progress_lines(mut self, v: bool) -> Self {
+        self.progress_lines = v;
+        self
+    }
+
+    /// Unweighted designs: continues past failed points.
+    pub fn with_allow_failures(mut self, v: bool) -> Self {
+        self.allow_failures = v;
+        self
+    }
+
+    /// Discards earlier results in the output folder.
+    pub fn with_fresh(mut self, v: bool) -> Self {
+        self.fresh = v;
+        self
+    }
+
+    /// Stops after this many newly finished points (the study resumes later).
+    pub fn with_max_new_points(mut self, v: usize) -> Self {
+        self.max_new_points = Some(v);
+        self
+    }
+
+    /// Runs only these points of the design (a shard).
+    pub fn with_points(mut self, v: Vec<usize>) -> Self {
+        self.points = Some(v);
+        self
+    }
+
+    /// Writes the CSV files and `summary.json` only.
+    pub fn with_no_report(mut self, v: bool) -> Self {
+        self.no_report = v;
+        self
+    }
+
+    /// Runs the points that failed in an earlier run again.
+    pub fn with_retry_failed(mut self, v: bool) -> Self {
+        self.retry_failed = v;
+        self
+    }
+
+    /// Runs each point in a worker process started from this executable (see the field).
+    pub fn with_isolate(mut self, v: PathBuf) -> Self {
+        self.isolate = Some(v);
+        self
+    }
+
+    /// The time limit of one run (see the field).
+    pub fn with_timeout_per_run(mut self, v: Duration) -> Self {
+        self.timeout_per_run = Some(v);
+        self
+    }
+
+    /// Starts a large study without asking.
+    pub fn with_yes(mut self, v: bool) -> Self {
+        self.yes = v;
+        self
+    }
+
+    /// Runs every point on a fresh FMU instance.
+    pub fn with_fresh_instances(mut self, v: bool) -> Self {
+        self.fresh_instances = v;
+        self
+    }
+
+    /// Instantiates the FMU with `loggingOn = true`.
+    pub fn with_fmu_logging(mut self, v: bool) -> Self {
+        self.fmu_logging = v;
+        self
+    }
+
+    /// Checks that the options fit together: `threads` at least 1, and `timeout_per_run`
+    /// either with `isolate` (a longer run is killed) or in a process that opted in to
+    /// [`guard::install_process_guards`] (in-process, a longer run ends the whole process,
+    /// which a library host must ask for).
+    pub fn check(&self) -> Result<(), RunError> {
+        if self.threads == Some(0) {
+            return Err(RunError::Options(
+                "threads = 0: give at least 1 worker thread (RunOptions::threads = None: \
+                 all cores)"
+                    .into(),
+            ));
+        }
+        if let (Some(limit), None) = (self.timeout_per_run, &self.isolate) {
+            if !guard::process_guards() {
+                return Err(RunError::Options(format!(
+                    "timeout_per_run = {} s without isolate: an FMU call cannot be interrupted \
+                     inside this process, so an overrun could only be stopped by ending the \
+                     whole process, which a library caller has not asked for. Set \
+                     RunOptions::isolate (each run in a worker process that is killed after \
+                     the limit; the --isolate of the command line), or call \
+                     uq_driver::study::run::guard::install_process_guards() first if this program \
+                     owns its process and may end on an overrun",
+                    limit.as_secs_f64()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether failed points may be left out (the option or the study's `allow_failures`).
+    pub fn allow_failures(&self, study: &Study) -> bool {
+        self.allow_failures || study.analysis.allow_failures
+    }
+}
