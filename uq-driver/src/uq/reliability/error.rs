@@ -1,6 +1,26 @@
 //! Errors of the reliability methods.
 
-use super::model::Abort;
+/// Why an evaluation stopped a method (as opposed to a failed run).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Abort {
+    /// The caller stopped (Ctrl-C, a budget, an FMU that cannot be loaded).
+    #[error("evaluation interrupted: {0}")]
+    Interrupted(String),
+    /// A stored run was at another point than the one now requested: the settings, the
+    /// seed, the model's values or the code changed since the runs were stored.
+    #[error(
+        "stored run {run} was at u = {stored:?} but u = {requested:?} is requested now; \
+         the stored runs belong to another study (settings, seed, model or version)"
+    )]
+    ReplayMismatch {
+        /// The run index.
+        run: u64,
+        /// The stored point.
+        stored: Vec<f64>,
+        /// The point requested.
+        requested: Vec<f64>,
+    },
+}
 
 /// Why a reliability method stopped without a result.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+pub use super::error::Abort;
 use super::error::ReliabilityError;
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
@@ -21,28 +22,6 @@ pub struct Point {
     pub run: u64,
     /// The standard normal coordinates.
     pub u: Vec<f64>,
-}
-
-/// Why an evaluation stopped a method (as opposed to a failed run).
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum Abort {
-    /// The caller stopped (Ctrl-C, a budget, an FMU that cannot be loaded).
-    #[error("evaluation interrupted: {0}")]
-    Interrupted(String),
-    /// A stored run was at another point than the one now requested: the settings, the
-    /// seed, the model's values or the code changed since the runs were stored.
-    #[error(
-        "stored run {run} was at u = {stored:?} but u = {requested:?} is requested now; \
-         the stored runs belong to another study (settings, seed, model or version)"
-    )]
-    ReplayMismatch {
-        /// The run index.
-        run: u64,
-        /// The stored point.
-        stored: Vec<f64>,
-        /// The point requested.
-        requested: Vec<f64>,
-    },
 }
 
 /// A limit state `g(u)` in independent standard normal space; failure is `g <= 0`.
