@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bogie;
+pub mod data_file;
 pub mod table;
 pub mod vehicle_track;
 pub mod wheel;
