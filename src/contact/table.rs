@@ -546,11 +546,11 @@ mod tests {
                 "found 3",
             ),
             (
-                with(4, &lines[2].to_string()),
+                with(4, lines[2]),
                 "line 5: y must ascend in equal steps",
                 "",
             ),
-            (with(2, &lines[1].to_string()), "line 3: y must ascend", ""),
+            (with(2, lines[1]), "line 3: y must ascend", ""),
         ];
         for (text, expected, also) in cases {
             let e = ContactTable::parse_csv(&text).unwrap_err().to_string();

@@ -123,7 +123,8 @@ mod tests {
     use super::*;
 
     fn temp_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("railuq-data-file-{tag}-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("railuq-data-file-{tag}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
@@ -148,7 +149,10 @@ mod tests {
     fn a_directory_is_refused() {
         let dir = temp_dir("dir");
         let e = read_data_file("contact_table", dir.to_str().unwrap(), None).unwrap_err();
-        assert!(e.contains("is a directory; a regular file is expected"), "{e}");
+        assert!(
+            e.contains("is a directory; a regular file is expected"),
+            "{e}"
+        );
         std::fs::remove_dir_all(dir).unwrap();
     }
 
@@ -166,7 +170,11 @@ mod tests {
         let (tx, rx) = std::sync::mpsc::channel();
         let path = fifo.clone();
         std::thread::spawn(move || {
-            let _ = tx.send(read_data_file("contact_table", path.to_str().unwrap(), None));
+            let _ = tx.send(read_data_file(
+                "contact_table",
+                path.to_str().unwrap(),
+                None,
+            ));
         });
         let result = rx
             .recv_timeout(std::time::Duration::from_secs(10))
