@@ -16,7 +16,7 @@
 
 use super::contact::MIN_NORMAL_FORCE;
 use super::equations::{base, dof, rhs, Car, Diagnostics, State, Track, N_STATES};
-use super::params::{bogie, wheelset, CAR};
+use super::params::{wheelset, CAR};
 use crate::contact::table::ContactSpline;
 
 /// The outputs at one instant.
@@ -82,6 +82,5 @@ pub fn outputs(
         out.ay_floor[b] = dx[c + dof::YD] + dx[c + dof::PSID] * xp - dx[c + dof::PHID] * zp;
         out.az_floor[b] = dx[c + dof::ZD] - dx[c + dof::CHID] * xp;
     }
-    let _ = bogie(0);
     out
 }

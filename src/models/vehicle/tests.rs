@@ -590,3 +590,90 @@ fn speed() {
         10.0 / wall
     );
 }
+
+/// Sustained hunting: some wheelset above 0.5 mm over the last 10 s of 40 s at speed `v`.
+fn hunts(m: &mut Vehicle, v: f64) -> bool {
+    m.set_real(VR_V, v).unwrap();
+    amplitude(m, 20.0, 0.01).unwrap();
+    let a = amplitude(m, 20.0, 0.01).unwrap();
+    println!(
+        "  {v:.3} m/s: {:?} mm",
+        a.map(|x| (x * 1e5).round() / 100.0)
+    );
+    max4(a) > 5e-4
+}
+
+/// The lowest speed at which the hunting state `m` (at speed `v`) keeps hunting when the speed
+/// is lowered with the state carried over: steps of 2 m/s, then 0.5 m/s from the last hunting
+/// state, then bisection to 0.05 m/s, each trial from the hunting state of the lowest hunting
+/// speed so far.
+fn fold(m: &Vehicle, v: f64) -> f64 {
+    let mut hunting = (m.clone(), v);
+    let mut v = v - 2.0;
+    for step in [2.0, 0.5] {
+        let mut trial = hunting.0.clone();
+        while hunts(&mut trial, v) {
+            hunting = (trial.clone(), v);
+            v -= step;
+        }
+        v = hunting.1 - step / 4.0;
+    }
+    let (mut lo, mut hi) = (hunting.1 - 0.5, hunting.1);
+    while hi - lo > 0.05 {
+        let mid = 0.5 * (lo + hi);
+        let mut trial = hunting.0.clone();
+        if hunts(&mut trial, mid) {
+            hi = mid;
+            hunting = (trial, mid);
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The nonlinear critical speed by continuation (MODELS §5): hunting from above the linear
+/// critical speed (120 m/s, 20 s) carried to 70 m/s, then [`fold`] from there, with both
+/// bogies hunting, and with one of them put back on the centre line (its frame and wheelsets'
+/// lateral states zeroed): near the fold only one bogie may hunt, and that motion outlives the
+/// one of both. `cargo test --release -p railuq --lib vehicle::tests::nonlinear_critical_speed
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn nonlinear_critical_speed() {
+    let mut m = model(120.0, [1e-4, 0.0, 8e-3, 0.0]);
+    amplitude(&mut m, 20.0, 0.01).unwrap();
+    assert!(hunts(&mut m, 70.0));
+    let lateral = [dof::Y, dof::YD, dof::PHI, dof::PHID];
+    let centred = |bogie_index: usize| {
+        let mut c = m.clone();
+        let mut x = *c.state().unwrap();
+        for i in [
+            params::bogie(bogie_index),
+            wheelset(2 * bogie_index),
+            wheelset(2 * bogie_index + 1),
+        ] {
+            let yaw = if i < 3 {
+                [dof::PSI, dof::PSID]
+            } else {
+                [dof::W_PSI, dof::W_PSID]
+            };
+            for k in lateral.iter().chain(&yaw) {
+                x[base(i) + k] = 0.0;
+            }
+        }
+        c.set_state(&x);
+        c
+    };
+    let both = fold(&m, 70.0);
+    println!("both bogies hunting: fold at {both:.2} m/s");
+    let trailing = fold(&centred(0), 70.0);
+    println!("trailing bogie hunting: fold at {trailing:.2} m/s");
+    let leading = fold(&centred(1), 70.0);
+    println!("leading bogie hunting: fold at {leading:.2} m/s");
+    let v_cr = m.v_cr_linear().unwrap();
+    println!(
+        "nonlinear critical speed: {:.2} m/s; linear critical speed: {v_cr:.2} m/s",
+        both.min(trailing).min(leading)
+    );
+}
