@@ -13,7 +13,7 @@ def driver_simulate(fmu, values, stop, step, tmp_path, outputs=()):
     out = tmp_path / "traj.csv"
     cmd = [str(DRIVER), "simulate", fmu, "--stop", str(stop), "--step", str(step), "--out", str(out)]
     for k, v in values.items():
-        cmd += ["--set", f"{k}={v!r}"]
+        cmd += ["--set", f"{k}={v}" if isinstance(v, str) else f"{k}={v!r}"]
     for o in outputs:
         cmd += ["--output", o]
     if not DRIVER.is_file():

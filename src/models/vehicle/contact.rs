@@ -117,7 +117,7 @@ pub fn wheelset_forces(
     let left = table.left(y_rel)?;
     let right = table.right(y_rel)?;
     let mut out = Wheelset::default();
-    let roll = k.ang[0].sin_cos();
+    let roll = libm::sincos(k.ang[0]);
     for (i, (sigma, row)) in [(1.0, left), (-1.0, right)].into_iter().enumerate() {
         let w = wheel(c, run, k, beta, z_rel, b, sigma, roll, &row);
         let (x, y, z) = (w.0, w.1.y, w.1.z);
@@ -156,7 +156,7 @@ fn wheel(
     let s = sigma * phi;
     let (sin_s, cos_s) = (sigma * roll.0, roll.1);
     let g = (r - aw * sin_s / cos_s) * sin_s + aw / cos_s - aw - r * s;
-    let (sin_d, cos_d) = delta.sin_cos();
+    let (sin_d, cos_d) = libm::sincos(delta);
     let (sin_t, cos_t) = (sin_d * cos_s + cos_d * sin_s, cos_d * cos_s - sin_d * sin_s);
     let dq = -g * sin_t - (z_rel + s * aw) * cos_t;
     let bracket = 1.0 + dq / row.q0;
@@ -174,7 +174,7 @@ fn wheel(
     let v = run.v;
     let omega = v / c.r_t + beta;
     let psi_b = psi + b * run.kappa;
-    let cos_se = run.cant.cos();
+    let cos_se = libm::cos(run.cant);
     let xi_x = (v + psi_b * yd + r * (psi_b * phid - omega) - sigma * aw * psid
         + sigma * c.a * v * cos_se * run.kappa)
         / v;

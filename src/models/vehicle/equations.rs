@@ -19,6 +19,9 @@
 //!                          Mz += (Ix − Iy) φ̇ Ω,     Iy β̇ = spin torque of the wheel–rail forces
 //! ```
 //!
+//! Trigonometric functions come from the `libm` crate (pure Rust), so that every platform
+//! computes the same numbers.
+//!
 //! The reference implementation divides the pitch moments of the car body and the bogie
 //! frames by Ix; here they are divided by Iy (MODELS §5.7). Pitch does not enter the lateral
 //! dynamics on straight track; `Iy_c` = 2.8e5 kg·m² reproduces the reference exactly.
@@ -266,7 +269,7 @@ pub fn rhs(
         }
     }
     let run = &track.run;
-    let (sin_se, cos_se) = run.cant.sin_cos();
+    let (sin_se, cos_se) = libm::sincos(run.cant);
     let v2k = run.v * run.v * run.kappa;
     let lateral = v2k * cos_se - GRAVITY * sin_se;
     let vertical = -v2k * sin_se - GRAVITY * cos_se;

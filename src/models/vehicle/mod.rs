@@ -268,11 +268,12 @@ impl Vehicle {
                         (spline, car)
                     }
                 };
+                use stability::NoCrossing;
                 match stability::linear_critical_speed(&car, &spline) {
                     Ok(v) => Ok(v),
-                    Err(e) if e.contains("stable from") => Ok(stability::SCAN_TO),
-                    Err(e) if e.contains("already unstable") => Ok(stability::SCAN_FROM),
-                    Err(e) => Err(e),
+                    Err(NoCrossing::StableThroughout) => Ok(stability::SCAN_TO),
+                    Err(NoCrossing::UnstableFromTheStart) => Ok(stability::SCAN_FROM),
+                    Err(e) => Err(e.to_string()),
                 }
             })
             .clone()

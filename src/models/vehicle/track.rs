@@ -238,7 +238,7 @@ impl Irregularity {
         } else if x <= self.fade_start {
             0.0
         } else {
-            0.5 * (1.0 - (PI * (x - self.fade_start) / self.fade_length).cos())
+            0.5 * (1.0 - libm::cos(PI * (x - self.fade_start) / self.fade_length))
         }
     }
 
