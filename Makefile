@@ -61,7 +61,8 @@ fmu:
 	stamp=$(FMU_DIR)/.package-command; \
 	inputs="$(LIB) target/release/railuq-fmu LICENSE-MIT LICENSE-APACHE $${extra:+$(DLL)}"; \
 	if [ -f "$$stamp" ] && [ "$$(cat "$$stamp")" = "$$cmd" ] \
-	   && ls $(FMU_DIR)/Wheel.fmu $(FMU_DIR)/Bogie.fmu $(FMU_DIR)/VehicleTrack.fmu >/dev/null 2>&1 \
+	   && ls $(FMU_DIR)/Wheel.fmu $(FMU_DIR)/Bogie.fmu $(FMU_DIR)/VehicleTrack.fmu \
+	     $(FMU_DIR)/Vehicle.fmu >/dev/null 2>&1 \
 	   && [ -z "$$(find $$inputs -newer "$$stamp" 2>/dev/null)" ]; then \
 	  echo "make fmu: $(FMU_DIR) is up to date"; \
 	else \
@@ -118,10 +119,12 @@ test: lint venv win64-toolchain build fmu
 
 # The FMU crate's tests run on a debug build that carries the test-only panic trigger
 # (tests/fmi_abi.rs); the packaged FMUs in target/fmu come from the release build without it.
-# The driver's tests run in release mode: they run real studies.
+# The Vehicle's dynamics tests (tens of simulated seconds each) run in release mode, as do the
+# driver's tests: they run real studies.
 test-rust:
 	$(CARGO) build -p railuq --lib --features test-panic
 	$(CARGO) test -p railuq --features test-panic
+	$(CARGO) test --release -p railuq --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
 	  $(CARGO) test --release -p uq-driver -p out-file
 

@@ -232,7 +232,7 @@ struct Case {
 
 fn cases() -> Vec<Case> {
     use railuq::fmi2::xml::guid;
-    use railuq::models::{bogie, vehicle_track, wheel};
+    use railuq::models::{bogie, vehicle, vehicle_track, wheel};
     vec![
         Case {
             model: "Wheel",
@@ -257,6 +257,14 @@ fn cases() -> Vec<Case> {
             internal: 1e-4,
             episode: 500, // 0-0.5 s
             outputs: [("Zc", 100), ("Zc_acc", 101), ("Zw1", 108)],
+        },
+        Case {
+            model: "Vehicle",
+            guid: guid(&vehicle::INFO),
+            step: 0.01,
+            internal: 5.7e-4, // RK4 substep at the default 40 m/s (1.8/rho, rho = 3169 1/s)
+            episode: 1000,    // 0-10 s on straight track from the default disturbance
+            outputs: [("y_w1", 102), ("Y_1L", 110), ("Q_1L", 118)],
         },
     ]
 }

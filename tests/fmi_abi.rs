@@ -1952,3 +1952,82 @@ fn unsupported_and_status_functions() {
     assert_eq!(unsafe { (fmu.cancel_step)(inst.c) }, ERROR);
     inst.assert_logged(ERROR, &["fmi2CancelStep"]);
 }
+
+// ================================================================ Vehicle
+
+#[test]
+fn the_vehicle_continues_through_fmu_states_and_a_new_speed_and_discards_on_derailment() {
+    use railuq::models::vehicle::{self, VR_R, VR_SPEED, VR_V, VR_Y0_W3, VR_Y_W3};
+    let guid = railuq::fmi2::xml::guid(&vehicle::INFO);
+    let car = Spec::new("vehicle")
+        .guid(Some(&guid))
+        .instantiate()
+        .unwrap_or_else(|log| panic!("Vehicle: {log:#?}"));
+    assert_eq!(car.set(VR_V, 60.0), OK);
+    car.init(0.0, None);
+    let h = 0.01;
+    let run = |n: usize| -> Vec<u64> {
+        (0..n)
+            .map(|_| {
+                let now = {
+                    let mut v = 0.0;
+                    // SAFETY: live instance, writable value.
+                    let s =
+                        unsafe { (car.fmu.get_real_status)(car.c, LAST_SUCCESSFUL_TIME, &mut v) };
+                    assert_eq!(s, OK);
+                    v
+                };
+                assert_eq!(car.step(now, h), OK, "{:#?}", car.log());
+                car.get(VR_Y_W3).to_bits()
+            })
+            .collect()
+    };
+    run(20);
+    let mut s: FmuState = null_mut();
+    assert_eq!(car.get_state(&mut s), OK);
+    let first = run(10);
+    assert_eq!(car.set_state(s), OK);
+    assert_eq!(
+        run(10),
+        first,
+        "the run from an FMU state repeats bit for bit"
+    );
+    // The speed is tunable: a new one between steps, a fixed parameter is refused.
+    assert_eq!(car.set(VR_V, 55.0), OK);
+    run(1);
+    assert_eq!(car.get(VR_SPEED), 55.0);
+    assert_eq!(car.set(VR_R, 1000.0), ERROR);
+    assert_eq!(car.free_state(&mut s), OK);
+
+    // A curve far too tight for the speed: the car derails, fmi2DoStep discards and the
+    // simulation ends where the last step ended.
+    let car = Spec::new("derail")
+        .guid(Some(&guid))
+        .instantiate()
+        .unwrap_or_else(|log| panic!("Vehicle: {log:#?}"));
+    for (vr, v) in [(VR_V, 45.0), (VR_R, 300.0), (VR_Y0_W3, 0.0)] {
+        assert_eq!(car.set(vr, v), OK);
+    }
+    car.init(0.0, None);
+    let mut t = 0.0;
+    let status = loop {
+        let s = car.step(t, h);
+        if s != OK || t > 5.0 {
+            break s;
+        }
+        t += h;
+    };
+    assert_eq!(status, DISCARD, "{:#?}", car.log());
+    car.assert_logged(DISCARD, &["fmi2DoStep", "derailment: wheelset"]);
+    let (mut terminated, mut last) = (0, -1.0);
+    // SAFETY: live instance, writable values.
+    let (s1, s2) = unsafe {
+        (
+            (car.fmu.get_boolean_status)(car.c, TERMINATED, &mut terminated),
+            (car.fmu.get_real_status)(car.c, LAST_SUCCESSFUL_TIME, &mut last),
+        )
+    };
+    assert_eq!((s1, terminated), (OK, 1));
+    assert_eq!(s2, OK);
+    assert!((last - t).abs() < 1e-9, "{last} vs {t}");
+}

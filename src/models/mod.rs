@@ -4,7 +4,9 @@
 #![forbid(unsafe_code)]
 
 pub mod bogie;
+pub mod data_file;
 pub mod table;
+pub mod vehicle;
 pub mod vehicle_track;
 pub mod wheel;
 
@@ -449,7 +451,7 @@ pub struct ModelEntry {
 
 /// Every model this library serves.
 pub fn registry() -> &'static [ModelEntry] {
-    static REGISTRY: [ModelEntry; 3] = [
+    static REGISTRY: [ModelEntry; 4] = [
         ModelEntry {
             info: &wheel::INFO,
             create: wheel::Wheel::boxed,
@@ -461,6 +463,10 @@ pub fn registry() -> &'static [ModelEntry] {
         ModelEntry {
             info: &vehicle_track::INFO,
             create: vehicle_track::VehicleTrack::boxed,
+        },
+        ModelEntry {
+            info: &vehicle::INFO,
+            create: vehicle::Vehicle::boxed,
         },
     ];
     &REGISTRY

@@ -1,6 +1,6 @@
 """The win64 DLL of the FMUs, run for real: a small FMI importer in C (tests/wine/importer.c),
 built with mingw-w64, loads it under Wine (Debian's wine64), steps the Wheel and is compared
-with the closed form and with the linux64 binary run by fmpy (Bogie and VehicleTrack too, and
+with the closed form and with the linux64 binary run by fmpy (Bogie, VehicleTrack, Vehicle too, and
 VehicleTrack reading a measured profile from its resources folder, given as a file:///Z:/...
 URI); calls in the wrong state must return fmi2Error.
 
@@ -250,7 +250,7 @@ def test_wheel_dll_under_wine_equals_the_linux_binary_bit_for_bit(wheel, wine):
     assert np.array_equal(win, linux), np.max(np.abs(win - linux))
 
 
-@pytest.mark.parametrize("name, stop", [("Bogie", 1.0), ("VehicleTrack", 0.2)])
+@pytest.mark.parametrize("name, stop", [("Bogie", 1.0), ("VehicleTrack", 0.2), ("Vehicle", 1.0)])
 def test_other_models_dll_under_wine_follow_the_linux_binary(wine, name, stop):
     fmu = extracted(name)
     try:

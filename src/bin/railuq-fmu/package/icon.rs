@@ -318,6 +318,87 @@ fn vehicle_track_scene() -> Vec<(Shape, Rgb)> {
     s
 }
 
+/// The full car seen from the front: car body rolled a little on the secondary springs, a bogie
+/// frame on the primary springs, a wheelset with coned wheels on two rails.
+fn vehicle_scene() -> Vec<(Shape, Rgb)> {
+    let mut s = vec![(
+        Shape::Polygon(vec![(0.03, 0.95), (0.97, 0.95), (0.9, 0.86), (0.1, 0.86)]),
+        BALLAST,
+    )];
+    s.push((rect(0.08, 0.83, 0.92, 0.87), WOOD));
+    for x in [0.2, 0.8] {
+        s.push((rect(x - 0.035, 0.8, x + 0.035, 0.83), STEEL));
+        s.push((rect(x - 0.02, 0.78, x + 0.02, 0.8), LIGHT_STEEL));
+    }
+    // Wheelset: axle and two coned wheels with their flanges inside the rails.
+    s.push((
+        Shape::Capsule {
+            a: (0.12, 0.7),
+            b: (0.88, 0.7),
+            w: 0.03,
+        },
+        DARK,
+    ));
+    for (x, side) in [(0.2, 1.0), (0.8, -1.0)] {
+        // The tread is coned: the rolling radius grows towards the flange (inside).
+        let (outer, inner) = (0.77, 0.78);
+        let (left, right) = if side > 0.0 {
+            (outer, inner)
+        } else {
+            (inner, outer)
+        };
+        s.push((
+            Shape::Polygon(vec![
+                (x - 0.05, 0.62),
+                (x + 0.05, 0.62),
+                (x + 0.05, right),
+                (x - 0.05, left),
+            ]),
+            DARK,
+        ));
+        s.push((
+            rect(x + 0.04 * side - 0.012, 0.62, x + 0.04 * side + 0.012, 0.81),
+            DARK,
+        ));
+    }
+    // Primary springs from the axle boxes to the bogie frame.
+    for x in [0.1, 0.9] {
+        s.push((rect(x - 0.035, 0.67, x + 0.035, 0.73), STEEL));
+        s.extend(
+            spring((x, 0.67), (x, 0.6), 2, 0.05, 0.012)
+                .into_iter()
+                .map(|sh| (sh, ORANGE)),
+        );
+    }
+    s.push((
+        Shape::RoundRect {
+            min: (0.05, 0.55),
+            max: (0.95, 0.6),
+            r: 0.012,
+        },
+        DEEP_BLUE,
+    ));
+    // Secondary springs and the car body, rolled about the floor's centre.
+    for x in [0.3, 0.7] {
+        s.extend(
+            spring((x, 0.55), (x, 0.46), 3, 0.07, 0.016)
+                .into_iter()
+                .map(|sh| (sh, ORANGE)),
+        );
+    }
+    let pivot = (0.5, 0.45);
+    let roll = -0.03;
+    s.push((turned_rect((0.5, 0.28), 0.86, 0.36, pivot, roll), BLUE));
+    for x in [0.24, 0.5, 0.76] {
+        s.push((turned_rect((x, 0.24), 0.16, 0.1, pivot, roll), GLASS));
+    }
+    s.push((
+        turned_rect((0.5, 0.44), 0.86, 0.025, pivot, roll),
+        DEEP_BLUE,
+    ));
+    s
+}
+
 /// Premultiplied RGBA pixels in 0..1.
 struct Canvas {
     px: Vec<[f32; 4]>,
@@ -380,6 +461,7 @@ pub fn model_png(name: &str) -> Vec<u8> {
     let scene = match name {
         "Bogie" => bogie_scene(),
         "VehicleTrack" => vehicle_track_scene(),
+        "Vehicle" => vehicle_scene(),
         _ => wheel_scene(),
     };
     let mut canvas = Canvas::new();
@@ -426,7 +508,7 @@ mod tests {
     #[test]
     fn each_model_gets_a_distinct_decodable_picture() {
         let mut seen = HashSet::new();
-        for name in ["Wheel", "Bogie", "VehicleTrack"] {
+        for name in ["Wheel", "Bogie", "VehicleTrack", "Vehicle"] {
             let bytes = model_png(name);
             let (info, px) = decode(&bytes);
             assert_eq!((info.width, info.height), (SIZE as u32, SIZE as u32));
