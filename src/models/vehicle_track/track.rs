@@ -249,27 +249,8 @@ impl Track {
     }
 
     /// Zr at the sleepers, `out[i] = Σ_k Z_k(x_{i+1}) q_k`.
-    fn synthesize(
-        dst: &mut DstI,
-        fold_bin: &[usize],
-        fold_sign: &[f64],
-        scale: f64,
-        q: &[f64],
-        bins: &mut [f64],
-        out: &mut [f64],
-    ) {
-        if q.len() <= bins.len() {
-            // NM ≤ N: no aliasing, the fold is the identity.
-            bins[..q.len()].copy_from_slice(q);
-            bins[q.len()..].iter_mut().for_each(|b| *b = 0.0);
-        } else {
-            bins.iter_mut().for_each(|b| *b = 0.0);
-            for ((&b, &s), &qk) in fold_bin.iter().zip(fold_sign).zip(q) {
-                if b != usize::MAX {
-                    bins[b] += s * qk;
-                }
-            }
-        }
+    fn synthesize(dst: &mut DstI, scale: f64, q: &[f64], bins: &mut [f64], out: &mut [f64]) {
+        fold(q, bins);
         dst.transform(bins, out);
         out.iter_mut().for_each(|v| *v *= scale);
     }
@@ -278,16 +259,13 @@ impl Track {
     fn analyze_add(&mut self, factor: f64, out: &mut [f64]) {
         self.dst.transform(&self.frs, &mut self.bins);
         let c = factor * self.scale;
-        if self.nm <= self.n {
-            for (o, &b) in out.iter_mut().zip(&self.bins) {
-                *o += c * b;
-            }
-            return;
+        let (low, high) = out.split_at_mut(self.nm.min(self.n));
+        for (o, &b) in low.iter_mut().zip(&self.bins) {
+            *o += c * b;
         }
-        for ((o, &b), &s) in out.iter_mut().zip(&self.fold_bin).zip(&self.fold_sign) {
-            if b != usize::MAX {
-                *o += c * s * self.bins[b];
-            }
+        // Mode N + 1 has a node at every sleeper; modes N + 2 … fold back with a sign.
+        for (o, &b) in high.iter_mut().skip(1).zip(self.bins.iter().rev()) {
+            *o += -c * b;
         }
     }
 
@@ -438,12 +416,7 @@ impl Track {
             for ((w, &a), &ad) in self.modal.iter_mut().zip(q).zip(qd) {
                 *w = t.kp * a + t.cp * ad;
             }
-            self.bins.fill(0.0);
-            for ((&b, &s), &w) in self.fold_bin.iter().zip(&self.fold_sign).zip(&self.modal) {
-                if b != usize::MAX {
-                    self.bins[b] += s * w;
-                }
-            }
+            fold(&self.modal, &mut self.bins);
         }
         self.dst.transform(&self.bins, &mut self.r);
         let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);
@@ -485,14 +458,23 @@ impl Track {
                 *a = -w2 * qk + c * b;
             }
         } else {
-            let folds = self.fold_bin.iter().zip(&self.fold_sign);
-            let modes = acc_q.iter_mut().zip(q).zip(&self.omega2).zip(folds);
-            for (((a, &qk), &w2), (&b, &sg)) in modes {
-                *a = if b == usize::MAX {
-                    -w2 * qk
-                } else {
-                    -w2 * qk + c * sg * self.bins[b]
-                };
+            // Two contiguous loops: modes 1 … N read bin k - 1; mode N + 1 (a node at every
+            // sleeper) none; modes N + 2 … NM read bins N - 1, N - 2, … with the sign flipped.
+            let (a_low, a_high) = acc_q.split_at_mut(n);
+            let (q_low, q_high) = q.split_at(n);
+            let (w_low, w_high) = self.omega2.split_at(n);
+            let low = a_low.iter_mut().zip(q_low).zip(w_low).zip(&self.bins);
+            for (((a, &qk), &w2), &b) in low {
+                *a = -w2 * qk + c * b;
+            }
+            a_high[0] = -w_high[0] * q_high[0];
+            let high = a_high[1..]
+                .iter_mut()
+                .zip(&q_high[1..])
+                .zip(&w_high[1..])
+                .zip(self.bins.iter().rev());
+            for (((a, &qk), &w2), &b) in high {
+                *a = -w2 * qk + -c * b;
             }
         }
         let cw: [f64; 4] = std::array::from_fn(|j| scale * p[j]);
@@ -537,15 +519,7 @@ impl Track {
         let (n, nm) = (self.n, self.nm);
         let t = self.p;
         let (q, zs, zb) = (&y[..nm], &y[nm..nm + n], &y[nm + n..]);
-        Self::synthesize(
-            &mut self.dst,
-            &self.fold_bin,
-            &self.fold_sign,
-            self.scale,
-            q,
-            &mut self.bins,
-            &mut self.r,
-        );
+        Self::synthesize(&mut self.dst, self.scale, q, &mut self.bins, &mut self.r);
         let (out_q, rest) = out.split_at_mut(nm);
         let (out_s, out_b) = rest.split_at_mut(n);
         for i in 0..n {
@@ -585,7 +559,7 @@ impl Track {
         let half = (n + 1) as f64 / 2.0;
         let mut diag = vec![0.0; dim];
         for k in 0..nm {
-            let sup = if self.fold_bin[k] == usize::MAX {
+            let sup = if k == n {
                 0.0
             } else {
                 t.kp * self.scale * self.scale * half
@@ -662,6 +636,20 @@ impl Track {
                 part[i] = if i + m < n { part[i + m] } else { 0.0 };
             }
         }
+    }
+}
+
+/// Folds modal amplitudes onto the N sleeper bins of the sine transform (NM ≤ 2N + 1):
+/// sin(kπi/(N+1)) for k = N + 1 + r equals −sin((N + 1 − r)πi/(N+1)), so mode k ≤ N goes to
+/// bin k − 1, mode N + 1 (a node at every sleeper) nowhere, and mode N + 1 + r to bin N − r
+/// with the sign flipped. Two contiguous loops, no index table.
+fn fold(modal: &[f64], bins: &mut [f64]) {
+    let n = bins.len();
+    let (low, high) = modal.split_at(modal.len().min(n));
+    bins[..low.len()].copy_from_slice(low);
+    bins[low.len()..].fill(0.0);
+    for (b, &w) in bins.iter_mut().rev().zip(high.iter().skip(1)) {
+        *b -= w;
     }
 }
 

@@ -134,3 +134,37 @@ fn refuses_bad_sizes() {
     assert!(Track::new(paper_track(63, 128)).is_err());
     assert!(Track::new(paper_track(63, 127)).is_ok());
 }
+
+#[test]
+fn contiguous_fold_equals_the_sine_identity_bit_for_bit() {
+    // Independent of the kernel: the fold must reproduce Σ_k w_k sin(kπi/(N+1)) at every
+    // sleeper i, i.e. bin b collects +w_{b+1} and −w_{2N+1−b}; mode N + 1 vanishes on the grid.
+    for (n, nm) in [(7, 3), (7, 7), (7, 8), (7, 9), (7, 15), (127, 255)] {
+        let modal: Vec<f64> = (0..nm).map(|k| ((k * 37 % 11) as f64 - 5.3) * 1.7).collect();
+        let mut bins = vec![f64::NAN; n];
+        fold(&modal, &mut bins);
+        for (b, &got) in bins.iter().enumerate() {
+            let mut want = 0.0;
+            for (k, &w) in modal.iter().enumerate() {
+                let m = k + 1;
+                if m == b + 1 {
+                    want += w;
+                } else if m == 2 * n + 1 - b {
+                    want -= w;
+                }
+            }
+            assert_eq!(got.to_bits(), want.to_bits(), "n {n} nm {nm} bin {b}");
+        }
+        // The sine identity itself, on the grid.
+        let l = (n + 1) as f64;
+        for i in 1..=n {
+            let direct: f64 = (1..=nm)
+                .map(|m| modal[m - 1] * (m as f64 * PI * i as f64 / l).sin())
+                .sum();
+            let folded: f64 = (1..=n)
+                .map(|m| bins[m - 1] * (m as f64 * PI * i as f64 / l).sin())
+                .sum();
+            assert!((direct - folded).abs() < 1e-9, "n {n} nm {nm} i {i}");
+        }
+    }
+}
