@@ -140,7 +140,9 @@ fn contiguous_fold_equals_the_sine_identity_bit_for_bit() {
     // Independent of the kernel: the fold must reproduce Σ_k w_k sin(kπi/(N+1)) at every
     // sleeper i, i.e. bin b collects +w_{b+1} and −w_{2N+1−b}; mode N + 1 vanishes on the grid.
     for (n, nm) in [(7, 3), (7, 7), (7, 8), (7, 9), (7, 15), (127, 255)] {
-        let modal: Vec<f64> = (0..nm).map(|k| ((k * 37 % 11) as f64 - 5.3) * 1.7).collect();
+        let modal: Vec<f64> = (0..nm)
+            .map(|k| ((k * 37 % 11) as f64 - 5.3) * 1.7)
+            .collect();
         let mut bins = vec![f64::NAN; n];
         fold(&modal, &mut bins);
         for (b, &got) in bins.iter().enumerate() {

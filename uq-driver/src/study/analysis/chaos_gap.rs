@@ -38,7 +38,7 @@ pub(crate) fn chaos_gap_warnings(
                 unit: unit(&o.name),
                 times: Some(&o.times),
             };
-            out.extend(chaos_gap(&column, &o.std, sc, askey_hint));
+            out.extend(chaos_gap(&column, &o.mean, &o.std, sc, askey_hint));
         }
     }
     for c in &a.quantity_chaos {
@@ -48,7 +48,13 @@ pub(crate) fn chaos_gap_warnings(
                 unit: unit(&q.name),
                 times: None,
             };
-            out.extend(chaos_gap(&column, &[q.std], &c.pce.std(), askey_hint));
+            out.extend(chaos_gap(
+                &column,
+                &[q.mean],
+                &[q.std],
+                &c.pce.std(),
+                askey_hint,
+            ));
         }
     }
     out
@@ -59,6 +65,17 @@ struct Column<'a> {
     name: &'a str,
     unit: Option<&'a str>,
     times: Option<&'a [f64]>,
+}
+
+/// A Std at or below this fraction of the magnitude of its mean is rounding: the column is
+/// deterministic (an output the inputs do not reach, such as a prescribed speed), and a
+/// relative comparison of two such Stds measures nothing (1.5e-14 against 3e-22 read as a
+/// gap of 2.7e17 %).
+const DETERMINISTIC: f64 = 1e-9;
+
+/// Whether a column of mean `mean` and Std `std` is deterministic to rounding.
+fn deterministic(mean: f64, std: f64) -> bool {
+    std.abs() <= DETERMINISTIC * mean.abs()
 }
 
 /// Whether a column whose Std is `s` is resolved among the columns of Std `std`: above 1e-3
@@ -82,7 +99,13 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
     let mut out = Vec::new();
     let mut missing = false;
     for o in &a.outputs {
+        let constant = o
+            .mean
+            .iter()
+            .zip(&o.std)
+            .all(|(m, s)| deterministic(*m, *s));
         match &o.chaos_error {
+            Some(_) if constant => {}
             Some(e) => {
                 if let Some((v, k)) = series_error(e, &o.std).filter(|w| w.0 > CHAOS_ERROR) {
                     out.push(match k {
@@ -97,10 +120,13 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
                     });
                 }
             }
-            None => missing |= o.std.iter().any(|s| *s > 0.0),
+            None => missing |= !constant && o.std.iter().any(|s| *s > 0.0),
         }
     }
     for q in &a.quantities {
+        if deterministic(q.mean, q.std) {
+            continue;
+        }
         match &q.chaos_error {
             Some(e) if e.kind == ChaosErrorKind::OrderDifference.name() => {
                 if e.value.is_finite() && e.value > CHAOS_ERROR {
@@ -178,14 +204,25 @@ fn top_order_warning(name: &str, at: &str, share: f64) -> String {
 
 /// The warning of one output (`times`) or quantity (`None`) whose Std is `std` by the method
 /// and `std_chaos` by its chaos, at the column where they differ most (columns whose Std is
-/// below 1e-3 of the largest are left out: rounding dominates there).
-fn chaos_gap(column: &Column, std: &[f64], std_chaos: &[f64], askey_hint: bool) -> Option<String> {
+/// below 1e-3 of the largest, or [`deterministic`] by their `mean`, are left out: rounding
+/// dominates there).
+fn chaos_gap(
+    column: &Column,
+    mean: &[f64],
+    std: &[f64],
+    std_chaos: &[f64],
+    askey_hint: bool,
+) -> Option<String> {
     let resolved = resolved(std);
     let (k, gap) = std
         .iter()
         .zip(std_chaos)
+        .zip(mean)
         .enumerate()
-        .filter(|(_, (s, c))| s.is_finite() && c.is_finite() && resolved(**s))
+        .filter(|(_, ((s, c), m))| {
+            s.is_finite() && c.is_finite() && resolved(**s) && !deterministic(**m, **s)
+        })
+        .map(|(k, ((s, c), _))| (k, (s, c)))
         .map(|(k, (s, c))| (k, (s * s - c * c).abs() / (s * s)))
         .fold(None, |w: Option<(usize, f64)>, (k, g)| match w {
             Some((_, best)) if best >= g => w,
@@ -219,4 +256,34 @@ fn chaos_gap(column: &Column, std: &[f64], std_chaos: &[f64], askey_hint: bool) 
             ""
         },
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn column(name: &str) -> Column<'_> {
+        Column {
+            name,
+            unit: Some("m/s"),
+            times: None,
+        }
+    }
+
+    #[test]
+    fn a_deterministic_output_gets_no_chaos_gap_warning_from_rounding_noise() {
+        // A prescribed speed of 50 m/s: the quadrature's Std is rounding (1.5e-14), the
+        // chaos's another rounding (3e-22).
+        let w = chaos_gap(&column("V"), &[50.0], &[1.5e-14], &[3e-22], false);
+        assert!(w.is_none(), "{w:?}");
+    }
+
+    #[test]
+    fn a_real_gap_is_still_reported() {
+        let w = chaos_gap(&column("q"), &[50.0], &[2.0], &[1.5], false).expect("a warning");
+        assert!(w.contains("less variance"), "{w}");
+        assert!(chaos_gap(&column("q"), &[0.0], &[2.0], &[1.99], false).is_none());
+        // A Std above the rounding level of its mean is compared, however small.
+        assert!(chaos_gap(&column("q"), &[1.0], &[1e-6], &[0.5e-6], false).is_some());
+    }
 }
