@@ -84,7 +84,7 @@ win64-toolchain:
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
 	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme README.md
+	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme docs/src/reference/fmu-variables.md
 
 $(VPY): tests/python/requirements.txt
 	$(PYTHON) -m venv $(VENV)
