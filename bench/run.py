@@ -12,7 +12,7 @@ FMUs and the Python venv), or directly:
 target/bench/BENCHMARKS-hd.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
-goals of the issue are reported as met or not met. The only hard failures are missing
+goals set for the comparisons are reported as met or not met. The only hard failures are missing
 prerequisites, a failing command, and a failed correctness check (fmpy vs uq-driver), which
 invalidates the comparison: BENCHMARKS.md is still written, then the script exits with 1.
 
@@ -878,7 +878,7 @@ def bench_analysis_report(work, repeats, checks, all_builtins):
 # ------------------------------------------------------------------ high-dimensional goals
 
 def bench_hd_goals(work):
-    """Issue 11's goals (Ishigami, borehole, g-function through the Functions test FMU; the
+    """The high-dimensional goals (Ishigami, borehole, g-function through the Functions test FMU; the
     VehicleTrack 8-D chaos), runs counted, beside OpenTURNS and chaospy (bench/hd_goals.py)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import hd_goals

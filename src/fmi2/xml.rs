@@ -348,8 +348,9 @@ pre{{background:#f6f6f6;padding:.5em}}</style></head><body>
     )
 }
 
-/// The Markdown table of a model's variables, as README.md shows it (between the markers
-/// [`readme_markers`]); `make xml` rewrites those blocks.
+/// The Markdown table of a model's variables, as the user guide shows it
+/// (`docs/src/reference/fmu-variables.md`, between the markers [`readme_markers`]); `make xml`
+/// rewrites those blocks.
 pub fn markdown_table(info: &ModelInfo) -> String {
     let mut t = String::from(
         "| name | vr | type | causality | variability | start | unit | description |\n\
@@ -377,7 +378,7 @@ pub fn markdown_table(info: &ModelInfo) -> String {
     t
 }
 
-/// The comment lines that enclose a model's generated table in README.md.
+/// The comment lines that enclose a model's generated table in the guide's variables page.
 pub fn readme_markers(info: &ModelInfo) -> (String, String) {
     (
         format!(
@@ -449,21 +450,22 @@ mod tests {
         assert!(xml.contains("<Unit name=\"N/m\"><BaseUnit kg=\"1\" s=\"-2\"/></Unit>"));
     }
 
-    /// README.md's variable tables must equal what the variable tables generate.
+    /// The guide's variable tables must equal what the variable tables generate.
     #[test]
-    fn readme_variable_tables_do_not_drift() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md");
+    fn guide_variable_tables_do_not_drift() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("docs/src/reference/fmu-variables.md");
         let text = std::fs::read_to_string(&path).unwrap();
         let infos: Vec<&ModelInfo> = registry().iter().map(|e| e.info).collect();
         let (updated, found) = update_readme_tables(&text, &infos);
         assert_eq!(
             found,
             infos.len(),
-            "README.md lacks a marked variable table"
+            "docs/src/reference/fmu-variables.md lacks a marked variable table"
         );
         assert!(
             updated == text,
-            "README.md's variable tables drifted from the models: run `make xml` and commit"
+            "docs/src/reference/fmu-variables.md drifted from the models: run `make xml` and commit"
         );
     }
 

@@ -13,8 +13,9 @@ from binaries import PE, elf_section_names, max_glibc
 from conftest import ROOT, fmu_path
 
 MODELS = ["Wheel", "Bogie", "VehicleTrack", "Vehicle"]
-# The oldest glibc the Linux binary runs on, as README.md states it. A build that needs a newer
-# one fails here: then say so in the README (and here).
+# The oldest glibc the Linux binary runs on, as the user guide states it
+# (docs/src/reference/fmus.md). A build that needs a newer one fails here: then say so there
+# (and here).
 GLIBC_MAX = (2, 34)
 
 

@@ -10,8 +10,8 @@
 //! ## A study of an FMU: [`spec::Study::parse`] → [`study::run_study`] → [`study::StudyResult`]
 //!
 //! A study is described in TOML (the same file `uq-driver run` takes; see [`spec`] and the
-//! README for every key), run with [`study::run_study`] into an output folder, and its
-//! statistics come back typed:
+//! user guide's study-file reference, `docs/src/reference/study-file.md`, for every key), run
+//! with [`study::run_study`] into an output folder, and its statistics come back typed:
 //!
 //! ```no_run
 //! use std::path::Path;

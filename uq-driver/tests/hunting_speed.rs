@@ -3,9 +3,10 @@
 //! with the hunting criterion written here (largest |Y| over the last second at or above the
 //! threshold). Fast configuration: 60 s runs, RK4 step 4 ms, communication step 0.02 s,
 //! tolerance 0.1 m/s (the numbers are not the converged critical speed: that needs longer
-//! runs, see the README). Also: the point's random values reach the constant-speed runs, the
-//! records are the same in-process, isolated, resumed and sharded, and a bracket that misses
-//! the transition or settings that do not fit the FMU are clear errors.
+//! runs, see the bogie in the user guide's models page). Also: the point's random values
+//! reach the constant-speed runs, the records are the same in-process, isolated, resumed and
+//! sharded, and a bracket that misses the transition or settings that do not fit the FMU are
+//! clear errors.
 
 use std::path::{Path, PathBuf};
 

@@ -1,7 +1,8 @@
 //! Build helper: `railuq-fmu xml DIR` writes the model descriptions; `railuq-fmu readme FILE`
-//! rewrites the marked variable tables of README.md; `railuq-fmu package
-//! [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]` writes one `.fmu` per model
-//! carrying every library given, each under the platform folder its header names;
+//! rewrites the marked variable tables of a Markdown file (the guide's variables page);
+//! `railuq-fmu package [--library LIB]... [--keep-debug] LIB OUT_DIR [MODEL...]` writes one
+//! `.fmu` per model carrying every library given, each under the platform folder its header
+//! names;
 //! `railuq-fmu contact --out FILE [...]` writes a wheel–rail contact table and its plot.
 
 use std::path::{Path, PathBuf};
@@ -86,7 +87,8 @@ fn run_package(a: &PackageArgs) -> Result<(), PackageError> {
     Ok(())
 }
 
-/// Rewrites the marked variable tables of `path` (README.md) from the models' tables.
+/// Rewrites the marked variable tables of `path` (docs/src/reference/fmu-variables.md) from
+/// the models' tables.
 fn update_readme(path: &Path) -> Result<(), PackageError> {
     let io = |source| PackageError::Io {
         path: path.to_path_buf(),

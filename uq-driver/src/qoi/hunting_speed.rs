@@ -31,7 +31,8 @@
 //! motion lingers near the vanished cycle before it decays (measured on the bogie: 0.005 m/s
 //! below the fold, |Y| stays above 0.1 mm for 90 s; 0.035 m/s below, 76 s; 0.8 m/s below, 51 s).
 //! A run that ends before the decay is counted as hunting, so a short `duration` biases both
-//! speeds downwards; choose it from a convergence check (see the README for the bogie's).
+//! speeds downwards; choose it from a convergence check (see the bogie's in the user guide,
+//! `docs/src/reference/models.md`).
 
 use std::collections::BTreeMap;
 

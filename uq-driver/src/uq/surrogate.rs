@@ -3,10 +3,11 @@
 //! the coefficients and the estimated truncation error. [`Surrogate`] reads it back,
 //! evaluates it at physical parameter values and samples it.
 //!
-//! The format (version 1) is documented in the README ("The surrogate"). A chaos term is
-//! `prod_i p^(i)_{k_i}(t_i)`, `p^(i)` the orthonormal polynomial of input `i`'s family on
-//! its germ `t_i`; an input's value is `offset + scale t_i` (`map = "affine"`) or
-//! `F_i^-1(Phi(t_i))` (`map = "normal"`), correlated inputs through the Gaussian copula.
+//! The format (version 1) is documented in the user guide
+//! (`docs/src/reference/surrogate-format.md`). A chaos term is `prod_i p^(i)_{k_i}(t_i)`,
+//! `p^(i)` the orthonormal polynomial of input `i`'s family on its germ `t_i`; an input's
+//! value is `offset + scale t_i` (`map = "affine"`) or `F_i^-1(Phi(t_i))` (`map =
+//! "normal"`), correlated inputs through the Gaussian copula.
 
 use std::path::Path;
 
