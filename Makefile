@@ -141,7 +141,7 @@ test-rust:
 	$(CARGO) test -p railuq --features test-panic
 	$(CARGO) test --release -p railuq --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
-	  $(CARGO) test --release -p uq-driver -p out-file
+	  $(CARGO) test --release -p uq-driver -p out-file -p in-file
 
 test-python: venv
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python

@@ -2,7 +2,8 @@
 //! [`read_data_file`], with the checks every such read needs.
 //!
 //! - A relative path is resolved in the FMU's resources folder when the importer gave one.
-//! - Only a regular file is read: a directory, a FIFO, a socket or a device is refused before
+//! - The rest is the `in-file` crate's (shared with uq-driver's input files):
+//!   only a regular file is read: a directory, a FIFO, a socket or a device is refused before
 //!   it is opened for reading (a FIFO opened for reading would block until a writer comes), and
 //!   the file is opened non-blocking and checked again on the open handle, so that a path
 //!   swapped for a FIFO in between cannot hang the run either.
@@ -13,8 +14,6 @@
 //! quote the file's contents (a wrong path may name a file that is not ours to show in a log).
 #![forbid(unsafe_code)]
 
-use std::fs::{File, OpenOptions};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Largest data file read (bytes): 64 MiB.
@@ -30,43 +29,11 @@ pub fn resolve(value: &str, resource_dir: Option<&Path>) -> PathBuf {
     }
 }
 
-/// What kind of file system object `meta` describes, for an error message.
-fn kind(meta: &std::fs::Metadata) -> &'static str {
-    let t = meta.file_type();
-    if t.is_dir() {
-        return "a directory";
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-        if t.is_block_device() || t.is_char_device() {
-            return "a device";
-        }
-    }
-    "not a regular file"
-}
-
-fn open_non_blocking(path: &Path) -> std::io::Result<File> {
-    let mut options = OpenOptions::new();
-    options.read(true);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_NONBLOCK);
-    }
-    options.open(path)
-}
-
 /// Reads the text of the file parameter `param` names (`value`, resolved by [`resolve`]).
 ///
 /// The error says which parameter, which path and what is wrong with it: missing, not a
-/// regular file, larger than [`MAX_DATA_FILE_BYTES`], unreadable or not UTF-8.
+/// regular file, larger than [`MAX_DATA_FILE_BYTES`], unreadable or not UTF-8. The rules are
+/// the `in-file` crate's, which uq-driver's input files follow too.
 pub fn read_data_file(
     param: &str,
     value: &str,
@@ -75,46 +42,19 @@ pub fn read_data_file(
     let path = resolve(value, resource_dir);
     let shown = path.display();
     let refuse = |what: &str| format!("{param} '{shown}': {what}");
-    let meta = std::fs::metadata(&path).map_err(|e| refuse(&format!("cannot be read: {e}")))?;
-    if !meta.is_file() {
-        return Err(refuse(&format!(
-            "is {}; a regular file is expected",
-            kind(&meta)
-        )));
-    }
-    let file = open_non_blocking(&path).map_err(|e| refuse(&format!("cannot be opened: {e}")))?;
-    let meta = file
-        .metadata()
-        .map_err(|e| refuse(&format!("cannot be read: {e}")))?;
-    if !meta.is_file() {
-        return Err(refuse(&format!(
-            "is {}; a regular file is expected",
-            kind(&meta)
-        )));
-    }
-    if meta.len() > MAX_DATA_FILE_BYTES {
-        return Err(refuse(&format!(
-            "has {} bytes, more than the {} MiB a data file may have",
-            meta.len(),
+    in_file::read_text(&path, MAX_DATA_FILE_BYTES).map_err(|e| match e {
+        Ok(line) => refuse(&format!(
+            "line {line} is not UTF-8 text (a text file of numbers is expected)"
+        )),
+        Err(in_file::ReadError::TooLarge { size, .. }) => refuse(&format!(
+            "has {size} bytes, more than the {} MiB a data file may have",
             MAX_DATA_FILE_BYTES >> 20
-        )));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(MAX_DATA_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| refuse(&format!("cannot be read: {e}")))?;
-    if bytes.len() as u64 > MAX_DATA_FILE_BYTES {
-        return Err(refuse(&format!(
+        )),
+        Err(in_file::ReadError::Grew { .. }) => refuse(&format!(
             "grew beyond the {} MiB a data file may have while it was read",
             MAX_DATA_FILE_BYTES >> 20
-        )));
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let line = 1 + e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count();
-        refuse(&format!(
-            "line {line} is not UTF-8 text (a text file of numbers is expected)"
-        ))
+        )),
+        Err(other) => refuse(&other.to_string()),
     })
 }
 
@@ -188,7 +128,7 @@ mod tests {
     fn a_file_beyond_the_size_cap_is_refused_before_it_is_read() {
         let dir = temp_dir("big");
         let path = dir.join("big.csv");
-        let f = File::create(&path).unwrap();
+        let f = std::fs::File::create(&path).unwrap();
         f.set_len(MAX_DATA_FILE_BYTES + 1).unwrap(); // sparse: no disk space used
         let e = read_data_file("p", path.to_str().unwrap(), None).unwrap_err();
         assert!(e.contains("more than the 64 MiB"), "{e}");

@@ -39,6 +39,7 @@ mod study_chaos;
 mod study_nested;
 mod study_sampling;
 mod study_wheel;
+mod tampered_folders;
 mod test_fmus;
 mod undefined_numbers;
 

@@ -37,7 +37,8 @@ fn records_path(dir: &Path) -> std::path::PathBuf {
 fn write_store(dir: &Path, m: &Manifest) -> Vec<std::ops::Range<usize>> {
     let (s, _) = Store::open(dir, m, true).unwrap();
     let mut ranges = Vec::new();
-    let mut at = 0;
+    // The store's identity frame comes first.
+    let mut at = fs::metadata(records_path(dir)).unwrap().len() as usize;
     for i in 0..m.n_points {
         let rec = if i % 7 == 3 {
             Record::Failed(format!("point {i} failed: ∆ too large"))

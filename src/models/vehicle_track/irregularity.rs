@@ -35,6 +35,7 @@
 #![forbid(unsafe_code)]
 
 use super::fft::{Complex, Fft};
+use crate::models::data_file::{read_data_file, resolve};
 use std::f64::consts::PI;
 use std::path::Path;
 use std::sync::Arc;
@@ -246,6 +247,9 @@ pub struct MeasuredProfile {
 impl MeasuredProfile {
     /// Parses CSV text: two numbers per line (`,`, `;`, tab or space separated); blank lines
     /// and lines starting with `#` are skipped, and so is one header line before the data.
+    ///
+    /// Errors name `source` and the line, never the line's contents or its numbers: a wrong
+    /// path may name a file that is not ours to show in a log.
     pub fn parse(text: &str, source: &str) -> Result<Self, String> {
         let (mut x, mut z) = (Vec::new(), Vec::new());
         let mut header_allowed = true;
@@ -262,16 +266,14 @@ impl MeasuredProfile {
             match nums {
                 Some(v) if v.len() >= 2 => {
                     if !(v[0].is_finite() && v[1].is_finite()) {
-                        return Err(format!("{source}:{}: non-finite value", no + 1));
+                        return Err(format!("{source}: line {}: non-finite value", no + 1));
                     }
-                    if let Some(&last) = x.last() {
-                        if v[0] <= last {
-                            return Err(format!(
-                                "{source}:{}: x = {} m does not increase (previous {last} m)",
-                                no + 1,
-                                v[0]
-                            ));
-                        }
+                    if x.last().is_some_and(|&last| v[0] <= last) {
+                        return Err(format!(
+                            "{source}: line {}: x does not increase (each x [m] must be \
+                             greater than the one on the line before)",
+                            no + 1
+                        ));
                     }
                     x.push(v[0]);
                     z.push(v[1]);
@@ -279,7 +281,8 @@ impl MeasuredProfile {
                 _ if header_allowed && x.is_empty() => {}
                 _ => {
                     return Err(format!(
-                        "{source}:{}: expected two numbers 'x [m], z [m]', found '{line}'",
+                        "{source}: line {}: expected two numbers 'x [m], z [m]' (separated by \
+                         ',', ';', a tab or spaces)",
                         no + 1
                     ))
                 }
@@ -296,21 +299,18 @@ impl MeasuredProfile {
         })
     }
 
-    /// Reads `path`; a relative path is taken relative to `resource_dir` when given.
+    /// Reads `path` (a regular file of at most 64 MiB, by the rules of
+    /// [`read_data_file`](crate::models::data_file::read_data_file)); a relative path is taken
+    /// relative to `resource_dir` when given.
     pub fn read(path: &str, resource_dir: Option<&Path>) -> Result<Self, String> {
         if path.is_empty() {
             return Err(
                 "irregularity = 10 (measured) needs profile_file, a CSV of x [m], z [m]".into(),
             );
         }
-        let p = Path::new(path);
-        let full = match resource_dir {
-            Some(dir) if p.is_relative() => dir.join(p),
-            _ => p.to_path_buf(),
-        };
-        let text = std::fs::read_to_string(&full)
-            .map_err(|e| format!("cannot read profile_file '{}': {e}", full.display()))?;
-        Self::parse(&text, &full.display().to_string())
+        let text = read_data_file("profile_file", path, resource_dir)?;
+        let full = resolve(path, resource_dir);
+        Self::parse(&text, &full.display().to_string()).map_err(|e| format!("profile_file {e}"))
     }
 
     /// Range of x covered (m).
@@ -618,6 +618,42 @@ mod tests {
         let e =
             MeasuredProfile::read("no_such_file.csv", Some(Path::new("/nonexistent"))).unwrap_err();
         assert!(e.contains("/nonexistent/no_such_file.csv"), "{e}");
+    }
+
+    /// profile_file = "/etc/shadow" failed with a message quoting its second line (kept with
+    /// the failed point in points.csv); a FIFO hung the run, /dev/zero grew to ~2 GB.
+    #[test]
+    fn a_profile_file_error_never_quotes_the_file_and_special_files_are_refused() {
+        let e = MeasuredProfile::parse("root:x:0:0\nsecret:$6$abc:1\n", "p").unwrap_err();
+        assert_eq!(
+            e,
+            "p: line 2: expected two numbers 'x [m], z [m]' (separated by ',', ';', a tab or \
+             spaces)"
+        );
+        let e = MeasuredProfile::parse("x,z\n1234,1\n999,2\n", "p").unwrap_err();
+        assert!(!e.contains("1234") && !e.contains("999"), "{e}");
+        assert!(e.contains("line 3: x does not increase"), "{e}");
+        #[cfg(unix)]
+        {
+            let e = MeasuredProfile::read("/dev/zero", None).unwrap_err();
+            assert!(e.contains("is a device; a regular file is expected"), "{e}");
+            let dir = std::env::temp_dir().join(format!("railuq-fifo-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let fifo = dir.join("profile.csv");
+            let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+            if matches!(made, Ok(s) if s.success()) {
+                let (tx, rx) = std::sync::mpsc::channel();
+                let path = fifo.to_str().unwrap().to_owned();
+                std::thread::spawn(move || {
+                    let _ = tx.send(MeasuredProfile::read(&path, None).map(|_| ()));
+                });
+                let r = rx
+                    .recv_timeout(std::time::Duration::from_secs(10))
+                    .expect("reading a FIFO must not block");
+                assert!(r.unwrap_err().contains("is a FIFO (named pipe)"));
+            }
+            std::fs::remove_dir_all(dir).unwrap();
+        }
     }
 
     #[test]

@@ -44,7 +44,7 @@ pub(crate) enum Command {
         #[arg(long)]
         shard: Option<usize>,
         /// Worker threads (default: all cores).
-        #[arg(long, short)]
+        #[arg(long, short, value_parser = parse_threads)]
         threads: Option<usize>,
         /// MC/LHS: continue past failed points.
         #[arg(long)]
@@ -162,7 +162,7 @@ pub(crate) struct RunArgs {
     #[arg(long, short)]
     pub(crate) out: PathBuf,
     /// Worker threads (default: all cores).
-    #[arg(long, short)]
+    #[arg(long, short, value_parser = parse_threads)]
     pub(crate) threads: Option<usize>,
     /// MC/LHS: continue past failed points and report how many failed.
     #[arg(long)]
@@ -245,6 +245,29 @@ impl SafetyArgs {
     }
 }
 
+/// `--threads N`: a whole number, at least 1. The message says what to do in the command's
+/// terms (`--threads 0` used to be refused naming a Rust type's field).
+pub(crate) fn parse_threads(s: &str) -> Result<usize, String> {
+    at_least_one(s, "or leave --threads out to use every core")
+}
+
+/// `--cpus-per-task N`: a whole number, at least 1.
+pub(crate) fn parse_cpus(s: &str) -> Result<usize, String> {
+    at_least_one(s, "or leave --cpus-per-task out for 1")
+}
+
+fn at_least_one(s: &str, otherwise: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(0) => Err(format!(
+            "0 threads cannot run anything: give at least 1, {otherwise}"
+        )),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!(
+            "a whole number at least 1 is expected, {otherwise}"
+        )),
+    }
+}
+
 pub(crate) fn parse_timeout(s: &str) -> Result<std::time::Duration, String> {
     let v: f64 = s.trim().parse().map_err(|e| format!("{e}"))?;
     if !(v.is_finite() && v > 0.0) {
@@ -270,7 +293,7 @@ pub(crate) struct SlurmArgs {
     #[arg(long)]
     pub(crate) time: Option<String>,
     /// CPUs per shard task (also its threads).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_cpus)]
     pub(crate) cpus_per_task: Option<usize>,
     /// Extra #SBATCH option (repeatable), e.g. --sbatch=--account=rail.
     #[arg(long = "sbatch")]

@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::args::*;
-use crate::fmu::{Fmu, VariableKind};
+use crate::fmu::{Causality, Fmu, VariableKind};
 use crate::report::csv::push_shortest;
 use crate::spec::{Experiment, FixedValue, InvalidExperiment};
 use crate::study::plan::size;
@@ -72,10 +72,23 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         .stop
         .or(de.stop_time)
         .context("no --stop and no default stop time in the FMU")?;
-    let step = a
-        .step
-        .or(de.step_size)
-        .context("no --step and no default step size in the FMU")?;
+    let step = match a.step.or(de.step_size) {
+        Some(h) => h,
+        None => {
+            let h = auto_interval(stop - start).context(
+                "no --step, no default step size in the FMU, and no time to divide (stop <= \
+                 start): give --step",
+            )?;
+            eprintln!(
+                "uq-driver: note: no --step and no default step size in the FMU: communication \
+                 step {} s ({} steps from {start} s to {stop} s, chosen as fmpy's simulate_fmu \
+                 chooses it: a round step giving 500 to 1000 steps; --step sets another)",
+                shortest(h),
+                ((stop - start) / h).round()
+            );
+            h
+        }
+    };
     let experiment = Experiment { start, stop, step };
     experiment.check().map_err(|e| match e {
         InvalidExperiment::ZeroStep => anyhow::anyhow!(
@@ -83,10 +96,35 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         ),
         other => other.into(),
     })?;
-    let series = if a.outputs.is_empty() {
-        fmu.description().output_variables().count()
+    // The first column is the time: `--output time` (the FMU's independent variable, or no
+    // variable at all) adds no second one.
+    let md = fmu.description();
+    let is_time = |n: &str| {
+        n == "time"
+            && md
+                .variable("time")
+                .is_none_or(|v| v.causality == Causality::Independent)
+    };
+    let mut outputs: Vec<String> = a.outputs.iter().filter(|n| !is_time(n)).cloned().collect();
+    if outputs.len() < a.outputs.len() {
+        eprintln!(
+            "uq-driver: note: the time is the first column of the CSV; --output time adds no \
+             second one"
+        );
+        if outputs.is_empty() {
+            // Only the time asked for: record the FMU's time variable, left out below.
+            anyhow::ensure!(
+                md.variable("time").is_some(),
+                "--output time only: the time is always the first column; name a variable to \
+                 record with --output (`uq-driver inspect` lists them)"
+            );
+            outputs.push("time".into());
+        }
+    }
+    let series = if outputs.is_empty() {
+        md.output_variables().count()
     } else {
-        a.outputs.len()
+        outputs.len()
     };
     size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
@@ -110,7 +148,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         runner::simulate_with(
             &fmu,
             &params,
-            &a.outputs,
+            &outputs,
             a.input.as_deref(),
             &times,
             a.fmu_logging,
@@ -119,6 +157,9 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     for (name, why) in &sim.skipped {
         eprintln!("uq-driver: note: output '{name}' not recorded: {why}");
     }
+    let columns: Vec<usize> = (0..sim.names.len())
+        .filter(|&k| !is_time(&sim.names[k]))
+        .collect();
     if sim.names.is_empty() {
         eprintln!(
             "uq-driver: warning: nothing to record: the FMU has no output that can be written \
@@ -132,20 +173,47 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         );
     }
     let mut text = String::from("time");
-    for n in &sim.names {
+    for &o in &columns {
         text.push(',');
-        crate::report::csv::push_field(&mut text, n);
+        crate::report::csv::push_field(&mut text, &sim.names[o]);
     }
     text.push('\n');
     for (k, t) in sim.times.iter().enumerate() {
         push_shortest(&mut text, *t);
-        for s in &sim.series {
+        for &o in &columns {
             text.push(',');
-            push_shortest(&mut text, s[k]);
+            push_shortest(&mut text, sim.series[o][k]);
         }
         text.push('\n');
     }
     emit(&text, a.out.as_deref())
+}
+
+/// The communication step fmpy's `simulate_fmu` takes for a Co-Simulation FMU without a
+/// default step size (`fmpy.util.auto_interval`, 0.3.32): a power of ten near a thousandth of
+/// `t` (s), times 5, 4, 2, 1/2, 1/4 or 1/5, so that `t` takes 500 to 1000 steps (s). `None`
+/// for a `t` that is not positive and finite.
+pub(crate) fn auto_interval(t: f64) -> Option<f64> {
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    // numpy's round: half to even.
+    let mut h = 10f64.powf(t.log10().round_ties_even() - 3.0);
+    let n = t / h;
+    if n >= 2500.0 {
+        h *= 5.0;
+    } else if n >= 2000.0 {
+        h *= 4.0;
+    } else if n >= 1000.0 {
+        h *= 2.0;
+    } else if n <= 200.0 {
+        h /= 5.0;
+    } else if n <= 250.0 {
+        h /= 4.0;
+    } else if n <= 500.0 {
+        h /= 2.0;
+    }
+    Some(h)
 }
 
 pub(crate) fn inspect(path: &Path) -> Result<()> {
@@ -258,4 +326,31 @@ fn described_range(kind: &VariableKind, description: &str) -> String {
     format!("range [{}, {}] {description}", shortest(lo), shortest(hi))
         .trim_end()
         .to_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An FMU without a default step could not be simulated without --step; fmpy picks one.
+    #[test]
+    fn the_step_chosen_without_a_default_is_fmpys() {
+        // fmpy.util.auto_interval(t) for these t, from fmpy 0.3.32.
+        for (t, h) in [
+            (1.0, 0.002),
+            (10.0, 0.02),
+            (2.0, 0.004),
+            (3.0, 0.005),
+            (0.5, 0.0005),
+            (7.0, 0.01),
+            (100.0, 0.2),
+        ] {
+            let got = auto_interval(t).unwrap();
+            assert!((got - h).abs() <= 1e-12 * h, "t = {t}: {got} vs {h}");
+            let n = t / got;
+            assert!((500.0..=1000.0).contains(&n.round()), "t = {t}: {n} steps");
+        }
+        assert_eq!(auto_interval(0.0), None);
+        assert_eq!(auto_interval(f64::NAN), None);
+    }
 }

@@ -117,6 +117,18 @@ pub enum DescriptionError {
         /// The number of variables.
         count: usize,
     },
+    /// `ModelStructure/Outputs` does not list exactly the variables with causality
+    /// `"output"` (FMI 2.0, section 2.2.8): this one is an output it does not list, or it
+    /// lists this one, which is not an output.
+    #[error("{}", outputs_mismatch(name, *.index, causality))]
+    OutputsMismatch {
+        /// The variable.
+        name: String,
+        /// Its 1-based index among the variables.
+        index: usize,
+        /// Its causality.
+        causality: &'static str,
+    },
     /// The file is larger than [`ParseLimits::max_bytes`].
     #[error(
         "the file is {size} bytes, more than the limit of {limit} bytes for modelDescription.xml"
@@ -144,6 +156,23 @@ pub enum DescriptionError {
         /// What was found instead, e.g. `it is UTF-16 (little-endian byte-order mark)`.
         found: String,
     },
+}
+
+/// The message of [`DescriptionError::OutputsMismatch`].
+fn outputs_mismatch(name: &str, index: usize, causality: &str) -> String {
+    let rule = "FMI 2.0 requires ModelStructure/Outputs to list exactly the variables with \
+                causality=\"output\"";
+    if causality == "output" {
+        format!(
+            "variable '{name}' (index {index}) has causality=\"output\", but \
+             ModelStructure/Outputs does not list it; {rule}"
+        )
+    } else {
+        format!(
+            "ModelStructure/Outputs lists variable '{name}' (index {index}), whose causality \
+             is \"{causality}\", not \"output\"; {rule}"
+        )
+    }
 }
 
 /// Limits that protect parsing against hostile or broken files.

@@ -215,6 +215,45 @@ fn plan_study(p: &Plan) -> Result<Study, ShardError> {
     Ok(study)
 }
 
+/// Refuses a plan whose study or FMU is no longer the one it was planned with: the manifest
+/// the plan's study gives now (its hash, the FMU's SHA-256, the sizes) must be the one
+/// `plan.json` recorded, which every shard's store carries too. A `plan.json` whose study
+/// was edited (another seed: another design, paired with the shards' outputs of the
+/// planned one) or an FMU replaced since is refused, naming what differs.
+fn check_plan(
+    dir: &Path,
+    p: &Plan,
+    study: &Study,
+    fmu: &crate::fmu::Fmu,
+    design: &Design,
+) -> Result<(), ShardError> {
+    let now = fingerprint::manifest(study, fmu, design)?;
+    if now == p.manifest {
+        return Ok(());
+    }
+    let what = if now.fmu_sha256 != p.manifest.fmu_sha256 {
+        format!(
+            "the FMU {} changed since the plan was written (SHA-256 now {}, planned {})",
+            p.fmu_path.display(),
+            now.fmu_sha256,
+            p.manifest.fmu_sha256
+        )
+    } else if now.study_hash != p.manifest.study_hash {
+        format!(
+            "the study in plan.json is not the one that was planned (study hash now {}, \
+             planned {}): plan.json was edited, or the study's input file changed; plan \
+             again into a new folder",
+            now.study_hash, p.manifest.study_hash
+        )
+    } else {
+        format!(
+            "the design has {} points of {} values, the plan {} of {}",
+            now.n_points, now.n_values, p.manifest.n_points, p.manifest.n_values
+        )
+    };
+    Err(ShardError::Shard(format!("{}: {what}", dir.display())))
+}
+
 /// `uq-driver run-shard`: runs shard `k` of the plan in `dir`.
 pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, ShardError> {
     let p = load_plan(dir)?;
@@ -227,15 +266,7 @@ pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, 
     let study = plan_study(&p)?;
     let fmu = open_fmu(&study)?;
     let design = design(&study)?;
-    let now = fingerprint::manifest(&study, &fmu, &design)?;
-    if now != p.manifest {
-        return Err(ShardError::Shard(format!(
-            "{}: the FMU or the study changed since the plan was written (SHA-256 now {}, planned {})",
-            p.fmu_path.display(),
-            now.fmu_sha256,
-            p.manifest.fmu_sha256
-        )));
-    }
+    check_plan(dir, &p, &study, &fmu, &design)?;
     let opts = RunOptions {
         points: Some(shard_points(design.len(), p.shards, k)),
         ..opts.clone()
@@ -259,6 +290,9 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
     let method = sampling(&study)?;
     let fmu = open_fmu(&study)?;
     let design = design(&study)?;
+    check_plan(dir, &p, &study, &fmu, &design)?;
+    let iface = crate::study::plan::resolve::interface(&study, &fmu).map_err(RunError::from)?;
+    let rules = run::record_rules(&iface, &study.times());
     let n = design.len();
     // The analysis's memory, checked as `run` checks it (refused, or large: `--yes`).
     crate::study::plan::size::check_runs(&study, n, opts).map_err(StudyRunError::from)?;
@@ -276,7 +310,8 @@ pub fn merge(dir: &Path, out: &Path, opts: &RunOptions) -> Result<StudyResult, S
             continue;
         }
         shard_runs.resize_with(k + 1, || None);
-        let opened = Store::open_in_place(&sdir, &p.manifest, false).map(|(_, runs)| runs);
+        let opened =
+            Store::open_checked(&sdir, &p.manifest, false, Some(&rules)).map(|(_, runs)| runs);
         let recs = opened.map_err(|e| match e {
             StoreError::Mismatch { what, .. } => ShardError::Shard(format!(
                 "shard {k} ({}) does not belong to this plan: {what}",

@@ -454,6 +454,25 @@ impl Builder {
         if let Some(&index) = self.outputs.iter().find(|&&i| i == 0 || i > count) {
             return Err(DescriptionError::BadOutputIndex { index, count });
         }
+        // FMI 2.0 (2.2.8): ModelStructure/Outputs lists exactly the variables with
+        // causality="output"; compared as sets, as fmpy.validation does.
+        let mut listed = vec![false; count];
+        for &i in &self.outputs {
+            listed[i - 1] = true;
+        }
+        let mismatch = self
+            .variables
+            .iter()
+            .zip(&listed)
+            .position(|(v, &l)| (v.causality == Causality::Output) != l);
+        if let Some(k) = mismatch {
+            let v = &self.variables[k];
+            return Err(DescriptionError::OutputsMismatch {
+                name: v.name.clone(),
+                index: k + 1,
+                causality: v.causality.as_str(),
+            });
+        }
         Ok(ModelDescription {
             fmi_version: self.fmi_version,
             model_name: self.model_name,

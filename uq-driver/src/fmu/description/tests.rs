@@ -343,6 +343,10 @@ fn same_value_reference_in_other_types_and_aliases_are_accepted() {
            <ScalarVariable name="d" valueReference="3"><String/></ScalarVariable>
            <ScalarVariable name="e" valueReference="4" causality="output"><Real/></ScalarVariable>
            <ScalarVariable name="e_alias" valueReference="4"><Real/></ScalarVariable>"#,
+    )
+    .replace(
+        "<ModelStructure/>",
+        "<ModelStructure><Outputs><Unknown index=\"5\"/></Outputs></ModelStructure>",
     );
     assert_eq!(parse(&xml).unwrap().variables.len(), 6);
 }
@@ -422,5 +426,48 @@ fn enumeration_min_and_max_are_read() {
             min: Some(1),
             max: Some(3),
         }
+    );
+}
+
+/// An FMU with an empty `<ModelStructure/>` but an output variable was accepted, and
+/// `simulate` said "the FMU has no output" and exited 0; fmpy's validation refuses it.
+#[test]
+fn outputs_missing_from_model_structure_make_an_invalid_description() {
+    let output = MINIMAL.replace(
+        "<ScalarVariable name=\"x\" valueReference=\"0\">",
+        "<ScalarVariable name=\"x\" valueReference=\"0\" causality=\"output\">",
+    );
+    let err = parse(&output).unwrap_err();
+    assert_eq!(
+        err,
+        DescriptionError::OutputsMismatch {
+            name: "x".into(),
+            index: 1,
+            causality: "output"
+        }
+    );
+    assert!(
+        err.to_string().starts_with(
+            "variable 'x' (index 1) has causality=\"output\", but ModelStructure/Outputs does \
+             not list it; FMI 2.0 requires"
+        ),
+        "{err}"
+    );
+    let listed = output.replace(
+        "<ModelStructure/>",
+        "<ModelStructure><Outputs><Unknown index=\"1\"/></Outputs></ModelStructure>",
+    );
+    assert!(parse(&listed).is_ok());
+    // A listed variable that is not an output (x is local by default).
+    let not_output = MINIMAL.replace(
+        "<ModelStructure/>",
+        "<ModelStructure><Outputs><Unknown index=\"1\"/></Outputs></ModelStructure>",
+    );
+    let err = parse(&not_output).unwrap_err().to_string();
+    assert!(
+        err.starts_with(
+            "ModelStructure/Outputs lists variable 'x' (index 1), whose causality is \"local\""
+        ),
+        "{err}"
     );
 }

@@ -8,7 +8,9 @@
 //! (`SeriesColumns`). A chaos's surrogate draws are taken per block of its columns too.
 //!
 //! Block size: a block and one copy of it by the estimator stay within [`block_bytes`]
-//! (default [`BLOCK_BYTES`], 256 MiB; `RAILUQ_ANALYSIS_BLOCK_BYTES` overrides it). A block
+//! ([`BLOCK_BYTES`], 256 MiB, or [`BLOCK_SHARE`] of the memory available to the process,
+//! whichever is less: a study under a memory limit analyses in smaller blocks instead of
+//! failing an allocation; `RAILUQ_ANALYSIS_BLOCK_BYTES` overrides both). A block
 //! is a whole multiple of [`BLOCK_ALIGN`] columns (at least that many, even beyond the
 //! budget), or the whole series: the surrogate draws multiply the basis by the coefficients
 //! in tasks of 32 columns (`surrogate.rs`), and blocks that split at the same columns give the
@@ -18,6 +20,7 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use super::columns::{column, Column};
+use crate::study::plan::size::available_memory;
 use crate::uq::method::{ChaosError, Estimate, MethodError, Sobol, SobolIntervals};
 use crate::uq::pce::Pce;
 
@@ -26,18 +29,42 @@ pub const BLOCK_BYTES: usize = 256 << 20;
 /// Blocks are whole multiples of this many columns.
 pub const BLOCK_ALIGN: usize = 32;
 
-/// The block budget: `RAILUQ_ANALYSIS_BLOCK_BYTES` if set to a number, else [`BLOCK_BYTES`].
+/// The share of the available memory a block and its copy may take (an eighth: the block is
+/// held about 1.5 times over, a chaos's draws as much again, and the rest of the study and
+/// the allocator's own reservations need room too).
+pub const BLOCK_SHARE: f64 = 0.125;
+
+/// The block budget (bytes): `RAILUQ_ANALYSIS_BLOCK_BYTES` if set to a number, else the least
+/// of [`BLOCK_BYTES`] and [`BLOCK_SHARE`] of the memory available to the process now
+/// ([`available_memory`]).
 pub fn block_bytes() -> usize {
-    std::env::var("RAILUQ_ANALYSIS_BLOCK_BYTES")
+    block_bytes_for(available_memory())
+}
+
+/// [`block_bytes`] with `available` bytes of memory (`None`: not known).
+pub(crate) fn block_bytes_for(available: Option<f64>) -> usize {
+    if let Some(b) = std::env::var("RAILUQ_ANALYSIS_BLOCK_BYTES")
         .ok()
         .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(BLOCK_BYTES)
+    {
+        return b;
+    }
+    match available {
+        // A block never goes below BLOCK_ALIGN columns (block_width), whatever this says.
+        Some(a) if a >= 0.0 => BLOCK_BYTES.min((a * BLOCK_SHARE) as usize),
+        _ => BLOCK_BYTES,
+    }
 }
 
 /// Columns per block of `rows` rows out of `nt` columns (see the module documentation).
 pub fn block_width(nt: usize, rows: usize) -> usize {
+    block_width_in(nt, rows, block_bytes())
+}
+
+/// [`block_width`] within a budget of `budget` bytes.
+pub(crate) fn block_width_in(nt: usize, rows: usize, budget: usize) -> usize {
     let per_column = 2 * 8 * rows.max(1);
-    let w = block_bytes() / per_column;
+    let w = budget / per_column;
     if w >= nt {
         return nt.max(1);
     }
@@ -327,12 +354,37 @@ mod tests {
         );
         assert_eq!(blocks(5, 5).collect::<Vec<_>>(), vec![(0, 5)]);
         // A block of 10 000 rows of 501 columns fits the default budget: one block.
-        if std::env::var_os("RAILUQ_ANALYSIS_BLOCK_BYTES").is_none() {
-            assert_eq!(block_width(501, 10_000), 501);
-            // 10^6 rows: 16 MB per column, 16 columns fit; at least 32 are taken.
-            assert_eq!(block_width(100_000, 1_000_000), 32);
-            assert_eq!(block_width(100_000, 10_000) % BLOCK_ALIGN, 0);
+        assert_eq!(block_width_in(501, 10_000, BLOCK_BYTES), 501);
+        // 10^6 rows: 16 MB per column, 16 columns fit; at least 32 are taken.
+        assert_eq!(block_width_in(100_000, 1_000_000, BLOCK_BYTES), 32);
+        assert_eq!(
+            block_width_in(100_000, 10_000, BLOCK_BYTES) % BLOCK_ALIGN,
+            0
+        );
+    }
+
+    /// Under a memory limit (`ulimit -v`) a study whose estimate fitted ran all its runs,
+    /// then aborted in the analysis ("memory allocation failed"): its blocks took 256 MiB
+    /// whatever the limit. They now take at most an eighth of the memory available.
+    #[test]
+    fn blocks_shrink_to_the_memory_available() {
+        if std::env::var_os("RAILUQ_ANALYSIS_BLOCK_BYTES").is_some() {
+            return;
         }
+        const MIB: f64 = 1024.0 * 1024.0;
+        assert_eq!(block_bytes_for(None), BLOCK_BYTES);
+        assert_eq!(block_bytes_for(Some(16.0 * 1024.0 * MIB)), BLOCK_BYTES);
+        assert_eq!(block_bytes_for(Some(512.0 * MIB)), 64 << 20);
+        // 400 runs of 100 001 points: 6.4 kB per column (the block and its copy); 64 MiB
+        // holds 10 464 columns (a multiple of 32), 256 MiB held 41 920.
+        let w = block_width_in(100_001, 400, block_bytes_for(Some(512.0 * MIB)));
+        assert_eq!(w, 10_464);
+        assert_eq!(block_bytes_for(Some(0.0)), 0);
+        assert_eq!(
+            block_width_in(100_001, 400, 0),
+            BLOCK_ALIGN,
+            "never below 32 columns"
+        );
     }
 
     #[test]

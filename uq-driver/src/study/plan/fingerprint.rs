@@ -61,8 +61,9 @@ pub fn study_hash(study: &Study) -> String {
     }
     if let Some(path) = &study.inputs {
         // The signals themselves change the records, not the file's name. An unreadable file
-        // is refused before any run (Interface::resolve).
-        let content = std::fs::read(path)
+        // (or one that is not a regular file: a FIFO is never opened for reading) is refused
+        // before any run (Interface::resolve).
+        let content = in_file::read(path, crate::study::plan::inputs::MAX_INPUT_FILE_BYTES)
             .map(|b| format!("{:x}", Sha256::digest(&b)))
             .unwrap_or_default();
         key["inputs"] = serde_json::json!(content);

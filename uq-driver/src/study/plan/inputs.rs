@@ -7,6 +7,11 @@
 //! row after the value from then on). Numbers as Rust or Python write them; Boolean columns
 //! also take `true`/`false`. Empty lines and lines starting with `#` are skipped.
 //!
+//! Only a regular file of at most [`MAX_INPUT_FILE_BYTES`] is read, never blocking (a FIFO,
+//! a device or a folder is refused before it is opened for reading), and the errors name a
+//! line and a column, never the file's text: a wrong path may name a file that is not the
+//! user's to show (`/etc/shadow`).
+//!
 //! fmpy 0.3.32's convention, reproduced exactly:
 //! - continuous Real inputs are interpolated linearly, `w0·v0 + w1·v1` with
 //!   `w0 = (t1 − t)/(t1 − t0)`, `w1 = 1 − w0`; Integer, Boolean and Enumeration inputs, and
@@ -68,18 +73,43 @@ pub struct InputTable {
     pub names: Vec<String>,
 }
 
+/// Largest input file read (bytes): 256 MiB (a few million rows of a few signals).
+pub const MAX_INPUT_FILE_BYTES: u64 = 256 << 20;
+
+/// The text of the input file `path`: a regular file of at most [`MAX_INPUT_FILE_BYTES`],
+/// UTF-8. The error never quotes the file.
+pub(crate) fn read_input_file(path: &Path) -> Result<String, InputError> {
+    in_file::read_text(path, MAX_INPUT_FILE_BYTES).map_err(|e| match e {
+        Ok(line) => InputError::Invalid {
+            path: path.to_path_buf(),
+            where_: format!("line {line}"),
+            message: "not UTF-8 text (a CSV file of numbers is expected)".into(),
+        },
+        Err(in_file::ReadError::Missing(source) | in_file::ReadError::Open(source)) => {
+            InputError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        }
+        // "input file f: is a FIFO (named pipe); a regular file is expected"
+        Err(other) => InputError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::other(other.to_string()),
+        },
+    })
+}
+
 /// `math.isclose(a, b)` with Python's defaults (relative 1e-9, absolute 0).
 pub fn isclose(a: f64, b: f64) -> bool {
     a == b || (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
 }
 
 impl InputTable {
-    /// Reads `path` and resolves its columns against `md`.
+    /// Reads `path` and resolves its columns against `md`. Only a regular file of at most
+    /// [`MAX_INPUT_FILE_BYTES`] is read, never blocking (a FIFO or a device is refused before
+    /// it is opened for reading: the `in-file` crate's rules).
     pub fn load(path: &Path, md: &ModelDescription) -> Result<InputTable, InputError> {
-        let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = read_input_file(path)?;
         Self::parse(&text, path, md)
     }
 
@@ -110,7 +140,8 @@ impl InputTable {
         }
         let kinds = names[1..]
             .iter()
-            .map(|n| column_kind(md, n).map_err(|m| invalid("header".into(), m)))
+            .enumerate()
+            .map(|(j, n)| column_kind(md, n, j + 2).map_err(|m| invalid("header".into(), m)))
             .collect::<Result<Vec<_>, _>>()?;
         for (j, n) in names.iter().enumerate().skip(1) {
             if names[1..j].contains(n) {
@@ -137,7 +168,7 @@ impl InputTable {
                 let v = parse_cell(cell).ok_or_else(|| {
                     invalid(
                         format!("line {line}, column {}", j + 1),
-                        format!("'{cell}' is not a number"),
+                        "not a number (nor true or false)".into(),
                     )
                 })?;
                 columns[j].push(v);
@@ -156,11 +187,7 @@ impl InputTable {
         if let Some(k) = times.windows(2).position(|w| w[1] < w[0]) {
             return Err(invalid(
                 format!("row {}", k + 2),
-                format!(
-                    "time {} comes after {}: times must not decrease",
-                    times[k + 1],
-                    times[k]
-                ),
+                "the time is less than the row before's: times must not decrease".into(),
             ));
         }
         let mut table = InputTable {
@@ -176,7 +203,7 @@ impl InputTable {
             let bad = |k: usize, what: &str| {
                 invalid(
                     format!("row {}, column '{name}'", k + 1),
-                    format!("{} is not {what}", values[k]),
+                    format!("the value is not {what}"),
                 )
             };
             match kind {
@@ -212,6 +239,20 @@ impl InputTable {
             }
         }
         Ok(table)
+    }
+
+    /// The column that sets the variable `name` of `md`, if one does: compared by base type
+    /// and value reference, so that a column naming an alias of the variable counts too.
+    pub fn column_for(&self, md: &ModelDescription, name: &str) -> Option<&str> {
+        let key = |n: &str| {
+            md.variable(n)
+                .map(|v| (v.kind.base_type(), v.value_reference))
+        };
+        let wanted = key(name)?;
+        self.names
+            .iter()
+            .find(|c| key(c) == Some(wanted))
+            .map(String::as_str)
     }
 
     /// Sets every input at time `t` (s); `after_event` takes the value after a jump at `t`.
@@ -303,11 +344,18 @@ enum ColumnKind {
     Boolean,
 }
 
-/// The value reference and the kind of the variable a column names.
-fn column_kind(md: &ModelDescription, name: &str) -> Result<(u32, ColumnKind), String> {
+/// The value reference and the kind of the variable column `number` (1-based) names. A name
+/// that is no variable of the FMU is not quoted (the file may not be an input file at all,
+/// and not ours to show); once it names a variable, the name is the FMU's.
+fn column_kind(
+    md: &ModelDescription,
+    name: &str,
+    number: usize,
+) -> Result<(u32, ColumnKind), String> {
     let var = md.variable(name).ok_or_else(|| {
         format!(
-            "column '{name}' names no variable of the FMU ({})",
+            "column {number} names no variable of the FMU ({}): the columns after the time \
+             must be named after inputs or tunable parameters (`uq-driver inspect` lists them)",
             md.model_name
         )
     })?;

@@ -370,6 +370,22 @@ impl Interface {
                 signal_names.push(s.to_owned());
             }
         }
+        let inputs = vars.inputs(study.inputs.as_deref())?;
+        if let Some(table) = &inputs {
+            let random = study
+                .parameters
+                .iter()
+                .map(|p| (p.name.as_str(), ROLE_RANDOM));
+            let fixed = study.fixed.keys().map(|n| (n.as_str(), ROLE_FIXED));
+            let speed = study.qoi.iter().flat_map(|q| match q {
+                QoiSpec::HuntingSpeed(h) => std::iter::once(h.speed_parameter.as_str())
+                    .chain(h.set.keys().map(String::as_str))
+                    .collect(),
+                _ => Vec::new(),
+            });
+            let speed = speed.map(|n| (n, ROLE_SPEED));
+            vars.check_not_inputs(table, random.chain(fixed).chain(speed))?;
+        }
         Ok(Interface {
             random,
             fixed,
@@ -377,7 +393,7 @@ impl Interface {
             signal_names,
             n_stored: study.outputs.len(),
             qois: study.qoi.clone(),
-            inputs: vars.inputs(study.inputs.as_deref())?,
+            inputs,
             skipped: Vec::new(),
             speed_runs: Vec::new(),
         })
@@ -410,6 +426,10 @@ impl Interface {
             outputs.to_vec()
         };
         let fixed = vars.settings(params.iter().map(|(n, v)| (n.as_str(), v)))?;
+        let inputs = vars.inputs(inputs)?;
+        if let Some(table) = &inputs {
+            vars.check_not_inputs(table, params.iter().map(|(n, _)| (n.as_str(), ROLE_SET)))?;
+        }
         Ok(Interface {
             random: Vec::new(),
             fixed,
@@ -417,7 +437,7 @@ impl Interface {
             n_stored: names.len(),
             signal_names: names,
             qois: Vec::new(),
-            inputs: vars.inputs(inputs)?,
+            inputs,
             skipped,
             speed_runs: Vec::new(),
         })
@@ -492,6 +512,12 @@ fn to_i32(v: f64) -> Option<i32> {
     (v.fract() == 0.0 && v >= f64::from(i32::MIN) && v <= f64::from(i32::MAX)).then_some(v as i32)
 }
 
+/// What a variable given a value before the run is, for [`Variables::check_not_inputs`].
+const ROLE_RANDOM: &str = "a random parameter ([[parameters]])";
+const ROLE_FIXED: &str = "given a value in [fixed]";
+const ROLE_SPEED: &str = "set by a hunting_speed quantity (its speed_parameter or set)";
+const ROLE_SET: &str = "given a value (--set)";
+
 /// Lookups of study variables in one FMU, with errors that name it.
 pub(super) struct Variables<'a> {
     pub(super) fmu: &'a Fmu,
@@ -565,6 +591,33 @@ impl<'a> Variables<'a> {
         file.map(|f| InputTable::load(f, self.fmu.description()))
             .transpose()
             .map_err(|e: InputError| self.error(VariableProblem::Inputs(e.to_string())))
+    }
+
+    /// Refuses a variable that is given a value before the run (`set`: name and role) and is
+    /// also a column of the input file `table`: the file's value would replace it at every
+    /// step, silently (every run of a study the same, a Std of 0).
+    fn check_not_inputs<'n>(
+        &self,
+        table: &InputTable,
+        set: impl Iterator<Item = (&'n str, &'static str)>,
+    ) -> Result<(), InterfaceError> {
+        for (name, role) in set {
+            if let Some(column) = table.column_for(self.fmu.description(), name) {
+                let alias = if column == name {
+                    String::new()
+                } else {
+                    format!(" (as its alias '{column}')")
+                };
+                return Err(self.error(VariableProblem::Inputs(format!(
+                    "'{name}' is {role} and also a column{alias} of the input file {}: the \
+                     file's values would replace it at every step of every run. A variable \
+                     is either given a value before the run or follows the input file: \
+                     remove the column from the file, or '{name}' from the study",
+                    table.path.display()
+                ))));
+            }
+        }
+        Ok(())
     }
 
     pub(super) fn check_settable(&self, var: &ScalarVariable) -> Result<(), InterfaceError> {

@@ -754,10 +754,10 @@ mod tests {
     #[test]
     fn block_columns_agree_with_the_analysis() {
         for (nt, rows) in [(501, 10_000), (100_000, 1_000_000), (70_000, 3_000), (5, 1)] {
-            let budget = blocks::block_bytes() as f64;
+            let budget = blocks::block_bytes();
             assert_eq!(
-                block_columns(nt as f64, rows as f64, budget),
-                blocks::block_width(nt, rows) as f64,
+                block_columns(nt as f64, rows as f64, budget as f64),
+                blocks::block_width_in(nt, rows, budget) as f64,
                 "{nt} x {rows}"
             );
         }

@@ -15,6 +15,7 @@ use crate::study::run::guard::StudyGuard;
 use crate::study::run::instances::{self, InstancePolicy, ResetCheck, Slot};
 use crate::study::run::isolate::{WorkerFailure, WorkerPool};
 use crate::study::run::worker_fmu::WorkerFmus;
+use crate::study::store::valid::RecordRules;
 use crate::study::store::{Entry, Record, Store};
 use crate::uq::method::Design;
 
@@ -40,6 +41,8 @@ pub(super) struct Batch<'a> {
     pub(super) check_reset: bool,
     /// Warnings of the runs, each printed once.
     pub(super) notes: Notes,
+    /// What a successful record must hold; one that does not fails its point.
+    pub(super) rules: RecordRules,
 }
 
 /// Counters shared by the points of a batch.
@@ -111,6 +114,10 @@ impl Batch<'_> {
             }
         }
         let (rec, fatal) = match run() {
+            Ok(Outcome::Done(Record::Ok(v))) => match self.rules.check(v.iter().copied()) {
+                Ok(()) => (Record::Ok(v), None),
+                Err(problem) => (Record::Failed(format!("the run gave {problem}")), None),
+            },
             Ok(Outcome::Done(rec)) => (rec, None),
             Ok(Outcome::Fatal(rec, message)) => (rec, Some(message)),
             // Refused after another instance's Fatal: not run, not stored.

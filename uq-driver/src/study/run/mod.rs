@@ -21,8 +21,10 @@ use std::time::{Duration, Instant};
 use crate::fmu::Fmu;
 use crate::spec::Study;
 use crate::study::plan::fingerprint;
+use crate::study::plan::interface::Interface;
 use crate::study::progress::{Progress, ProgressMode};
 use crate::study::store::lock::FolderLock;
+use crate::study::store::valid::RecordRules;
 use crate::study::store::{Entry, Store, StoreError, StoredRuns};
 use crate::uq::method::Design;
 use batch::{Batch, Notes};
@@ -89,7 +91,10 @@ pub fn run_points(
             out_dir.display()
         ));
     }
-    let (store, mut runs) = Store::open_in_place(out_dir, &manifest, opts.fresh)?;
+    let iface = crate::study::plan::resolve::interface(study, fmu)?;
+    let times = study.times();
+    let rules = record_rules(&iface, &times);
+    let (store, mut runs) = Store::open_checked(out_dir, &manifest, opts.fresh, Some(&rules))?;
     let records = runs.entries();
     if let Some(note) = store.recovery().summary() {
         crate::study::progress::message(&format!("warning: {note}"));
@@ -125,9 +130,7 @@ pub fn run_points(
         .num_threads(threads)
         .build()
         .map_err(RunError::Pool)?;
-    let iface = crate::study::plan::resolve::interface(study, fmu)?;
     iface.check_design(fmu, &design.values)?;
-    let times = study.times();
     crate::study::plan::interface::check_step_sizes(fmu, &times)?;
     let policy = InstancePolicy {
         reuse: false,
@@ -157,6 +160,7 @@ pub fn run_points(
         policy,
         check_reset: !opts.fresh_instances && missing.len() >= 2,
         notes: Notes::default(),
+        rules,
     };
     let mode = match (opts.progress, opts.progress_lines) {
         (true, _) => ProgressMode::Bar,
@@ -191,6 +195,13 @@ pub fn run_points(
         fmu_sha256: manifest.fmu_sha256,
         warnings,
     })
+}
+
+/// What the records of runs of `iface` over `times` (s) must hold (finite outputs, valid
+/// quantity pairs), checked before a record is stored and when a store is opened.
+pub(crate) fn record_rules(iface: &Interface, times: &[f64]) -> RecordRules {
+    let quantities = iface.qois.iter().flat_map(|q| q.quantity_names()).collect();
+    RecordRules::new(&iface.signal_names[..iface.n_stored], times, quantities)
 }
 
 /// Opens the study's FMU.

@@ -178,6 +178,18 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
     };
     let bytes: &[u8] = map.as_deref().unwrap_or_default();
     let scanned = format::scan_format(bytes, manifest.n_values, format::detect_format(bytes));
+    // A records.bin copied from another study's folder says whose records it holds.
+    let foreign = scanned
+        .identities
+        .iter()
+        .any(|(json, _)| serde_json::from_slice::<Manifest>(json).ok().as_ref() != Some(&manifest));
+    if foreign {
+        return Err(invalid(
+            &rp,
+            "holds the records of another study or FMU than store/manifest.json says (the file \
+             was copied from another folder)",
+        ));
+    }
     // The first success of each point, in design order; the values stay in the map.
     let mut ok: Vec<(usize, Range<usize>)> = scanned
         .records

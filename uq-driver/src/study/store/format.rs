@@ -7,8 +7,11 @@
 //! magic F5 52 51 32 | index u64 | kind u8 | length u64 | header crc32 | payload | record crc32
 //! ```
 //!
-//! `kind` is 0 for a finished run (payload: `length / 8` f64 values) and 1 for a failed run
-//! (payload: a UTF-8 message). The header CRC-32 covers index, kind and length, so a length is
+//! `kind` is 0 for a finished run (payload: `length / 8` f64 values), 1 for a failed run
+//! (payload: a UTF-8 message) and 2 for the store's identity (index 0; payload: the JSON of
+//! the store's [`Manifest`](super::Manifest): the study hash, the FMU's SHA-256 and the
+//! sizes), the first frame of every store written since stores carry it, so that the file
+//! itself says which study and FMU its records belong to. The header CRC-32 covers index, kind and length, so a length is
 //! trusted only when its header checksum holds; the record CRC-32 covers index, kind, length
 //! and payload. After a bad record the reader scans forward for the next magic whose header and
 //! record checksums hold, so one damaged record costs only its own point. The first magic byte
@@ -63,6 +66,9 @@ pub struct Decoded {
     pub records: Vec<(usize, Record, Range<usize>)>,
     /// The damaged stretches, in file order.
     pub skipped: Vec<Skipped>,
+    /// The identity frames (the store's manifest as JSON), in file order, with their byte
+    /// ranges: one at the start of a store written since stores carry one.
+    pub identities: Vec<(Vec<u8>, Range<usize>)>,
 }
 
 impl Decoded {
@@ -73,12 +79,25 @@ impl Decoded {
     }
 }
 
+/// `kind` of the frame that holds a store's identity.
+const KIND_IDENTITY: u8 = 2;
+
 /// Encodes one record in format 2.
 pub fn encode(index: usize, rec: &Record) -> Vec<u8> {
     let (kind, payload): (u8, Vec<u8>) = match rec {
         Record::Ok(v) => (0, v.iter().flat_map(|x| x.to_le_bytes()).collect()),
         Record::Failed(m) => (1, m.as_bytes().to_vec()),
     };
+    frame(index, kind, &payload)
+}
+
+/// Encodes the identity frame of a store (`identity`: the manifest's JSON), written first.
+pub fn encode_identity(identity: &[u8]) -> Vec<u8> {
+    frame(0, KIND_IDENTITY, identity)
+}
+
+/// One format-2 frame.
+fn frame(index: usize, kind: u8, payload: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER + payload.len() + TRAILER);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&(index as u64).to_le_bytes());
@@ -86,10 +105,10 @@ pub fn encode(index: usize, rec: &Record) -> Vec<u8> {
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     let header_crc = crc32fast::hash(&out[4..HEADER - 4]);
     out.extend_from_slice(&header_crc.to_le_bytes());
-    out.extend_from_slice(&payload);
+    out.extend_from_slice(payload);
     let mut h = crc32fast::Hasher::new();
     h.update(&out[4..HEADER - 4]);
-    h.update(&payload);
+    h.update(payload);
     out.extend_from_slice(&h.finalize().to_le_bytes());
     out
 }
@@ -226,6 +245,8 @@ pub struct Scanned {
     pub records: Vec<(usize, Slot, Range<usize>)>,
     /// The damaged stretches, in file order.
     pub skipped: Vec<Skipped>,
+    /// The identity frames, as [`Decoded::identities`].
+    pub identities: Vec<(Vec<u8>, Range<usize>)>,
 }
 
 /// The values of a record's payload (`n_values` little-endian f64).
@@ -236,26 +257,38 @@ pub fn values_of(payload: &[u8]) -> Vec<f64> {
         .collect()
 }
 
+/// What a checksummed frame holds.
+enum Content {
+    /// A point's record.
+    Record(usize, Slot),
+    /// The store's identity (the manifest's JSON).
+    Identity,
+}
+
 /// The record a checksummed frame at `pos` holds, or why it cannot be used.
 fn interpret(
     f: &Frame<'_>,
     pos: usize,
     head: usize,
     n_values: usize,
-) -> Result<(usize, Slot), String> {
+    format: Format,
+) -> Result<Content, String> {
+    if f.kind == KIND_IDENTITY && format == Format::V2 {
+        return Ok(Content::Identity);
+    }
     let index = usize::try_from(f.index).map_err(|_| format!("point {} out of range", f.index))?;
+    let record = |slot| Ok(Content::Record(index, slot));
     match f.kind {
         0 if Some(f.payload.len()) == n_values.checked_mul(8) => {
-            Ok((index, Slot::Ok(pos + head..pos + head + f.payload.len())))
+            record(Slot::Ok(pos + head..pos + head + f.payload.len()))
         }
         0 => Err(format!(
             "{} bytes of values where the study records {n_values} values ({} bytes)",
             f.payload.len(),
             n_values.saturating_mul(8)
         )),
-        1 => Ok((
-            index,
-            Slot::Failed(String::from_utf8_lossy(f.payload).into_owned()),
+        1 => record(Slot::Failed(
+            String::from_utf8_lossy(f.payload).into_owned(),
         )),
         k => Err(format!("unknown record kind {k}")),
     }
@@ -279,6 +312,7 @@ pub fn decode_format(bytes: &[u8], n_values: usize, format: Format) -> Decoded {
             })
             .collect(),
         skipped: scanned.skipped,
+        identities: scanned.identities,
     }
 }
 
@@ -293,8 +327,11 @@ pub fn scan_format(bytes: &[u8], n_values: usize, format: Format) -> Scanned {
     while pos < bytes.len() {
         match frame(bytes, pos) {
             Ok(f) => {
-                match interpret(&f, pos, head, n_values) {
-                    Ok((i, slot)) => out.records.push((i, slot, pos..f.end)),
+                match interpret(&f, pos, head, n_values, format) {
+                    Ok(Content::Record(i, slot)) => out.records.push((i, slot, pos..f.end)),
+                    Ok(Content::Identity) => {
+                        out.identities.push((f.payload.to_vec(), pos..f.end));
+                    }
                     Err(reason) => out.skipped.push(Skipped {
                         bytes: pos as u64..f.end as u64,
                         point: usize::try_from(f.index).ok(),

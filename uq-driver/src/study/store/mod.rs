@@ -17,6 +17,7 @@ pub mod export;
 pub mod format;
 pub mod lock;
 mod runs;
+pub(crate) mod valid;
 
 use std::fmt;
 use std::fs::{self, File, OpenOptions};
@@ -29,6 +30,7 @@ use serde::{Deserialize, Serialize};
 
 pub use format::{encode, Format, Skipped, Slot};
 pub use runs::{Entry, StoredRuns, Values};
+use valid::RecordRules;
 
 /// What the store is for; a store written for another study is refused.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -102,12 +104,19 @@ pub struct Recovery {
     pub backup: Option<PathBuf>,
     /// Whether the store was converted from format 1.
     pub converted_from_v1: bool,
+    /// Whether `records.bin` did not say which study and FMU its records belong to (written
+    /// before stores carried their identity), so that its records could only be taken on
+    /// trust; the identity of the study it was opened for is now written at its start.
+    pub identity_added: bool,
 }
 
 impl Recovery {
-    /// Whether the store was intact (nothing skipped, cut or converted).
+    /// Whether the store was intact (nothing skipped, cut, converted or identified).
     pub fn is_clean(&self) -> bool {
-        self.skipped.is_empty() && self.truncated.is_none() && !self.converted_from_v1
+        self.skipped.is_empty()
+            && self.truncated.is_none()
+            && !self.converted_from_v1
+            && !self.identity_added
     }
 
     /// A message for the user, or `None` when the store was intact.
@@ -121,6 +130,14 @@ impl fmt::Display for Recovery {
         write!(f, "results store {}: ", self.path.display())?;
         if self.converted_from_v1 {
             write!(f, "converted from the format before format 2; ")?;
+        }
+        if self.identity_added {
+            write!(
+                f,
+                "its records did not say which study and FMU they belong to (written by an \
+                 earlier uq-driver; taken to be this study's, as its manifest.json says), so \
+                 the study's identity was added at its start; "
+            )?;
         }
         if !self.skipped.is_empty() {
             let n = self.skipped.len();
@@ -232,10 +249,28 @@ impl Store {
     /// ([`StoredRuns`]). The file is scanned through a memory map (its pages are the page
     /// cache's, not this process's heap), and copied into memory only to repair a damaged
     /// or convert an old store.
+    ///
+    /// `records.bin` starts with the store's identity (the manifest: study hash, FMU
+    /// SHA-256, sizes): a file that holds the identity of another study or FMU is refused
+    /// ([`StoreError::Mismatch`]), as is a `manifest.json` of another, so a `records.bin`
+    /// copied from another study's folder is never read as this one's. A file written before
+    /// stores carried their identity gets it ([`Recovery::identity_added`]).
     pub fn open_in_place(
         dir: &Path,
         manifest: &Manifest,
         fresh: bool,
+    ) -> Result<(Store, StoredRuns), StoreError> {
+        Store::open_checked(dir, manifest, fresh, None)
+    }
+
+    /// [`Store::open_in_place`], where a successful record whose values break `rules`
+    /// (a non-finite output: never stored by a run, so the file was damaged or edited) is
+    /// read as a failure of its point that says so.
+    pub(crate) fn open_checked(
+        dir: &Path,
+        manifest: &Manifest,
+        fresh: bool,
+        rules: Option<&RecordRules>,
     ) -> Result<(Store, StoredRuns), StoreError> {
         let sdir = dir.join("store");
         if fresh && sdir.exists() {
@@ -244,6 +279,7 @@ impl Store {
         // A planted link (the folder may be shared, the run root's) is never written through.
         out_file::sub_folder(&sdir).map_err(io_err(&sdir))?;
         check_manifest(dir, &sdir.join("manifest.json"), manifest)?;
+        let identity = format::encode_identity(&identity_json(manifest));
         let path = sdir.join("records.bin");
         let mut file = OpenOptions::new()
             .create(true)
@@ -263,36 +299,54 @@ impl Store {
         let bytes: &[u8] = map.as_deref().unwrap_or_default();
 
         let fmt = format::detect_format(bytes);
-        let (mut done, kept, skipped) = read_records(bytes, fmt, manifest);
+        let scan = read_records(bytes, fmt, manifest, rules);
+        check_identities(dir, &scan.identities, manifest)?;
+        let Scan {
+            mut done,
+            kept,
+            skipped,
+            identities,
+        } = scan;
+        // The identity at the start of the file, where every store now has it.
+        let identity_end = identities
+            .first()
+            .filter(|(_, r)| r.start == 0)
+            .map(|(_, r)| r.end);
         let mut recovery = Recovery {
             path: path.clone(),
             kept: kept.len(),
             converted_from_v1: fmt == Format::V1,
+            identity_added: !bytes.is_empty() && identity_end.is_none(),
             ..Recovery::default()
         };
-        let valid_end = kept.last().map_or(0, |(_, r)| r.end);
+        let valid_end = kept
+            .last()
+            .map_or(0, |(_, r)| r.end)
+            .max(identity_end.unwrap_or(0));
         let damage_inside = skipped.iter().any(|s| s.bytes.start < valid_end as u64);
         let found = bytes.len();
         let mut len = found;
-        if fmt == Format::V1 || damage_inside {
+        if fmt == Format::V1 || damage_inside || recovery.identity_added {
             // The kept records go to a new file straight from the map, a record at a time:
             // a store larger than the memory is repaired too.
-            let tmp = write_tmp(&path, |w| write_kept(w, bytes, fmt, &kept, &done))?;
+            let tmp = write_tmp(&path, |w| {
+                w.write_all(&identity)?;
+                write_kept(w, bytes, fmt, &kept, &done)
+            })?;
             drop(map);
-            let (new_file, backup) = replace(&path, &tmp, &label(fmt))?;
+            // Adding the identity alone loses nothing: the file as found is kept only when
+            // records were converted or dropped.
+            let label = (fmt == Format::V1 || damage_inside).then(|| label(fmt));
+            let (new_file, backup) = replace(&path, &tmp, label.as_deref())?;
             file = new_file;
-            recovery.backup = Some(backup);
+            recovery.backup = backup;
             // Where each point's values are now.
             let new_len = file.metadata().map_err(io_err(&path))?.len();
-            let new_map = if new_len == 0 {
-                None
-            } else {
-                // As above: the file this run just wrote under the folder's lock; the map is
-                // dropped before anything appends to it.
-                Some(crate::sys::map_read_only(&file).map_err(io_err(&path))?)
-            };
-            let written: &[u8] = new_map.as_deref().unwrap_or_default();
-            done = read_records(written, Format::V2, manifest).0;
+            // As above: the file this run just wrote under the folder's lock (never empty:
+            // it starts with the identity); the map is dropped before anything appends to it.
+            let new_map = crate::sys::map_read_only(&file).map_err(io_err(&path))?;
+            let written: &[u8] = &new_map[..new_len as usize];
+            done = read_records(written, Format::V2, manifest, rules).done;
             len = written.len();
         } else if valid_end < found {
             drop(map);
@@ -301,6 +355,11 @@ impl Store {
             file.seek(SeekFrom::End(0)).map_err(io_err(&path))?;
             recovery.truncated = Some((found - valid_end) as u64);
             len = valid_end;
+        }
+        if len == 0 {
+            // A new store: its identity first.
+            file.write_all(&identity).map_err(io_err(&path))?;
+            len = identity.len();
         }
 
         let mut rerun: Vec<usize> = skipped
@@ -353,14 +412,28 @@ impl Store {
 /// A valid record's point and its bytes in the file.
 type Kept = (usize, std::ops::Range<usize>);
 
+/// What [`read_records`] found.
+struct Scan {
+    /// The first record of each point (a later one replaces a failure).
+    done: Vec<Option<Slot>>,
+    /// Every valid record of the design, in file order.
+    kept: Vec<Kept>,
+    /// The skipped stretches, in file order.
+    skipped: Vec<Skipped>,
+    /// The identity frames (the manifest's JSON), in file order.
+    identities: Vec<(Vec<u8>, std::ops::Range<usize>)>,
+}
+
 /// Scans `bytes` for `manifest`: the first record of each point (a later one replaces a
-/// failure), every valid record of the design (in file order), and the skipped stretches (in
-/// file order; a valid record of a point beyond the design counts as skipped).
+/// failure; a success whose values break `rules` reads as a failure that says so), every
+/// valid record of the design (in file order), the skipped stretches (in file order; a valid
+/// record of a point beyond the design counts as skipped) and the identity frames.
 fn read_records(
     bytes: &[u8],
     fmt: Format,
     manifest: &Manifest,
-) -> (Vec<Option<Slot>>, Vec<Kept>, Vec<Skipped>) {
+    rules: Option<&RecordRules>,
+) -> Scan {
     let scanned = format::scan_format(bytes, manifest.n_values, fmt);
     let mut done: Vec<Option<Slot>> = vec![None; manifest.n_points];
     let mut kept = Vec::with_capacity(scanned.records.len());
@@ -377,6 +450,17 @@ fn read_records(
             });
             continue;
         }
+        let slot = match (slot, rules) {
+            (Slot::Ok(r), Some(rules)) => match rules.check_bytes(&bytes[r.clone()]) {
+                Ok(()) => Slot::Ok(r),
+                Err(problem) => Slot::Failed(format!(
+                    "its record in the results store holds {problem}: a run never stores \
+                     one (the point fails instead), so the store was damaged or edited; \
+                     --retry-failed runs the point again"
+                )),
+            },
+            (slot, _) => slot,
+        };
         // The first result of a point is kept, except that a later record replaces a failure
         // (a point run again by `--retry-failed`).
         if matches!(done[i], None | Some(Slot::Failed(_))) {
@@ -385,7 +469,71 @@ fn read_records(
         kept.push((i, range));
     }
     skipped.sort_by_key(|s| s.bytes.start);
-    (done, kept, skipped)
+    Scan {
+        done,
+        kept,
+        skipped,
+        identities: scanned.identities,
+    }
+}
+
+/// The identity a store's `records.bin` starts with: the manifest as JSON.
+fn identity_json(manifest: &Manifest) -> Vec<u8> {
+    serde_json::to_vec(manifest).expect("serializable")
+}
+
+/// Refuses identity frames of another study or FMU than `manifest`'s.
+fn check_identities(
+    dir: &Path,
+    identities: &[(Vec<u8>, std::ops::Range<usize>)],
+    manifest: &Manifest,
+) -> Result<(), StoreError> {
+    for (json, range) in identities {
+        let other = match serde_json::from_slice::<Manifest>(json) {
+            Ok(m) if &m == manifest => continue,
+            Ok(m) => m,
+            Err(_) => {
+                return Err(StoreError::Mismatch {
+                    dir: dir.to_path_buf(),
+                    what: format!(
+                        "store/records.bin holds, at byte {}, a study identity that cannot be \
+                         read",
+                        range.start
+                    ),
+                })
+            }
+        };
+        let what = if other.fmu_sha256 != manifest.fmu_sha256 {
+            "its FMU differs"
+        } else if other.study_hash != manifest.study_hash {
+            "its study definition differs"
+        } else {
+            "its design has other sizes"
+        };
+        let place = if range.start == 0 {
+            String::new()
+        } else {
+            format!(" from byte {}", range.start)
+        };
+        return Err(StoreError::Mismatch {
+            dir: dir.to_path_buf(),
+            what: format!(
+                "store/records.bin holds{place} the records of another study or FMU ({what}: \
+                 study hash {}, FMU SHA-256 {}, where this one has {} and {}), although \
+                 store/manifest.json matches: the file was copied from another folder",
+                short(&other.study_hash),
+                short(&other.fmu_sha256),
+                short(&manifest.study_hash),
+                short(&manifest.fmu_sha256)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The first 12 characters of a hash, for messages.
+fn short(hash: &str) -> &str {
+    hash.get(..12).unwrap_or(hash)
 }
 
 /// The name of the kept copy of a store rewritten from format `fmt`.
@@ -489,19 +637,29 @@ fn write_tmp(
 }
 
 /// Replaces the store file `path` by `tmp` (from [`write_tmp`]), keeping the file as found
-/// as `records.<label>.bin` (a hard link where the file system allows it, else a copy);
-/// returns the new file, open for reading and appending, and the backup's path.
-fn replace(path: &Path, tmp: &Path, label: &str) -> Result<(File, PathBuf), StoreError> {
+/// as `records.<label>.bin` when a label is given (a hard link where the file system allows
+/// it, else a copy); returns the new file, open for reading and appending, and the backup's
+/// path.
+fn replace(
+    path: &Path,
+    tmp: &Path,
+    label: Option<&str>,
+) -> Result<(File, Option<PathBuf>), StoreError> {
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut backup = dir.join(format!("records.{label}.bin"));
-    let mut n = 1;
-    while backup.exists() {
-        n += 1;
-        backup = dir.join(format!("records.{label}-{n}.bin"));
-    }
+    let backup = label.map(|label| {
+        let mut backup = dir.join(format!("records.{label}.bin"));
+        let mut n = 1;
+        while backup.exists() {
+            n += 1;
+            backup = dir.join(format!("records.{label}-{n}.bin"));
+        }
+        backup
+    });
     let kept = (|| {
-        if fs::hard_link(path, &backup).is_err() {
-            fs::copy(path, &backup)?;
+        if let Some(backup) = &backup {
+            if fs::hard_link(path, backup).is_err() {
+                fs::copy(path, backup)?;
+            }
         }
         fs::rename(tmp, path)
     })();
@@ -574,6 +732,109 @@ mod tests {
             Store::open(dir.path(), &other, true).is_ok(),
             "--fresh starts over"
         );
+    }
+
+    /// A records.bin copied from another study's folder (its manifest.json left as it was)
+    /// was read as this study's: the shard's outputs paired with another design's inputs.
+    #[test]
+    fn a_records_file_of_another_study_is_refused_even_under_a_matching_manifest() {
+        let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let mut other = manifest();
+        other.study_hash = "t".into();
+        let (s, _) = Store::open(a.path(), &manifest(), false).unwrap();
+        s.append(0, &Record::Ok(vec![1.0, 2.0])).unwrap();
+        drop(s);
+        let (s, _) = Store::open(b.path(), &other, false).unwrap();
+        s.append(0, &Record::Ok(vec![3.0, 4.0])).unwrap();
+        drop(s);
+        let records = |d: &tempfile::TempDir| d.path().join("store/records.bin");
+        fs::copy(records(&b), records(&a)).unwrap();
+        let e = Store::open(a.path(), &manifest(), false).unwrap_err();
+        assert!(matches!(e, StoreError::Mismatch { .. }), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.contains(
+                "store/records.bin holds the records of another study or FMU (its \
+                           study definition differs"
+            ) && text.contains("copied from another folder"),
+            "{text}"
+        );
+        // Appended to this study's own file: refused too, naming where it starts.
+        let own = {
+            let (s, _) = Store::open(a.path(), &manifest(), true).unwrap();
+            s.append(0, &Record::Ok(vec![1.0, 2.0])).unwrap();
+            drop(s);
+            fs::read(records(&a)).unwrap()
+        };
+        let theirs = fs::read(records(&b)).unwrap();
+        fs::write(records(&a), [own.clone(), theirs].concat()).unwrap();
+        let text = Store::open(a.path(), &manifest(), false)
+            .unwrap_err()
+            .to_string();
+        assert!(text.contains(&format!("from byte {}", own.len())), "{text}");
+    }
+
+    /// A store written before stores carried their identity still resumes, once, with a
+    /// note, and carries it from then on; nothing is lost.
+    #[test]
+    fn a_store_without_an_identity_is_resumed_and_gets_one() {
+        let dir = tempfile::tempdir().unwrap();
+        drop(Store::open(dir.path(), &manifest(), false).unwrap());
+        let path = dir.path().join("store/records.bin");
+        let old = [
+            encode(0, &Record::Ok(vec![1.0, 2.0])),
+            encode(3, &Record::Failed("x".into())),
+        ]
+        .concat();
+        fs::write(&path, &old).unwrap();
+        let (s, done) = Store::open(dir.path(), &manifest(), false).unwrap();
+        assert!(s.recovery().identity_added);
+        assert_eq!(
+            s.recovery().backup,
+            None,
+            "nothing to keep: no record was dropped"
+        );
+        assert!(s
+            .recovery()
+            .to_string()
+            .contains("the study's identity was added"));
+        assert_eq!(done[0], Some(Record::Ok(vec![1.0, 2.0])));
+        assert_eq!(done[3], Some(Record::Failed("x".into())));
+        drop(s);
+        let bytes = fs::read(&path).unwrap();
+        assert!(bytes.ends_with(&old));
+        let (s, _) = Store::open(dir.path(), &manifest(), false).unwrap();
+        assert!(s.recovery().is_clean(), "{}", s.recovery());
+    }
+
+    /// A forged record of NaNs (valid checksums) gave a NaN mean in q.csv with exit status
+    /// 0: with the study's rules it reads as a failure of its point that says why.
+    #[test]
+    fn a_stored_record_of_non_finite_values_reads_as_a_failed_point() {
+        let dir = tempfile::tempdir().unwrap();
+        let (s, _) = Store::open(dir.path(), &manifest(), false).unwrap();
+        s.append(1, &Record::Ok(vec![f64::NAN, 2.0])).unwrap();
+        s.append(2, &Record::Ok(vec![1.0, 2.0])).unwrap();
+        drop(s);
+        let rules = RecordRules::new(&["q".into()], &[0.0, 0.5], Vec::new());
+        let (_, runs) = Store::open_checked(dir.path(), &manifest(), false, Some(&rules)).unwrap();
+        match runs.record(1).unwrap() {
+            Some(Record::Failed(m)) => assert!(
+                m.starts_with(
+                    "its record in the results store holds a non-finite value (NaN) of output \
+                     'q' at t = 0 s"
+                ) && m.contains("--retry-failed"),
+                "{m}"
+            ),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(runs.record(2).unwrap(), Some(Record::Ok(vec![1.0, 2.0])));
+        // A later valid record of the point (--retry-failed) replaces the failure.
+        let (s, _) = Store::open(dir.path(), &manifest(), false).unwrap();
+        s.append(1, &Record::Ok(vec![5.0, 6.0])).unwrap();
+        drop(s);
+        let (_, runs) = Store::open_checked(dir.path(), &manifest(), false, Some(&rules)).unwrap();
+        assert_eq!(runs.record(1).unwrap(), Some(Record::Ok(vec![5.0, 6.0])));
     }
 
     #[test]
