@@ -746,3 +746,79 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
         "{err}"
     );
 }
+
+/// An FMU whose `<ModelStructure/>` is empty although it has outputs was read as having no
+/// output: `simulate` warned "nothing to record" and exited 0. fmpy's validation refuses it.
+#[test]
+fn an_empty_model_structure_with_outputs_is_an_invalid_model_description() {
+    let dir = tempfile::tempdir().unwrap();
+    let xml = model_description();
+    let start = xml.find("<ModelStructure>").unwrap();
+    let end = xml.find("</ModelStructure>").unwrap() + "</ModelStructure>".len();
+    let empty = format!("{}<ModelStructure/>{}", &xml[..start], &xml[end..]);
+    // No binary needed: the description is refused before any library is loaded.
+    let fmu = write_fmu(dir.path(), "Empty.fmu", &empty, None);
+    let o = run(&["simulate", utf8(&fmu), "--stop", "1", "--step", "0.5"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(
+            "invalid modelDescription.xml: variable 'x' (index 1) has causality=\"output\", \
+             but ModelStructure/Outputs does not list it"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("nothing to record"), "{err}");
+}
+
+/// `simulate --output time` wrote the time column twice (`time,time,x`).
+#[test]
+fn simulate_output_time_writes_the_time_column_once() {
+    let Some(bins) = binaries() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = write_fmu(
+        dir.path(),
+        "Dahlquist.fmu",
+        &model_description(),
+        Some(&bins.full),
+    );
+    let args = ["simulate", utf8(&fmu), "--stop", "0.2", "--step", "0.1"];
+    let o = run(&[&args[..], &["--output", "time", "--output", "x"]].concat());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let out = String::from_utf8(o.stdout).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "time,x", "{out}");
+    assert_eq!(lines.len(), 4, "{out}");
+    // x = exp(-t) exactly at the communication points (the C FMU's exact update).
+    let x: f64 = lines[2].split(',').nth(1).unwrap().parse().unwrap();
+    assert!((x - (-0.1f64).exp()).abs() < 1e-12, "{x}");
+    assert!(err.contains("--output time adds no second one"), "{err}");
+    // Only the time: the FMU's independent variable, one column.
+    let o = run(&[&args[..], &["--output", "time"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(out, "time\n0\n0.1\n0.2\n");
+}
+
+/// An FMU without a default step size could not be simulated without `--step`; fmpy's
+/// `simulate_fmu` picks one (`auto_interval`: 0.002 s for 1 s, 500 steps).
+#[test]
+fn simulate_without_a_default_step_takes_the_step_fmpy_takes() {
+    let Some(bins) = binaries() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let xml = model_description().replace(" stepSize=\"0.1\"", "");
+    assert!(!xml.contains("stepSize"));
+    let fmu = write_fmu(dir.path(), "NoStep.fmu", &xml, Some(&bins.full));
+    let o = run(&["simulate", utf8(&fmu), "--output", "x"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let out = String::from_utf8(o.stdout).unwrap();
+    let rows: Vec<&str> = out.lines().skip(1).collect();
+    assert_eq!(rows.len(), 501, "0 to 1 s by 0.002 s");
+    assert_eq!(rows[1].split(',').next(), Some("0.002"));
+    assert!(
+        err.contains("communication step 0.002 s (500 steps"),
+        "{err}"
+    );
+}

@@ -26,6 +26,7 @@ mod fuzz_corpus;
 mod hd_goals;
 mod hunting_speed;
 mod importer_features;
+mod input_files;
 mod instance_lifecycle;
 mod isolation;
 mod large_studies;
