@@ -41,6 +41,7 @@ mod study_sampling;
 mod study_wheel;
 mod test_fmus;
 mod undefined_numbers;
+mod vehicle_studies;
 
 /// The `.rs` files of the folder `dir` (below `tests/`) but `skip`, without their extension.
 fn rust_files(dir: &str, skip: &str) -> Vec<String> {

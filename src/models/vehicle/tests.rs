@@ -653,8 +653,9 @@ fn speed() {
     );
 }
 
-/// Sustained hunting: some wheelset above 0.5 mm over the last 10 s of 40 s at speed `v`.
-fn hunts(m: &mut Vehicle, v: f64) -> bool {
+/// Sustained hunting: some wheelset above `threshold` (m) over the last 20 s of 40 s at speed
+/// `v`.
+fn hunts(m: &mut Vehicle, v: f64, threshold: f64) -> bool {
     m.set_real(VR_V, v).unwrap();
     amplitude(m, 20.0, 0.01).unwrap();
     let a = amplitude(m, 20.0, 0.01).unwrap();
@@ -662,19 +663,19 @@ fn hunts(m: &mut Vehicle, v: f64) -> bool {
         "  {v:.3} m/s: {:?} mm",
         a.map(|x| (x * 1e5).round() / 100.0)
     );
-    max4(a) > 5e-4
+    max4(a) > threshold
 }
 
 /// The lowest speed at which the hunting state `m` (at speed `v`) keeps hunting when the speed
 /// is lowered with the state carried over: steps of 2 m/s, then 0.5 m/s from the last hunting
 /// state, then bisection to 0.05 m/s, each trial from the hunting state of the lowest hunting
 /// speed so far.
-fn fold(m: &Vehicle, v: f64) -> f64 {
+fn fold(m: &Vehicle, v: f64, threshold: f64) -> f64 {
     let mut hunting = (m.clone(), v);
     let mut v = v - 2.0;
     for step in [2.0, 0.5] {
         let mut trial = hunting.0.clone();
-        while hunts(&mut trial, v) {
+        while hunts(&mut trial, v, threshold) {
             hunting = (trial.clone(), v);
             v -= step;
         }
@@ -684,7 +685,7 @@ fn fold(m: &Vehicle, v: f64) -> f64 {
     while hi - lo > 0.05 {
         let mid = 0.5 * (lo + hi);
         let mut trial = hunting.0.clone();
-        if hunts(&mut trial, mid) {
+        if hunts(&mut trial, mid, threshold) {
             hi = mid;
             hunting = (trial, mid);
         } else {
@@ -695,7 +696,7 @@ fn fold(m: &Vehicle, v: f64) -> f64 {
 }
 
 /// The nonlinear critical speed by continuation (MODELS §5): hunting from above the linear
-/// critical speed (120 m/s, 20 s) carried to 70 m/s, then [`fold`] from there, with both
+/// critical speed (120 m/s, 20 s; the built-in table: 80 m/s) carried to 70 m/s, then [`fold`] from there, with both
 /// bogies hunting, and with one of them put back on the centre line (its frame and wheelsets'
 /// lateral states zeroed): near the fold only one bogie may hunt, and that motion outlives the
 /// one of both. With the RSGEO table and with the built-in one (set `RAILUQ_TABLE=rsgeo` or
@@ -705,19 +706,29 @@ fn fold(m: &Vehicle, v: f64) -> f64 {
 #[ignore]
 fn nonlinear_critical_speed() {
     let only = std::env::var("RAILUQ_TABLE").unwrap_or_default();
-    for (name, table) in [("rsgeo", rsgeo_path()), ("builtin", String::new())] {
+    // The built-in table's flange is met at 6.2 mm (RSGEO's at 8.7 mm): at 120 m/s the car
+    // hunting on it climbs the flange within 10 s; from 80 m/s it hunts on the flanges (5 to
+    // 6 mm). Below that cycle's fold a tread oscillation of 0.3 to 1.7 mm across the tread's
+    // contact jump (0.22 mm) lingers down to 20 m/s and less, its amplitude nearly
+    // independent of the speed (0.5 mm at 22 to 24 m/s): a 0.5 mm threshold would put the
+    // "fold" where that amplitude happens to cross it; 3 mm separates the two.
+    for (name, table, start, threshold) in [
+        ("rsgeo", rsgeo_path(), 120.0, 5e-4),
+        ("builtin", String::new(), 80.0, 3e-3),
+    ] {
         if only.is_empty() || only == name {
-            println!("{name} table:");
-            continuation_folds(&table);
+            println!("{name} table (hunting: above {} mm):", threshold * 1e3);
+            continuation_folds(&table, start, threshold);
         }
     }
 }
 
-/// [`nonlinear_critical_speed`] with contact table `table`.
-fn continuation_folds(table: &str) {
-    let mut m = model_with(table, 120.0, [1e-4, 0.0, 8e-3, 0.0]);
+/// [`nonlinear_critical_speed`] with contact table `table`, hunting from speed `start`,
+/// hunting when some wheelset exceeds `threshold` (m).
+fn continuation_folds(table: &str, start: f64, threshold: f64) {
+    let mut m = model_with(table, start, [1e-4, 0.0, 8e-3, 0.0]);
     amplitude(&mut m, 20.0, 0.01).unwrap();
-    assert!(hunts(&mut m, 70.0));
+    assert!(hunts(&mut m, 70.0, threshold));
     let lateral = [dof::Y, dof::YD, dof::PHI, dof::PHID];
     let centred = |bogie_index: usize| {
         let mut c = m.clone();
@@ -739,11 +750,11 @@ fn continuation_folds(table: &str) {
         c.set_state(&x);
         c
     };
-    let both = fold(&m, 70.0);
+    let both = fold(&m, 70.0, threshold);
     println!("both bogies hunting: fold at {both:.2} m/s");
-    let trailing = fold(&centred(0), 70.0);
+    let trailing = fold(&centred(0), 70.0, threshold);
     println!("trailing bogie hunting: fold at {trailing:.2} m/s");
-    let leading = fold(&centred(1), 70.0);
+    let leading = fold(&centred(1), 70.0, threshold);
     println!("leading bogie hunting: fold at {leading:.2} m/s");
     let v_cr = m.v_cr_linear().unwrap();
     println!(
