@@ -56,11 +56,13 @@ pub const MIN_SPEED: f64 = 1.0;
 /// the tread and onto the flange, and a spline through a jump overshoots.
 pub const BUILTIN_SMOOTHING: f64 = 0.05e-3;
 
+/// A contact table with its splines, shared between instances.
+type SharedTable = (Arc<ContactTable>, Arc<ContactSpline>);
+
 /// The built-in table and its splines, computed once per process (shared by every instance,
 /// kept across fmi2Reset).
-fn builtin() -> Result<&'static (Arc<ContactTable>, Arc<ContactSpline>), ModelError> {
-    static BUILTIN: OnceLock<Result<(Arc<ContactTable>, Arc<ContactSpline>), String>> =
-        OnceLock::new();
+fn builtin() -> Result<&'static SharedTable, ModelError> {
+    static BUILTIN: OnceLock<Result<SharedTable, String>> = OnceLock::new();
     BUILTIN
         .get_or_init(|| {
             let raw = crate::contact::default_table().map_err(|e| e.to_string())?;
@@ -260,7 +262,7 @@ impl Vehicle {
     }
 
     /// The contact table `contact_table` names (the built-in one when empty), with its splines.
-    fn load_table(&self) -> Result<(Arc<ContactTable>, Arc<ContactSpline>), ModelError> {
+    fn load_table(&self) -> Result<SharedTable, ModelError> {
         if self.contact_table.is_empty() {
             return builtin().cloned();
         }
