@@ -167,6 +167,8 @@ paper: build fmu
 	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
 	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
+	$(DRIVER) run builtin:vehicle-critical-speed --out out/vehicle-critical-speed
+	$(DRIVER) run builtin:vehicle-curve-safety --out out/vehicle-curve-safety
 	@echo "reports: out/paper-*/index.html"
 
 # Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser, the

@@ -20,9 +20,11 @@ GOAL_SHARE = 0.20
 GOAL_PEERS = 3.0
 # Built-ins left out by default: their runs take 15 minutes to an hour or more on 2 cores
 # (the bogie's 20 000-sample Latin hypercube, alone or in paper-bogie; the 8-input
-# vehicle-track's 5 000-sample reference; the ride-comfort study over many tracks). They are
-# in `make paper`.
-LONG = ("bogie-lhs-20000", "paper-bogie", "vehicle-track-8d-lhs", "paper-vehicle-track-tracks")
+# vehicle-track's 5 000-sample reference; the ride-comfort study over many tracks; the full
+# car's critical speed, 256 runs of 240 s; its running safety in curves, 200 runs of 15 s).
+# They are in `make paper`.
+LONG = ("bogie-lhs-20000", "paper-bogie", "vehicle-track-8d-lhs", "paper-vehicle-track-tracks",
+        "vehicle-critical-speed", "vehicle-curve-safety")
 
 
 def builtins(driver, h):

@@ -6,10 +6,11 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
-                                  [--only hd]
+                                  [--only hd|vehicle]
 
 `--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
-target/bench/BENCHMARKS-hd.md.
+target/bench/BENCHMARKS-hd.md, `--only vehicle` the full car's real-time factor alone into
+target/bench/BENCHMARKS-vehicle.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals set for the comparisons are reported as met or not met. The only hard failures are missing
@@ -43,7 +44,7 @@ CARGO = os.environ.get("CARGO", "cargo")
 DRIVER = Path(os.environ.get("RAILUQ_DRIVER", ROOT / "target" / "release" / "uq-driver"))
 FMU_DIR = Path(os.environ.get("RAILUQ_FMU_DIR", ROOT / "target" / "fmu"))
 LIB = ROOT / "target" / "release" / "librailuq.so"
-MODELS = ("Wheel", "Bogie", "VehicleTrack")
+MODELS = ("Wheel", "Bogie", "VehicleTrack", "Vehicle")
 
 # The wheel study of the paper (section 3), as in the built-in studies.
 M, Q0 = 10.0, 0.1
@@ -56,6 +57,7 @@ CHECK_TOL = 1e-12
 GOAL_FMPY = 50.0
 GOAL_THREADS = 1.9
 GOAL_RTF = 5.0
+GOAL_VEHICLE_RTF = 20.0
 GOAL_VT_DEFAULT = 40.0
 GOAL_VT_FINE = 4.0
 GOAL_VT_ACCURACY = 1e-12
@@ -711,6 +713,46 @@ def bench_realtime(work, repeats, step_cost):
     return sec
 
 
+# ------------------------------------------------------------------ 6b. the full car
+
+def bench_vehicle_realtime(work, repeats):
+    """The Vehicle FMU (the full car, 66 states) on straight track at 40 m/s, one thread."""
+    sec = Section("6b. Real-time factor of the full car (Vehicle, straight track, 40 m/s, "
+                  "one thread)",
+                  ["experiment", "simulated (s)", "wall, best (s)", "wall median (s)",
+                   "CPU / wall", "real-time factor (best)", "(median)"])
+    sim = 20.0
+    out = work / "Vehicle.csv"
+    extra = ["--set", "v=40", "--set", "ramp=0", "--stop", f"{sim:g}", "--step", "0.01"]
+    cmd = [str(DRIVER), "simulate", str(fmu("Vehicle")), *extra, "--out", str(out)]
+    sec.cmd(f"target/release/uq-driver simulate {rel(fmu('Vehicle'))} {' '.join(extra)} "
+            f"--out {rel(out)}   # x{repeats}")
+    walls, util = [], []
+    for _ in range(repeats):
+        wall, cpu, _ = run_cmd(cmd)
+        walls.append(wall)
+        util.append(cpu / wall)
+    with open(out) as f:
+        header = f.readline().strip().split(",")
+        rows = [line.strip().split(",") for line in f if line.strip()]
+    if len(rows) != round(sim / 0.01) + 1:
+        die(f"{out}: expected {round(sim / 0.01) + 1} rows, got {len(rows)}")
+    speed = [float(r[header.index("speed")]) for r in rows]
+    if max(abs(v - 40.0) for v in speed) > 1e-9:
+        die(f"{out}: the speed is not 40 m/s throughout")
+    b, m = best_median(walls)
+    sec.row(f"0–{sim:g} s, step 0.01 s, dt ≤ 1 ms (default), built-in S1002/UIC60 1:40 table, "
+            f"the default initial disturbance", f"{sim:g}", fmt_s(b), fmt_s(m),
+            f"{statistics.median(util):.2f}", fmt_ratio(sim / b), fmt_ratio(sim / m))
+    sec.note("Wall time of the whole command (open the FMU, instantiate, compute the built-in "
+             "contact table from the profiles, initialise, simulate, write the CSV of every "
+             "output); real-time factor = simulated time / wall time.")
+    sec.done(f"The full car runs {sim / b:.1f}× faster than real time at 40 m/s on one thread "
+             f"(best of {repeats}). Goal ≥ {GOAL_VEHICLE_RTF:g}×: "
+             f"{goal(sim / b >= GOAL_VEHICLE_RTF)}.")
+    return sec
+
+
 # ------------------------------------------------------------------ big model descriptions
 
 GOAL_PARSE_1E5 = 1.0
@@ -1020,7 +1062,7 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
-SECTIONS = ("hd",)
+SECTIONS = ("hd", "vehicle")
 
 
 def main():
@@ -1062,6 +1104,10 @@ def main():
         if args.only == "hd":
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
             sections, same_threads, same_iso = bench_hd_goals(work), True, True
+        elif args.only == "vehicle":
+            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
+            sections = [bench_vehicle_realtime(work, repeats)]
+            same_threads, same_iso = True, True
         else:
             sections, same_threads, same_iso, lib_same = all_sections(args, work, repeats,
                                                                       checks)
@@ -1087,12 +1133,13 @@ def all_sections(args, work, repeats, checks):
     s3, same_threads = bench_threads(work, 1 if args.quick else max(repeats, 7))
     s4, s5 = bench_paper_wheel(work)
     s6 = bench_realtime(work, repeats if args.quick else max(repeats, 5), step_cost)
+    s6b = bench_vehicle_realtime(work, repeats if args.quick else max(repeats, 5))
     s_parse = bench_parse_description(work, repeats)
     s7 = bench_vt_stepping(work, s1.other)
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
     s_hd = bench_hd_goals(work)
-    return ([s1, s2, s3, s4, s5, s6, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
+    return ([s1, s2, s3, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
             same_iso, lib_same)
 
 

@@ -7,7 +7,8 @@
 //!   contact angles);
 //! - [`hertz`], [`kalker`]: the contact ellipse, penetration and creep coefficients;
 //! - [`compute`](mod@compute): all of it as a [`ContactTable`] ([`compute_table`], [`default_table`]);
-//! - [`conicity`]: equivalent conicity from Δr(y) (EN 15302).
+//! - [`conicity`]: equivalent conicity from Δr(y) (EN 15302);
+//! - [`smooth`]: a short moving average in y that makes a rigid table fit for splines.
 //!
 //! Pure Rust, no FMI types.
 #![forbid(unsafe_code)]
@@ -19,6 +20,7 @@ pub mod hertz;
 pub mod kalker;
 pub mod profile;
 pub mod s1002;
+pub mod smooth;
 pub mod table;
 pub mod uic60;
 

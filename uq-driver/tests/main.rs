@@ -43,6 +43,7 @@ mod study_wheel;
 mod tampered_folders;
 mod test_fmus;
 mod undefined_numbers;
+mod vehicle_studies;
 
 /// The `.rs` files of the folder `dir` (below `tests/`) but `skip`, without their extension.
 fn rust_files(dir: &str, skip: &str) -> Vec<String> {

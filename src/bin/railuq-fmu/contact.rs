@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use railuq::contact::conicity::DeltaR;
+use railuq::contact::smooth::smoothed;
 use railuq::contact::{
     compute, ContactError, ContactSettings, ContactSolution, Profile, RollingCurvature,
 };
@@ -16,7 +17,7 @@ use crate::svg::{render, Curve, Panel};
 /// Usage of the command.
 pub const USAGE: &str = "railuq-fmu contact --out FILE [--wheel CSV] [--rail CSV] [--inclination N]
        [--gauge MM] [--flange-back MM] [--r0 M] [--n0 N] [--y-max MM] [--step MM]
-       [--curvature meridian|radius]";
+       [--curvature meridian|radius] [--smooth MM]";
 
 /// Help on the options.
 pub const HELP: &str =
@@ -26,7 +27,10 @@ upright rails), gauge 1435 mm at 14 mm below the top, flange backs 1360 mm apart
 N0 = the Cooperrider car's weight / 8, y from -17 to 17 mm in steps of 0.01 mm. --wheel and
 --rail read measured profiles: lines `y, z` in mm; wheel y from the flange back (rolling circle
 at 70 mm), rail y from its centre line; both positive toward the field side, z up. --curvature radius
-takes 1/r for the wheel's curvature along the rolling direction (as RSGEO) instead of cos δ / r.";
+takes 1/r for the wheel's curvature along the rolling direction (as RSGEO) instead of cos δ / r.
+--smooth MM averages every column over a bell-shaped window of three boxes of half-width MM in y
+(default 0: the rigid contact as computed, with its jumps); the Vehicle FMU's built-in table is
+the default table with --smooth 0.05 (see the README, Contact geometry).";
 
 /// Failures of the command.
 #[derive(Debug, thiserror::Error)]
@@ -69,6 +73,7 @@ pub struct ContactArgs {
     y_max_mm: f64,
     step_mm: f64,
     curvature: RollingCurvature,
+    smooth_mm: f64,
 }
 
 /// Parses the options after `contact`.
@@ -85,6 +90,7 @@ pub fn parse(args: &[String]) -> Result<ContactArgs, ContactCliError> {
         y_max_mm: 17.0,
         step_mm: 0.01,
         curvature: RollingCurvature::Meridian,
+        smooth_mm: 0.0,
     };
     let mut out = None;
     let mut it = args.iter();
@@ -112,6 +118,7 @@ pub fn parse(args: &[String]) -> Result<ContactArgs, ContactCliError> {
             "--n0" => a.n0 = Some(number(&mut it)?),
             "--y-max" => a.y_max_mm = number(&mut it)?,
             "--step" => a.step_mm = number(&mut it)?,
+            "--smooth" => a.smooth_mm = number(&mut it)?,
             "--curvature" => {
                 a.curvature = match value(&mut it)?.as_str() {
                     "meridian" => RollingCurvature::Meridian,
@@ -127,6 +134,11 @@ pub fn parse(args: &[String]) -> Result<ContactArgs, ContactCliError> {
         }
     }
     a.out = out.ok_or_else(|| ContactCliError::Usage("--out FILE is required".into()))?;
+    if !(a.smooth_mm >= 0.0 && a.smooth_mm.is_finite()) {
+        return Err(ContactCliError::Usage(
+            "--smooth MM (half-width of the moving average in y) needs MM >= 0".into(),
+        ));
+    }
     if a.inclination.is_nan() || a.inclination <= 0.0 {
         return Err(ContactCliError::Usage(
             "--inclination N (rails at 1:N) needs N > 0 (inf for upright rails)".into(),
@@ -256,7 +268,8 @@ pub fn run(a: &ContactArgs) -> Result<(), ContactCliError> {
             .collect(),
         Err(_) => Vec::new(),
     };
-    write_output(&a.out, solution.table.to_string().as_bytes())?;
+    let table = smoothed(&solution.table, a.smooth_mm * 1e-3);
+    write_output(&a.out, table.to_string().as_bytes())?;
     let mut svg_path = a.out.clone().into_os_string();
     svg_path.push(".svg");
     let svg_path = PathBuf::from(svg_path);

@@ -56,7 +56,8 @@ pub struct Bogie {
     pub phi0: f64,
     /// Largest internal RK4 step (s).
     pub dt: f64,
-    /// Start time of the run (s), where V = V0.
+    /// Time (s) from which V = V0 − (t − t_start)/Δf: the start time of the run, or the time
+    /// at which V0 was last set between steps.
     pub t_start: f64,
     /// Current time (s).
     pub t: f64,
@@ -153,7 +154,13 @@ impl Model for Bogie {
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
-        TABLE.set_real(self, vr, value)
+        let warning = TABLE.set_real(self, vr, value)?;
+        if vr == VR_V0 {
+            // A new speed takes effect from now: the ramp (if any) restarts from it (the
+            // initialization sets t_start to the start time).
+            self.t_start = self.t;
+        }
+        Ok(warning)
     }
 
     fn initialize(&mut self, ctx: &InitContext) -> Result<(), ModelError> {

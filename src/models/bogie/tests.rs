@@ -289,6 +289,35 @@ fn tunable_parameters_act_from_the_next_step() {
 }
 
 #[test]
+fn a_new_speed_takes_effect_from_the_step_it_is_set_and_restarts_the_ramp() {
+    // Set at t = 1 s to 80 m/s on a ramp of 10 s²/m: V(1.5) = 80 − 0.5/10.
+    let mut b = Bogie::default();
+    b.initialize(&InitContext::default()).unwrap();
+    b.do_step(0.0, 1.0).unwrap();
+    assert!((b.get_real(VR_V).unwrap() - 99.9).abs() < 1e-12);
+    b.set_real(VR_V0, 80.0).unwrap();
+    assert_eq!(b.get_real(VR_V).unwrap(), 80.0);
+    b.do_step(1.0, 0.5).unwrap();
+    assert!((b.get_real(VR_V).unwrap() - 79.95).abs() < 1e-12);
+    // The same as a run that started at 80 m/s at t = 1 s from the same state.
+    let mut c = Bogie {
+        v0: 80.0,
+        ..Bogie::default()
+    };
+    c.initialize(&InitContext {
+        start_time: 1.0,
+        ..InitContext::default()
+    })
+    .unwrap();
+    let mut a = Bogie::default();
+    a.initialize(&InitContext::default()).unwrap();
+    a.do_step(0.0, 1.0).unwrap();
+    c.x = a.x;
+    c.do_step(1.0, 0.5).unwrap();
+    assert_eq!(c.x, b.x);
+}
+
+#[test]
 fn save_restore_round_trip() {
     let mut b = Bogie {
         v0: 90.0,

@@ -37,7 +37,7 @@ variables! {
     real_parameter("phi_c", VR_PHI_C = 12, None, b.p.phi_c, 0.60252e-3, Fixed, positive, "Lateral creep normalisation phi (dimensionless) [lit] True & Kaas-Petersen", min = 0.0),
     real_parameter("k0", VR_K0 = 13, Some("N/m"), b.p.k0, 14.60e6, Fixed, non_negative, "Flange stiffness [lit] True & Kaas-Petersen", min = 0.0),
     real_parameter("delta", VR_DELTA = 14, Some("m"), b.p.delta, 9.1e-3, Fixed, non_negative, "Flange clearance (dead band of the flange spring) [lit] True & Kaas-Petersen", min = 0.0),
-    real_parameter("V0", VR_V0 = 15, Some("m/s"), b.v0, 100.0, Fixed, above_min_speed, "Speed at the start time; must exceed 1 m/s [assumed]", min = MIN_SPEED),
+    real_parameter("V0", VR_V0 = 15, Some("m/s"), b.v0, 100.0, Tunable, above_min_speed, "Speed at the start time; must exceed 1 m/s; set between steps it takes effect from then on (the ramp restarts from it) [assumed]", min = MIN_SPEED),
     real_parameter("ramp", VR_RAMP = 16, Some("s2/m"), b.ramp, 10.0, Fixed, finite, "Speed ramp Df in s2/m: V = V0 - (t - t_start)/Df, i.e. the speed falls by 1/Df m/s per second; 0 = constant speed V0, < 0 = rising speed [paper eq. 29]"),
     real_parameter("Y0", VR_Y0 = 17, Some("m"), b.y0, 0.012, Fixed, finite, "Initial lateral displacement Y(t_start) [assumed]"),
     real_parameter("phi0", VR_PHI0 = 18, Some("rad"), b.phi0, 0.0, Fixed, finite, "Initial yaw angle phi(t_start) [assumed]"),
@@ -110,7 +110,9 @@ V = V0 &minus; (t &minus; t_start)/&Delta;f                                     
 <tr><td>dt</td><td>1 ms</td><td>numerical</td></tr>
 </table>
 <p>K_sy, C_sy and K_phi are tunable (the random parameters of the paper's study); a change between
-communication steps acts from the next step on. Negative or non-finite stiffnesses and
+communication steps acts from the next step on. V0 is tunable too: set between steps, the speed
+is V0 from then on (the ramp restarts from it), so that a run can lower its speed in stages
+with its state carried over (continuation). Negative or non-finite stiffnesses and
 dampings, non-positive masses, lengths and creep normalisations are refused. The speed must stay
 above 1 m/s (the creepages divide by V): a step that would reach V &le; 1 m/s fails with an error;
 with the defaults that is after t = 990 s.</p>

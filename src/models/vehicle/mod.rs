@@ -45,21 +45,40 @@ use params::{wheelset, Params};
 use std::cell::OnceCell;
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::sync::OnceLock;
 use track::{Course, Irregularity, MeasuredTrack, Source};
 
 /// Lowest running speed (m/s): the creepages divide by the speed.
 pub const MIN_SPEED: f64 = 1.0;
 
-/// The text of the built-in contact table: RSGEO's S1002 wheel on UIC60 rail inclined 1:40,
-/// the table of the reference study (a copy of tests/data/rsgeo_s1002_uic60_1in40.csv).
-const RSGEO_TABLE: &str = include_str!("../../../tests/data/rsgeo_s1002_uic60_1in40.csv");
+/// Half-width (m) of the moving average ([`crate::contact::smooth::smoothed`]) that makes the
+/// computed S1002/UIC60 table fit for the model's cubic splines: the rigid contact jumps across
+/// the tread and onto the flange, and a spline through a jump overshoots.
+pub const BUILTIN_SMOOTHING: f64 = 0.05e-3;
 
-/// The contact table used when `contact_table` is empty: S1002 on UIC60 inclined 1:40.
-///
-/// For now this is the RSGEO table of the reference study (a file compiled in); the table
-/// computed from the S1002 and UIC60 profiles replaces it here.
-pub fn builtin_contact_table() -> ContactTable {
-    ContactTable::parse_csv(RSGEO_TABLE).expect("the built-in contact table is valid")
+/// A contact table with its splines, shared between instances.
+type SharedTable = (Arc<ContactTable>, Arc<ContactSpline>);
+
+/// The built-in table and its splines, computed once per process (shared by every instance,
+/// kept across fmi2Reset).
+fn builtin() -> Result<&'static SharedTable, ModelError> {
+    static BUILTIN: OnceLock<Result<SharedTable, String>> = OnceLock::new();
+    BUILTIN
+        .get_or_init(|| {
+            let raw = crate::contact::default_table().map_err(|e| e.to_string())?;
+            let table = crate::contact::smooth::smoothed(&raw, BUILTIN_SMOOTHING);
+            let spline = ContactSpline::new(&table);
+            Ok((Arc::new(table), Arc::new(spline)))
+        })
+        .as_ref()
+        .map_err(|e| ModelError::Other(format!("the built-in contact table: {e}")))
+}
+
+/// The contact table used when `contact_table` is empty: S1002 wheels on UIC60 rails inclined
+/// 1:40, standard gauge, computed from the profiles ([`crate::contact::default_table`]) and
+/// smoothed over [`BUILTIN_SMOOTHING`] in y (the same as `railuq-fmu contact --smooth 0.05`).
+pub fn builtin_contact_table() -> Result<ContactTable, ModelError> {
+    builtin().map(|(t, _)| t.as_ref().clone())
 }
 
 /// Track irregularity parameters.
@@ -230,10 +249,22 @@ impl Vehicle {
         })
     }
 
-    /// The contact table `contact_table` names (the built-in one when empty).
-    fn load_table(&self) -> Result<ContactTable, ModelError> {
+    /// The envelopes over wheelsets and wheels: largest |y| of the wheelsets (m), largest Y/Q,
+    /// largest |ΣY| (N), largest ΔQ/Q.
+    fn envelope(&self) -> (f64, f64, f64, f64) {
+        let o = self.outputs();
+        let max = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NEG_INFINITY, f64::max);
+        let y = max(&mut (0..4).map(|w| self.x_at(base(wheelset(w)) + dof::Y).abs()));
+        let yq = max(&mut o.yq.iter().flatten().copied());
+        let sum_y = max(&mut o.sum_y.iter().map(|s| s.abs()));
+        let dqq = max(&mut o.dqq.iter().flatten().copied());
+        (y, yq, sum_y, dqq)
+    }
+
+    /// The contact table `contact_table` names (the built-in one when empty), with its splines.
+    fn load_table(&self) -> Result<SharedTable, ModelError> {
         if self.contact_table.is_empty() {
-            return Ok(builtin_contact_table());
+            return builtin().cloned();
         }
         let text = read_data_file(
             "contact_table",
@@ -252,7 +283,8 @@ impl Vehicle {
                 shown.display()
             )));
         }
-        Ok(table)
+        let spline = Arc::new(ContactSpline::new(&table));
+        Ok((Arc::new(table), spline))
     }
 
     /// The linear critical speed (m/s) at the current parameters, computed on first use.
@@ -262,8 +294,7 @@ impl Vehicle {
                 let (spline, car) = match &self.run {
                     Some(r) => (r.spline.clone(), r.car.clone()),
                     None => {
-                        let table = self.load_table().map_err(|e| e.to_string())?;
-                        let spline = Arc::new(ContactSpline::new(&table));
+                        let (_, spline) = self.load_table().map_err(|e| e.to_string())?;
                         let car = Car::new(self.p, &spline);
                         (spline, car)
                     }
@@ -433,8 +464,7 @@ impl Model for Vehicle {
         self.run = None;
         self.outputs = OnceCell::new();
         self.v_cr = OnceCell::new();
-        let table = self.load_table()?;
-        let spline = Arc::new(ContactSpline::new(&table));
+        let (table, spline) = self.load_table()?;
         for (w, &y) in self.y0.iter().enumerate() {
             if y.abs() >= spline.limit() {
                 return Err(Self::invalid(
@@ -486,7 +516,7 @@ impl Model for Vehicle {
         self.run = Some(Run {
             bound: RateBound::new(&self.p, &spline),
             car,
-            table: Arc::new(table),
+            table,
             spline,
             course,
             irregularity,

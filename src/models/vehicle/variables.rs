@@ -176,6 +176,10 @@ variables! {
     output("psi_b1", VR_PSI_B1 = 158, Some("rad"), m.x_at(18), "Yaw of bogie frame 1"),
     output("y_b2", VR_Y_B2 = 159, Some("m"), m.x_at(20), "Lateral displacement of bogie frame 2"),
     output("psi_b2", VR_PSI_B2 = 160, Some("rad"), m.x_at(28), "Yaw of bogie frame 2"),
+    output("y_w_max", VR_Y_W_MAX = 161, Some("m"), m.envelope().0, "Largest |lateral displacement| of the four wheelsets, max |y_w1..4|: one signal in which the hunting of either bogie shows"),
+    output("YQ_max", VR_YQ_MAX = 162, None, m.envelope().1, "Largest derailment ratio Y/Q of the eight wheels (as YQ_*)"),
+    output("SumY_max", VR_SUMY_MAX = 163, Some("N"), m.envelope().2, "Largest |track-shifting force| of the four wheelsets, max |SumY_1..4|"),
+    output("dQQ_max", VR_DQQ_MAX = 164, None, m.envelope().3, "Largest wheel unloading of the eight wheels, max dQQ_*"),
 }
 
 /// Static description of the vehicle model.

@@ -1,6 +1,8 @@
-//! Constant-speed critical speed by bisection: the lowest speed at which a given initial
-//! disturbance keeps hunting, and the highest at which it dies out, found from runs at fixed
-//! speeds (the quantity a bogie designer compares with), not read off a speed ramp.
+//! Constant-speed critical speed: the lowest speed at which hunting persists, and the highest
+//! at which it dies out, found from runs at fixed speeds (the quantity a bogie designer
+//! compares with), not read off a speed ramp; by bisection over runs from a disturbance
+//! (`mode = "bisection"`, the default) or by continuation (`mode = "continuation"`: see
+//! [Continuation](#continuation)).
 //!
 //! # Definition
 //!
@@ -33,12 +35,46 @@
 //! A run that ends before the decay is counted as hunting, so a short `duration` biases both
 //! speeds downwards; choose it from a convergence check (see the bogie's in the user guide,
 //! `docs/src/reference/models.md`).
+//!
+//! # Continuation
+//!
+//! Where the limit cycle's basin is small near the fold (the full car: a large displacement of
+//! one wheelset dies out at speeds well above the fold), runs that each start from the
+//! disturbance find a speed well above the fold. [`continue_down`] follows the hunting branch
+//! instead, on one simulation whose speed is lowered between steps (the speed parameter must
+//! be tunable):
+//!
+//! - a first stage of `duration` s at `high` from the disturbance: dies out there:
+//!   [`HuntingSpeed::NeverHunts`];
+//! - then stages of `duration` s at high − `speed_step`, high − 2 `speed_step`, … (not below
+//!   `low`), each continuing from the final state of the one before, until a stage dies out;
+//!   still hunting at `low`: [`HuntingSpeed::AlwaysHunts`];
+//! - then bisection between the last speed that kept hunting and the first that did not, to
+//!   `tolerance`: each trial continues from the final state of the lowest speed that kept
+//!   hunting so far (fmi2GetFMUstate / fmi2SetFMUstate; needed only when `tolerance` is below
+//!   `speed_step`).
+//!
+//! A stage keeps hunting by [`keeps_hunting`] over its last `window` s. The result is
+//! [`HuntingSpeed::Found`] with the lowest speed at which the hunting persisted and the
+//! highest at which it died out; that costs one stage per `speed_step` from `high` down to the
+//! fold plus ⌈log2(`speed_step`/`tolerance`)⌉ (the runs reported count the stages).
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
 use crate::fmu::FixedValue;
+
+/// How a `hunting_speed` quantity searches the speeds (`mode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SearchMode {
+    /// Bisection over runs that each start from the disturbance (the default).
+    #[default]
+    Bisection,
+    /// Continuation down the hunting branch, the state carried from speed to speed.
+    Continuation,
+}
 
 /// Settings of a `hunting_speed` quantity (`[[qoi]] kind = "hunting_speed"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -48,19 +84,29 @@ pub struct HuntingSpeedSpec {
     /// disturbance dies out is reported as `<name>_decay`.
     pub name: String,
     /// The FMU parameter holding the (constant) speed, e.g. "V0" (a Real, settable before
-    /// initialization, not a random parameter).
+    /// initialization, not a random parameter; tunable for `mode = "continuation"`).
     pub speed_parameter: String,
+    /// How the speeds are searched (default bisection). Left out of the serialized settings
+    /// when default, so the study hash of existing studies is unchanged.
+    #[serde(default, skip_serializing_if = "is_bisection")]
+    pub mode: SearchMode,
+    /// Continuation only: how far the speed is lowered from one stage to the next (units of
+    /// the speed parameter, e.g. m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_step: Option<f64>,
     /// Further values set for these runs only, after `[fixed]` and the point's random values
     /// (e.g. `{ ramp = 0.0 }` for a constant speed); not random parameters.
     #[serde(default)]
     pub set: BTreeMap<String, FixedValue>,
-    /// Lower end of the bracket (units of the speed parameter, e.g. m/s).
+    /// Lower end of the bracket (units of the speed parameter, e.g. m/s); continuation: the
+    /// lowest speed a stage runs at.
     pub low: f64,
-    /// Upper end of the bracket.
+    /// Upper end of the bracket; continuation: the speed of the first stage.
     pub high: f64,
     /// Bisection stops when the two speeds are at most this far apart.
     pub tolerance: f64,
-    /// Simulated time of each constant-speed run (s), from the study's start time.
+    /// Simulated time of each constant-speed run (s), from the study's start time;
+    /// continuation: of each stage.
     pub duration: f64,
     /// Communication step of these runs (s; default: the study's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -76,6 +122,10 @@ pub struct HuntingSpeedSpec {
     /// Exceedance limits: P(q > limit) is reported for both speeds.
     #[serde(default)]
     pub limits: Vec<f64>,
+}
+
+fn is_bisection(m: &SearchMode) -> bool {
+    *m == SearchMode::Bisection
 }
 
 fn default_window() -> f64 {
@@ -131,12 +181,49 @@ impl HuntingSpeedSpec {
         if let Some((k, _)) = self.set.iter().find(|(_, v)| !v.is_finite()) {
             return Some(format!("`set` value of '{k}' is not finite"));
         }
+        match (self.mode, self.speed_step) {
+            (SearchMode::Bisection, Some(_)) => {
+                return Some("speed_step is a setting of mode = \"continuation\"".into())
+            }
+            (SearchMode::Continuation, None) => {
+                return Some(
+                    "mode = \"continuation\" needs speed_step, how far the speed is lowered \
+                     from one stage to the next"
+                        .into(),
+                )
+            }
+            (SearchMode::Continuation, Some(d)) if !positive(d) || d > self.high - self.low => {
+                return Some(format!(
+                    "speed_step must be > 0 and at most high - low = {}, got {d}",
+                    self.high - self.low
+                ))
+            }
+            _ => {}
+        }
         None
     }
 
-    /// Constant-speed runs of one point when the transition is inside the bracket.
+    /// Whether the search needs to go back to a saved state (fmi2GetFMUstate and
+    /// fmi2SetFMUstate): continuation refined below its `speed_step`.
+    pub(crate) fn needs_fmu_state(&self) -> bool {
+        self.mode == SearchMode::Continuation && self.speed_step.is_some_and(|d| self.tolerance < d)
+    }
+
+    /// Constant-speed runs (continuation: stages) of one point when the transition is inside
+    /// the bracket (continuation: at most, with the fold at `low`).
     pub fn runs_when_found(&self) -> usize {
-        2 + bisection_steps(self.high - self.low, self.tolerance)
+        match (self.mode, self.speed_step) {
+            (SearchMode::Continuation, Some(d)) => {
+                let stages = ((self.high - self.low) / d).ceil() as usize;
+                1 + stages
+                    + if self.tolerance < d {
+                        bisection_steps(d, self.tolerance)
+                    } else {
+                        0
+                    }
+            }
+            _ => 2 + bisection_steps(self.high - self.low, self.tolerance),
+        }
     }
 }
 
@@ -213,6 +300,84 @@ pub fn bisect<E>(
     Ok(HuntingSpeed::Found {
         hunts: hi,
         decays: lo,
+        runs,
+    })
+}
+
+/// One simulation whose speed can be changed between stages, for [`continue_down`].
+pub(crate) trait Stages {
+    /// A saved state.
+    type Saved;
+    /// Why a stage failed.
+    type Error;
+    /// The first stage, from the disturbance at `speed`: whether it keeps hunting.
+    fn first(&mut self, speed: f64) -> Result<bool, Self::Error>;
+    /// One more stage at `speed` from the current state: whether it keeps hunting.
+    fn next(&mut self, speed: f64) -> Result<bool, Self::Error>;
+    /// The current state, saved.
+    fn save(&mut self) -> Result<Self::Saved, Self::Error>;
+    /// Back to a saved state (which stays saved).
+    fn restore(&mut self, saved: &Self::Saved) -> Result<(), Self::Error>;
+    /// A saved state no longer needed.
+    fn release(&mut self, saved: Self::Saved) -> Result<(), Self::Error>;
+}
+
+/// Continuation down the hunting branch from `high` in steps of `speed_step`, not below `low`,
+/// then bisection to `tolerance` (see [Continuation](self#continuation)).
+pub(crate) fn continue_down<S: Stages>(
+    low: f64,
+    high: f64,
+    speed_step: f64,
+    tolerance: f64,
+    sim: &mut S,
+) -> Result<HuntingSpeed, S::Error> {
+    if !sim.first(high)? {
+        return Ok(HuntingSpeed::NeverHunts);
+    }
+    let refine = tolerance < speed_step;
+    let mut saved = if refine { Some(sim.save()?) } else { None };
+    let (mut hunts, mut runs) = (high, 1);
+    let mut decays = loop {
+        let v = (hunts - speed_step).max(low);
+        if v >= hunts {
+            if let Some(s) = saved.take() {
+                sim.release(s)?;
+            }
+            return Ok(HuntingSpeed::AlwaysHunts);
+        }
+        runs += 1;
+        if !sim.next(v)? {
+            break v;
+        }
+        hunts = v;
+        if refine {
+            let old = saved.replace(sim.save()?);
+            if let Some(s) = old {
+                sim.release(s)?;
+            }
+        }
+    };
+    if let Some(mut from) = saved {
+        while hunts - decays > tolerance {
+            let mid = 0.5 * (decays + hunts);
+            if mid <= decays || mid >= hunts {
+                break; // floating-point resolution reached
+            }
+            sim.restore(&from)?;
+            runs += 1;
+            if sim.next(mid)? {
+                hunts = mid;
+                let old = std::mem::replace(&mut from, sim.save()?);
+                sim.release(old)?;
+            } else {
+                decays = mid;
+            }
+        }
+        sim.release(from)?;
+    }
+    Ok(HuntingSpeed::Found {
+        hunts,
+        decays,
         runs,
     })
 }
@@ -345,5 +510,175 @@ mod tests {
              tolerance = 0.02\nduration = 200.0\nsignal = \"Y\"\ntolerence = 1.0",
         );
         assert!(r.unwrap_err().to_string().contains("unknown field"));
+    }
+
+    /// A model with a fold at `fold` whose disturbance reaches the limit cycle only above
+    /// `basin`: the first stage hunts from `basin` up, a later one keeps hunting when the
+    /// state before it hunted and its speed is at least `fold`.
+    struct Hysteresis {
+        fold: f64,
+        basin: f64,
+        hunting: bool,
+        speeds: Vec<f64>,
+        live: i32,
+        restores: usize,
+    }
+
+    impl Hysteresis {
+        fn new(fold: f64, basin: f64) -> Self {
+            Hysteresis {
+                fold,
+                basin,
+                hunting: false,
+                speeds: Vec::new(),
+                live: 0,
+                restores: 0,
+            }
+        }
+    }
+
+    impl Stages for Hysteresis {
+        type Saved = bool;
+        type Error = f64;
+        fn first(&mut self, speed: f64) -> Result<bool, f64> {
+            self.speeds.push(speed);
+            self.hunting = speed >= self.basin;
+            Ok(self.hunting)
+        }
+        fn next(&mut self, speed: f64) -> Result<bool, f64> {
+            if speed < 0.0 {
+                return Err(speed);
+            }
+            self.speeds.push(speed);
+            self.hunting = self.hunting && speed >= self.fold;
+            Ok(self.hunting)
+        }
+        fn save(&mut self) -> Result<bool, f64> {
+            self.live += 1;
+            Ok(self.hunting)
+        }
+        fn restore(&mut self, saved: &bool) -> Result<(), f64> {
+            self.restores += 1;
+            self.hunting = *saved;
+            Ok(())
+        }
+        fn release(&mut self, _: bool) -> Result<(), f64> {
+            self.live -= 1;
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn continuation_finds_the_fold_below_the_basin_that_bisection_finds() {
+        for fold in [52.13, 55.0, 60.01, 79.99] {
+            let mut m = Hysteresis::new(fold, 85.0);
+            let r = continue_down(40.0, 120.0, 2.0, 0.05, &mut m).unwrap();
+            let HuntingSpeed::Found {
+                hunts,
+                decays,
+                runs,
+            } = r
+            else {
+                panic!("{r:?}")
+            };
+            assert!(decays < fold && fold <= hunts, "{decays} {fold} {hunts}");
+            assert!(hunts - decays <= 0.05, "{decays} {hunts}");
+            assert_eq!(runs, m.speeds.len());
+            assert_eq!(m.live, 0, "every saved state is released");
+            // Down in steps of 2 m/s from 120, then 6 bisections of the last 2 m/s.
+            let stages = ((120.0 - fold) / 2.0).floor() as usize + 1;
+            assert_eq!(runs, 1 + stages + 6, "{:?}", m.speeds);
+            assert_eq!(m.restores, 6);
+            assert_eq!(&m.speeds[..3], &[120.0, 118.0, 116.0]);
+            // Bisection from the disturbance finds the basin instead.
+            let mut b = Hysteresis::new(fold, 85.0);
+            let HuntingSpeed::Found { hunts, .. } =
+                bisect(40.0, 120.0, 0.05, |v| b.first(v)).unwrap()
+            else {
+                panic!()
+            };
+            assert!((hunts - 85.0).abs() <= 0.05, "{hunts}");
+        }
+    }
+
+    #[test]
+    fn continuation_without_refinement_saves_no_state() {
+        let mut m = Hysteresis::new(61.0, 85.0);
+        let r = continue_down(40.0, 120.0, 2.0, 2.0, &mut m).unwrap();
+        assert_eq!(
+            r,
+            HuntingSpeed::Found {
+                hunts: 62.0,
+                decays: 60.0,
+                runs: 31
+            }
+        );
+        assert_eq!((m.live, m.restores), (0, 0));
+    }
+
+    #[test]
+    fn continuation_outside_the_bracket_and_failures() {
+        // Never hunts at `high`.
+        let mut m = Hysteresis::new(50.0, 130.0);
+        assert_eq!(
+            continue_down(40.0, 120.0, 2.0, 0.1, &mut m).unwrap(),
+            HuntingSpeed::NeverHunts
+        );
+        assert_eq!(m.speeds, [120.0]);
+        // Still hunting at `low`: the last stage runs at `low` exactly.
+        let mut m = Hysteresis::new(30.0, 85.0);
+        assert_eq!(
+            continue_down(41.0, 120.0, 2.0, 0.1, &mut m).unwrap(),
+            HuntingSpeed::AlwaysHunts
+        );
+        assert_eq!(*m.speeds.last().unwrap(), 41.0);
+        assert_eq!(m.live, 0);
+        // A failed stage stops the search with its error.
+        let mut m = Hysteresis::new(-10.0, 0.0);
+        assert_eq!(continue_down(-5.0, 3.0, 2.0, 0.1, &mut m), Err(-1.0));
+    }
+
+    #[test]
+    fn continuation_settings_are_checked() {
+        let mut s = spec();
+        s.mode = SearchMode::Continuation;
+        assert!(s.problem().unwrap().contains("needs speed_step"));
+        s.speed_step = Some(2.0);
+        assert_eq!(s.problem(), None);
+        assert!(s.needs_fmu_state());
+        // 60 / 2 = 30 stages below 100 m/s, the first at 100, 7 halvings of 2 m/s to 0.02.
+        assert_eq!(s.runs_when_found(), 1 + 30 + 7);
+        s.tolerance = 2.0;
+        assert!(!s.needs_fmu_state());
+        s.speed_step = Some(0.0);
+        assert!(s.problem().unwrap().contains("speed_step must be > 0"));
+        s.speed_step = Some(61.0);
+        assert!(s.problem().unwrap().contains("at most high - low"));
+        let mut b = spec();
+        b.speed_step = Some(2.0);
+        assert!(b
+            .problem()
+            .unwrap()
+            .contains("setting of mode = \"continuation\""));
+        let parsed: HuntingSpeedSpec = toml::from_str(
+            "name = \"v\"\nspeed_parameter = \"v\"\nmode = \"continuation\"\nspeed_step = 2.0\n\
+             low = 40.0\nhigh = 120.0\ntolerance = 0.05\nduration = 40.0\nsignal = \"y\"",
+        )
+        .unwrap();
+        assert_eq!(
+            (parsed.mode, parsed.speed_step),
+            (SearchMode::Continuation, Some(2.0))
+        );
+        assert!(toml::from_str::<HuntingSpeedSpec>(
+            "name = \"v\"\nspeed_parameter = \"v\"\nmode = \"continued\"\nlow = 1.0\n\
+             high = 2.0\ntolerance = 0.1\nduration = 4.0\nsignal = \"y\""
+        )
+        .is_err());
+        // The default mode is left out of the serialized settings (study hashes unchanged).
+        let text = serde_json::to_string(&spec()).unwrap();
+        assert!(
+            !text.contains("mode") && !text.contains("speed_step"),
+            "{text}"
+        );
     }
 }

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::qoi::critical_speed::CriticalSpeedError;
-use crate::qoi::hunting_speed::HuntingSpeedSpec;
+use crate::qoi::hunting_speed::{HuntingSpeedSpec, SearchMode};
 use crate::qoi::sperling::{Direction, SperlingError, Statistic, Window};
 
 /// A scalar quantity of interest computed from each run's time series (`[[qoi]]`, tagged by
@@ -414,15 +414,30 @@ impl QoiSpec {
             QoiSpec::Final { signal, .. } => format!("{} at the stop time", words.signal(signal)),
             QoiSpec::HuntingSpeed(h) => {
                 let speed = |x: f64| words.value(x, &h.speed_parameter);
+                let search = match h.speed_step {
+                    Some(d) if h.mode == SearchMode::Continuation => format!(
+                        "continuation on {} from {} down in steps of {} (not below {}), each \
+                         stage of {} s from the state the one before left, refined to {}",
+                        h.speed_parameter,
+                        speed(h.high),
+                        speed(d),
+                        h.low,
+                        h.duration,
+                        speed(h.tolerance)
+                    ),
+                    _ => format!(
+                        "bisection on {} over {}–{} (to {}) by runs of {} s",
+                        h.speed_parameter,
+                        h.low,
+                        speed(h.high),
+                        speed(h.tolerance),
+                        h.duration
+                    ),
+                };
                 format!(
-                    "constant-speed critical speed: bisection on {} over {}–{} (to {}) by runs \
-                     of {} s; a run keeps hunting when max |{}| over its last {} s is at least \
-                     {} ({} = lowest speed seen hunting, {}_decay = highest seen dying out)",
-                    h.speed_parameter,
-                    h.low,
-                    speed(h.high),
-                    speed(h.tolerance),
-                    h.duration,
+                    "constant-speed critical speed: {search}; a run keeps hunting when max |{}| \
+                     over its last {} s is at least {} ({} = lowest speed seen hunting, \
+                     {}_decay = highest seen dying out)",
                     words.signal(&h.signal),
                     h.window,
                     words.value(h.threshold, &h.signal),

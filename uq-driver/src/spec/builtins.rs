@@ -93,6 +93,18 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "paper-vehicle-track-tracks",
         include_str!("../../studies/paper-vehicle-track-tracks.toml"),
     ),
+    (
+        "vehicle-nominal",
+        include_str!("../../studies/vehicle-nominal.toml"),
+    ),
+    (
+        "vehicle-critical-speed",
+        include_str!("../../studies/vehicle-critical-speed.toml"),
+    ),
+    (
+        "vehicle-curve-safety",
+        include_str!("../../studies/vehicle-curve-safety.toml"),
+    ),
 ];
 
 /// The text of a built-in study.

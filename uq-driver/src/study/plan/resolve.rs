@@ -1,12 +1,12 @@
 //! A study resolved against its FMU: the [`Interface`] of its runs, including the runs of its
 //! own of each `hunting_speed` quantity ([`crate::qoi::hunting_speed`]): at each design point,
 //! runs at constant speeds with the point's random values, the study's `[fixed]` values, the
-//! quantity's `set` values and the speed parameter, bisected on the same FMU instance as the
-//! point's run (`run::point`). They are part of the point's evaluation, so their results are
+//! quantity's `set` values and the speed parameter, bisected (or continued stage by stage) on
+//! the same FMU instance as the point's run (`run::point`). They are part of the point's evaluation, so their results are
 //! stored in the point's record (resumable, shardable, and the same in a `--isolate` worker).
 
-use crate::fmu::{Fmu, VariableKind};
-use crate::qoi::hunting_speed::HuntingSpeedSpec;
+use crate::fmu::{Fmu, Variability, VariableKind};
+use crate::qoi::hunting_speed::{HuntingSpeedSpec, SearchMode};
 use crate::qoi::QoiSpec;
 use crate::spec::{Experiment, Study};
 use crate::study::plan::interface::{
@@ -74,6 +74,32 @@ impl SpeedRuns {
             )));
         }
         vars.check_settable(var)?;
+        if h.mode == SearchMode::Continuation {
+            if var.variability != Variability::Tunable {
+                return Err(problem(format!(
+                    "mode = \"continuation\" changes the speed between steps, but the speed \
+                     parameter '{}' is {}, not tunable",
+                    h.speed_parameter,
+                    var.variability.as_str()
+                )));
+            }
+            if h.needs_fmu_state()
+                && !vars
+                    .fmu
+                    .description()
+                    .co_simulation
+                    .can_get_and_set_fmu_state
+            {
+                return Err(problem(format!(
+                    "mode = \"continuation\" with a tolerance ({}) below speed_step ({}) goes \
+                     back to the last hunting state (fmi2GetFMUstate, fmi2SetFMUstate), but the \
+                     FMU declares canGetAndSetFMUstate=\"false\"; set tolerance = speed_step to \
+                     run without refinement",
+                    h.tolerance,
+                    h.speed_step.unwrap_or(f64::NAN)
+                )));
+            }
+        }
         let speed = var.value_reference;
         let set = vars.settings(h.set.iter().map(|(n, v)| (n.as_str(), v)))?;
         let mut run = base.clone();

@@ -91,6 +91,11 @@ impl Slot {
         Ok(self.inst.insert(inst))
     }
 
+    /// The instance of the run in progress, if any.
+    pub(crate) fn current(&mut self) -> Option<&mut Instance> {
+        self.inst.as_mut()
+    }
+
     /// Frees the instance (a failed run's may be in an error state).
     pub fn discard(&mut self) {
         self.inst = None;

@@ -2,7 +2,8 @@
 //! errors ([`error`]), the output folder (its lock, its store and the in-process time limit)
 //! and the failure policy are here; a batch of points runs in [`batch`] (one FMU instance per
 //! worker, reused through `fmi2Reset` once the reset self-check has passed: [`instances`]),
-//! one point in [`point`], or each in a worker process ([`isolate`]); [`guard`] keeps what
+//! one point in [`point`] (the runs of its own of a `hunting_speed` quantity in `speed_runs`),
+//! or each in a worker process ([`isolate`]); [`guard`] keeps what
 //! the process must know of a study in progress.
 
 pub mod batch;
@@ -12,6 +13,7 @@ pub mod instances;
 pub mod isolate;
 pub mod options;
 pub mod point;
+mod speed_runs;
 pub mod worker_fmu;
 
 use std::path::Path;

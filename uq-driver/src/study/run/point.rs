@@ -7,12 +7,11 @@ use std::path::Path;
 use super::error::{PointError, RunError};
 use super::instances::{first_difference, same_record, InstancePolicy, ResetCheck, Slot};
 use crate::fmu::{Fmu, FmuError, Instance, Status, StatusKind};
-use crate::qoi::evaluate::{evaluate, Code};
-use crate::qoi::hunting_speed::{bisect, keeps_hunting, HuntingSpeed, HuntingSpeedSpec};
+use crate::qoi::evaluate::evaluate;
 use crate::qoi::QoiSpec;
 use crate::spec::FixedValue;
 use crate::study::plan::inputs::isclose;
-use crate::study::plan::interface::{Interface, RandomValueError, SpeedRuns};
+use crate::study::plan::interface::{Interface, RandomValueError};
 
 /// What one run recorded.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,6 +58,20 @@ pub(super) fn simulate_point(
     times: &[f64],
     extra: &[(u32, f64)],
 ) -> Result<Trace, PointError> {
+    simulate_point_to(fmu, slot, iface, values, times, extra, true)
+}
+
+/// [`simulate_point`], telling the FMU the stop time (the last of `times`) or not
+/// (`stop_defined` false: the run may go on after `times`, as a continuation does).
+pub(super) fn simulate_point_to(
+    fmu: &Fmu,
+    slot: &mut Slot,
+    iface: &Interface,
+    values: &[f64],
+    times: &[f64],
+    extra: &[(u32, f64)],
+    stop_defined: bool,
+) -> Result<Trace, PointError> {
     check_times(times)?;
     let nt = times.len();
     let inst = slot.start(fmu)?;
@@ -72,7 +85,7 @@ pub(super) fn simulate_point(
         inst.set_real(&vr, &v)?;
     }
     let stop = times[nt - 1]; // checked: at least one time
-    inst.setup_experiment(None, times[0], Some(stop))?;
+    inst.setup_experiment(None, times[0], stop_defined.then_some(stop))?;
     inst.enter_initialization_mode()?;
     if let Some(inputs) = &iface.inputs {
         inputs.apply(inst, times[0], false)?;
@@ -127,7 +140,7 @@ fn store_column(values: &mut [f64], column: &[f64], nt: usize, k: usize) {
 /// When `error` from `fmi2DoStep` from `current` means the FMU ended the simulation
 /// (fmi2Discard and fmi2Terminated true): the time it ended at (its last successful time, or
 /// `current` if it cannot say).
-fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f64> {
+pub(super) fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) -> Option<f64> {
     let FmuError::Call {
         status: Status::Discard,
         ..
@@ -317,80 +330,6 @@ pub fn simulate_with(
         skipped: iface.skipped,
         ended_at,
     })
-}
-
-impl SpeedRuns {
-    /// The bisection at one design point (`values` of the random parameters) on `slot`'s
-    /// instance (reset, or a fresh one, between runs, by its policy): the record's (value, code) pairs of both quantities, `name` then
-    /// `name_decay`.
-    pub fn evaluate(
-        &self,
-        h: &HuntingSpeedSpec,
-        fmu: &Fmu,
-        slot: &mut Slot,
-        values: &[f64],
-    ) -> Result<[f64; 4], PointError> {
-        let outcome = bisect(h.low, h.high, h.tolerance, |v| {
-            self.hunts(h, fmu, slot, values, v)
-                .map_err(|source| PointError::SpeedRun {
-                    name: h.name.clone(),
-                    parameter: h.speed_parameter.clone(),
-                    speed: v,
-                    source: Box::new(source),
-                })
-        })?;
-        Ok(match outcome {
-            HuntingSpeed::Found { hunts, decays, .. } => {
-                let ok = Code::Ok as u8 as f64;
-                [hunts, ok, decays, ok]
-            }
-            HuntingSpeed::NeverHunts => {
-                let c = Code::NeverHunts as u8 as f64;
-                [f64::NAN, c, f64::NAN, c]
-            }
-            HuntingSpeed::AlwaysHunts => {
-                let c = Code::NeverStops as u8 as f64;
-                [f64::NAN, c, f64::NAN, c]
-            }
-        })
-    }
-
-    /// One run at `speed`: whether the disturbance keeps hunting.
-    fn hunts(
-        &self,
-        h: &HuntingSpeedSpec,
-        fmu: &Fmu,
-        slot: &mut Slot,
-        values: &[f64],
-        speed: f64,
-    ) -> Result<bool, PointError> {
-        let nt = self.times.len();
-        let trace = simulate_point(
-            fmu,
-            slot,
-            &self.run,
-            values,
-            &self.times,
-            &[(self.speed, speed)],
-        )
-        .inspect_err(|_| slot.discard())?;
-        if let Some((time, _)) = trace.ended {
-            slot.discard();
-            return Err(PointError::EndedEarly {
-                time,
-                stop: self.times[nt - 1],
-            });
-        }
-        let series = &trace.values[..nt];
-        if let Some(k) = series.iter().position(|v| !v.is_finite()) {
-            slot.discard();
-            return Err(PointError::NonFinite {
-                signal: h.signal.clone(),
-                time: self.times[k],
-            });
-        }
-        Ok(keeps_hunting(&self.times, series, h.window, h.threshold))
-    }
 }
 
 /// "K = 1.2, C = 3" for messages.
