@@ -97,8 +97,8 @@ win64-toolchain:
 
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme README.md
+	env $(ZIG_ENV) $(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
+	env $(ZIG_ENV) $(CARGO) run -q -p railuq --bin railuq-fmu -- readme README.md
 
 $(VPY): tests/python/requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -120,14 +120,14 @@ run: build fmu
 
 lint:
 	$(CARGO) fmt --all -- --check
-	$(CARGO) clippy --workspace --all-targets -- -D warnings
-	RUSTDOCFLAGS="-D warnings" $(CARGO) doc -p uq-driver --no-deps
+	env $(ZIG_ENV) $(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" env $(ZIG_ENV) $(CARGO) doc -p uq-driver --no-deps
 	$(PYTHON) uq-driver/api_items.py target/doc/uq_driver/all.html 250
 
 fmt:
 	$(CARGO) fmt --all
 
-test: lint venv win64-toolchain build fmu
+test: venv lint win64-toolchain build fmu
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
@@ -136,9 +136,9 @@ test: lint venv win64-toolchain build fmu
 # The Vehicle's dynamics tests (tens of simulated seconds each) run in release mode, as do the
 # driver's tests: they run real studies.
 test-rust:
-	$(CARGO) build -p railuq --lib --features test-panic
-	$(CARGO) test -p railuq --features test-panic
-	$(CARGO) test --release -p railuq --lib models::vehicle::
+	env $(ZIG_ENV) $(CARGO) build -p railuq --lib --features test-panic
+	env $(ZIG_ENV) $(CARGO) test -p railuq --features test-panic
+	env $(ZIG_ENV) $(CARGO) test --release -p railuq --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
 	  env $(ZIG_ENV) $(CARGO) test --release -p uq-driver -p out-file
 
@@ -162,7 +162,7 @@ $(VENV)/.bench-requirements: bench/requirements.txt $(VPY)
 	touch $@
 
 bench: build fmu venv $(VENV)/.bench-requirements
-	CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
+	env $(ZIG_ENV) CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
 # Every study of the paper (long: about an hour and a half on 2 cores, most of it the bogie's
 # 20 000-sample and the 8-input vehicle-track's 5 000-sample Latin hypercubes and the 15 552 runs
