@@ -145,14 +145,14 @@ test-rust:
 test-python: venv wheel
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
 
-# The Python package: a release wheel built by maturin (the venv's, no download) through the
+# The Python package: a release wheel built by maturin (the venv's, on PATH; no download) by the
 # package's PEP 517 backend, carrying the FMUs of target/fmu, then installed into the venv
 # (the tests import it from there). `python3 -m pip install ./python` does the same in one step
 # for a user (building the FMUs itself).
 WHEEL_DIR := target/wheels
 wheel: venv fmu
 	rm -rf $(WHEEL_DIR)
-	env $(ZIG_ENV) RAILUQ_WHEEL_FMUS="$(CURDIR)/$(FMU_DIR)" \
+	env $(ZIG_ENV) RAILUQ_WHEEL_FMUS="$(CURDIR)/$(FMU_DIR)" PATH="$(CURDIR)/$(VENV)/bin:$$PATH" \
 	  $(VPY) -m pip wheel -q --no-build-isolation --no-deps -w $(WHEEL_DIR) ./python
 	$(VPY) -m pip install -q --force-reinstall --no-deps $(WHEEL_DIR)/railuq-*.whl
 

@@ -43,7 +43,7 @@ SAMPLED = {
     ],
     "outputs": {"variables": ["q"]},
     "qoi": [{"kind": "max_abs", "name": "q_peak", "signal": "q", "from": 0.5,
-             "limits": [0.02]}],
+             "limits": [0.04]}],
     "method": {"kind": "lhs", "samples": 300},
 }
 
@@ -60,6 +60,18 @@ def driver(*args, check=True):
     if check and p.returncode != 0:
         pytest.fail(f"uq-driver {' '.join(map(str, args))} failed:\n{p.stderr}")
     return p
+
+
+def cli_error(stderr):
+    """The error the command line printed, as the package words it: the text after
+    `uq-driver: error: ` (with its continuation lines), and each `uq-driver: hint: ...` line
+    as `hint: ...`."""
+    lines = stderr.splitlines()
+    first = next(k for k, line in enumerate(lines) if line.startswith("uq-driver: error: "))
+    out = [lines[first][len("uq-driver: error: "):]]
+    for line in lines[first + 1:]:
+        out.append(line[len("uq-driver: "):] if line.startswith("uq-driver: hint: ") else line)
+    return "\n".join(out)
 
 
 def read_csv(path_or_text):
@@ -91,10 +103,9 @@ def assert_same_statistics(results, out):
         assert np.array_equal(results.mean(var), column(csvf, "mean"))
         assert np.array_equal(results.std(var), column(csvf, "std"))
         for level, values in results.quantiles(var).items():
-            assert np.array_equal(values, column(csvf, f"q{level:g}")), level
+            assert np.array_equal(values, column(csvf, f"q{100 * level:g}")), level
     summary = json.loads((out / "summary.json").read_text())
-    assert {q["name"]: q for q in summary["quantities"]} == \
-        {name: results.quantity(name) for name in results.quantities}
+    assert summary["quantities"] == {name: results.quantity(name) for name in results.quantities}
     for key in ("quantities", "outputs", "parameters", "method", "model_runs", "failed_runs"):
         assert results.summary[key] == summary[key], key
 
@@ -143,8 +154,8 @@ def test_simulate_errors_carry_the_command_lines_message(tmp_path):
     p = driver("simulate", fmu, "--set", "Kx=1", "--stop", "0.1", "--step", "0.01",
                "--out", tmp_path / "x.csv", check=False)
     assert p.returncode != 0
-    assert "Kx" in str(e.value)
-    assert f"uq-driver: error: {e.value}" in p.stderr
+    assert "Kx" in str(e.value) and "hint: 'Kx': did you mean 'K'?" in str(e.value)
+    assert str(e.value) == cli_error(p.stderr)
 
 
 # ---------------------------------------------------------------- studies
@@ -173,9 +184,9 @@ def test_a_sampled_study_from_a_dict_equals_the_command_line_bit_for_bit(tmp_pat
     assert_same_statistics(r, out)
     assert isinstance(r.mean("q_peak"), float)
     (row,) = r.exceedance["q_peak"]
-    cli_q = json.loads((out / "summary.json").read_text())["quantities"][0]
-    assert row["limit"] == 0.02 and 0.0 <= row["p"] <= 1.0
-    assert row["p"] == cli_q["exceedance"][0]["p"]
+    cli_q = json.loads((out / "summary.json").read_text())["quantities"]["q_peak"]
+    assert row["limit"] == 0.04 and 0.0 < row["p"] < 1.0
+    assert [row["limit"], row["p"], row["std_error"]] == cli_q["exceedance"][0]
     # The same study from TOML text and from a file gives the same numbers.
     again = railuq.Study.from_toml(study.toml).run(progress=False)
     assert np.array_equal(again.mean("q"), r.mean("q"))
@@ -207,7 +218,7 @@ def test_study_file_errors_are_the_command_lines_messages(tmp_path):
         railuq.Study.from_file(f)
     p = driver("run", f, "--out", tmp_path / "out", check=False)
     assert p.returncode != 0
-    assert f"uq-driver: error: {e.value}" in p.stderr
+    assert str(e.value) == cli_error(p.stderr)
 
 
 # ---------------------------------------------------------------- surrogate
@@ -287,9 +298,12 @@ def test_python_m_railuq_is_the_command_line():
     p = subprocess.run([sys.executable, "-m", "railuq", "list"], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     assert p.stdout == driver("list").stdout
-    p = subprocess.run([sys.executable, "-m", "railuq", "run", "nope"], capture_output=True,
-                       text=True)
-    assert p.returncode != 0 and "uq-driver: error:" in p.stderr and "nope" in p.stderr
+    p = subprocess.run([sys.executable, "-m", "railuq", "run", "wheel-scn", "--out", "unused"],
+                       capture_output=True, text=True)
+    assert p.returncode != 0
+    assert cli_error(p.stderr) == cli_error(driver("run", "wheel-scn", "--out", "unused",
+                                                   check=False).stderr)
+    assert "did you mean" in p.stderr
 
 
 # ---------------------------------------------------------------- the binaries
