@@ -258,7 +258,7 @@ def test_surrogate_equals_uq_driver_surrogate_eval_and_sample(tmp_path):
 
 def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeypatch):
     study = railuq.Study.from_dict(dict(SAMPLED, name="wheel-lhs-stop",
-                                        method={"kind": "lhs", "samples": 20000}))
+                                        method={"kind": "lhs", "samples": 5000}))
     from railuq import _progress
 
     seen = []
@@ -276,7 +276,7 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
     with pytest.raises(KeyboardInterrupt):
         study.run(out=out, threads=1, report=False)
     first_total = seen[-1][1]
-    assert first_total == 20000
+    assert first_total == 5000
     seen.clear()
     monkeypatch.setattr(_progress.Display, "update", update)
 
@@ -287,8 +287,8 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
     monkeypatch.setattr(_progress.Display, "update", recording)
     r = study.run(out=out, report=False)
     resumed_total = max(t for _, t in seen)
-    assert 0 < resumed_total < 20000, "the second run did not resume the first one's points"
-    assert r.summary["runs_resumed"] == 20000 - resumed_total
+    assert 0 < resumed_total < 5000, "the second run did not resume the first one's points"
+    assert r.summary["runs_resumed"] == 5000 - resumed_total
     assert_same_statistics(r, cli_study(tmp_path, study))
 
 
