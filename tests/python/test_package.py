@@ -292,6 +292,31 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
     assert_same_statistics(r, cli_study(tmp_path, study))
 
 
+def test_a_running_study_releases_the_gil(tmp_path):
+    """Another Python thread keeps running while the study's points run."""
+    import threading
+
+    study = railuq.Study.from_dict(dict(SAMPLED, name="wheel-lhs-gil",
+                                        method={"kind": "lhs", "samples": 3000}))
+    count, stop = [0], threading.Event()
+
+    def spin():
+        while not stop.is_set():
+            count[0] += 1
+
+    t = threading.Thread(target=spin)
+    t.start()
+    try:
+        before = count[0]
+        r = study.run(out=tmp_path / "py", threads=1, progress=False, report=False)
+        during = count[0] - before
+    finally:
+        stop.set()
+        t.join()
+    assert r.summary["model_runs"] == 3000
+    assert during > 10_000, f"the other thread ran {during} loops while the study ran"
+
+
 # ---------------------------------------------------------------- the command line
 
 def test_python_m_railuq_is_the_command_line():
