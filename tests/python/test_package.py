@@ -18,6 +18,8 @@ import pytest
 
 from binaries import max_glibc
 from conftest import DRIVER, FMU_DIR, ROOT
+# The C test FMUs, built by test_test_fmus.py's fixtures, and its reference for them.
+from test_test_fmus import built, features_fmu, functions_fmu, hashed_normal  # noqa: F401
 
 try:
     import railuq
@@ -156,6 +158,29 @@ def test_simulate_errors_carry_the_command_lines_message(tmp_path):
     assert p.returncode != 0
     assert "Kx" in str(e.value) and "hint: 'Kx': did you mean 'K'?" in str(e.value)
     assert str(e.value) == cli_error(p.stderr)
+
+
+def test_simulate_a_c_test_fmu_gives_its_closed_form(functions_fmu):
+    """A Reference-FMU-like FMU written in C (uq-driver/tests/fmus): y = x1 + function + sigma_h
+    * N(seed), y_t = y (1 + t), the reference computed in test_test_fmus.py."""
+    df = railuq.simulate(functions_fmu, set={"function": 4, "seed": 9, "x1": 0.5, "x2": -2.0,
+                                             "sigma_h": 2.0}, stop=2.0, step=0.25)
+    y = 0.5 + 4.0 + 2.0 * hashed_normal(9)
+    np.testing.assert_allclose(df["y"], y, rtol=1e-14)
+    np.testing.assert_allclose(df["y_t"], y * (1 + df["time"]), rtol=1e-14)
+    assert len(df) == 9
+
+
+def test_simulate_sets_parameters_of_every_type(features_fmu):
+    text = "grüße, 世界"
+    df = railuq.simulate(features_fmu, set={"int_param": -17, "bool_param": True,
+                                            "enum_param": 3, "string_param": text}, step=0.5,
+                         outputs=["int_out", "bool_out", "enum_out", "string_len"])
+    assert list(df.columns) == ["time", "int_out", "bool_out", "enum_out", "string_len"]
+    assert (df.dtypes == np.float64).all()
+    assert list(df["int_out"]) == [-17.0] * 3 and list(df["bool_out"]) == [1.0] * 3
+    assert list(df["enum_out"]) == [3.0] * 3
+    assert list(df["string_len"]) == [float(len(text.encode()))] * 3
 
 
 # ---------------------------------------------------------------- studies
