@@ -6,14 +6,19 @@ it to ``target/fmu``, so the wheel carries the very FMUs ``make test`` checks, w
 included); otherwise they are built here: ``cargo build --release -p railuq`` and
 ``railuq-fmu package`` (linux64 only). Both steps reuse the workspace's ``target/``.
 
+On x86-64 Linux every link goes through ``.cargo/zig-cc`` (zig, from the ``ziglang`` package
+the build requires, linking against glibc 2.17) unless a linker is set already
+(``CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER``, as ``make`` sets it) or ``RAILUQ_ZIG=no``:
+the wheel then loads on any Linux from glibc 2.17 on, whatever the build machine's glibc.
+
 Everything else is maturin's: ``[tool.maturin]`` in pyproject.toml, and maturin's own
-environment variables (``MATURIN_PEP517_ARGS``, ...). Cargo's linker settings pass through:
-``make`` links with zig for an old glibc floor when it is installed (see the Makefile).
+environment variables (``MATURIN_PEP517_ARGS``, ...).
 """
 from __future__ import annotations
 
 import json
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -60,6 +65,25 @@ def _built_fmus(work: Path) -> Path:
     return work
 
 
+LINKER = "CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER"
+
+
+def _zig_linker() -> None:
+    """Links with zig against an old glibc (see the module's documentation)."""
+    if LINKER in os.environ or os.environ.get("RAILUQ_ZIG", "auto") == "no":
+        return
+    if sys.platform != "linux" or platform.machine() not in ("x86_64", "AMD64"):
+        return
+    try:
+        import ziglang  # noqa: F401
+    except ImportError:
+        _say("no zig (the ziglang package): linking against the build machine's glibc")
+        return
+    os.environ[LINKER] = str(ROOT / ".cargo" / "zig-cc")
+    os.environ.setdefault("RAILUQ_ZIG_PYTHON", sys.executable)
+    _say(f"linking with zig against glibc {os.environ.get('RAILUQ_GLIBC', '2.17')}")
+
+
 def _put_fmus() -> None:
     given = os.environ.get("RAILUQ_WHEEL_FMUS")
     if given:
@@ -79,10 +103,12 @@ def _put_fmus() -> None:
 
 
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
+    _zig_linker()
     _put_fmus()
     return maturin.build_wheel(wheel_directory, config_settings, metadata_directory)
 
 
 def build_editable(wheel_directory, config_settings=None, metadata_directory=None):
+    _zig_linker()
     _put_fmus()
     return maturin.build_editable(wheel_directory, config_settings, metadata_directory)
