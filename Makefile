@@ -152,7 +152,7 @@ test-python: venv wheel
 WHEEL_DIR := target/wheels
 wheel: venv fmu
 	rm -rf $(WHEEL_DIR)
-	env $(ZIG_ENV) RAILUQ_WHEEL_FMUS="$(CURDIR)/$(FMU_DIR)" PATH="$(CURDIR)/$(VENV)/bin:$$PATH" \
+	env $(ZIG_ENV) RAILUQ_ZIG=$(ZIG) RAILUQ_WHEEL_FMUS="$(CURDIR)/$(FMU_DIR)" PATH="$(CURDIR)/$(VENV)/bin:$$PATH" \
 	  $(VPY) -m pip wheel -q --no-build-isolation --no-deps -w $(WHEEL_DIR) ./python
 	$(VPY) -m pip install -q --force-reinstall --no-deps $(WHEEL_DIR)/railuq-*.whl
 
