@@ -161,7 +161,7 @@ $(VENV)/.bench-requirements: bench/requirements.txt $(VPY)
 	$(VPY) -m pip install -q -r bench/requirements.txt
 	touch $@
 
-bench: build fmu venv $(VENV)/.bench-requirements
+bench: build fmu venv wheel $(VENV)/.bench-requirements
 	env $(ZIG_ENV) CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
 # Every study of the paper (long: about an hour and a half on 2 cores, most of it the bogie's
