@@ -3,6 +3,7 @@
 #   make test   every test: fmt, clippy, Rust unit + integration tests, fmpy checks
 #   make bench  benchmarks, writes BENCHMARKS.md
 #   make docs   the user guide (docs/, mdBook) into target/book
+#   make wheel  the Python package (python/) as a wheel in target/wheels, installed into .venv
 SHELL := /bin/bash
 .SHELLFLAGS := -eu -o pipefail -c
 CARGO ?= cargo
@@ -26,7 +27,7 @@ IN_CI := $(filter-out 0 false no False FALSE No NO,$(strip $(CI)))
 FMI2_HEADERS = $(shell $(VPY) -c 'import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), "c-code"))')
 
 .PHONY: all build fmu xml run test test-rust test-python lint fmt bench paper clean venv \
-	win64-toolchain docs
+	win64-toolchain docs wheel
 
 all: build fmu
 
@@ -34,10 +35,23 @@ all: build fmu
 # dependencies (nalgebra, ...) over the packages it is asked to build, so `-p railuq` alone
 # after `--workspace` (or the other way round) rebuilt the FMU crate twice on every
 # `make run`. Now the second one is a no-op.
-CARGO_BUILD := $(CARGO) build --release --workspace
+# The Python package's extension module (python/, a workspace member) is built by `make wheel`
+# only.
+CARGO_BUILD := $(CARGO) build --release --workspace --exclude railuq-python
+
+# ZIG=auto (default): when the venv has zig (the ziglang package, which `make venv` installs),
+# every x86-64 Linux binary (the FMU libraries, uq-driver, the Python module, the tests) is
+# linked by .cargo/zig-cc against glibc $(GLIBC) instead of the build machine's, so that it loads
+# on older Linux systems; ZIG=no: the system linker. Decided when a recipe runs (the venv may be
+# made by the same `make test`). Only the link changes: the code is the same.
+ZIG ?= auto
+GLIBC ?= 2.17
+ZIG_ENV = $$(if [ "$(ZIG)" != no ] && [ -x $(VPY) ] && $(VPY) -m ziglang version >/dev/null 2>&1; \
+  then echo "CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER=$(CURDIR)/.cargo/zig-cc \
+  RAILUQ_ZIG_PYTHON=$(CURDIR)/$(VPY) RAILUQ_GLIBC=$(GLIBC)"; fi)
 
 build:
-	$(CARGO_BUILD)
+	env $(ZIG_ENV) $(CARGO_BUILD)
 
 # The packaged binaries are stripped of symbols and debug info (the ones under target/ keep
 # theirs for profiling). The FMUs are packaged again only when the packaging command or one
@@ -45,12 +59,12 @@ build:
 # byte-reproducible, so a needless repackaging changed the FMU's SHA-256 and made the next
 # `make run` refuse its own result folders ("the FMU differs").
 fmu:
-	$(CARGO_BUILD)
+	env $(ZIG_ENV) $(CARGO_BUILD)
 	@extra=; \
 	if [ "$(WIN64)" != no ]; then \
 	  if why=$$(bash tests/wine/toolchain.sh check-build 2>&1); then \
 	    echo "$(CARGO) build --release -p railuq --lib --target $(WIN_TARGET)"; \
-	    $(CARGO) build --release -p railuq --lib --target $(WIN_TARGET); \
+	    env $(ZIG_ENV) $(CARGO) build --release -p railuq --lib --target $(WIN_TARGET); \
 	    extra="--library $(DLL)"; \
 	  elif [ "$(WIN64)" = yes ] || [ -n "$(IN_CI)" ]; then \
 	    echo "make fmu: cannot build the win64 binary: $$why" >&2; exit 1; \
@@ -84,8 +98,8 @@ win64-toolchain:
 
 # Regenerate the checked-in model descriptions from the Rust variable tables.
 xml:
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
-	$(CARGO) run -q -p railuq --bin railuq-fmu -- readme docs/src/reference/fmu-variables.md
+	env $(ZIG_ENV) $(CARGO) run -q -p railuq --bin railuq-fmu -- xml modelDescription
+	env $(ZIG_ENV) $(CARGO) run -q -p railuq --bin railuq-fmu -- readme docs/src/reference/fmu-variables.md
 
 $(VPY): tests/python/requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -124,14 +138,14 @@ lint:
 	@# cargo fmt misses files it does not reach through `mod` (macro-declared modules, fuzz
 	@# targets, benches' helpers): every tracked .rs file is checked on its own too.
 	git ls-files -z '*.rs' | xargs -0 rustfmt --edition 2021 --check
-	$(CARGO) clippy --workspace --all-targets -- -D warnings
-	RUSTDOCFLAGS="-D warnings" $(CARGO) doc -p uq-driver --no-deps
+	env $(ZIG_ENV) $(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" env $(ZIG_ENV) $(CARGO) doc -p uq-driver --no-deps
 	$(PYTHON) uq-driver/api_items.py target/doc/uq_driver/all.html 250
 
 fmt:
 	$(CARGO) fmt --all
 
-test: lint venv win64-toolchain build fmu docs
+test: venv lint win64-toolchain build fmu docs
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
@@ -140,22 +154,33 @@ test: lint venv win64-toolchain build fmu docs
 # The Vehicle's dynamics tests (tens of simulated seconds each) run in release mode, as do the
 # driver's tests: they run real studies.
 test-rust:
-	$(CARGO) build -p railuq --lib --features test-panic
-	$(CARGO) test -p railuq --features test-panic
-	$(CARGO) test --release -p railuq --lib models::vehicle::
+	env $(ZIG_ENV) $(CARGO) build -p railuq --lib --features test-panic
+	env $(ZIG_ENV) $(CARGO) test -p railuq --features test-panic
+	env $(ZIG_ENV) $(CARGO) test --release -p railuq --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
-	  $(CARGO) test --release -p uq-driver -p out-file -p in-file
+	  env $(ZIG_ENV) $(CARGO) test --release -p uq-driver -p out-file -p in-file
 
-test-python: venv
+test-python: venv wheel
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
+
+# The Python package: a release wheel built by maturin (the venv's, on PATH; no download) by the
+# package's PEP 517 backend, carrying the FMUs of target/fmu, then installed into the venv
+# (the tests import it from there). `python3 -m pip install ./python` does the same in one step
+# for a user (building the FMUs itself).
+WHEEL_DIR := target/wheels
+wheel: venv fmu
+	rm -rf $(WHEEL_DIR)
+	env $(ZIG_ENV) RAILUQ_ZIG=$(ZIG) RAILUQ_WHEEL_FMUS="$(CURDIR)/$(FMU_DIR)" PATH="$(CURDIR)/$(VENV)/bin:$$PATH" \
+	  $(VPY) -m pip wheel -q --no-build-isolation --no-deps -w $(WHEEL_DIR) ./python
+	$(VPY) -m pip install -q --force-reinstall --no-deps $(WHEEL_DIR)/railuq-*.whl
 
 # The bench's peers (OpenTURNS, chaospy) go into the same venv.
 $(VENV)/.bench-requirements: bench/requirements.txt $(VPY)
 	$(VPY) -m pip install -q -r bench/requirements.txt
 	touch $@
 
-bench: build fmu venv $(VENV)/.bench-requirements
-	CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
+bench: build fmu venv wheel $(VENV)/.bench-requirements
+	env $(ZIG_ENV) CARGO="$(CARGO)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) bench/run.py
 
 # Every study of the paper (long: about an hour and a half on 2 cores, most of it the bogie's
 # 20 000-sample and the 8-input vehicle-track's 5 000-sample Latin hypercubes and the 15 552 runs

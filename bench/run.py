@@ -62,6 +62,7 @@ GOAL_VT_DEFAULT = 40.0
 GOAL_VT_FINE = 4.0
 GOAL_VT_ACCURACY = 1e-12
 GOAL_ISOLATE = 0.10
+GOAL_PYTHON = 0.05
 
 
 class BenchError(Exception):
@@ -544,6 +545,55 @@ def bench_threads(work, repeats):
                 f"{os.cpu_count()} cores busy, taking CPU from the second thread" if busy
                 else "") + ".")
     return sec, same
+
+
+# ------------------------------------------------------------------ the Python package
+
+PYTHON_RUN = ("import sys, railuq; railuq.builtin('wheel-lhs-10000').run(out=sys.argv[1], "
+              "fresh=True, report=False, progress=False)")
+
+
+def bench_python(work, repeats):
+    """builtin:wheel-lhs-10000 from Python (railuq, the package `make wheel` installs into the
+    venv) against the command line, both without the report; alternated."""
+    sec = Section("3b. The Python package vs the command line (builtin:wheel-lhs-10000)",
+                  ["path", "runs wall, best (s)", "runs median (s)", "command wall, best (s)",
+                   "command median (s)"])
+    py = [sys.executable, "-c", PYTHON_RUN]
+    sec.cmd(f"target/release/uq-driver run builtin:wheel-lhs-10000 --out "
+            f"{rel(work / 'lhs10000-cli')} --fresh --no-report   # x{repeats}")
+    sec.cmd(f"python -c \"{PYTHON_RUN}\" {rel(work / 'lhs10000-py')}   # x{repeats}")
+    if subprocess.run([sys.executable, "-c", "import railuq"], capture_output=True).returncode:
+        sec.note("The railuq package is not installed in this venv (`make wheel` installs it).")
+        sec.done("Not measured: railuq is not installed.")
+        return sec
+    res = {"cli": ([], []), "python": ([], [])}
+    for _ in range(repeats):
+        for path in ("cli", "python"):  # alternate, so that slow phases of other load hit both
+            out_dir = work / f"lhs10000-{'py' if path == 'python' else 'cli'}"
+            cmd = ([str(DRIVER), "run", "builtin:wheel-lhs-10000", "--out", str(out_dir),
+                    "--fresh", "--no-report"] if path == "cli" else py + [str(out_dir)])
+            wall, _cpu, _ = run_cmd(cmd)
+            s = json.loads((out_dir / "summary.json").read_text())
+            if s["model_runs"] != 10000 or s["failed_runs"]:
+                die(f"{out_dir}/summary.json: unexpected runs/failures")
+            res[path][0].append(s["wall_time_s"])
+            res[path][1].append(wall)
+    for path in ("cli", "python"):
+        rb, rm = best_median(res[path][0])
+        cb, cm = best_median(res[path][1])
+        sec.row(path, fmt_s(rb), fmt_s(rm), fmt_s(cb), fmt_s(cm))
+    same = all((work / "lhs10000-cli" / f).read_bytes() == (work / "lhs10000-py" / f).read_bytes()
+               for f in ("q.csv", "points.csv"))
+    sec.note(f"Check: q.csv and points.csv are byte-identical from both paths: "
+             f"{'OK' if same else 'FAILED'}.")
+    runs = min(res["python"][0]) / min(res["cli"][0]) - 1
+    whole = min(res["python"][1]) / min(res["cli"][1]) - 1
+    sec.done(f"The Python path costs {100 * runs:+.1f} % on the model runs and {100 * whole:+.1f} % "
+             f"on the whole command (best times; the interpreter's start and `import railuq` "
+             f"included). Goal ≤ {100 * GOAL_PYTHON:.0f} %: "
+             f"{goal(runs <= GOAL_PYTHON and whole <= GOAL_PYTHON)}.")
+    return sec
 
 
 # ------------------------------------------------------------------ 4./5. paper-wheel
@@ -1131,6 +1181,7 @@ def all_sections(args, work, repeats, checks):
     s1, step_cost, lib_same = bench_fmi_step(work, 0.3 if args.quick else 1.5)
     s2 = bench_wheel_1000(work, repeats, args.quick, checks)
     s3, same_threads = bench_threads(work, 1 if args.quick else max(repeats, 7))
+    s3b = bench_python(work, 1 if args.quick else max(repeats, 5))
     s4, s5 = bench_paper_wheel(work)
     s6 = bench_realtime(work, repeats if args.quick else max(repeats, 5), step_cost)
     s6b = bench_vehicle_realtime(work, repeats if args.quick else max(repeats, 5))
@@ -1139,7 +1190,7 @@ def all_sections(args, work, repeats, checks):
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
     s_hd = bench_hd_goals(work)
-    return ([s1, s2, s3, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
+    return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
             same_iso, lib_same)
 
 

@@ -42,16 +42,7 @@ pub(crate) fn study_spec(arg: &str) -> Result<String> {
 /// like percentages and checks that its FMU (and every variant's) can be found.
 pub(crate) fn load_study(arg: &str) -> Result<Study> {
     let s = Study::load(&study_spec(arg)?)?;
-    for w in cov_warnings(&s.source) {
-        eprintln!("uq-driver: warning: {w}");
-    }
-    let mut studies = vec![&s];
-    if let Some(suite) = &s.suite {
-        studies.extend(&suite.variants);
-    }
-    for st in studies {
-        check_fmu_found(st)?;
-    }
+    super::check_study(&s)?;
     Ok(s)
 }
 

@@ -28,7 +28,20 @@ use tools::*;
 /// The `uq-driver` program: parses the command line, runs the command, prints errors (with
 /// hints) and returns the exit status.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    main_with(std::env::args_os())
+}
+
+/// [`main`] with the arguments given (the first one names the program in usage messages),
+/// for a host that is not the `uq-driver` executable: `python -m railuq ARGS...` calls it.
+/// It is the whole program: it installs the process guards (Ctrl-C ends the process, as
+/// for `uq-driver`), prints on stdout and stderr, and `--help`, `--version` and a bad
+/// argument end the process as clap does.
+pub fn main_with<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = Cli::parse_from(args);
     if matches!(cli.command, Command::Worker) {
         return ExitCode::from(u8::try_from(crate::study::run::isolate::serve()).unwrap_or(1));
     }
@@ -54,6 +67,64 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The text the command line prints for an error: the error and its causes on one line,
+/// then a line `hint: ...` for each "did you mean" (a misspelt TOML key, kind or FMU
+/// variable). A host reports errors in the command line's words with it (the Python
+/// package's exceptions carry it).
+pub fn error_message(e: &anyhow::Error) -> String {
+    let mut text = causes(e);
+    for h in hints(e) {
+        text.push_str("\nhint: ");
+        text.push_str(&h);
+    }
+    text
+}
+
+/// What `uq-driver simulate FMU` does before it writes its CSV, for a host: one run of the
+/// FMU at `fmu` with `set` set before initialization, recording `outputs` (every output
+/// that can be recorded when empty) from `start` to `stop` every `step` (s; each `None`
+/// takes the FMU's default experiment, `start` else 0). The same checks and errors as the
+/// command; its notes and warnings go to the sink of [`crate::study::set_message_sink`].
+pub fn simulate(
+    fmu: &std::path::Path,
+    set: &[(String, crate::fmu::FixedValue)],
+    outputs: &[String],
+    start: Option<f64>,
+    stop: Option<f64>,
+    step: Option<f64>,
+) -> Result<crate::study::Simulation> {
+    let a = SimulateArgs {
+        fmu: fmu.to_path_buf(),
+        set: Vec::new(),
+        outputs: outputs.to_vec(),
+        input: None,
+        start,
+        stop,
+        step,
+        out: None,
+        fmu_logging: false,
+    };
+    simulation(&a, set, false)
+}
+
+/// The checks `uq-driver run` makes on a study it loaded, before running it: every FMU it
+/// names (a suite's variants too) exists, else an error lists every place searched; `cov`
+/// values that look like percentages are warned about (to the sink of
+/// [`crate::study::set_message_sink`]).
+pub fn check_study(s: &Study) -> Result<()> {
+    for w in cov_warnings(&s.source) {
+        crate::study::progress::message(&format!("uq-driver: warning: {w}"));
+    }
+    let mut studies = vec![s];
+    if let Some(suite) = &s.suite {
+        studies.extend(&suite.variants);
+    }
+    for st in studies {
+        check_fmu_found(st)?;
+    }
+    Ok(())
 }
 
 /// The error and its causes, each once: a cause whose text an outer message already
@@ -186,7 +257,7 @@ fn dispatch(cmd: Command) -> Result<()> {
             Ok(())
         }
         Command::Inspect { fmu } => inspect(&fmu),
-        Command::Simulate(args) => simulate(args),
+        Command::Simulate(args) => tools::simulate(args),
         Command::Surrogate(cmd) => surrogate(cmd),
         Command::Compare { dirs, out } => {
             crate::report::compare::write(&dirs, &out)?;

@@ -10,7 +10,8 @@ use crate::fmu::{Causality, Fmu, VariableKind};
 use crate::report::csv::push_shortest;
 use crate::spec::{Experiment, FixedValue, InvalidExperiment};
 use crate::study::plan::size;
-use crate::study::run::{self as runner, guard};
+use crate::study::progress::message;
+use crate::study::run::{self as runner, guard, Simulation};
 use crate::uq::surrogate::Surrogate;
 
 /// The file named by `--out`, or `None` for standard output (no `--out`, or `--out -`).
@@ -65,6 +66,40 @@ pub(crate) fn surrogate(cmd: SurrogateCommand) -> Result<()> {
 
 /// `uq-driver simulate`: one run as CSV.
 pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
+    let params: Vec<(String, FixedValue)> = a
+        .set
+        .iter()
+        .map(|(n, v)| (n.clone(), FixedValue::Text(v.clone())))
+        .collect();
+    let to_stdout = out_path(a.out.as_deref()).is_none();
+    let sim = simulation(&a, &params, to_stdout)?;
+    let mut text = String::from("time");
+    for n in &sim.names {
+        text.push(',');
+        crate::report::csv::push_field(&mut text, n);
+    }
+    text.push('\n');
+    for (k, t) in sim.times.iter().enumerate() {
+        push_shortest(&mut text, *t);
+        for s in &sim.series {
+            text.push(',');
+            push_shortest(&mut text, s[k]);
+        }
+        text.push('\n');
+    }
+    emit(&text, a.out.as_deref())
+}
+
+/// The run of `uq-driver simulate` (and of [`super::simulate`]): `params` set before
+/// initialization, the experiment from `a` or the FMU's default experiment; what it notes
+/// (values outside a variable's range, outputs not recorded, an early end) goes to the
+/// message sink. With `redirect_stdout` what the FMU prints goes to stderr meanwhile (the
+/// CSV is written to stdout).
+pub(crate) fn simulation(
+    a: &SimulateArgs,
+    params: &[(String, FixedValue)],
+    redirect_stdout: bool,
+) -> Result<Simulation> {
     let fmu = Fmu::open(&a.fmu)?;
     let de = fmu.description().default_experiment.unwrap_or_default();
     let start = a.start.or(de.start_time).unwrap_or(0.0);
@@ -129,25 +164,18 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
     size::check_simulation(experiment.n_steps() as f64 + 1.0, series)?;
     let times = experiment.times();
     crate::study::plan::interface::check_step_sizes(&fmu, &times)?;
-    let params: Vec<(String, FixedValue)> = a
-        .set
-        .into_iter()
-        .map(|(n, v)| (n, FixedValue::Text(v)))
-        .collect();
-    for (name, value) in &params {
+    for (name, value) in params {
         if let Some(w) = crate::study::plan::ranges::value_warning(&fmu, name, value) {
-            eprintln!("uq-driver: warning: {w}");
+            message(&format!("uq-driver: warning: {w}"));
         }
     }
-    let sim = {
+    let mut sim = {
         // An FMU that calls exit() is reported; what it prints stays out of a CSV on stdout.
         let _exit = guard::SimulationGuard::begin(&a.fmu);
-        let _stdout = out_path(a.out.as_deref())
-            .is_none()
-            .then(guard::StdoutToStderr::begin);
+        let _stdout = redirect_stdout.then(guard::StdoutToStderr::begin);
         runner::simulate_with(
             &fmu,
-            &params,
+            params,
             &outputs,
             a.input.as_deref(),
             &times,
@@ -155,38 +183,36 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         )?
     };
     for (name, why) in &sim.skipped {
-        eprintln!("uq-driver: note: output '{name}' not recorded: {why}");
+        message(&format!(
+            "uq-driver: note: output '{name}' not recorded: {why}"
+        ));
     }
-    let columns: Vec<usize> = (0..sim.names.len())
-        .filter(|&k| !is_time(&sim.names[k]))
-        .collect();
     if sim.names.is_empty() {
-        eprintln!(
+        message(
             "uq-driver: warning: nothing to record: the FMU has no output that can be written \
-             as a number (name variables with --output)"
+             as a number (name variables with --output)",
         );
     }
     if let Some(t) = sim.ended_at {
-        eprintln!(
+        message(&format!(
             "uq-driver: note: the FMU ended the simulation at t = {t} s (before the stop time \
              {stop} s); the output ends there"
-        );
+        ));
     }
-    let mut text = String::from("time");
-    for &o in &columns {
-        text.push(',');
-        crate::report::csv::push_field(&mut text, &sim.names[o]);
-    }
-    text.push('\n');
-    for (k, t) in sim.times.iter().enumerate() {
-        push_shortest(&mut text, *t);
-        for &o in &columns {
-            text.push(',');
-            push_shortest(&mut text, sim.series[o][k]);
-        }
-        text.push('\n');
-    }
-    emit(&text, a.out.as_deref())
+    // The time is the CSV's first column (and the host's time axis): a recorded time
+    // variable is not a second one.
+    let keep: Vec<bool> = sim.names.iter().map(|n| !is_time(n)).collect();
+    let mut k = 0;
+    sim.names.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    let mut k = 0;
+    sim.series.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    Ok(sim)
 }
 
 /// The communication step fmpy's `simulate_fmu` takes for a Co-Simulation FMU without a

@@ -3,6 +3,7 @@
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::RwLock;
 
 use toml::Spanned;
 
@@ -41,15 +42,38 @@ impl Study {
     }
 }
 
+/// The folders of [`add_fmu_dir`].
+static HOST_FMU_DIRS: RwLock<Vec<PathBuf>> = RwLock::new(Vec::new());
+
+/// Adds `dir` to [`fmu_search_path`], after `$RAILUQ_FMU_DIR` and before the folders beside
+/// the executable, for the rest of the process: a host that ships FMUs of its own (the
+/// Python package, whose executable is the Python interpreter) makes `builtin:NAME` and
+/// `fmu = "Wheel.fmu"` find them. Adding a folder twice adds it once.
+pub fn add_fmu_dir(dir: impl Into<PathBuf>) {
+    let dir = dir.into();
+    let mut dirs = HOST_FMU_DIRS.write().unwrap_or_else(|e| e.into_inner());
+    if !dirs.contains(&dir) {
+        dirs.push(dir);
+    }
+}
+
 /// Folders searched for an FMU named by a relative path that is not next to the study file,
-/// in order: `$RAILUQ_FMU_DIR`; beside the executable, `<exe dir>/fmu` (an installed binary
-/// with its FMUs) and `<exe dir>/../share/railuq/fmu` (a `PREFIX/bin` + `PREFIX/share`
-/// install); `<exe dir>/../fmu` (`target/fmu` for a cargo build); `./target/fmu`.
+/// in order: `$RAILUQ_FMU_DIR`; the folders of [`add_fmu_dir`]; beside the executable,
+/// `<exe dir>/fmu` (an installed binary with its FMUs) and `<exe dir>/../share/railuq/fmu`
+/// (a `PREFIX/bin` + `PREFIX/share` install); `<exe dir>/../fmu` (`target/fmu` for a cargo
+/// build); `./target/fmu`.
 pub fn fmu_search_path() -> Vec<PathBuf> {
     let mut dirs = Vec::new();
     if let Some(d) = std::env::var_os("RAILUQ_FMU_DIR") {
         dirs.push(PathBuf::from(d));
     }
+    dirs.extend(
+        HOST_FMU_DIRS
+            .read()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .cloned(),
+    );
     if let Some(exe_dir) = std::env::current_exe()
         .ok()
         .and_then(|e| e.parent().map(Path::to_path_buf))

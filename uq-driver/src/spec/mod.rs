@@ -48,7 +48,7 @@ pub use file::{
     quantile_column, Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs,
     PaperValue, StudyFile, Variant,
 };
-pub use load::{fmu_candidates, fmu_search_path};
+pub use load::{add_fmu_dir, fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};
 pub use study::{Study, Suite};
 

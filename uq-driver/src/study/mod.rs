@@ -26,7 +26,9 @@ pub use plan::interface::{InterfaceError, VariableProblem};
 pub use plan::size::SizeError;
 pub use progress::{set_message_sink, Sink};
 pub use run::guard::install_process_guards;
-pub use run::{simulate, simulate_with, FailedPoint, PointError, RunError, RunOptions, Simulation};
+pub use run::{
+    simulate, simulate_with, FailedPoint, PointError, RunControl, RunError, RunOptions, Simulation,
+};
 pub use store::lock::LockError;
 pub use store::StoreError;
 

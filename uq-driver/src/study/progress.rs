@@ -117,11 +117,13 @@ impl Progress {
         }
     }
 
-    /// Prints a line on stderr without garbling the bar.
+    /// Prints a line on stderr without garbling the bar (a bar is drawn on the command
+    /// line's terminal only); without a bar the line is a message to the sink of
+    /// [`set_message_sink`], as every other note of the library.
     pub fn println(&self, line: &str) {
         match &self.bar {
             Some(b) => b.suspend(|| eprintln!("{line}")),
-            None => eprintln!("{line}"),
+            None => message(line),
         }
     }
 

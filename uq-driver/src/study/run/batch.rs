@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use super::error::{PointError, RunError};
+use super::options::RunControl;
 use super::point::{describe_values, run_point};
 use crate::spec::Study;
 use crate::study::plan::interface::Interface;
@@ -43,6 +44,8 @@ pub(super) struct Batch<'a> {
     pub(super) notes: Notes,
     /// What a successful record must hold; one that does not fails its point.
     pub(super) rules: RecordRules,
+    /// The host's stop request and progress counter.
+    pub(super) control: Option<&'a RunControl>,
 }
 
 /// Counters shared by the points of a batch.
@@ -104,7 +107,7 @@ impl Batch<'_> {
         run: impl FnOnce() -> Result<Outcome, RunError>,
     ) -> Result<Option<(usize, Entry)>, RunError> {
         let stop = &shared.stop;
-        if stop.load(Ordering::Relaxed) {
+        if stop.load(Ordering::Relaxed) || self.control.is_some_and(RunControl::stopped) {
             return Ok(None);
         }
         if let Some(max) = self.max_new {
@@ -132,6 +135,9 @@ impl Batch<'_> {
         }
         let entry = self.store.append(i, &rec)?;
         progress.inc();
+        if let Some(c) = self.control {
+            c.point_done();
+        }
         if let Some(message) = fatal {
             return Err(RunError::Fatal {
                 point: i,

@@ -34,7 +34,7 @@ pub use error::{FailedPoint, PointError, RunError};
 use guard::StudyGuard;
 use instances::InstancePolicy;
 use isolate::{IsolateOptions, WorkerPool};
-pub use options::RunOptions;
+pub use options::{RunControl, RunOptions};
 pub use point::{simulate, simulate_with, Simulation};
 use worker_fmu::WorkerFmus;
 
@@ -163,7 +163,11 @@ pub fn run_points(
         check_reset: !opts.fresh_instances && missing.len() >= 2,
         notes: Notes::default(),
         rules,
+        control: opts.control.as_deref(),
     };
+    if let Some(c) = &opts.control {
+        c.begin(missing.len());
+    }
     let mode = match (opts.progress, opts.progress_lines) {
         (true, _) => ProgressMode::Bar,
         (false, true) => ProgressMode::Lines,

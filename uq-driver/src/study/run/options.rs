@@ -1,6 +1,8 @@
 //! How to run a study: the options of `run`, `run-shard` and `merge` as a library takes them.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use super::error::RunError;
@@ -54,6 +56,72 @@ pub struct RunOptions {
     /// `--fmu-logging`: instantiate with `loggingOn = true` (the FMU's messages are kept with
     /// failed points, capped, not printed).
     pub fmu_logging: bool,
+    /// A host's hand on the run from another thread: stop it, read its progress (None: the
+    /// run goes to its end, or to a signal of the process guards).
+    pub control: Option<Arc<RunControl>>,
+}
+
+/// A host's hand on a running study from another thread (a GUI, the Python package): ask it
+/// to stop, and read how many points are done. Shared through [`RunOptions::control`].
+///
+/// [`RunControl::stop`] is the library's Ctrl-C: no point starts after it, the points
+/// running finish and are stored, and [`crate::study::run_study`] returns
+/// [`crate::study::StudyRunError::Incomplete`]; a later run into the same folder resumes
+/// (as after Ctrl-C on the command line). An FMU call is never interrupted, and a study
+/// whose points were all done before the stop completes. A control serves one run at a
+/// time; [`RunControl::progress`] counts the points of the variant running now (a suite runs
+/// its variants one after another).
+///
+/// ```
+/// use std::sync::Arc;
+/// use uq_driver::study::{RunControl, RunOptions};
+/// let control = Arc::new(RunControl::default());
+/// let opts = RunOptions::default().with_control(Arc::clone(&control));
+/// // ... run_study(&study, out, &opts) on one thread; on another:
+/// let (done, total) = control.progress();
+/// assert_eq!((done, total), (0, 0));
+/// control.stop();
+/// assert!(control.stopped());
+/// # drop(opts);
+/// ```
+#[derive(Debug, Default)]
+pub struct RunControl {
+    stop: AtomicBool,
+    done: AtomicUsize,
+    total: AtomicUsize,
+}
+
+impl RunControl {
+    /// Asks the run to stop: no new point starts (see the type).
+    pub fn stop(&self) {
+        self.stop.store(true, Ordering::Release);
+    }
+
+    /// Whether [`RunControl::stop`] was called.
+    pub fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Acquire)
+    }
+
+    /// `(done, total)`: points finished in this invocation and points it has to run (those
+    /// not found finished in the results store) of the batch running now; `(0, 0)` before
+    /// the points start.
+    pub fn progress(&self) -> (usize, usize) {
+        (
+            self.done.load(Ordering::Acquire),
+            self.total.load(Ordering::Acquire),
+        )
+    }
+
+    /// A batch of `total` points starts.
+    pub(crate) fn begin(&self, total: usize) {
+        self.done.store(0, Ordering::Release);
+        self.total.store(total, Ordering::Release);
+    }
+
+    /// One more point finished.
+    pub(crate) fn point_done(&self) {
+        self.done.fetch_add(1, Ordering::AcqRel);
+    }
 }
 
 impl RunOptions {
@@ -138,6 +206,12 @@ impl RunOptions {
     /// Instantiates the FMU with `loggingOn = true`.
     pub fn with_fmu_logging(mut self, v: bool) -> Self {
         self.fmu_logging = v;
+        self
+    }
+
+    /// Shares `v` with the run: stop it or read its progress from another thread.
+    pub fn with_control(mut self, v: Arc<RunControl>) -> Self {
+        self.control = Some(v);
         self
     }
 
