@@ -40,7 +40,7 @@
 //!
 //! Where the limit cycle's basin is small near the fold (the full car: a large displacement of
 //! one wheelset dies out at speeds well above the fold), runs that each start from the
-//! disturbance find a speed well above the fold. [`continue_down`] follows the hunting branch
+//! disturbance find a speed well above the fold. `continue_down` follows the hunting branch
 //! instead, on one simulation whose speed is lowered between steps (the speed parameter must
 //! be tunable):
 //!
