@@ -29,6 +29,10 @@ use tools::*;
 /// hints) and returns the exit status.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Under `ulimit -v`, threads' own malloc arenas cannot be reserved and every allocation
+    // becomes a system call (runs 50 times slower): the CLI owns its process, so it keeps
+    // the allocator to a few arenas there (library hosts are left alone).
+    crate::sys::fewer_arenas_under_an_address_limit();
     if matches!(cli.command, Command::Worker) {
         return ExitCode::from(u8::try_from(crate::study::run::isolate::serve()).unwrap_or(1));
     }
