@@ -123,3 +123,34 @@ fn merge_and_slurm_take_no_report_as_run_does() {
     let merge = read(&sl2.join("slurm/merge.sbatch"));
     assert!(!merge.contains("--no-report"), "{merge}");
 }
+
+/// A mistyped subcommand with swapped letters (`rnu`) got no "did you mean": clap's own
+/// similarity misses it.
+#[test]
+fn a_mistyped_subcommand_gets_a_did_you_mean() {
+    for (wrong, right) in [("rnu", "run"), ("simulte", "simulate"), ("mrege", "merge")] {
+        let o = crate::support::run(&[wrong, "x"]);
+        let err = crate::support::stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("unrecognized subcommand '{wrong}'"))
+                && err.contains(&format!("a similar subcommand exists: '{right}'")),
+            "{err}"
+        );
+    }
+    let err = crate::support::stderr(&crate::support::run(&["zzzz"]));
+    assert!(!err.contains("similar"), "{err}");
+}
+
+/// `--threads 0` was refused naming a Rust type's field.
+#[test]
+fn threads_0_is_refused_in_the_command_s_terms() {
+    let o = crate::support::run(&["run", "x.toml", "--out", "o", "--threads", "0"]);
+    let err = crate::support::stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("0 threads cannot run anything: give at least 1, or leave --threads out"),
+        "{err}"
+    );
+    assert!(!err.contains("NonZero") && !err.contains("usize"), "{err}");
+}

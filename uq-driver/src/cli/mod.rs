@@ -25,6 +25,33 @@ use load::*;
 use print::*;
 use tools::*;
 
+/// clap's error for an unknown subcommand, with a "did you mean" where clap found none
+/// (`rnu` for `run`: clap's similarity misses swapped letters; [`crate::suggest::closest`]
+/// takes one edit as a likely typo).
+fn with_subcommand_suggestion(mut e: clap::Error) -> clap::Error {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::InvalidSubcommand || e.get(ContextKind::SuggestedSubcommand).is_some()
+    {
+        return e;
+    }
+    let Some(ContextValue::String(wrong)) = e.get(ContextKind::InvalidSubcommand).cloned() else {
+        return e;
+    };
+    let command = <Cli as clap::CommandFactory>::command();
+    let names = command
+        .get_subcommands()
+        .filter(|c| !c.is_hide_set())
+        .map(|c| c.get_name().to_owned())
+        .collect::<Vec<_>>();
+    if let Some(name) = crate::suggest::closest(&wrong, names.iter().map(String::as_str)) {
+        e.insert(
+            ContextKind::SuggestedSubcommand,
+            ContextValue::Strings(vec![name.to_owned()]),
+        );
+    }
+    e
+}
+
 /// The `uq-driver` program: parses the command line, runs the command, prints errors (with
 /// hints) and returns the exit status.
 pub fn main() -> ExitCode {
@@ -41,7 +68,11 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    let cli = Cli::parse_from(args);
+    let cli = Cli::try_parse_from(args).unwrap_or_else(|e| with_subcommand_suggestion(e).exit());
+    // Under `ulimit -v`, threads' own malloc arenas cannot be reserved and every allocation
+    // becomes a system call (runs 50 times slower): the command line owns its process, so it
+    // keeps the allocator to a few arenas there (library hosts are left alone).
+    crate::sys::fewer_arenas_under_an_address_limit();
     if matches!(cli.command, Command::Worker) {
         return ExitCode::from(u8::try_from(crate::study::run::isolate::serve()).unwrap_or(1));
     }

@@ -34,6 +34,33 @@ pub fn dup2(from: RawFd, to: RawFd) -> io::Result<()> {
     Ok(())
 }
 
+/// Under an address-space limit (`ulimit -v`), keeps the C allocator to 2 arenas
+/// (`mallopt(M_ARENA_MAX, 2)`); without a limit it does nothing. glibc gives each thread
+/// an arena that reserves 64 MiB of address space; under a limit of a few hundred MiB the
+/// reservations fail and every allocation falls back to a `mmap` and `munmap` of its own:
+/// a Wheel study of 400 runs of 50 001 points under `ulimit -v 250000` took 254 s (4.3
+/// million `mmap` calls, 80 % of them failing) instead of 5 s. Returns whether it applied.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+pub fn fewer_arenas_under_an_address_limit() -> bool {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes the rlimit it is given a valid pointer to.
+    let got = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) };
+    if got != 0 || limit.rlim_cur == libc::RLIM_INFINITY {
+        return false;
+    }
+    // SAFETY: mallopt takes no pointers; M_ARENA_MAX may be set at any time.
+    unsafe { libc::mallopt(libc::M_ARENA_MAX, 2) == 1 }
+}
+
+/// Does nothing where the C library is not glibc.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+pub fn fewer_arenas_under_an_address_limit() -> bool {
+    false
+}
+
 /// Flushes every C stream (`fflush(NULL)`): what code in the process printed with C's stdio
 /// (an FMU's `printf`) reaches its descriptor.
 pub fn flush_c_streams() {
