@@ -30,9 +30,12 @@ fn vehicle_nominal_reports_the_hunting_and_the_linear_critical_speed() {
     let v_hunt_decay = mean(&out, "v_hunt_decay");
     // The linear critical speed of the car on the built-in table, and the fold of its hunting
     // branch found by a continuation written separately in the FMU crate's tests (the same
-    // criterion: hunting when some wheelset exceeds 3 mm in the last 20 of 40 s at a
-    // speed; 38.58 m/s, the middle of its last bracket): `cargo test --release -p railuq --lib vehicle::tests::nonlinear_critical_speed
-    // -- --ignored --nocapture` with RAILUQ_TABLE=builtin.
+    // criterion: hunting when some wheelset exceeds 1 mm in the last 20 of 40 s at a speed):
+    // `cargo test --release -p railuq --lib vehicle::tests::nonlinear_critical_speed --
+    // --ignored --nocapture` with RAILUQ_TABLE=builtin. Near the fold the amplitude falls from
+    // 1.3 mm at 30 m/s to 0.3-0.8 mm at 28-29 m/s, not monotonically, so the fold depends a
+    // little on the path of speeds taken: that search ends at 29.05 m/s with both bogies
+    // hunting, 28.48 and 28.58 m/s with one of them.
     assert!(
         (v_cr_linear - LINEAR).abs() < 0.01,
         "v_cr_linear {v_cr_linear}"
@@ -41,15 +44,19 @@ fn vehicle_nominal_reports_the_hunting_and_the_linear_critical_speed() {
         v_hunt_decay < v_hunt && v_hunt - v_hunt_decay <= 0.05 + 1e-9,
         "{v_hunt_decay} {v_hunt}"
     );
-    assert!((v_hunt - FOLD).abs() < 0.2, "v_hunt {v_hunt}");
+    assert!(
+        (FOLDS.0 - 0.2..=FOLDS.1 + 0.2).contains(&v_hunt),
+        "v_hunt {v_hunt}"
+    );
     // A subcritical Hopf bifurcation: the car hunts well below the linear critical speed.
     assert!(v_hunt < v_cr_linear - 2.0, "{v_hunt} {v_cr_linear}");
 }
 
 /// The linear critical speed (m/s) of the nominal car on the built-in table.
 const LINEAR: f64 = 50.85;
-/// The fold of the hunting branch (m/s), both bogies hunting, on the built-in table.
-const FOLD: f64 = 38.58;
+/// The folds of the hunting branch (m/s) on the built-in table, lowest and highest of the
+/// three paths.
+const FOLDS: (f64, f64) = (28.48, 29.05);
 
 #[test]
 fn the_long_vehicle_studies_plan_against_the_vehicle_fmu() {
