@@ -92,7 +92,10 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
             if let Some([lo, hi]) = e.beyond_runs {
                 p.upper_95 = None;
                 p.warnings.push(format!(
-                    "counted over draws of the chaos surrogate with the limit outside the range                      of the model runs ({lo} to {hi}): the chaos's extrapolation, which its                      truncation-error estimate does not cover, so no interval is given;                      `importance_sampling` estimates it from model runs"
+                    "counted over draws of the chaos surrogate with the limit outside the range \
+                     of the model runs ({lo} to {hi}): the chaos's extrapolation, which its \
+                     truncation-error estimate does not cover, so no interval is given; \
+                     `importance_sampling` estimates it from model runs"
                 ));
             }
             p
