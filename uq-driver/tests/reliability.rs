@@ -197,6 +197,9 @@ fn importance_sampling_after_form_covers_the_exact_probability_within_its_cov() 
     let ci = e["ci_95"].as_array().unwrap();
     assert!(f(&ci[0]) < got && got < f(&ci[1]));
     assert!(e["runs"].as_u64().unwrap() <= 2_000 + 20 * 8);
+    // The page's plots: importance factors and P against runs.
+    assert!(out.join("q_1_importance.svg").is_file());
+    assert!(out.join("q_1_convergence.svg").is_file());
 }
 
 #[test]
