@@ -152,6 +152,7 @@ paper: build fmu
 	$(DRIVER) run builtin:vehicle-track-8d-pce --out out/vehicle-track-8d-pce
 	$(DRIVER) run builtin:vehicle-track-8d-lhs --out out/vehicle-track-8d-lhs
 	$(DRIVER) run builtin:paper-bogie --out out/paper-bogie
+	$(DRIVER) run builtin:bogie-instability-probability --out out/bogie-instability-probability --yes
 	@echo "reports: out/paper-*/index.html"
 
 # Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser, the

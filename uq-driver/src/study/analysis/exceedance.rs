@@ -90,7 +90,9 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
                 p.p = e.p;
             }
             if let Some([lo, hi]) = e.beyond_runs {
+                // The draws' binomial CoV is not the error of the chaos's tail either.
                 p.upper_95 = None;
+                p.cov = None;
                 p.warnings.push(format!(
                     "counted over draws of the chaos surrogate with the limit outside the range \
                      of the model runs ({lo} to {hi}): the chaos's extrapolation, which its \
