@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::support::csv::Csv;
 use crate::support::{
     run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
 };
@@ -412,4 +413,65 @@ fn morris_ranks_the_inputs_of_a_linear_sum_by_their_scatter() {
         assert!(f(&m["sigma"][format!("x{}", i + 1)]).abs() < 1e-6 * v);
     }
     assert_eq!(summary(&out)["model_runs"].as_u64().unwrap(), 10 * (4 + 1));
+}
+
+#[test]
+fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // y = x1 + x2, standard normal: a chaos of order 2 fits it exactly, yet a count of its
+    // draws beyond the last few runs is extrapolation as far as the runs can tell.
+    let inputs: String = ["x1", "x2"]
+        .iter()
+        .map(|n| {
+            format!(
+                "[[parameters]]\nname = \"{n}\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"
+            )
+        })
+        .collect();
+    let sd = 2f64.sqrt();
+    // P = 0.3 (about 30 of the 100 runs beyond) and 0.02 (about 2 beyond); below: 0.3.
+    let (wide, tail) = (sd * normal_isf(0.3), sd * normal_isf(0.02));
+    let p = study(
+        dir.path(),
+        "chaos",
+        5,
+        &inputs,
+        &[wide, tail],
+        &[-wide],
+        "kind = \"pce_regression\"\nsamples = 100\norder = 2",
+    );
+    let out = dir.path().join("chaos");
+    let text = run_study_ok(&p, &out, &[]);
+    let r = reliability(&out);
+    assert_eq!(r.len(), 3);
+    let runs = Csv::read(&out.join("q_samples.csv")).numeric().col("q");
+    assert_eq!(runs.len(), 100);
+    for e in &r {
+        assert_eq!(e["method"], "chaos");
+        let limit = f(&e["limit"]);
+        let beyond = runs
+            .iter()
+            .filter(|&&x| {
+                if e["direction"] == "below" {
+                    x < limit
+                } else {
+                    x > limit
+                }
+            })
+            .count();
+        if beyond < 10 {
+            assert!(
+                e["ci_95"].is_null() && e["cov"].is_null(),
+                "{beyond} runs beyond: {e}"
+            );
+            let w = e["warnings"][0].as_str().unwrap();
+            assert!(w.contains("importance_sampling"), "{w}");
+        } else {
+            assert!(e["ci_95"].is_array(), "{beyond} runs beyond: {e}");
+        }
+    }
+    assert!(text.contains("no interval"), "{text}");
 }

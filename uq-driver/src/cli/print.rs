@@ -44,7 +44,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
     for q in &r.quantities {
         let u = q.unit.as_deref();
         let v = |x: f64| with_unit(&six_digits(x), u);
-        if q.reliability.is_some() && q.mean.is_nan() || q.morris.is_some() {
+        if crate::uq::method::notes_of_kind(&s.method.kind).adaptive {
             // An adaptive method: its runs are not samples of the inputs' law.
             print_reliability(q);
         } else if q.deterministic {
@@ -128,6 +128,14 @@ fn print_reliability(q: &ScalarStats) {
             sig(r.p),
             r.method,
             count(r.runs, "run", "runs")
+        );
+    }
+    if q.reliability.is_none() && q.morris.is_none() {
+        println!(
+            "  {}: no probability asked (values over the runs from {} to {})",
+            q.name,
+            value(q.min),
+            value(q.max)
         );
     }
     if let Some(m) = &q.morris {

@@ -220,6 +220,10 @@ impl SobolSummary {
     }
 }
 
+/// Fewer model runs than this beyond a limit: a chaos's count of draws there gets no
+/// interval (see [`ExceedanceCount::note_tail`]).
+pub(crate) const TAIL_RUNS: usize = 10;
+
 /// P(q > limit) counted over the runs (or the draws of a surrogate).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ExceedanceCount {
@@ -255,6 +259,13 @@ pub struct ExceedanceCount {
     /// (P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub beyond_runs: Option<[f64; 2]>,
+    /// Counted over the draws of a chaos surrogate with the limit inside the range of the
+    /// model runs but only `[k, n]`: `k` of the `n` runs on its failing side (fewer than
+    /// 10): the chaos's tail there rests on a handful of runs, which its
+    /// truncation-error estimate (an average over the whole range) does not speak for; no
+    /// interval is given (`ci_kind` `none_sparse_tail`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub runs_in_tail: Option<[usize; 2]>,
     /// `above`: the count is of draws above the limit (`P(q > limit)`, the quantity's
     /// `limits`); `below`: below it (`P(q < limit)`, its `limits_below`).
     pub direction: &'static str,
@@ -284,6 +295,21 @@ impl ExceedanceCount {
             self.ci_95 = [f64::NAN; 2];
             self.upper_95 = f64::NAN;
             self.ci_kind = "none_extrapolation";
+        }
+    }
+
+    /// Sets [`Self::runs_in_tail`] when the count is over the `draws` of a chaos, the limit
+    /// lies inside the range of the runs, and fewer than 10 of the `runs` model
+    /// runs (`beyond` of them) are on its failing side; the interval and upper bound are
+    /// dropped as in [`Self::note_range`]. (A 400-run regression chaos of a smooth lognormal
+    /// response with a leave-one-out error of 1.5 % printed 7.0e-4, interval 6.5e-4–7.6e-4,
+    /// for an exact 1.0e-3.)
+    pub fn note_tail(&mut self, draws: Draws, beyond: usize, runs: usize) {
+        if draws == Draws::Chaos && self.beyond_runs.is_none() && beyond < TAIL_RUNS {
+            self.runs_in_tail = Some([beyond, runs]);
+            self.ci_95 = [f64::NAN; 2];
+            self.upper_95 = f64::NAN;
+            self.ci_kind = "none_sparse_tail";
         }
     }
 
@@ -340,6 +366,17 @@ impl ExceedanceCount {
                 "{head}: P = {} (95 % lower bound of P{kind}: {})",
                 sig(self.p),
                 sig(self.ci_95[0])
+            );
+        }
+        if let Some([k, n]) = self.runs_in_tail {
+            return format!(
+                "{head}: P = {}, no interval (only {} of the {} model runs lie beyond the \
+                 limit: the chaos's tail there is mostly extrapolation, which its \
+                 truncation-error estimate does not cover; importance_sampling estimates it \
+                 from model runs)",
+                sig(self.p),
+                group_digits(k),
+                group_digits(n)
             );
         }
         if self.beyond_runs.is_some() {

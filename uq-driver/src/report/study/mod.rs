@@ -452,7 +452,7 @@ fn quantity_section(
     summary: &Summary,
     names: &[&str],
 ) -> Result<Section, ReportError> {
-    if reliability::is_adaptive(q) {
+    if reliability::is_adaptive(summary) {
         return reliability::section(dir, q, summary, names);
     }
     let name = &q.name;

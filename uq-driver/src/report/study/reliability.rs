@@ -12,10 +12,10 @@ use crate::report::file_name::stem;
 use crate::results::numbers::count;
 use crate::results::{sig, LimitProbability, MorrisScreening, ScalarStats, Summary};
 
-/// Whether `q` is a quantity of a reliability or screening study (its runs are not samples
-/// of the inputs' law: no density or moments).
-pub(super) fn is_adaptive(q: &ScalarStats) -> bool {
-    q.morris.is_some() || (q.reliability.is_some() && q.mean.is_nan())
+/// Whether the study is a reliability or screening study (its runs are not samples of the
+/// inputs' law: no density or moments).
+pub(super) fn is_adaptive(summary: &Summary) -> bool {
+    crate::uq::method::notes_of_kind(&summary.method.kind).adaptive
 }
 
 /// The section of quantity `q` of a reliability or screening study.
@@ -65,6 +65,13 @@ pub(super) fn section(
                 format!("{} / {}", sig(m.mu_star[n]), sig(m.sigma[n])),
             ]
         }));
+    }
+    if q.reliability.is_none() && q.morris.is_none() {
+        text.push_str(&format!(
+            "\n\nNo probability of {name} was asked of the method (no `limits` or \
+             `limits_below`, or not among the method's `quantities`): only the range of its \
+             values over the runs is shown."
+        ));
     }
     if q.n_valid > 0 {
         rows.push(vec![

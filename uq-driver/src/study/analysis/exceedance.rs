@@ -50,6 +50,7 @@ pub fn count_on_side(draws: &[f64], limit: f64, side: Side, source: Draws) -> Ex
         ci_kind: "clopper_pearson",
         outer_samples: None,
         beyond_runs: None,
+        runs_in_tail: None,
         direction: crate::results::direction(side),
     }
 }
@@ -88,6 +89,16 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
             );
             if e.outer_samples.is_some() {
                 p.p = e.p;
+            }
+            if let Some([k, n]) = e.runs_in_tail {
+                p.upper_95 = None;
+                p.cov = None;
+                p.warnings.push(format!(
+                    "counted over draws of the chaos surrogate with only {k} of the {n} model \
+                     runs beyond the limit: the chaos's tail there is mostly extrapolation, \
+                     which its truncation-error estimate does not cover, so no interval is \
+                     given; `importance_sampling` estimates it from model runs"
+                ));
             }
             if let Some([lo, hi]) = e.beyond_runs {
                 // The draws' binomial CoV is not the error of the chaos's tail either.

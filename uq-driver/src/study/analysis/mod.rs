@@ -397,8 +397,18 @@ fn scalar_stats_counted(
                 }
                 _ => count_on_side(&density_samples, l, side, estimate.draws),
             };
-            // A chaos's draws beyond every model run: its extrapolation alone.
+            // A chaos's draws beyond every model run: its extrapolation alone; or beyond a
+            // handful of them: mostly so.
             e.note_range(estimate.draws, [smallest, largest]);
+            let beyond = runs
+                .valid
+                .iter()
+                .filter(|&&x| match side {
+                    Side::Above => x > l,
+                    Side::Below => x < l,
+                })
+                .count();
+            e.note_tail(estimate.draws, beyond, runs.valid.len());
             e
         })
         .collect();

@@ -284,6 +284,7 @@ impl Method for Form {
     fn notes() -> KindNotes {
         KindNotes {
             name: Some("a FORM study"),
+            adaptive: true,
             ..KindNotes::default()
         }
     }

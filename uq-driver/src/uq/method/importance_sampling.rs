@@ -140,6 +140,7 @@ impl Method for ImportanceSampling {
     fn notes() -> KindNotes {
         KindNotes {
             name: Some("an importance-sampling study"),
+            adaptive: true,
             ..KindNotes::default()
         }
     }

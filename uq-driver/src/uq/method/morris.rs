@@ -91,6 +91,7 @@ impl Method for Morris {
     fn notes() -> KindNotes {
         KindNotes {
             name: Some("a Morris screening"),
+            adaptive: true,
             ..KindNotes::default()
         }
     }

@@ -104,6 +104,7 @@ impl Method for Sorm {
     fn notes() -> KindNotes {
         KindNotes {
             name: Some("a SORM study"),
+            adaptive: true,
             ..KindNotes::default()
         }
     }

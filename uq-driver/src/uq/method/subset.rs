@@ -117,6 +117,7 @@ impl Method for Subset {
     fn notes() -> KindNotes {
         KindNotes {
             name: Some("a subset-simulation study"),
+            adaptive: true,
             ..KindNotes::default()
         }
     }

@@ -242,6 +242,9 @@ pub struct KindNotes {
     pub truncation: Option<&'static str>,
     /// The method's name in a sentence ("an SGM study").
     pub name: Option<&'static str>,
+    /// The method chooses its runs, which are not samples of the inputs' law (the
+    /// reliability methods, Morris screening): no moments, densities or quantiles.
+    pub adaptive: bool,
 }
 
 /// A method that runs the model at the points of a design.
