@@ -285,13 +285,19 @@ impl ExceedanceCount {
 
     /// Sets [`Self::beyond_runs`] when the count is over the `draws` of a chaos and the limit
     /// lies outside `[smallest, largest]`, the range of the model runs. The count's interval
-    /// and upper bound are then dropped (NaN, `null` in `summary.json`, `ci_kind`
+    /// and upper bound are then dropped (but in a nested study, whose interval is over the
+    /// outer samples) (NaN, `null` in `summary.json`, `ci_kind`
     /// `none_extrapolation`): the draws' binomial interval says nothing of the chaos's own
     /// error in its tail, which no estimate covers.
     pub fn note_range(&mut self, draws: Draws, [smallest, largest]: [f64; 2]) {
         let outside = self.limit > largest || self.limit < smallest;
         if draws == Draws::Chaos && outside && smallest <= largest {
             self.beyond_runs = Some([smallest, largest]);
+            if self.outer_samples.is_some() {
+                // Nested: the interval over the outer samples stays (the spread of the
+                // tracks); the text names the inner chaoses' extrapolation.
+                return;
+            }
             self.ci_95 = [f64::NAN; 2];
             self.upper_95 = f64::NAN;
             self.ci_kind = "none_extrapolation";
@@ -379,7 +385,7 @@ impl ExceedanceCount {
                 group_digits(n)
             );
         }
-        if self.beyond_runs.is_some() {
+        if self.beyond_runs.is_some() && self.ci_kind == "none_extrapolation" {
             return format!(
                 "{head}: P = {}, no interval (the chaos's truncation-error estimate says \
                  nothing of its tail beyond the runs; importance_sampling estimates it from \

@@ -113,7 +113,6 @@ pub(crate) fn run_adaptive(
         error: None,
         capacity,
     };
-    let started = Instant::now();
     let result = method
         .0
         .run(&mut model, &inputs, &targets, &names, study.seed);
@@ -149,7 +148,6 @@ pub(crate) fn run_adaptive(
             return Err(StudyRunError::Method(e));
         }
     };
-    let _ = started;
     finish(
         study, &fmu, model, result, &targets, wall_time, out_dir, opts,
     )

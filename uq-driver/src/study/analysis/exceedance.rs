@@ -100,7 +100,7 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
                      given; `importance_sampling` estimates it from model runs"
                 ));
             }
-            if let Some([lo, hi]) = e.beyond_runs {
+            if let (Some([lo, hi]), "none_extrapolation") = (e.beyond_runs, e.ci_kind) {
                 // The draws' binomial CoV is not the error of the chaos's tail either.
                 p.upper_95 = None;
                 p.cov = None;
@@ -109,6 +109,12 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
                      of the model runs ({lo} to {hi}): the chaos's extrapolation, which its \
                      truncation-error estimate does not cover, so no interval is given; \
                      `importance_sampling` estimates it from model runs"
+                ));
+            } else if let Some([lo, hi]) = e.beyond_runs {
+                p.warnings.push(format!(
+                    "counted over draws of the inner chaoses with the limit outside the range \
+                     of the model runs ({lo} to {hi}): their extrapolation; the interval covers \
+                     the spread over the outer samples, not the chaoses' error in their tails"
                 ));
             }
             p
