@@ -33,6 +33,7 @@ mod large_studies;
 mod library;
 mod output_files;
 mod qoi_min_max;
+mod reliability;
 mod report_honest;
 mod sobol_sampling_intervals;
 mod store_recovery;

@@ -122,6 +122,10 @@ pub struct HuntingSpeedSpec {
     /// Exceedance limits: P(q > limit) is reported for both speeds.
     #[serde(default)]
     pub limits: Vec<f64>,
+    /// Limits below: P(q < limit) is reported for both speeds (e.g. the probability that
+    /// the bogie hunts below a line speed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub limits_below: Vec<f64>,
 }
 
 fn is_bisection(m: &SearchMode) -> bool {

@@ -31,6 +31,9 @@ pub enum QoiSpec {
         /// Exceedance limits: P(q > limit) is reported.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Sperling ride index of an acceleration signal (see [`sperling_index`](crate::qoi::sperling::sperling_index)).
     Sperling {
@@ -63,6 +66,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Largest |signal| over [from, to] (s).
     MaxAbs {
@@ -79,6 +85,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Smallest value of the signal (signed) over [from, to] (s): e.g. the least wheel–rail
     /// force, 0 when the wheel leaves the rail.
@@ -96,6 +105,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Largest value of the signal (signed) over [from, to] (s).
     Max {
@@ -112,6 +124,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Peak-to-peak value, max − min of the signal over [from, to] (s): e.g. the ripple of a
     /// wheel–rail force as the wheel passes the sleepers.
@@ -129,6 +144,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Value of a signal at the stop time.
     Final {
@@ -139,6 +157,9 @@ pub enum QoiSpec {
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
+        /// Limits below: P(q < limit) is reported.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        limits_below: Vec<f64>,
     },
     /// Constant-speed critical speed by bisection over runs of its own (see
     /// [`crate::qoi::hunting_speed`]): two quantities, `name` (lowest speed that keeps hunting)
@@ -292,6 +313,20 @@ impl QoiSpec {
             | QoiSpec::Range { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
             QoiSpec::HuntingSpeed(h) => &h.limits,
+        }
+    }
+
+    /// Limits below (of each of its quantities): P(q < limit) is reported.
+    pub fn limits_below(&self) -> &[f64] {
+        match self {
+            QoiSpec::CriticalSpeed { limits_below, .. }
+            | QoiSpec::Sperling { limits_below, .. }
+            | QoiSpec::MaxAbs { limits_below, .. }
+            | QoiSpec::Min { limits_below, .. }
+            | QoiSpec::Max { limits_below, .. }
+            | QoiSpec::Range { limits_below, .. }
+            | QoiSpec::Final { limits_below, .. } => limits_below,
+            QoiSpec::HuntingSpeed(h) => &h.limits_below,
         }
     }
 
@@ -576,7 +611,12 @@ impl QoiSpec {
     }
 
     fn check_limits(&self) -> Result<(), InvalidQuantity> {
-        match self.limits().iter().any(|l| !l.is_finite()) {
+        match self
+            .limits()
+            .iter()
+            .chain(self.limits_below())
+            .any(|l| !l.is_finite())
+        {
             true => Err(InvalidQuantity {
                 name: self.name().to_owned(),
                 problem: "limits must be finite".to_owned(),
@@ -686,6 +726,7 @@ mod tests {
             from: 1.5,
             to: None,
             limits: vec![],
+            limits_below: vec![],
         };
         assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (2.0, Code::Ok));
         let q = QoiSpec::Range {
@@ -694,6 +735,7 @@ mod tests {
             from: 0.5,
             to: Some(2.5),
             limits: vec![],
+            limits_below: vec![],
         };
         // Values at t = 1 and 2 only: the range is their difference, by hand.
         let (r, code) = evaluate(&q, &t, |_| &x[..]).unwrap();
@@ -705,12 +747,14 @@ mod tests {
             from: 10.0,
             to: None,
             limits: vec![],
+            limits_below: vec![],
         };
         assert!(evaluate(&q, &t, |_| &x[..]).is_err());
         let q = QoiSpec::Final {
             name: "f".into(),
             signal: "x".into(),
             limits: vec![],
+            limits_below: vec![],
         };
         assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (0.5, Code::Ok));
         let empty: [f64; 0] = [];

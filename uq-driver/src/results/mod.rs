@@ -8,6 +8,7 @@
 
 mod nested;
 pub mod numbers;
+mod reliability;
 
 pub use crate::qoi::scalar::QuantityDefinition;
 use crate::text::file_name::stem;
@@ -19,6 +20,8 @@ pub use nested::{
     ConditionalChaos, ConditionalTable, ExceedanceInterval, NestedScalar, OutputSplit,
     VarianceSplit,
 };
+pub(crate) use reliability::direction;
+pub use reliability::{LimitProbability, MorrisScreening};
 
 use crate::spec::{Experiment, FixedValue, PaperValue};
 use crate::uq::distributions::RandomParameter;
@@ -150,6 +153,14 @@ pub struct ScalarStats {
     /// `variance_split`, `mean_ci`, `std_ci`, `exceedance_ci`, ... sit beside the others).
     #[serde(flatten)]
     pub nested: Option<NestedScalar>,
+    /// The probability of each limit (`limits`, above, then `limits_below`), from the
+    /// reliability method, the runs or the chaos's draws (absent when the quantity has no
+    /// limit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reliability: Option<Vec<LimitProbability>>,
+    /// Morris's screening measures (a `morris` study).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub morris: Option<MorrisScreening>,
 }
 
 /// A scalar quantity's chaos truncation error in `summary.json`:
@@ -209,6 +220,10 @@ impl SobolSummary {
     }
 }
 
+/// Fewer model runs than this beyond a limit: a chaos's count of draws there gets no
+/// interval (see [`ExceedanceCount::note_tail`]).
+pub(crate) const TAIL_RUNS: usize = 10;
+
 /// P(q > limit) counted over the runs (or the draws of a surrogate).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ExceedanceCount {
@@ -244,6 +259,16 @@ pub struct ExceedanceCount {
     /// (P = 3.7e-4, interval 2.9e-4–4.6e-4, for a true 1e-3 beyond every run of a 4-node SCM).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub beyond_runs: Option<[f64; 2]>,
+    /// Counted over the draws of a chaos surrogate with the limit inside the range of the
+    /// model runs but only `[k, n]`: `k` of the `n` runs on its failing side (fewer than
+    /// 10): the chaos's tail there rests on a handful of runs, which its
+    /// truncation-error estimate (an average over the whole range) does not speak for; no
+    /// interval is given (`ci_kind` `none_sparse_tail`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub runs_in_tail: Option<[usize; 2]>,
+    /// `above`: the count is of draws above the limit (`P(q > limit)`, the quantity's
+    /// `limits`); `below`: below it (`P(q < limit)`, its `limits_below`).
+    pub direction: &'static str,
 }
 
 impl ExceedanceCount {
@@ -259,12 +284,44 @@ impl ExceedanceCount {
     }
 
     /// Sets [`Self::beyond_runs`] when the count is over the `draws` of a chaos and the limit
-    /// lies outside `[smallest, largest]`, the range of the model runs.
+    /// lies outside `[smallest, largest]`, the range of the model runs. The count's interval
+    /// and upper bound are then dropped (but in a nested study, whose interval is over the
+    /// outer samples) (NaN, `null` in `summary.json`, `ci_kind`
+    /// `none_extrapolation`): the draws' binomial interval says nothing of the chaos's own
+    /// error in its tail, which no estimate covers.
     pub fn note_range(&mut self, draws: Draws, [smallest, largest]: [f64; 2]) {
         let outside = self.limit > largest || self.limit < smallest;
         if draws == Draws::Chaos && outside && smallest <= largest {
             self.beyond_runs = Some([smallest, largest]);
+            if self.outer_samples.is_some() {
+                // Nested: the interval over the outer samples stays (the spread of the
+                // tracks); the text names the inner chaoses' extrapolation.
+                return;
+            }
+            self.ci_95 = [f64::NAN; 2];
+            self.upper_95 = f64::NAN;
+            self.ci_kind = "none_extrapolation";
         }
+    }
+
+    /// Sets [`Self::runs_in_tail`] when the count is over the `draws` of a chaos, the limit
+    /// lies inside the range of the runs, and fewer than 10 of the `runs` model
+    /// runs (`beyond` of them) are on its failing side; the interval and upper bound are
+    /// dropped as in [`Self::note_range`]. (A 400-run regression chaos of a smooth lognormal
+    /// response with a leave-one-out error of 1.5 % printed 7.0e-4, interval 6.5e-4–7.6e-4,
+    /// for an exact 1.0e-3.)
+    pub fn note_tail(&mut self, draws: Draws, beyond: usize, runs: usize) {
+        if draws == Draws::Chaos && self.beyond_runs.is_none() && beyond < TAIL_RUNS {
+            self.runs_in_tail = Some([beyond, runs]);
+            self.ci_95 = [f64::NAN; 2];
+            self.upper_95 = f64::NAN;
+            self.ci_kind = "none_sparse_tail";
+        }
+    }
+
+    /// Whether the count is of draws below the limit (`P(q < limit)`).
+    pub fn is_below(&self) -> bool {
+        self.direction == "below"
     }
 
     /// [`Self::describe`] with the limit (and the range of the runs) written by `value`,
@@ -280,9 +337,14 @@ impl ExceedanceCount {
             (_, w) => w,
         };
         let head = format!(
-            "{} of {} {what}{outer} exceeded {limit}",
+            "{} of {} {what}{outer} {} {limit}",
             group_digits(self.exceeded),
             group_digits(self.of),
+            if self.is_below() {
+                "fell below"
+            } else {
+                "exceeded"
+            }
         );
         let head = match self.beyond_runs {
             Some([_, largest]) if self.limit > largest => format!(
@@ -310,6 +372,25 @@ impl ExceedanceCount {
                 "{head}: P = {} (95 % lower bound of P{kind}: {})",
                 sig(self.p),
                 sig(self.ci_95[0])
+            );
+        }
+        if let Some([k, n]) = self.runs_in_tail {
+            return format!(
+                "{head}: P = {}, no interval (only {} of the {} model runs lie beyond the \
+                 limit: the chaos's tail there is mostly extrapolation, which its \
+                 truncation-error estimate does not cover; importance_sampling estimates it \
+                 from model runs)",
+                sig(self.p),
+                group_digits(k),
+                group_digits(n)
+            );
+        }
+        if self.beyond_runs.is_some() && self.ci_kind == "none_extrapolation" {
+            return format!(
+                "{head}: P = {}, no interval (the chaos's truncation-error estimate says \
+                 nothing of its tail beyond the runs; importance_sampling estimates it from \
+                 model runs)",
+                sig(self.p)
             );
         }
         if self.exceeded == 0 {

@@ -54,6 +54,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../studies/paper-bogie.toml"),
     ),
     (
+        "bogie-instability-probability",
+        include_str!("../../studies/bogie-instability-probability.toml"),
+    ),
+    (
         "vehicle-track-nominal",
         include_str!("../../studies/vehicle-track-nominal.toml"),
     ),

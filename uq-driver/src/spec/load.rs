@@ -170,7 +170,7 @@ fn study(
         .map(|(_, p)| p.name.clone())
         .collect();
     check_method(&cx, &mut study, &outer, file.method.span())?;
-    if let Evaluation::Sampling(_) = study.method().evaluation() {
+    if !matches!(study.method().evaluation(), Evaluation::Intrusive(_)) {
         let fmu = file
             .fmu
             .as_deref()

@@ -9,7 +9,8 @@ use crate::fmu::FixedValue;
 use crate::qoi::QoiSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::galerkin::system::SystemSpec;
-use crate::uq::method::{Evaluation, Method, MethodSpec, Problem};
+use crate::uq::method::adaptive::{self, Target};
+use crate::uq::method::{Evaluation, InvalidSettings, Method, MethodSpec, Problem};
 use crate::uq::random_inputs::{Correlation, RandomInputs};
 
 /// A validated study, ready to run.
@@ -142,7 +143,35 @@ impl Study {
         self.method()
             .validate(&self.problem(&times))
             .map_err(|err| invalid(format!("method {}: {err}", self.method().kind())))?;
-        if let Evaluation::Sampling(_) = self.method().evaluation() {
+        if self.method.nested().is_some() {
+            if let Some(q) = self.qoi.iter().find(|q| !q.limits_below().is_empty()) {
+                return Err(invalid(format!(
+                    "quantity '{}': `limits_below` is not available in a nested study (its \
+                     two-level intervals are of P(q > limit)); give the limit of -q, or run \
+                     one level",
+                    q.name()
+                )));
+            }
+        }
+        if let Evaluation::Adaptive(a) = self.method().evaluation() {
+            let targets = self
+                .adaptive_targets()
+                .map_err(|err| invalid(format!("method {}: {err}", self.method().kind())))?;
+            if a.needs_limits() && targets.is_empty() {
+                return Err(invalid(format!(
+                    "method {} estimates probabilities: give a quantity `limits` (P(q > limit)) \
+                     or `limits_below` (P(q < limit))",
+                    self.method().kind()
+                )));
+            }
+            if self.qoi.is_empty() {
+                return Err(invalid(format!(
+                    "method {} works on scalar quantities ([[qoi]]); the study has none",
+                    self.method().kind()
+                )));
+            }
+        }
+        if !matches!(self.method().evaluation(), Evaluation::Intrusive(_)) {
             match &self.fmu_path {
                 None => return Err(invalid("no FMU (`fmu_path` is None) to run".into())),
                 Some(p) if p.as_os_str().is_empty() => {
@@ -157,6 +186,29 @@ impl Study {
             }
         }
         Ok(())
+    }
+
+    /// The scalar quantities in record order, each with its limits above and below.
+    pub(crate) fn quantity_limits(&self) -> Vec<(String, Vec<f64>, Vec<f64>)> {
+        self.qoi
+            .iter()
+            .flat_map(|q| {
+                q.quantity_names()
+                    .into_iter()
+                    .map(move |n| (n, q.limits().to_vec(), q.limits_below().to_vec()))
+            })
+            .collect()
+    }
+
+    /// The probabilities an adaptive method estimates (one per quantity and limit, within
+    /// the method's `quantities`); empty for other methods.
+    pub(crate) fn adaptive_targets(&self) -> Result<Vec<Target>, InvalidSettings> {
+        match self.method().evaluation() {
+            Evaluation::Adaptive(a) if a.needs_limits() => {
+                adaptive::targets(&self.quantity_limits(), a.0.only())
+            }
+            _ => Ok(Vec::new()),
+        }
     }
 
     /// What the method sees of the study; `times` are [`Study::times`].

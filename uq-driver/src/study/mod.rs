@@ -8,7 +8,9 @@
 
 #![forbid(unsafe_code)]
 
+mod adaptive;
 pub(crate) mod analysis;
+mod facts;
 mod outcome;
 pub(crate) mod plan;
 pub(crate) mod progress;

@@ -42,6 +42,18 @@ pub enum StudyRunError {
         /// Points of the design.
         total: usize,
     },
+    /// An adaptive study (a reliability method) stopped before it finished (see
+    /// `max_new_points`): its runs are kept and replayed by the next run into the folder.
+    #[error(
+        "stopped after {runs} model runs ({new} new in this run) before the method finished; \
+         run again with the same --out (output folder) to resume"
+    )]
+    Stopped {
+        /// Runs in the results store.
+        runs: usize,
+        /// Runs made by this invocation.
+        new: usize,
+    },
 }
 
 /// What a finished study returns.

@@ -111,6 +111,12 @@ fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
             "a {} study solves its own system without running a model: nothing to shard",
             study.method().kind()
         ))),
+        Evaluation::Adaptive(_) => Err(ShardError::Usage(format!(
+            "a {} study chooses its points from the values of the runs before (batch after \
+             batch): it cannot be split into shards planned in advance; run it with `uq-driver \
+             run` (each batch runs in parallel on the threads of one machine)",
+            study.method().kind()
+        ))),
     }
 }
 

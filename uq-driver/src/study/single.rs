@@ -8,12 +8,10 @@ use std::time::Instant;
 use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
-use crate::results::{
-    FmuInfo, OutputSplit, OutputStats, OutputSummary, PointStatus, PointTable, RecordLayout,
-    ScalarStats, Summary, Timing, Versions,
-};
+use crate::results::{FmuInfo, OutputSplit, PointStatus, PointTable};
 use crate::spec::Study;
 use crate::study::analysis::{self, Analysed, AnalysisError};
+use crate::study::facts::{summary, RunFacts};
 use crate::study::outcome::{StudyResult, StudyRunError};
 use crate::study::plan::ranges;
 use crate::study::plan::size;
@@ -21,9 +19,7 @@ use crate::study::progress;
 use crate::study::run::{self, RunError, RunOptions, RunOutcome};
 use crate::study::store::{Entry, StoredRuns};
 use crate::uq::distributions::{Distribution, Germ};
-use crate::uq::method::{
-    ChaosBasis, Design, Draws, Evaluation, Intrusive, MethodSummary, Sampling,
-};
+use crate::uq::method::{ChaosBasis, Design, Draws, Evaluation, Intrusive, Sampling};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::surrogate::{NamedChaos, SurrogateFile};
 
@@ -39,6 +35,9 @@ pub(crate) fn run_single(
     })?;
     match study.method().evaluation() {
         Evaluation::Intrusive(method) => solve(study, method, out_dir, opts),
+        Evaluation::Adaptive(method) => {
+            crate::study::adaptive::run_adaptive(study, method, out_dir, opts)
+        }
         Evaluation::Sampling(method) => {
             let fmu = run::open_fmu(study)?;
             ranges::check_supports(study, &fmu).map_err(RunError::from)?;
@@ -68,66 +67,6 @@ pub(crate) fn run_single(
             result.warnings_shown = early.len() + noted;
             Ok(result)
         }
-    }
-}
-
-/// Facts of a run for the summary.
-struct RunFacts {
-    fmu: Option<FmuInfo>,
-    model_runs: usize,
-    runs_new: usize,
-    runs_resumed: usize,
-    failed: usize,
-    wall_time: f64,
-    threads: usize,
-    analysis_time: f64,
-}
-
-fn summary(
-    study: &Study,
-    facts: RunFacts,
-    method: MethodSummary,
-    warnings: Vec<String>,
-    outputs: &[OutputStats],
-    quantities: &[ScalarStats],
-) -> Summary {
-    Summary {
-        study: study.name.clone(),
-        description: study.description.clone(),
-        origin: study.origin.clone(),
-        method,
-        seed: study.seed,
-        experiment: study.experiment.clone(),
-        parameters: study.parameters.clone(),
-        correlation: study.correlation.clone(),
-        fixed: study.fixed.clone(),
-        fmu: facts.fmu,
-        model_runs: facts.model_runs,
-        runs_this_invocation: facts.runs_new,
-        runs_resumed: facts.runs_resumed,
-        failed_runs: facts.failed,
-        wall_time_s: facts.wall_time,
-        threads: facts.threads,
-        versions: Versions::default(),
-        warnings,
-        outputs: outputs
-            .iter()
-            .map(|s| (s.name.clone(), OutputSummary::of(s)))
-            .collect(),
-        quantities: quantities
-            .iter()
-            .map(|q| (q.name.clone(), q.clone()))
-            .collect::<BTreeMap<_, _>>(),
-        timing: Timing {
-            runs_s: facts.wall_time,
-            analysis_s: facts.analysis_time,
-            report_s: 0.0,
-        },
-        units: BTreeMap::new(),
-        record_layout: RecordLayout {
-            outputs: study.outputs.clone(),
-            quantities: study.qoi.iter().map(|q| q.name().to_owned()).collect(),
-        },
     }
 }
 

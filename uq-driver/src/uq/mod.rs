@@ -29,9 +29,6 @@ pub(crate) mod moments;
 pub(crate) mod pce;
 pub(crate) mod quadrature;
 pub(crate) mod random_inputs;
-// Not called by the library yet: the study runner gains its reliability methods next; until
-// then only the unit tests use it.
-#[allow(dead_code, unused_imports)]
 pub(crate) mod reliability;
 pub(crate) mod rng;
 pub(crate) mod sampling;

@@ -4,6 +4,7 @@
 
 mod files;
 mod plots;
+mod reliability;
 mod system;
 
 use crate::report::file_name::stem;
@@ -451,6 +452,9 @@ fn quantity_section(
     summary: &Summary,
     names: &[&str],
 ) -> Result<Section, ReportError> {
+    if reliability::is_adaptive(summary) {
+        return reliability::section(dir, q, summary, names);
+    }
     let name = &q.name;
     let unit = q.unit.as_deref();
     // Means, quantiles and extremes to the resolution the Std allows.

@@ -1,15 +1,30 @@
-//! P(q > limit) as counts with an exact (Clopper–Pearson) interval, so that "0 of N
-//! exceeded" carries its 95 % upper bound instead of a meaningless "0 ± 0".
+//! P(q > limit) and P(q < limit) as counts with an exact (Clopper–Pearson) interval, so
+//! that "0 of N exceeded" carries its 95 % upper bound instead of a meaningless "0 ± 0"; and
+//! the same counts as the `reliability` entries of a quantity.
 
-use crate::results::ExceedanceCount;
+use crate::results::{ExceedanceCount, LimitProbability};
 use crate::uq::method::Draws;
+use crate::uq::reliability::Side;
 
 /// `k` of `n` draws above `limit`, with the Clopper–Pearson 95 % interval of the probability
 /// (`[0, 1 − 0.025^(1/n)]` two-sided when none exceeds; the one-sided 95 % upper bound
 /// `1 − 0.05^(1/n)`, about `3/n`, the rule of three, is given beside it).
+#[cfg(test)]
 pub fn exceedance_count(draws: &[f64], limit: f64, source: Draws) -> ExceedanceCount {
+    count_on_side(draws, limit, Side::Above, source)
+}
+
+/// [`exceedance_count`] on either side: `k` of `n` draws above `limit` (`Side::Above`) or
+/// below it (`Side::Below`).
+pub fn count_on_side(draws: &[f64], limit: f64, side: Side, source: Draws) -> ExceedanceCount {
     let n = draws.len();
-    let k = draws.iter().filter(|&&x| x > limit).count();
+    let k = draws
+        .iter()
+        .filter(|&&x| match side {
+            Side::Above => x > limit,
+            Side::Below => x < limit,
+        })
+        .count();
     let (lo, hi) = clopper_pearson(k, n, 0.05);
     ExceedanceCount {
         limit,
@@ -35,7 +50,76 @@ pub fn exceedance_count(draws: &[f64], limit: f64, source: Draws) -> ExceedanceC
         ci_kind: "clopper_pearson",
         outer_samples: None,
         beyond_runs: None,
+        runs_in_tail: None,
+        direction: crate::results::direction(side),
     }
+}
+
+/// The `reliability` entries of counts (`method`: the study's method kind, for counts over
+/// its runs; counts over draws of a chaos are `chaos`).
+pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<LimitProbability> {
+    counts
+        .iter()
+        .map(|e| {
+            let side = if e.direction == "below" {
+                Side::Below
+            } else {
+                Side::Above
+            };
+            let chaos = e.of_what.contains("chaos");
+            let ci = e.ci_95.iter().all(|v| v.is_finite()).then_some(e.ci_95);
+            let kind = match e.ci_kind {
+                "clopper_pearson" if chaos => {
+                    "Clopper–Pearson of the draws (the surrogate's own error not included)"
+                }
+                "clopper_pearson" => "Clopper–Pearson (exact binomial) of the runs",
+                "outer_bootstrap" => "percentile bootstrap over the outer samples",
+                "outer_student_t" => "Student's t over the outer samples",
+                other => other,
+            };
+            let mut p = LimitProbability::counted(
+                e.limit,
+                side,
+                e.exceeded,
+                e.of,
+                ci,
+                e.upper_95,
+                if chaos { "chaos" } else { method },
+                kind,
+            );
+            if e.outer_samples.is_some() {
+                p.p = e.p;
+            }
+            if let Some([k, n]) = e.runs_in_tail {
+                p.upper_95 = None;
+                p.cov = None;
+                p.warnings.push(format!(
+                    "counted over draws of the chaos surrogate with only {k} of the {n} model \
+                     runs beyond the limit: the chaos's tail there is mostly extrapolation, \
+                     which its truncation-error estimate does not cover, so no interval is \
+                     given; `importance_sampling` estimates it from model runs"
+                ));
+            }
+            if let (Some([lo, hi]), "none_extrapolation") = (e.beyond_runs, e.ci_kind) {
+                // The draws' binomial CoV is not the error of the chaos's tail either.
+                p.upper_95 = None;
+                p.cov = None;
+                p.warnings.push(format!(
+                    "counted over draws of the chaos surrogate with the limit outside the range \
+                     of the model runs ({lo} to {hi}): the chaos's extrapolation, which its \
+                     truncation-error estimate does not cover, so no interval is given; \
+                     `importance_sampling` estimates it from model runs"
+                ));
+            } else if let Some([lo, hi]) = e.beyond_runs {
+                p.warnings.push(format!(
+                    "counted over draws of the inner chaoses with the limit outside the range \
+                     of the model runs ({lo} to {hi}): their extrapolation; the interval covers \
+                     the spread over the outer samples, not the chaoses' error in their tails"
+                ));
+            }
+            p
+        })
+        .collect()
 }
 
 /// A nested study's count: the interval and upper bound from the outer samples

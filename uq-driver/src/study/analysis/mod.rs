@@ -20,7 +20,9 @@ mod surrogate;
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
-pub use exceedance::{exceedance_count, nest_exceedance_count};
+#[cfg(test)]
+pub use exceedance::exceedance_count;
+pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
 
 use blocks::SeriesColumns;
 use columns::{column, Column};
@@ -36,6 +38,7 @@ use crate::results::{
 use crate::spec::{Analysis, Study};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, Sampling, Sobol, Solution};
+use crate::uq::reliability::Side;
 use crate::uq::surrogate::NamedChaos;
 
 /// Offset of the surrogate's random streams from the design's (independent draws).
@@ -50,6 +53,8 @@ pub struct Settings<'a> {
     pub seed: u64,
     /// The names of the random parameters, in study order (labels of Sobol' indices).
     pub parameters: &'a [RandomParameter],
+    /// The method's `kind` (the `method` of probabilities counted over its runs).
+    pub kind: &'a str,
     surrogates: &'a Surrogates,
 }
 
@@ -60,6 +65,7 @@ impl<'a> Settings<'a> {
             analysis: &study.analysis,
             seed: study.seed,
             parameters: &study.parameters,
+            kind: study.method().kind(),
             surrogates,
         }
     }
@@ -376,25 +382,39 @@ fn scalar_stats_counted(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
             (lo.min(x), hi.max(x))
         });
-    let exceedance_counts: Vec<ExceedanceCount> = q
+    let sides = q
         .limits()
         .iter()
-        .map(|&l| {
+        .map(|&l| (l, Side::Above))
+        .chain(q.limits_below().iter().map(|&l| (l, Side::Below)));
+    let exceedance_counts: Vec<ExceedanceCount> = sides
+        .map(|(l, side)| {
             let mut e = match independent {
                 Some((values, of_what)) if estimate.draws == Draws::Runs => {
-                    let mut e = exceedance_count(values, l, Draws::Runs);
+                    let mut e = count_on_side(values, l, side, Draws::Runs);
                     e.of_what = of_what.to_owned();
                     e
                 }
-                _ => exceedance_count(&density_samples, l, estimate.draws),
+                _ => count_on_side(&density_samples, l, side, estimate.draws),
             };
-            // A chaos's draws beyond every model run: its extrapolation alone.
+            // A chaos's draws beyond every model run: its extrapolation alone; or beyond a
+            // handful of them: mostly so.
             e.note_range(estimate.draws, [smallest, largest]);
+            let beyond = runs
+                .valid
+                .iter()
+                .filter(|&&x| match side {
+                    Side::Above => x > l,
+                    Side::Below => x < l,
+                })
+                .count();
+            e.note_tail(estimate.draws, beyond, runs.valid.len());
             e
         })
         .collect();
     let exceedance = exceedance_counts
         .iter()
+        .filter(|e| !e.is_below())
         .map(|e| {
             let se = (e.p * (1.0 - e.p) / e.of as f64).sqrt();
             (e.limit, e.p, se)
@@ -414,7 +434,6 @@ fn scalar_stats_counted(
         min: smallest,
         max: largest,
         exceedance,
-        exceedance_counts,
         pdf_x,
         pdf,
         deterministic,
@@ -439,6 +458,10 @@ fn scalar_stats_counted(
             value: e.values[0],
         }),
         nested: None,
+        reliability: (!exceedance_counts.is_empty())
+            .then(|| counted_probabilities(&exceedance_counts, settings.kind)),
+        exceedance_counts,
+        morris: None,
     })
 }
 

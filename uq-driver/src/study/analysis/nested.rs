@@ -286,6 +286,12 @@ fn quantity(
     {
         nested_count(count, e, &per_outer, stats.draws, range);
     }
+    if !stats.exceedance_counts.is_empty() {
+        stats.reliability = Some(super::counted_probabilities(
+            &stats.exceedance_counts,
+            settings.kind,
+        ));
+    }
     stats.nested = Some(nested);
     let mut warnings: Vec<String> = inner_chaos_warning(name, &cond, None).into_iter().collect();
     warnings.extend((s.var_outer < 0.0).then(|| {

@@ -80,6 +80,12 @@ pub fn study_hash(study: &Study) -> String {
 
 /// The store manifest of `study` on `fmu` with `design`.
 pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, RunError> {
+    manifest_for(study, fmu, design.len())
+}
+
+/// The store manifest of `study` on `fmu` for `n_points` points (an adaptive method: the
+/// most runs it may make).
+pub fn manifest_for(study: &Study, fmu: &Fmu, n_points: usize) -> Result<Manifest, RunError> {
     let iface = crate::study::plan::resolve::interface(study, fmu)?;
     let fmu_sha256 = sha256_file(fmu.path()).map_err(|source| FmuError::Io {
         path: fmu.path().to_path_buf(),
@@ -88,7 +94,7 @@ pub fn manifest(study: &Study, fmu: &Fmu, design: &Design) -> Result<Manifest, R
     Ok(Manifest {
         study_hash: study_hash(study),
         fmu_sha256,
-        n_points: design.len(),
+        n_points,
         n_values: iface.n_values(study.experiment.times().len()),
     })
 }

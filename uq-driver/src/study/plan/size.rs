@@ -361,7 +361,8 @@ fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footpri
         .max(1);
     let shape = Shape::of(study, threads);
     let mut footprint = estimate(&shape, shape.runs);
-    if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
+    let runs_model = !matches!(study.method().evaluation(), Evaluation::Intrusive(_));
+    if let (Some(n), true) = (shape.runs, runs_model) {
         let values = shape.outputs as f64 * shape.time_points + 2.0 * shape.quantities as f64;
         footprint.disk = disk::free_bytes(out_dir).map(|free| Disk {
             store: disk::store_bytes(n, values),
@@ -370,7 +371,7 @@ fn check_one(study: &Study, out_dir: &Path, opts: &RunOptions) -> Result<Footpri
     }
     judge(&footprint, true)?;
     let timed = opts.isolate.is_none() && opts.timeout_per_run.is_none();
-    if let (Some(n), Evaluation::Sampling(_)) = (shape.runs, study.method().evaluation()) {
+    if let (Some(n), true) = (shape.runs, runs_model) {
         let steps = n * (shape.time_points - 1.0).max(1.0) * shape.cost_factor;
         if timed && steps >= PROBE_MIN_STEPS {
             let per_point = probe(study, out_dir).map(|run| run * shape.cost_factor);

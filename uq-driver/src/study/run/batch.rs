@@ -18,60 +18,58 @@ use crate::study::run::isolate::{WorkerFailure, WorkerPool};
 use crate::study::run::worker_fmu::WorkerFmus;
 use crate::study::store::valid::RecordRules;
 use crate::study::store::{Entry, Record, Store};
-use crate::uq::method::Design;
 
 /// Points to run in parallel, each appended to the store as it finishes.
 pub(super) struct Batch<'a> {
     /// The FMU of each worker thread.
-    pub(super) fmus: WorkerFmus<'a>,
-    pub(super) iface: Interface,
+    pub(super) fmus: &'a WorkerFmus<'a>,
+    pub(super) iface: &'a Interface,
     pub(super) study: &'a Study,
-    pub(super) design: &'a Design,
-    pub(super) times: Vec<f64>,
+    pub(super) times: &'a [f64],
     pub(super) store: &'a Store,
     /// Stop at the first failure (failures not allowed, or a weighted design).
     pub(super) stop_on_failure: bool,
-    /// Stop after this many new points.
+    /// Stop after this many new points (counted over every batch of a study: `started`).
     pub(super) max_new: Option<usize>,
+    /// Points started so far by the batches of the study.
+    pub(super) started: &'a AtomicUsize,
     /// `--isolate`: the worker processes.
-    pub(super) workers: Option<WorkerPool>,
+    pub(super) workers: Option<&'a WorkerPool>,
     pub(super) guard: &'a StudyGuard,
     /// How in-process runs get their instance (before the reset self-check: never reused).
     pub(super) policy: InstancePolicy,
     /// Run the first point as the reset self-check, and reuse instances if it passes.
     pub(super) check_reset: bool,
     /// Warnings of the runs, each printed once.
-    pub(super) notes: Notes,
+    pub(super) notes: &'a Notes,
     /// What a successful record must hold; one that does not fails its point.
-    pub(super) rules: RecordRules,
+    pub(super) rules: &'a RecordRules,
     /// The host's stop request and progress counter.
     pub(super) control: Option<&'a RunControl>,
 }
 
-/// Counters shared by the points of a batch.
-#[derive(Default)]
-struct Shared {
-    stop: AtomicBool,
-    started: AtomicUsize,
-}
+/// A point of a batch: its index (in the design, or the run index of an adaptive method)
+/// and its parameter values.
+pub(crate) type Job<'v> = (usize, &'v [f64]);
 
 impl Batch<'_> {
     /// Runs `points`; returns where the result of each finished one is in the store (the
-    /// values are not kept). With [`Batch::check_reset`], the first point runs alone first as
-    /// the reset self-check, which decides whether the others reuse instances.
+    /// values are not kept), and the instance policy the runs used. With
+    /// [`Batch::check_reset`], the first point runs alone first as the reset self-check,
+    /// which decides whether the others (and later batches) reuse instances.
     pub(super) fn run(
         &self,
-        points: &[usize],
+        points: &[Job],
         progress: &Progress,
-    ) -> Result<Vec<(usize, Entry)>, RunError> {
-        let shared = Shared::default();
+    ) -> Result<(Vec<(usize, Entry)>, InstancePolicy), RunError> {
+        let stop = AtomicBool::new(false);
         let mut first = Vec::new();
         let mut policy = self.policy;
         let mut rest = points;
-        if let (true, Some((&i, others))) = (self.check_reset, points.split_first()) {
+        if let (true, Some((&(i, values), others))) = (self.check_reset, points.split_first()) {
             let mut check = ResetCheck::NotRun;
-            first.extend(self.point(i, &shared, progress, || {
-                let (outcome, c) = self.run_checked(i);
+            first.extend(self.point(i, values, &stop, progress, || {
+                let (outcome, c) = self.run_checked(i, values);
                 check = c;
                 outcome
             })?);
@@ -79,7 +77,7 @@ impl Batch<'_> {
                 self.notes.add(w, progress);
             }
             policy.reuse = check.reuse();
-            if let Some(workers) = &self.workers {
+            if let Some(workers) = self.workers {
                 workers.set_reuse(policy.reuse);
             }
             rest = others;
@@ -89,12 +87,16 @@ impl Batch<'_> {
             .with_min_len(1)
             .map_init(
                 || Slot::new(policy, false),
-                |slot, &i| self.point(i, &shared, progress, || self.run_one(slot, i, progress)),
+                |slot, &(i, values)| {
+                    self.point(i, values, &stop, progress, || {
+                        self.run_one(slot, i, values, progress)
+                    })
+                },
             )
             .filter_map(Result::transpose)
             .collect::<Result<_, _>>()?;
         first.extend(new);
-        Ok(first)
+        Ok((first, policy))
     }
 
     /// Runs point `i` by `run` unless the batch stopped, stores its record and says whether
@@ -102,16 +104,16 @@ impl Batch<'_> {
     fn point(
         &self,
         i: usize,
-        shared: &Shared,
+        values: &[f64],
+        stop: &AtomicBool,
         progress: &Progress,
         run: impl FnOnce() -> Result<Outcome, RunError>,
     ) -> Result<Option<(usize, Entry)>, RunError> {
-        let stop = &shared.stop;
         if stop.load(Ordering::Relaxed) || self.control.is_some_and(RunControl::stopped) {
             return Ok(None);
         }
         if let Some(max) = self.max_new {
-            if shared.started.fetch_add(1, Ordering::SeqCst) >= max {
+            if self.started.fetch_add(1, Ordering::SeqCst) >= max {
                 stop.store(true, Ordering::Relaxed);
                 return Ok(None);
             }
@@ -141,27 +143,28 @@ impl Batch<'_> {
         if let Some(message) = fatal {
             return Err(RunError::Fatal {
                 point: i,
-                values: describe_values(self.study, &self.design.values[i]),
+                values: describe_values(self.study, values),
                 message,
             });
         }
-        if let Some(why) = self
-            .workers
-            .as_ref()
-            .and_then(WorkerPool::take_reset_failure)
-        {
+        if let Some(why) = self.workers.and_then(WorkerPool::take_reset_failure) {
             self.notes.reset_failed(&why, progress);
         }
         Ok(Some((i, entry)))
     }
 
     /// Runs point `i` in-process (on `slot`'s instance) or in a worker process.
-    fn run_one(&self, slot: &mut Slot, i: usize, progress: &Progress) -> Result<Outcome, RunError> {
-        let values = &self.design.values[i];
+    fn run_one(
+        &self,
+        slot: &mut Slot,
+        i: usize,
+        values: &[f64],
+        progress: &Progress,
+    ) -> Result<Outcome, RunError> {
         let _running = self.guard.running(i, describe_values(self.study, values));
-        let Some(workers) = &self.workers else {
+        let Some(workers) = self.workers else {
             let fmu = self.fmus.current()?;
-            let result = run_point(&fmu, slot, &self.iface, values, &self.times);
+            let result = run_point(&fmu, slot, self.iface, values, self.times);
             if let Some(why) = slot.take_reset_failure() {
                 self.notes.reset_failed(&why, progress);
             }
@@ -172,10 +175,9 @@ impl Batch<'_> {
 
     /// Runs point `i` as the reset self-check: on a fresh instance (its record is the point's),
     /// then again after `fmi2Reset` of that instance, each run timed on its own.
-    fn run_checked(&self, i: usize) -> (Result<Outcome, RunError>, ResetCheck) {
-        let values = &self.design.values[i];
+    fn run_checked(&self, i: usize, values: &[f64]) -> (Result<Outcome, RunError>, ResetCheck) {
         let running = || self.guard.running(i, describe_values(self.study, values));
-        let Some(workers) = &self.workers else {
+        let Some(workers) = self.workers else {
             let fmu = match self.fmus.current() {
                 Ok(f) => f,
                 Err(e) => return (Err(e.into()), ResetCheck::NotRun),
@@ -183,7 +185,7 @@ impl Batch<'_> {
             let mut slot = Slot::new(self.policy, false);
             let first = {
                 let _running = running();
-                run_point(&fmu, &mut slot, &self.iface, values, &self.times)
+                run_point(&fmu, &mut slot, self.iface, values, self.times)
             };
             let Ok(record) = &first else {
                 return (Ok(in_process(first)), ResetCheck::NotRun);
@@ -191,12 +193,7 @@ impl Batch<'_> {
             let (check, fatal) = {
                 let _running = running();
                 crate::study::run::point::check_reset(
-                    &fmu,
-                    &mut slot,
-                    &self.iface,
-                    values,
-                    &self.times,
-                    record,
+                    &fmu, &mut slot, self.iface, values, self.times, record,
                 )
             };
             // Freed before the other points start (an FMU instantiable once per process).

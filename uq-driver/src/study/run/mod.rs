@@ -13,30 +13,28 @@ pub mod instances;
 pub mod isolate;
 pub mod options;
 pub mod point;
+pub(crate) mod session;
 mod speed_runs;
 pub mod worker_fmu;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use crate::fmu::Fmu;
 use crate::spec::Study;
 use crate::study::plan::fingerprint;
 use crate::study::plan::interface::Interface;
-use crate::study::progress::{Progress, ProgressMode};
 use crate::study::store::lock::FolderLock;
 use crate::study::store::valid::RecordRules;
-use crate::study::store::{Entry, Store, StoreError, StoredRuns};
+use crate::study::store::{Entry, StoreError, StoredRuns};
 use crate::uq::method::Design;
-use batch::{Batch, Notes};
+pub(crate) use batch::Job;
 pub use error::{FailedPoint, PointError, RunError};
 use guard::StudyGuard;
-use instances::InstancePolicy;
-use isolate::{IsolateOptions, WorkerPool};
 pub use options::{RunControl, RunOptions};
 pub use point::{simulate, simulate_with, Simulation};
-use worker_fmu::WorkerFmus;
+pub(crate) use session::Session;
 
 /// What a run produced: every point's record, in design order, read in place from the
 /// results store (the series of the runs are not held in memory).
@@ -83,24 +81,10 @@ pub fn run_points(
             design.len().saturating_sub(1)
         )));
     }
-    let started = Instant::now();
     let manifest = fingerprint::manifest(study, fmu, design)?;
-    prepare_out_dir(out_dir)?;
-    let lock = FolderLock::acquire(out_dir)?;
-    if let Some(previous) = lock.taken_over() {
-        crate::study::progress::message(&format!(
-            "note: {} was locked by a run that is no longer running ({previous}); taking it over",
-            out_dir.display()
-        ));
-    }
-    let iface = crate::study::plan::resolve::interface(study, fmu)?;
-    let times = study.times();
-    let rules = record_rules(&iface, &times);
-    let (store, mut runs) = Store::open_checked(out_dir, &manifest, opts.fresh, Some(&rules))?;
-    let records = runs.entries();
-    if let Some(note) = store.recovery().summary() {
-        crate::study::progress::message(&format!("warning: {note}"));
-    }
+    let stop_on_failure = !opts.allow_failures(study) || design.is_weighted();
+    let mut session = Session::open(study, fmu, manifest, out_dir, opts, stop_on_failure)?;
+    let records = session.runs.entries();
     let wanted: Vec<usize> = match &opts.points {
         Some(p) => p.clone(),
         None => (0..design.len()).collect(),
@@ -127,78 +111,26 @@ pub fn run_points(
             Some(Entry::Ok(_)) => false,
         })
         .collect();
-    let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(RunError::Pool)?;
-    iface.check_design(fmu, &design.values)?;
-    crate::study::plan::interface::check_step_sizes(fmu, &times)?;
-    let policy = InstancePolicy {
-        reuse: false,
-        logging_on: opts.fmu_logging,
-    };
-    let workers = opts.isolate.as_ref().map(|exe| {
-        WorkerPool::new(
-            IsolateOptions {
-                exe: exe.clone(),
-                timeout: opts.timeout_per_run,
-            },
-            &isolate::setup(fmu, &iface, &times, policy),
-        )
-    });
-    let guard = StudyGuard::begin(&study.name, out_dir, workers.is_none());
-    let batch = Batch {
-        fmus: WorkerFmus::new(fmu, threads),
-        iface,
-        study,
-        design,
-        times,
-        store: &store,
-        stop_on_failure: !opts.allow_failures(study) || design.is_weighted(),
-        max_new: opts.max_new_points,
-        workers,
-        guard: &guard,
-        policy,
-        check_reset: !opts.fresh_instances && missing.len() >= 2,
-        notes: Notes::default(),
-        rules,
-        control: opts.control.as_deref(),
-    };
+    session.iface.check_design(fmu, &design.values)?;
+    let jobs: Vec<Job> = missing
+        .iter()
+        .map(|&i| (i, design.values[i].as_slice()))
+        .collect();
     if let Some(c) = &opts.control {
         c.begin(missing.len());
     }
-    let mode = match (opts.progress, opts.progress_lines) {
-        (true, _) => ProgressMode::Bar,
-        (false, true) => ProgressMode::Lines,
-        _ => ProgressMode::Off,
-    };
-    let progress = Progress::new(mode, missing.len());
-    let done = AtomicBool::new(false);
-    let new = std::thread::scope(|scope| {
-        // In-process, only with the process guards (checked by `opts.check()` above).
-        if let (Some(limit), None) = (opts.timeout_per_run, &batch.workers) {
-            let (guard, done) = (&guard, &done);
-            scope.spawn(move || watchdog(guard, limit, done));
-        }
-        let new = pool.install(|| batch.run(&missing, &progress));
-        done.store(true, Ordering::Release);
-        new
-    })?;
-    progress.finish();
-    let warnings = batch.notes.into_warnings();
-    let n_new = new.len();
-    for (i, e) in new {
-        runs.set(i, e);
-    }
+    session.run(&jobs)?;
+    let (n_new, threads, opened) = (session.new, session.threads, session.opened);
+    let fmu_sha256 = session.manifest.fmu_sha256.clone();
+    let (runs, lock, warnings) = session.into_warnings();
     Ok(RunOutcome {
         runs,
         _lock: Some(lock),
         n_new,
         n_resumed: wanted.len() - missing.len(),
-        wall_time: started.elapsed().as_secs_f64(),
+        wall_time: opened.elapsed().as_secs_f64(),
         threads,
-        fmu_sha256: manifest.fmu_sha256,
+        fmu_sha256,
         warnings,
     })
 }

@@ -57,6 +57,59 @@ pub enum MethodError {
         /// Points of the design.
         total: usize,
     },
+    /// A run an adaptive method needs failed (every run of FORM and SORM; those of
+    /// importance sampling and subset simulation unless failed runs count as failures).
+    #[error(
+        "{target}: run {run} failed at {}: {message}. The runs before it are kept in the \
+         results store; run again with --retry-failed (RunOptions::retry_failed) to run it \
+         again once the cause is fixed",
+        named_values(.values)
+    )]
+    RunFailed {
+        /// The probability being estimated, e.g. `P(v_hunt < 60)`.
+        target: String,
+        /// The run index.
+        run: u64,
+        /// The physical inputs of the run, by name.
+        values: Vec<(String, f64)>,
+        /// What the model reported.
+        message: String,
+    },
+    /// FORM found no search direction: the gradient of the limit state is zero or not
+    /// finite at a point.
+    #[error(
+        "{target}: the gradient of the limit state is zero or not finite at {} (|grad g| = \
+         {norm} in standard normal space): FORM has no search direction there (a quantity \
+         that does not change with the inputs, or finite-difference steps below the model's \
+         resolution: raise `step`)",
+        named_values(.values)
+    )]
+    NoSearchDirection {
+        /// The probability being estimated.
+        target: String,
+        /// The physical inputs of the point, by name.
+        values: Vec<(String, f64)>,
+        /// The norm of the finite-difference gradient.
+        norm: f64,
+    },
+    /// An adaptive method was stopped from outside (a budget of runs, a fatal error of the
+    /// model) or the runs stored by an earlier invocation do not match those requested now.
+    #[error("{target}: {why}")]
+    Stopped {
+        /// The probability being estimated (or the method).
+        target: String,
+        /// Why.
+        why: String,
+    },
+}
+
+/// `K = 1.5, C = 20`.
+fn named_values(values: &[(String, f64)]) -> String {
+    values
+        .iter()
+        .map(|(n, v)| format!("{n} = {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 impl From<InvalidSystem> for InvalidSettings {

@@ -7,7 +7,11 @@
 //!   model at every point; the method's estimator turns a results matrix (points × columns:
 //!   the time steps of an output, or one scalar quantity) into an [`Estimate`];
 //! - an [`Intrusive`] method solves a projected system itself and returns one [`Estimate`]
-//!   per output ([`Solution`]).
+//!   per output ([`Solution`]);
+//! - an adaptive method ([`Evaluation::Adaptive`]: the reliability methods [`form`],
+//!   [`sorm`], [`importance_sampling`], [`subset`], and [`morris`] screening) asks for batches
+//!   of points as it goes; the study runs each batch through its runner and stores every run
+//!   (see `adaptive`).
 //!
 //! An [`Estimate`] holds moments per column, optionally a chaos surrogate (evaluable and
 //! sampleable), Sobol' indices and standard errors, and says where densities and quantiles
@@ -31,6 +35,7 @@
 //! - a nested study: the product of an outer and an inner design, and for every outer sample
 //!   the inner method's own [`Sampling::estimate`] on that sample's rows.
 
+pub(crate) mod adaptive;
 mod chaos;
 mod design;
 mod error;
@@ -40,18 +45,22 @@ mod traits;
 
 use serde::{Deserialize, Serialize};
 
+pub use adaptive::FailedRuns;
 pub use chaos::ChaosBasis;
 pub use design::Design;
 pub use error::{InvalidSettings, MethodError};
 pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
-    details, hyperbolic_terms, ChaosFit, Evaluation, Intrusive, KindNotes, Method, MethodSummary,
-    Problem, Sampling, Solution,
+    details, hyperbolic_terms, AdaptiveMethod, ChaosFit, Evaluation, Intrusive, KindNotes, Method,
+    MethodSummary, Problem, Sampling, Solution,
 };
 
 // The method modules: declared here, not by the macro below, so that rustfmt reaches them.
+pub mod form;
+pub mod importance_sampling;
 pub mod lhs;
 pub mod mc;
+pub mod morris;
 pub mod nested;
 pub mod nominal;
 pub mod pce_regression;
@@ -59,7 +68,9 @@ pub mod qmc;
 pub mod scm;
 pub mod sgm;
 pub mod sobol_sampling;
+pub mod sorm;
 pub mod sparse_grid;
+pub mod subset;
 
 /// Builds the `[method]` table from the list of methods: one line per method, `module::Type`,
 /// the module's name being the `kind` of study files.
@@ -114,6 +125,11 @@ methods! {
     sparse_grid::SparseGrid,
     pce_regression::PceRegression,
     nested::Nested,
+    form::Form,
+    sorm::Sorm,
+    importance_sampling::ImportanceSampling,
+    subset::Subset,
+    morris::Morris,
 }
 
 impl MethodSpec {

@@ -4,6 +4,7 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use super::adaptive::{AdaptiveResult, BatchModel, Target};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
@@ -120,6 +121,57 @@ pub enum Evaluation<'a> {
     Sampling(&'a dyn Sampling),
     /// The method solves its own projected system; the model is not run.
     Intrusive(&'a dyn Intrusive),
+    /// The method chooses its points as it goes, a batch at a time (the reliability methods
+    /// `form`, `sorm`, `importance_sampling`, `subset`), or runs one batch of points that
+    /// are not samples of the inputs' law (`morris`); the study runs every batch and
+    /// stores every run.
+    Adaptive(AdaptiveMethod<'a>),
+}
+
+/// An adaptive method, as the study runs it (opaque: the study runs it batch by batch
+/// through its runner and results store).
+#[derive(Clone, Copy)]
+pub struct AdaptiveMethod<'a>(pub(crate) &'a dyn Adaptive);
+
+impl AdaptiveMethod<'_> {
+    /// Whether the method estimates probabilities, so that the study needs `limits` or
+    /// `limits_below` (a screening method does not).
+    pub fn needs_limits(&self) -> bool {
+        self.0.needs_limits()
+    }
+}
+
+/// A method of [`Evaluation::Adaptive`]: it asks for batches of points of the independent
+/// standard normal space through a [`BatchModel`] and numbers its runs, so that a study
+/// can store each and resume by replaying them (see `adaptive`).
+pub(crate) trait Adaptive: Method {
+    /// At most how many runs the method makes for `dim` inputs and `targets` probabilities
+    /// (the capacity of the results store).
+    fn max_runs(&self, dim: usize, targets: usize) -> usize;
+
+    /// About how many runs it makes (for the size and time estimate before a study).
+    fn expected_runs(&self, dim: usize, targets: usize) -> f64;
+
+    /// Whether it estimates probabilities (and so needs limits).
+    fn needs_limits(&self) -> bool {
+        true
+    }
+
+    /// The quantities it is restricted to (empty: all).
+    fn only(&self) -> &[String] {
+        &[]
+    }
+
+    /// Runs the method on `model` for `targets` (one probability each; the quantities by
+    /// name in record order are `names`), deterministic in `seed`.
+    fn run(
+        &self,
+        model: &mut dyn BatchModel,
+        inputs: &RandomInputs,
+        targets: &[Target],
+        names: &[String],
+        seed: u64,
+    ) -> Result<AdaptiveResult, MethodError>;
 }
 
 /// A UQ method as the study runner and the report see it.
@@ -190,6 +242,9 @@ pub struct KindNotes {
     pub truncation: Option<&'static str>,
     /// The method's name in a sentence ("an SGM study").
     pub name: Option<&'static str>,
+    /// The method chooses its runs, which are not samples of the inputs' law (the
+    /// reliability methods, Morris screening): no moments, densities or quantiles.
+    pub adaptive: bool,
 }
 
 /// A method that runs the model at the points of a design.

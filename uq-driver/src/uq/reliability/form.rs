@@ -306,7 +306,8 @@ pub(crate) fn search(
              took its smallest step (noisy model values? try larger finite-difference steps)"
         ));
     }
-    if min_g > 0.0 {
+    // A converged search stands on the surface (|g| within the tolerance, either side).
+    if min_g > 0.0 && !converged {
         warnings.push(format!(
             "no run of FORM reached the failure domain (smallest g = {min_g:.4e})"
         ));

@@ -172,7 +172,7 @@ pub fn importance_sampling(
         ));
     } else if !reached_target {
         warnings.push(format!(
-            "the CoV {:.3} did not reach the target {} in {n} runs ({failures} failing samples)",
+            "the CoV {:.4} did not reach the target {} in {n} runs ({failures} failing samples)",
             cov.unwrap_or(f64::NAN),
             settings.target_cov
         ));

@@ -64,19 +64,16 @@ mod fixtures;
 mod tests;
 
 pub use error::ReliabilityError;
-pub use form::{form, Form, FormIteration, FormResult};
+pub use form::{form, Form, FormResult};
 pub use gradient::{Differences, Scheme};
-pub use importance::{
-    importance_sampling, ImportanceSampling, ImportanceSamplingResult, ImportanceStep,
-};
-pub use model::{
-    Abort, FnLimitState, LimitState, OnFailure, Outcome, PhysicalLimitState, Point, Replay, Side,
-    StoredRun, Threshold,
-};
-pub use morris::{Morris, MorrisDesign, MorrisResult, Trajectory};
-pub use multistart::{form_multistart, DesignPoint, MultiStart, MultiStartResult, Start};
+pub use importance::{importance_sampling, ImportanceSampling, ImportanceSamplingResult};
+pub use model::{Abort, LimitState, OnFailure, Outcome, Point, Side, Threshold};
+#[cfg(test)]
+pub use model::{PhysicalLimitState, Replay, StoredRun};
+pub use morris::{Morris, MorrisDesign, MorrisResult};
+pub use multistart::{form_multistart, MultiStart, MultiStartResult};
 pub use sorm::{sorm, Sorm, SormResult};
-pub use subset::{subset_simulation, Spread, Subset, SubsetLevel, SubsetResult};
+pub use subset::{subset_simulation, Spread, Subset, SubsetResult};
 
 use rand_chacha::ChaCha20Rng;
 

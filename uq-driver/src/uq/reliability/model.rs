@@ -1,13 +1,16 @@
 //! The model as the reliability methods see it: a batch evaluator of a limit state in
 //! standard normal space, its physical-space adapter, and the replay of stored runs.
 
+#[cfg(test)]
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
 pub use super::error::Abort;
 use super::error::ReliabilityError;
+#[cfg(test)]
 use crate::uq::distributions::Germ;
+#[cfg(test)]
 use crate::uq::random_inputs::RandomInputs;
 
 /// The result of one run: the value of the limit state `g` (or of the quantity, for a
@@ -40,12 +43,14 @@ pub trait LimitState {
     }
 }
 
+#[cfg(test)]
 /// A limit state from a closure of one point (analytic models, tests).
 pub struct FnLimitState<F> {
     dim: usize,
     g: F,
 }
 
+#[cfg(test)]
 impl<F: FnMut(&[f64]) -> Outcome> FnLimitState<F> {
     /// `g` in `dim` coordinates.
     pub fn new(dim: usize, g: F) -> Self {
@@ -53,6 +58,7 @@ impl<F: FnMut(&[f64]) -> Outcome> FnLimitState<F> {
     }
 }
 
+#[cfg(test)]
 impl<F: FnMut(&[f64]) -> Outcome> LimitState for FnLimitState<F> {
     fn dim(&self) -> usize {
         self.dim
@@ -93,6 +99,7 @@ impl Threshold {
     }
 }
 
+#[cfg(test)]
 /// A model of the physical inputs made a limit state in standard normal space:
 /// `x = T(u)` by [`RandomInputs::to_physical`] with [`Germ::Normal`] (each input's
 /// `F^-1(Phi(.))`, correlated inputs through the Gaussian copula), `q = model(x)`, and `g`
@@ -107,6 +114,7 @@ pub struct PhysicalLimitState<'a, F> {
     model: F,
 }
 
+#[cfg(test)]
 impl<'a, F> PhysicalLimitState<'a, F>
 where
     F: FnMut(&[(u64, Vec<f64>)]) -> Result<Vec<Outcome>, Abort>,
@@ -121,6 +129,7 @@ where
     }
 }
 
+#[cfg(test)]
 impl<F> LimitState for PhysicalLimitState<'_, F>
 where
     F: FnMut(&[(u64, Vec<f64>)]) -> Result<Vec<Outcome>, Abort>,
@@ -145,6 +154,7 @@ where
     }
 }
 
+#[cfg(test)]
 /// A finished run as a runner stores it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StoredRun {
@@ -154,6 +164,7 @@ pub struct StoredRun {
     pub outcome: Outcome,
 }
 
+#[cfg(test)]
 /// A limit state that answers the runs it has stored and forwards the others to `inner`,
 /// storing their outcomes too: the resume of a method after a kill (see the module
 /// documentation of [`crate::uq::reliability`]).
@@ -166,6 +177,7 @@ pub struct Replay<'a> {
     replayed: usize,
 }
 
+#[cfg(test)]
 impl<'a> Replay<'a> {
     /// Replays `stored` (run index to run) in front of `inner`.
     pub fn new(inner: &'a mut dyn LimitState, stored: BTreeMap<u64, StoredRun>) -> Self {
@@ -174,11 +186,6 @@ impl<'a> Replay<'a> {
             runs: stored,
             replayed: 0,
         }
-    }
-
-    /// Every run so far, stored and new.
-    pub fn runs(&self) -> &BTreeMap<u64, StoredRun> {
-        &self.runs
     }
 
     /// The runs answered from the store.
@@ -192,6 +199,7 @@ impl<'a> Replay<'a> {
     }
 }
 
+#[cfg(test)]
 impl LimitState for Replay<'_> {
     fn dim(&self) -> usize {
         self.inner.dim()

@@ -30,7 +30,9 @@ use serde::{Deserialize, Serialize};
 use super::error::ReliabilityError;
 use super::model::Outcome;
 use super::{stream, Purpose};
+#[cfg(test)]
 use crate::uq::distributions::Germ;
+#[cfg(test)]
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::rng;
 
@@ -161,6 +163,7 @@ impl MorrisDesign {
     }
 
     /// Every point as physical values of `inputs`, in run order.
+    #[cfg(test)]
     pub fn physical(&self, inputs: &RandomInputs) -> Vec<Vec<f64>> {
         self.points()
             .iter()

@@ -9,6 +9,8 @@
  *   3 g-function    y = prod_{i=1..8} (|4 x_i - 2| + a_i) / (1 + a_i)
  *   4 two-level     y = f_x + sigma_h h_seed, f_x = x1 + x2^2, h_seed = a standard normal
  *                   obtained by hashing the Integer parameter `seed` (SplitMix64 + Box-Muller)
+ *   5 linear        y = x1 + x2 + ... + x8 (closed-form tails for normal inputs)
+ *   6 sum of squares y = x1^2 + x2^2 + ... + x8^2 (a chi-square for standard normal inputs)
  * y is computed once at the end of initialization; the time-varying output is
  * y_t = y (1 + t). f_x and h_seed are outputs too (for the other functions f_x = y, h_seed = 0).
  * One fmi2DoStep is an addition and a multiplication.
@@ -22,7 +24,7 @@
 #define PI 3.14159265358979323846
 #define GUID "{d6f1c9a4-5b3e-4f1a-8c2d-railuq-test-functions}"
 
-enum { ISHIGAMI = 1, BOREHOLE = 2, G_FUNCTION = 3, TWO_LEVEL = 4 };
+enum { ISHIGAMI = 1, BOREHOLE = 2, G_FUNCTION = 3, TWO_LEVEL = 4, LINEAR = 5, SQUARES = 6 };
 
 typedef struct {
     fmi2Integer function;
@@ -75,7 +77,7 @@ static const Variable VARIABLES[] = {
     REAL_PARAMETER("a8", 30, g_a[7]),
     REAL_PARAMETER("sigma_h", 31, sigma_h),
     {"function", TYPE_INTEGER, 0, KIND_FIXED_PARAMETER, offsetof(Data, function), 1, ISHIGAMI,
-     TWO_LEVEL},
+     SQUARES},
     {"seed", TYPE_INTEGER, 1, KIND_FIXED_PARAMETER, offsetof(Data, seed), 0, 0, 0},
 };
 
@@ -152,6 +154,13 @@ static void calculate(Instance *inst) {
         d->f_x = d->x[0] + d->x[1] * d->x[1];
         d->h_seed = hashed_normal(d->seed);
         break;
+    case LINEAR:
+    case SQUARES: {
+        int i;
+        d->f_x = 0.0;
+        for (i = 0; i < 8; i++) d->f_x += d->function == LINEAR ? d->x[i] : d->x[i] * d->x[i];
+        break;
+    }
     default: d->f_x = NAN; break;
     }
     d->y = d->f_x + d->sigma_h * d->h_seed;

@@ -52,7 +52,7 @@ impl ChaosShape {
         let dim = study.parameters.len();
         let fit = match study.method().evaluation() {
             Evaluation::Sampling(m) => m.chaos_fit(&study.parameters)?,
-            Evaluation::Intrusive(_) => return None,
+            Evaluation::Intrusive(_) | Evaluation::Adaptive(_) => return None,
         };
         let a = &study.analysis;
         let series = if study.outputs.is_empty() {

@@ -61,6 +61,15 @@ impl Shape {
                 m.whole_series(),
             ),
             Evaluation::Intrusive(_) => (Some(0.0), true, true, false),
+            Evaluation::Adaptive(a) => {
+                let targets = study.adaptive_targets().map_or(0, |t| t.len());
+                (
+                    Some(a.0.expected_runs(study.parameters.len(), targets)),
+                    false,
+                    false,
+                    false,
+                )
+            }
         };
         let mut signals: Vec<&str> = study.outputs.iter().map(String::as_str).collect();
         for s in study.qoi.iter().flat_map(|q| q.signals()) {

@@ -136,7 +136,7 @@ impl Conditional {
 fn sampling(spec: &MethodSpec) -> Option<&dyn Sampling> {
     match spec.method().evaluation() {
         Evaluation::Sampling(s) => Some(s),
-        Evaluation::Intrusive(_) => None,
+        Evaluation::Intrusive(_) | Evaluation::Adaptive(_) => None,
     }
 }
 
@@ -519,7 +519,7 @@ impl Sampling for Nested {
         let count = |spec: &MethodSpec, params: &[RandomParameter]| match spec.method().evaluation()
         {
             Evaluation::Sampling(m) => m.planned_runs_for(params),
-            Evaluation::Intrusive(_) => None,
+            Evaluation::Intrusive(_) | Evaluation::Adaptive(_) => None,
         };
         Some(count(&self.outer, &outer)? * count(&self.inner, &inner)?)
     }
@@ -529,6 +529,7 @@ impl Sampling for Nested {
         match self.inner.method().evaluation() {
             Evaluation::Sampling(m) => m.draws_from_chaos(),
             Evaluation::Intrusive(_) => true,
+            Evaluation::Adaptive(_) => false,
         }
     }
 

@@ -1,0 +1,217 @@
+//! Small probabilities and screening in `summary.json`: `quantities.NAME.reliability` (one
+//! entry per limit, every method that gives probabilities) and `quantities.NAME.morris`.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::uq::method::adaptive::{generalised_beta, LimitResult, Screening};
+use crate::uq::reliability::Side;
+
+/// One probability of a quantity against a limit (`quantities.NAME.reliability[k]` in
+/// `summary.json`). Fields a method does not give are `null`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct LimitProbability {
+    /// The limit, in the quantity's unit.
+    pub limit: f64,
+    /// `above` (`P(q > limit)`, the quantity's `limits`) or `below` (`P(q < limit)`, its
+    /// `limits_below`).
+    pub direction: &'static str,
+    /// The estimate of the probability.
+    pub p: f64,
+    /// Its 95 % interval (`null` where the method gives none, e.g. FORM and SORM, which have
+    /// no error estimate).
+    pub ci_95: Option<[f64; 2]>,
+    /// Its coefficient of variation (sampling methods).
+    pub cov: Option<f64>,
+    /// Reliability index: FORM's `β` (`form`, `sorm`, and `importance_sampling` after
+    /// FORM), else the generalised index `−Φ⁻¹(p)`.
+    pub beta: Option<f64>,
+    /// FORM's design point in physical units, by parameter name.
+    pub design_point: Option<BTreeMap<String, f64>>,
+    /// FORM's importance factors `α_i²` by parameter name (sum 1; with correlated inputs
+    /// those of the independent coordinates in the order of `[[parameters]]`).
+    pub importance: Option<BTreeMap<String, f64>>,
+    /// Model runs this probability took (or the runs / draws counted, for a sampling
+    /// method).
+    pub runs: usize,
+    /// The method that gave `p`: `form`, `sorm`, `importance_sampling`, `subset`, or the
+    /// sampling method's kind (counted over its runs), or `chaos` (counted over draws of a
+    /// chaos surrogate).
+    pub method: String,
+    /// A one-sided 95 % upper bound of `p` when no run (or draw) failed; `null` otherwise.
+    pub upper_95: Option<f64>,
+    /// How `ci_95` was found, in words.
+    pub ci_kind: Option<String>,
+    /// What the method reported besides (the FORM iterations, the SORM curvatures, the
+    /// importance-sampling and subset histories, the multi-start design points), under
+    /// the keys `form`, `sorm`, `importance_sampling`, `subset`, `multistart`.
+    #[serde(flatten)]
+    pub details: serde_json::Map<String, serde_json::Value>,
+    /// Warnings of this probability.
+    pub warnings: Vec<String>,
+    /// The method's own result (the report's plots).
+    #[serde(skip)]
+    pub(crate) result: Option<Box<LimitResult>>,
+}
+
+/// `above` or `below`.
+pub(crate) fn direction(side: Side) -> &'static str {
+    match side {
+        Side::Above => "above",
+        Side::Below => "below",
+    }
+}
+
+impl LimitProbability {
+    /// The entry of an adaptive method's result, the parameters named by `names`.
+    pub(crate) fn of(r: &LimitResult, names: &[&str]) -> LimitProbability {
+        let by_name = |v: &[f64]| -> BTreeMap<String, f64> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().copied())
+                .collect()
+        };
+        let mut details = serde_json::Map::new();
+        let mut put = |key: &str, v: Option<serde_json::Value>| {
+            if let Some(v) = v {
+                details.insert(key.to_owned(), v);
+            }
+        };
+        put(
+            "form",
+            r.form.as_ref().and_then(|f| serde_json::to_value(f).ok()),
+        );
+        put(
+            "sorm",
+            r.sorm.as_ref().and_then(|f| serde_json::to_value(f).ok()),
+        );
+        put(
+            "importance_sampling",
+            r.importance_sampling
+                .as_ref()
+                .and_then(|f| serde_json::to_value(f).ok()),
+        );
+        put(
+            "subset",
+            r.subset.as_ref().and_then(|f| serde_json::to_value(f).ok()),
+        );
+        put(
+            "multistart",
+            r.multistart
+                .as_ref()
+                .and_then(|f| serde_json::to_value(f).ok()),
+        );
+        let ci_kind = r.ci_95.map(|_| match r.method {
+            "subset" => "log-normal on the CoV of fully correlated levels (conservative)".into(),
+            _ => "log-normal with the estimated CoV".into(),
+        });
+        LimitProbability {
+            limit: r.target.threshold.limit,
+            direction: direction(r.target.threshold.side),
+            p: r.probability,
+            ci_95: r.ci_95,
+            cov: r.cov,
+            beta: r.beta,
+            design_point: r.design_point.as_ref().map(|(_, x)| by_name(x)),
+            importance: r.importance.as_deref().map(by_name),
+            runs: r.runs as usize,
+            method: r.method.to_owned(),
+            upper_95: r.upper_95,
+            ci_kind,
+            details,
+            warnings: r.warnings.clone(),
+            result: Some(Box::new(r.clone())),
+        }
+    }
+
+    /// The entry of a probability counted over `of` runs or draws (`k` of them on the failing
+    /// side), with its interval `ci_95` (of kind `ci_kind`) and upper bound.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn counted(
+        limit: f64,
+        side: Side,
+        k: usize,
+        of: usize,
+        ci_95: Option<[f64; 2]>,
+        upper_95: f64,
+        method: &str,
+        ci_kind: &str,
+    ) -> LimitProbability {
+        let p = if of == 0 {
+            f64::NAN
+        } else {
+            k as f64 / of as f64
+        };
+        LimitProbability {
+            limit,
+            direction: direction(side),
+            p,
+            ci_95,
+            cov: (k > 0).then(|| ((1.0 - p) / (of as f64 * p)).sqrt()),
+            beta: generalised_beta(p),
+            design_point: None,
+            importance: None,
+            runs: of,
+            method: method.to_owned(),
+            upper_95: (k == 0).then_some(upper_95),
+            ci_kind: ci_95.map(|_| ci_kind.to_owned()),
+            details: serde_json::Map::new(),
+            warnings: Vec::new(),
+            result: None,
+        }
+    }
+
+    /// `P(v_hunt < 60)`.
+    pub fn label(&self, quantity: &str) -> String {
+        let op = if self.direction == "below" { "<" } else { ">" };
+        format!("P({quantity} {op} {})", self.limit)
+    }
+}
+
+/// Morris's screening measures of a quantity (`quantities.NAME.morris`), by parameter name,
+/// per unit of probability level of each input.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct MorrisScreening {
+    /// Mean absolute elementary effect `μ*` (the ranking measure).
+    pub mu_star: BTreeMap<String, f64>,
+    /// Standard deviation of the elementary effects `σ` (non-linearity, interactions).
+    pub sigma: BTreeMap<String, f64>,
+    /// Mean elementary effect `μ`.
+    pub mu: BTreeMap<String, f64>,
+    /// The parameters by decreasing `μ*`.
+    pub ranking: Vec<String>,
+    /// Elementary effects per parameter (fewer than the trajectories where runs failed).
+    pub effects: BTreeMap<String, usize>,
+    /// Warnings.
+    pub warnings: Vec<String>,
+}
+
+impl MorrisScreening {
+    /// The entry of a screening, the parameters named by `names`.
+    pub(crate) fn of(s: &Screening, names: &[&str]) -> MorrisScreening {
+        let m = &s.morris;
+        let by_name = |v: &[f64]| -> BTreeMap<String, f64> {
+            names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().copied())
+                .collect()
+        };
+        MorrisScreening {
+            mu_star: by_name(&m.mu_star),
+            sigma: by_name(&m.sigma),
+            mu: by_name(&m.mu),
+            ranking: m.ranking.iter().map(|&i| names[i].to_owned()).collect(),
+            effects: names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(m.effects.iter().copied())
+                .collect(),
+            warnings: m.warnings.clone(),
+        }
+    }
+}

@@ -1,0 +1,477 @@
+//! Small probabilities from a study file: `kind = "form" | "sorm" | "importance_sampling" |
+//! "subset" | "morris"` on the Functions test FMU (`function = 5`: y = x1 + … + x8, a limit
+//! state linear in standard normal space for normal inputs, so `P` is known exactly;
+//! `function = 6`: y = x1² + … + x8², a chi-square for standard normal inputs), and on the
+//! Once test FMU for a run that fails. The references are closed forms written here (the
+//! normal tail by its own continued fraction), never the code under test.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::support::csv::Csv;
+use crate::support::{
+    run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
+};
+
+/// `P(Z > z)` of a standard normal, by the Lentz continued fraction of Mills' ratio for
+/// `z ≥ 3` and the series of `erf` below (relative error below 1e-12 in both).
+fn normal_sf(z: f64) -> f64 {
+    if z < 3.0 {
+        // Φ(z) = 1/2 + φ(z) Σ z^(2k+1) / (1·3·…·(2k+1)).
+        let phi = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        let (mut term, mut sum) = (z, z);
+        for k in 1..400 {
+            term *= z * z / (2 * k + 1) as f64;
+            sum += term;
+            if term.abs() < 1e-17 * sum.abs() {
+                break;
+            }
+        }
+        return 0.5 - phi * sum;
+    }
+    // Mills' ratio R(z) = 1/(z + 1/(z + 2/(z + 3/(z + …)))), evaluated from the tail.
+    let mut r = 0.0;
+    for k in (1..200).rev() {
+        r = k as f64 / (z + r);
+    }
+    (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt() / (z + r)
+}
+
+/// The `z` with `P(Z > z) = p` (bisection on [`normal_sf`]).
+fn normal_isf(p: f64) -> f64 {
+    let (mut lo, mut hi) = (-10.0, 40.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if normal_sf(mid) > p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// A study on the Functions FMU: `function`, the `[[parameters]]` (and `[[correlation]]`)
+/// text `inputs`, the quantity `q` = y with `limits` (above) and `below`, the method table.
+fn study(
+    dir: &Path,
+    name: &str,
+    function: u32,
+    inputs: &str,
+    limits: &[f64],
+    below: &[f64],
+    method: &str,
+) -> PathBuf {
+    let fmu = test_fmus::test_fmu("Functions").expect("the Functions test FMU");
+    let text = format!(
+        "{head}[fixed]\nfunction = {function}\n{inputs}\n[outputs]\nvariables = [\"y\"]\n\
+         [[qoi]]\nkind = \"final\"\nname = \"q\"\nsignal = \"y\"\nlimits = {limits:?}\n\
+         limits_below = {below:?}\n[method]\n{method}\n",
+        head = study_head(name, &fmu, 7, "start = 0.0\nstop = 0.1\nstep = 0.1"),
+    );
+    write_toml(dir, name, &text)
+}
+
+/// Eight normal inputs `x1..x8` (mean `i`, std `0.5 + 0.1 i`), `x1`–`x2` correlated by
+/// 0.5 and `x3`–`x4` by −0.3; returns the text and the mean and Std of their sum.
+fn correlated_normals() -> (String, f64, f64) {
+    let mut text = String::new();
+    let (mut mean, mut var) = (0.0, 0.0);
+    let sd: Vec<f64> = (1..=8).map(|i| 0.5 + 0.1 * i as f64).collect();
+    for i in 1..=8 {
+        let m = i as f64;
+        text += &format!(
+            "[[parameters]]\nname = \"x{i}\"\ndistribution = \"normal\"\nmean = {m}\nstd = {}\n",
+            sd[i - 1]
+        );
+        mean += m;
+        var += sd[i - 1] * sd[i - 1];
+    }
+    text += "[[correlation]]\nbetween = [\"x1\", \"x2\"]\nrho = 0.5\n";
+    text += "[[correlation]]\nbetween = [\"x3\", \"x4\"]\nrho = -0.3\n";
+    // Normal marginals: the Gaussian copula's correlation is the requested one.
+    var += 2.0 * 0.5 * sd[0] * sd[1] - 2.0 * 0.3 * sd[2] * sd[3];
+    (text, mean, var.sqrt())
+}
+
+/// `quantities.q.reliability` of the output folder `out`.
+fn reliability(out: &Path) -> Vec<Value> {
+    summary(out)["quantities"]["q"]["reliability"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no reliability in {}", out.display()))
+        .clone()
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("{v} is not a number"))
+}
+
+#[test]
+fn form_and_sorm_give_the_exact_probability_of_a_linear_sum_of_correlated_normals() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (inputs, mean, sd) = correlated_normals();
+    // P(q > a) = 1e-4 and P(q < b) = 1e-3 exactly.
+    let (pa, pb) = (1e-4, 1e-3);
+    let a = mean + sd * normal_isf(pa);
+    let b = mean - sd * normal_isf(pb);
+    for kind in ["form", "sorm"] {
+        let p = study(
+            dir.path(),
+            kind,
+            5,
+            &inputs,
+            &[a],
+            &[b],
+            &format!("kind = \"{kind}\""),
+        );
+        let out = dir.path().join(kind);
+        let text = run_study_ok(&p, &out, &[]);
+        let r = reliability(&out);
+        assert_eq!(r.len(), 2, "{r:?}");
+        for (e, exact, direction, limit) in [(&r[0], pa, "above", a), (&r[1], pb, "below", b)] {
+            assert_eq!(e["direction"], direction);
+            assert_eq!(e["method"], kind);
+            assert!((f(&e["limit"]) - limit).abs() < 1e-9 * limit.abs());
+            let got = f(&e["p"]);
+            assert!(
+                (got - exact).abs() < 0.01 * exact,
+                "{kind} {direction}: {got} for {exact}"
+            );
+            let beta = f(&e["beta"]);
+            assert!((beta - normal_isf(exact)).abs() < 0.01, "beta {beta}");
+            // FORM and SORM give no error estimate: no interval, no CoV.
+            assert!(e["ci_95"].is_null() && e["cov"].is_null(), "{e}");
+            // At most 20 runs per input for FORM (SORM adds its Hessian).
+            let runs = e["runs"].as_u64().unwrap();
+            if kind == "form" {
+                assert!(runs <= 20 * 8, "{runs} runs");
+            }
+            // The design point lies on the limit: its sum is the limit.
+            let x: f64 = e["design_point"].as_object().unwrap().values().map(f).sum();
+            assert!(
+                (x - limit).abs() < 1e-3 * sd,
+                "design point sums to {x}, limit {limit}"
+            );
+            let imp: f64 = e["importance"].as_object().unwrap().values().map(f).sum();
+            assert!((imp - 1.0).abs() < 1e-6, "importance factors sum to {imp}");
+        }
+        // The one-line summary in the terminal names β and P.
+        assert!(text.contains("β") && text.contains("P(q > "), "{text}");
+        assert!(out.join("index.html").is_file());
+    }
+}
+
+#[test]
+fn importance_sampling_after_form_covers_the_exact_probability_within_its_cov() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (inputs, mean, sd) = correlated_normals();
+    let exact = 1e-4;
+    let a = mean + sd * normal_isf(exact);
+    let p = study(
+        dir.path(),
+        "is",
+        5,
+        &inputs,
+        &[a],
+        &[],
+        "kind = \"importance_sampling\"\ntarget_cov = 0.05",
+    );
+    let out = dir.path().join("is");
+    run_study_ok(&p, &out, &[]);
+    let r = reliability(&out);
+    let e = &r[0];
+    assert_eq!(e["method"], "importance_sampling");
+    let (got, cov) = (f(&e["p"]), f(&e["cov"]));
+    assert!(cov <= 0.05 + 1e-12, "cov {cov}");
+    // Four standard errors: fails by chance about once in 16 000 seeds.
+    assert!(
+        (got - exact).abs() < 4.0 * cov * got,
+        "{got} ± {cov} for {exact}"
+    );
+    let ci = e["ci_95"].as_array().unwrap();
+    assert!(f(&ci[0]) < got && got < f(&ci[1]));
+    assert!(e["runs"].as_u64().unwrap() <= 2_000 + 20 * 8);
+    // The page's plots: importance factors and P against runs.
+    assert!(out.join("q_1_importance.svg").is_file());
+    assert!(out.join("q_1_convergence.svg").is_file());
+}
+
+#[test]
+fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Two standard normal inputs: y is chi-square with 2 degrees of freedom,
+    // P(y > b) = exp(-b/2) = 1e-4 at b = 2 ln 1e4 (a circle: FORM's single design point
+    // does not describe it).
+    let inputs: String = ["x1", "x2"]
+        .iter()
+        .map(|n| {
+            format!(
+                "[[parameters]]\nname = \"{n}\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"
+            )
+        })
+        .collect();
+    let exact = 1e-4;
+    let b = -2.0 * f64::ln(exact);
+    let p = study(
+        dir.path(),
+        "ss",
+        6,
+        &inputs,
+        &[b],
+        &[],
+        "kind = \"subset\"\nsamples_per_level = 2000",
+    );
+    let out = dir.path().join("ss");
+    run_study_ok(&p, &out, &[]);
+    let e = &reliability(&out)[0];
+    assert_eq!(e["method"], "subset");
+    let got = f(&e["p"]);
+    let cov = f(&e["cov"]);
+    assert!(cov < 0.3, "cov {cov}");
+    let ci = e["ci_95"].as_array().unwrap();
+    assert!(
+        f(&ci[0]) <= exact && exact <= f(&ci[1]),
+        "{got} ({ci:?}) for {exact}"
+    );
+    assert!(
+        e["design_point"].is_null() && e["importance"].is_null(),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_limit_never_reached_gives_a_zero_probability_with_an_upper_bound() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // x1, x2 uniform on [0, 1]: their sum never exceeds 2.5.
+    let inputs: String = ["x1", "x2"]
+        .iter()
+        .map(|n| {
+            format!(
+                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 1\n"
+            )
+        })
+        .collect();
+    let p = study(
+        dir.path(),
+        "never",
+        5,
+        &inputs,
+        &[2.5],
+        &[],
+        "kind = \"subset\"\nsamples_per_level = 500\nmax_levels = 4",
+    );
+    let out = dir.path().join("never");
+    run_study_ok(&p, &out, &[]);
+    let e = &reliability(&out)[0];
+    assert_eq!(f(&e["p"]), 0.0);
+    // 4 levels of 500 at p0 = 0.1: the bound is of the order of 0.1³ · 3/500.
+    let bound = f(&e["upper_95"]);
+    assert!(bound > 0.0 && bound < 1e-4, "upper bound {bound}");
+}
+
+#[test]
+fn a_failed_run_during_form_is_an_error_naming_the_point() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = test_fmus::test_fmu("Once").expect("the Once test FMU");
+    // Once: y = x t, so y(1) = x; every step with x > 2 fails with fmi2Error. FORM's first
+    // full step goes to x = 3, the limit.
+    let text = format!(
+        "{head}[fixed]\nfail_above = 2\nlog_bytes = 10\n[[parameters]]\nname = \"x\"\ndistribution = \
+         \"normal\"\nmean = 0\nstd = 1\n[outputs]\nvariables = [\"y\"]\n[[qoi]]\nkind = \
+         \"final\"\nname = \"q\"\nsignal = \"y\"\nlimits = [3.0]\n[method]\nkind = \"form\"\n",
+        head = study_head("failed", &fmu, 1, "start = 0.0\nstop = 1.0\nstep = 0.5"),
+    );
+    let p = write_toml(dir.path(), "failed", &text);
+    let out = dir.path().join("failed");
+    let o = run_study(&p, &out, &[]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("P(q > 3)"), "{err}");
+    assert!(err.contains("failed at x = "), "{err}");
+    let x: f64 = err
+        .split("failed at x = ")
+        .nth(1)
+        .unwrap()
+        .split(|c: char| c == ':' || c.is_whitespace())
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(x > 2.0, "the point named is x = {x}");
+    // Run again: the failed run is answered from the store, the same error.
+    let again = stderr(&run_study(&p, &out, &[]));
+    assert!(again.contains("failed at x = "), "{again}");
+}
+
+/// Kills `study` once its store holds about 300 runs of 10 001 values, resumes it, and
+/// compares the probabilities with those of an uninterrupted run.
+fn resumed_after_a_kill_gives_the_uninterrupted_numbers(kind: &str, method: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let (inputs, mean, sd) = correlated_normals();
+    let a = mean + sd * normal_isf(1e-3);
+    let fmu = test_fmus::test_fmu("Functions").expect("the Functions test FMU");
+    // A long series per run (10 001 points of y), so that the kill lands mid-way.
+    let text = format!(
+        "{head}[fixed]\nfunction = 5\n{inputs}\n[outputs]\nvariables = [\"y\"]\n\
+         [[qoi]]\nkind = \"final\"\nname = \"q\"\nsignal = \"y\"\nlimits = [{a}]\n\
+         [method]\n{method}\n",
+        head = study_head(kind, &fmu, 3, "start = 0.0\nstop = 1.0\nstep = 0.0001"),
+    );
+    let p = write_toml(dir.path(), kind, &text);
+    let full = dir.path().join("full");
+    run_study_ok(&p, &full, &["--no-report"]);
+    let part = dir.path().join("part");
+    run_killed(
+        &p,
+        &part,
+        &["--threads", "1", "--no-report"],
+        300 * 8 * 10_001,
+    );
+    assert!(!part.join("summary.json").exists(), "killed before the end");
+    run_study_ok(&p, &part, &["--no-report"]);
+    let (a, b) = (&reliability(&full)[0], &reliability(&part)[0]);
+    assert_eq!(a["p"], b["p"], "{kind}");
+    assert_eq!(a["cov"], b["cov"], "{kind}");
+    assert_eq!(a["runs"], b["runs"], "{kind}");
+    let s = summary(&part);
+    assert!(
+        s["runs_resumed"].as_u64().unwrap() >= 300,
+        "{}",
+        s["runs_resumed"]
+    );
+}
+
+#[test]
+fn importance_sampling_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    resumed_after_a_kill_gives_the_uninterrupted_numbers(
+        "is",
+        "kind = \"importance_sampling\"\ntarget_cov = 0.02\nbatch = 50",
+    );
+}
+
+#[test]
+fn subset_simulation_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    resumed_after_a_kill_gives_the_uninterrupted_numbers(
+        "subset",
+        "kind = \"subset\"\nsamples_per_level = 500",
+    );
+}
+
+#[test]
+fn morris_ranks_the_inputs_of_a_linear_sum_by_their_scatter() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // y = x1 + … + x4 with uniform inputs of widths 1, 2, 3, 4: every elementary effect of
+    // x_i, per unit of its probability level, is its width, so μ*_i = i and σ_i = 0.
+    let inputs: String = (1..=4)
+        .map(|i| {
+            format!(
+                "[[parameters]]\nname = \"x{i}\"\ndistribution = \"uniform\"\nlow = 0\nhigh = {i}\n"
+            )
+        })
+        .collect();
+    let p = study(
+        dir.path(),
+        "morris",
+        5,
+        &inputs,
+        &[],
+        &[],
+        "kind = \"morris\"\ntrajectories = 10",
+    );
+    let out = dir.path().join("morris");
+    run_study_ok(&p, &out, &[]);
+    let m = &summary(&out)["quantities"]["q"]["morris"];
+    let mu: Vec<f64> = (1..=4).map(|i| f(&m["mu_star"][format!("x{i}")])).collect();
+    for (i, v) in mu.iter().enumerate() {
+        // Per unit of probability level: dy/dq = the width of x_i.
+        assert!((v - (i + 1) as f64).abs() < 1e-9, "mu* {mu:?}");
+        assert!(f(&m["sigma"][format!("x{}", i + 1)]).abs() < 1e-6 * v);
+    }
+    assert_eq!(summary(&out)["model_runs"].as_u64().unwrap(), 10 * (4 + 1));
+}
+
+#[test]
+fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // y = x1 + x2, standard normal: a chaos of order 2 fits it exactly, yet a count of its
+    // draws beyond the last few runs is extrapolation as far as the runs can tell.
+    let inputs: String = ["x1", "x2"]
+        .iter()
+        .map(|n| {
+            format!(
+                "[[parameters]]\nname = \"{n}\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"
+            )
+        })
+        .collect();
+    let sd = 2f64.sqrt();
+    // P = 0.3 (about 30 of the 100 runs beyond) and 0.02 (about 2 beyond); below: 0.3.
+    let (wide, tail) = (sd * normal_isf(0.3), sd * normal_isf(0.02));
+    let p = study(
+        dir.path(),
+        "chaos",
+        5,
+        &inputs,
+        &[wide, tail],
+        &[-wide],
+        "kind = \"pce_regression\"\nsamples = 100\norder = 2",
+    );
+    let out = dir.path().join("chaos");
+    let text = run_study_ok(&p, &out, &[]);
+    let r = reliability(&out);
+    assert_eq!(r.len(), 3);
+    let runs = Csv::read(&out.join("q_samples.csv")).numeric().col("q");
+    assert_eq!(runs.len(), 100);
+    for e in &r {
+        assert_eq!(e["method"], "chaos");
+        let limit = f(&e["limit"]);
+        let beyond = runs
+            .iter()
+            .filter(|&&x| {
+                if e["direction"] == "below" {
+                    x < limit
+                } else {
+                    x > limit
+                }
+            })
+            .count();
+        if beyond < 10 {
+            assert!(
+                e["ci_95"].is_null() && e["cov"].is_null(),
+                "{beyond} runs beyond: {e}"
+            );
+            let w = e["warnings"][0].as_str().unwrap();
+            assert!(w.contains("importance_sampling"), "{w}");
+        } else {
+            assert!(e["ci_95"].is_array(), "{beyond} runs beyond: {e}");
+        }
+    }
+    assert!(text.contains("no interval"), "{text}");
+}
