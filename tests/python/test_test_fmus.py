@@ -288,6 +288,16 @@ BOREHOLE_RANGES = {"rw": (0.05, 0.15), "r": (100, 50000), "Tu": (63070, 115600),
                    "L": (1120, 1680), "Kw": (9855, 12045)}
 
 
+def test_linear_sum_and_sum_of_squares_at_random_points(functions_fmu):
+    rng = np.random.default_rng(2)
+    with slave(functions_fmu) as s:
+        for x in rng.normal(size=(20, 8)):
+            values = {f"x{i + 1}": v for i, v in enumerate(x)}
+            assert s.evaluate("y", function=5, **values) == pytest.approx(x.sum(), rel=1e-14)
+            assert s.evaluate("y", function=6, **values) == pytest.approx((x * x).sum(),
+                                                                           rel=1e-14)
+
+
 def test_ishigami_at_random_points(functions_fmu):
     rng = np.random.default_rng(1)
     with slave(functions_fmu) as s:
