@@ -29,7 +29,9 @@ LONG = ("bogie-lhs-20000", "paper-bogie", "vehicle-track-8d-lhs", "paper-vehicle
 
 def builtins(driver, h):
     _, _, out = h.run_cmd([str(driver), "list"])
-    return [line.split()[0].removeprefix("builtin:") for line in out.splitlines() if line.strip()]
+    # Each study's name on a line of its own ("builtin:NAME"), its description indented below.
+    return [line.removeprefix("builtin:") for line in out.splitlines()
+            if line.startswith("builtin:")]
 
 
 def timings(out_dir):

@@ -154,3 +154,22 @@ fn threads_0_is_refused_in_the_command_s_terms() {
     );
     assert!(!err.contains("NonZero") && !err.contains("usize"), "{err}");
 }
+
+/// `uq-driver list` printed lines of up to 842 characters (whole descriptions).
+#[test]
+fn list_lines_fit_in_100_characters() {
+    let out = run_ok(&["list"]);
+    for line in out.lines() {
+        let n = line.chars().count();
+        assert!(n <= 100, "{n} chars: {line}");
+    }
+    for name in ["wheel-scm", "wheel-sgm", "wheel-mc"] {
+        assert!(out.lines().any(|l| l == format!("builtin:{name}")), "{out}");
+    }
+    // The descriptions are whole, wrapped between words.
+    let words = out.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        words.contains("stochastic Galerkin method with Hermite chaos of total order 6 (28 terms)"),
+        "{out}"
+    );
+}

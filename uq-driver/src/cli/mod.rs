@@ -25,6 +25,27 @@ use load::*;
 use print::*;
 use tools::*;
 
+/// The width of `uq-driver list`'s lines (characters).
+const LIST_WIDTH: usize = 100;
+
+/// `text` in lines of at most `width` characters, broken between words (a longer word
+/// has a line of its own).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split_whitespace() {
+        let last = lines.last_mut().expect("at least one line");
+        if last.is_empty() {
+            last.push_str(word);
+        } else if last.chars().count() + 1 + word.chars().count() <= width {
+            last.push(' ');
+            last.push_str(word);
+        } else {
+            lines.push(word.to_owned());
+        }
+    }
+    lines
+}
+
 /// clap's error for an unknown subcommand, with a "did you mean" where clap found none
 /// (`rnu` for `run`: clap's similarity misses swapped letters; [`crate::suggest::closest`]
 /// takes one edit as a likely typo).
@@ -271,10 +292,12 @@ fn dispatch(cmd: Command) -> Result<()> {
         Command::Slurm(args) => slurm(args),
         Command::List => {
             let mut o = std::io::stdout().lock();
-            let w = BUILTINS.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
             for (name, text) in BUILTINS {
                 let s = Study::parse(text, name, None)?;
-                writeln!(o, "builtin:{name:<w$} {}", s.description)?;
+                writeln!(o, "builtin:{name}")?;
+                for line in wrap(&s.description, LIST_WIDTH - 4) {
+                    writeln!(o, "    {line}")?;
+                }
             }
             Ok(())
         }
