@@ -277,7 +277,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    // The Functions FMU declares function with min = 1, max = 4.
+    // The Functions FMU declares function with min = 1, max = 6.
     let body = function4(X1_X2, false).replace("function = 4", "function = 7");
     let s = study(
         dir.path(),
@@ -292,7 +292,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
     assert!(!o.status.success());
     let err = stderr(&o);
     assert!(
-        err.contains("'function' is an Integer declared with min = 1, max = 4")
+        err.contains("'function' is an Integer declared with min = 1, max = 6")
             && err.contains("the value 7 given for it is outside that range"),
         "{err}"
     );
