@@ -51,9 +51,8 @@ pub enum RunError {
     /// Points failed and failures are not allowed.
     #[error(
         "{}; first: {first}. After fixing the cause, run again \
-         with --retry-failed (RunOptions::retry_failed) to re-run the failed points (or \
-         --allow-failures, RunOptions::allow_failures, for Monte Carlo and LHS, to analyse the \
-         others)",
+         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
+         and LHS, to analyse the others)",
         failure_count(*.failed, *.total, *.not_run)
     )]
     PointsFailed {

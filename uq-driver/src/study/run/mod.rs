@@ -96,7 +96,7 @@ pub fn run_points(
     if failed_before > 0 && !opts.retry_failed {
         crate::study::progress::message(&format!(
             "note: {failed_before} point{} failed in an earlier run and {} not run again \
-             (--retry-failed, RunOptions::retry_failed, runs {} again)",
+             (--retry-failed runs {} again)",
             if failed_before == 1 { "" } else { "s" },
             if failed_before == 1 { "is" } else { "are" },
             if failed_before == 1 { "it" } else { "them" },
