@@ -35,7 +35,7 @@
 #define DECLARE(name) static fmi2##name##TYPE *fmi2##name;
 FUNCTIONS(DECLARE)
 
-#define MAX_VARS 64
+#define MAX_VARS 256
 
 static int errors_logged = 0;
 
