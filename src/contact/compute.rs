@@ -12,6 +12,7 @@
 //! the longitudinal one), the sum is held at that floor, so that b ≤ about 7 a; the number of
 //! such rows is reported.
 
+use crate::contact::Portable;
 use std::sync::OnceLock;
 
 use super::geometry::{Geometry, GeometryRow};
@@ -123,7 +124,7 @@ impl Default for ContactSettings {
         ContactSettings {
             wheel: s1002::s1002(),
             rail: uic60::uic60(),
-            inclination: (1.0f64 / 40.0).atan(),
+            inclination: (1.0f64 / 40.0).p_atan(),
             gauge: 1.435,
             gauge_depth: 0.014,
             flange_back: 1.360,
@@ -235,7 +236,7 @@ pub fn compute(settings: &ContactSettings) -> Result<ContactSolution, ContactErr
             let c = &g.left;
             let ax = 0.5 / c.r
                 * match settings.rolling_curvature {
-                    RollingCurvature::Meridian => c.delta.cos(),
+                    RollingCurvature::Meridian => c.delta.p_cos(),
                     RollingCurvature::Radius => 1.0,
                 };
             let mut by = 0.5 * (c.wheel_curvature + c.rail_curvature);

@@ -14,6 +14,7 @@
 //! singularities at the turning points, with the midpoint rule in θ. Where the motion would
 //! stop between the turning points (Δr = 0 over a range), λ is infinite and tan γ_e = 0.
 
+use crate::contact::Portable;
 use std::f64::consts::PI;
 
 /// Why an equivalent conicity cannot be computed.
@@ -150,12 +151,12 @@ impl DeltaR {
         let mut integral = 0.0;
         for k in 0..POINTS {
             let th = (k as f64 + 0.5) * dth;
-            let y = centre - amplitude * th.cos();
+            let y = centre - amplitude * th.p_cos();
             let drop = energy - self.primitive(y);
             if drop <= 1e-12 * scale {
                 return Ok(0.0);
             }
-            integral += amplitude * th.sin() / (2.0 * drop).sqrt() * dth;
+            integral += amplitude * th.p_sin() / (2.0 * drop).sqrt() * dth;
         }
         let lambda = 2.0 * integral;
         Ok(2.0 * PI * PI / (lambda * lambda))

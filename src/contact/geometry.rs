@@ -22,6 +22,7 @@
 
 use super::compute::{ContactError, ContactSettings};
 use super::profile::Profile;
+use crate::contact::Portable;
 
 /// Grid spacing of the tabulated profiles (m).
 const STEP: f64 = 2e-5;
@@ -539,13 +540,13 @@ impl Geometry {
             s: t.s,
             aw: self.d + t.s,
             r,
-            delta: (-dr).atan(),
-            wheel_curvature: -d2r / (1.0 + dr * dr).powf(1.5),
+            delta: (-dr).p_atan(),
+            wheel_curvature: -d2r / (1.0 + dr * dr).p_powf(1.5),
             y_track: t.y,
             rail_u: (1.0 - f) * self.rail_u[i] + f * self.rail_u[i + 1],
             zc: zr,
-            rail_curvature: -d2zr / (1.0 + dzr * dzr).powf(1.5),
-            rail_angle: dzr.atan(),
+            rail_curvature: -d2zr / (1.0 + dzr * dzr).p_powf(1.5),
+            rail_angle: dzr.p_atan(),
         }
     }
 
@@ -648,7 +649,7 @@ mod tests {
                 })
                 .collect();
             let wheel = Profile::wheel_from_csv(&csv, 0.07).unwrap();
-            let rail = Profile::crown(rho, rho * 60f64.to_radians().sin()).unwrap();
+            let rail = Profile::crown(rho, rho * 60f64.to_radians().p_sin()).unwrap();
             let (fb, r0) = (1.36, 0.425);
             let d = 0.5 * fb + 0.07;
             let settings = ContactSettings {
@@ -656,7 +657,7 @@ mod tests {
                 rail: rail.clone(),
                 inclination: 0.0,
                 gauge: 2.0 * d - rho,
-                gauge_depth: rho * (1.0 - 30f64.to_radians().cos()),
+                gauge_depth: rho * (1.0 - 30f64.to_radians().p_cos()),
                 flange_back: fb,
                 rolling_circle: 0.07,
                 r0,

@@ -13,6 +13,7 @@
 //!
 //! The ratio A_large / A_small fixes e; then A_small fixes α.
 
+use crate::contact::Portable;
 use std::f64::consts::PI;
 
 /// Complete elliptic integrals of the first and second kind, K(m) and E(m), for the parameter
@@ -84,8 +85,8 @@ pub fn hertz(normal: f64, ax: f64, by: f64, young: f64, poisson: f64) -> Hertz {
         // Solve in t = −ln(1 − m) (β/α = e^(−t/2)): f(t) = ln g − ln ratio rises with t. Start
         // from β/α ≈ (small/large)^(2/3), then secant steps kept in a bracket that grows until
         // it holds the root and shrinks with every step (bisection when the secant leaves it).
-        let f = |t: f64| (g(-(-t).exp_m1()) / ratio).ln();
-        let mut t = (-(4.0 / 3.0) * (small / large).ln()).max(1e-8);
+        let f = |t: f64| (g(-(-t).p_exp_m1()) / ratio).p_ln();
+        let mut t = (-(4.0 / 3.0) * (small / large).p_ln()).max(1e-8);
         let mut ft = f(t);
         let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
         let mut prev: Option<(f64, f64)> = None;
@@ -114,11 +115,11 @@ pub fn hertz(normal: f64, ax: f64, by: f64, young: f64, poisson: f64) -> Hertz {
             t = next;
             ft = f(t);
         }
-        -(-t).exp_m1()
+        -(-t).p_exp_m1()
     };
     let (k, d1, _) = differences(m);
     // small = (p0/E*) β/(e² α²) (K − E) with p0 = 3N/(2π α β) → α³ = 3N (K − E)/(2π E* e² small).
-    let alpha = (3.0 * normal * d1 / (2.0 * PI * e_star * small)).cbrt();
+    let alpha = (3.0 * normal * d1 / (2.0 * PI * e_star * small)).p_cbrt();
     let beta = alpha * (1.0 - m).sqrt();
     let p0 = 3.0 * normal / (2.0 * PI * alpha * beta);
     let q0 = p0 * beta * k / e_star;
@@ -153,9 +154,9 @@ mod tests {
             for (x, w) in nodes {
                 let th = c + 0.5 * h * x;
                 let t = beta * th.tan();
-                let dt = beta / (th.cos() * th.cos());
-                let f =
-                    2.0 * dt / ((alpha * alpha + t * t).powf(p) * (beta * beta + t * t).powf(q));
+                let dt = beta / (th.p_cos() * th.p_cos());
+                let f = 2.0 * dt
+                    / ((alpha * alpha + t * t).p_powf(p) * (beta * beta + t * t).p_powf(q));
                 sum += 0.5 * h * w * f;
             }
         }
@@ -178,7 +179,7 @@ mod tests {
         let (n, r, young, nu) = (1e4, 0.5, 2.1e11, 0.3);
         let e_star = young / (2.0 * (1.0 - nu * nu));
         let h = hertz(n, 0.5 / r, 0.5 / r, young, nu);
-        let a = (3.0 * n * r / (4.0 * e_star)).cbrt();
+        let a = (3.0 * n * r / (4.0 * e_star)).p_cbrt();
         assert!((h.a - a).abs() < 1e-12 * a && (h.b - a).abs() < 1e-12 * a);
         assert!((h.q0 - a * a / r).abs() < 1e-10 * h.q0);
     }

@@ -13,6 +13,7 @@
 //! one version there has C23(a/b = 0.8, ν = 0.25) = 1.15, a typo for 1.25 (the row reads 1.13,
 //! 1.25, 1.40 in Kalker's table and in CONTACT's later version).
 
+use crate::contact::Portable;
 use std::f64::consts::PI;
 
 /// Table rows g = 0.1, 0.2, …, 1.0; for each row [C11; C22; C23] at ν = [0, 0.25, 0.5].
@@ -85,16 +86,16 @@ fn asymptotes(g: f64, nu: f64, wide: bool) -> [f64; 3] {
         [
             PI * PI / (4.0 * (1.0 - nu)),
             PI * PI / 4.0,
-            PI * g.sqrt() / (3.0 * (1.0 - nu)) * (1.0 + nu * ((16.0 / g).ln() - 5.0)),
+            PI * g.sqrt() / (3.0 * (1.0 - nu)) * (1.0 + nu * ((16.0 / g).p_ln() - 5.0)),
         ]
     } else {
-        let al = (16.0 / (g * g)).ln();
-        let l4 = 3.0 - 4f64.ln();
+        let al = (16.0 / (g * g)).p_ln();
+        let l4 = 3.0 - 4f64.p_ln();
         let d = (1.0 - nu) * al + 2.0 * nu;
         [
             2.0 * PI / ((al - 2.0 * nu) * g) * (1.0 + l4 / (al - 2.0 * nu)),
             2.0 * PI / g * (1.0 + (1.0 - nu) * l4 / d) / d,
-            2.0 * PI / (3.0 * g.powf(1.5) * ((1.0 - nu) * al - 2.0 + 4.0 * nu)),
+            2.0 * PI / (3.0 * g.p_powf(1.5) * ((1.0 - nu) * al - 2.0 + 4.0 * nu)),
         ]
     }
 }

@@ -30,3 +30,45 @@ pub use compute::{
 };
 pub use profile::{Profile, ProfileError};
 pub use table::{ContactTable, TableError, TableRow};
+
+/// The transcendental functions of the contact geometry, from the pure-Rust `libm`: the same
+/// last bits on every platform, so that the win64 DLL computes the built-in table the Linux
+/// library does (the C libraries' atan, pow and log differ in the last ulp, and the Vehicle's
+/// outputs followed by 2e-11 instead of bit for bit).
+pub(crate) trait Portable {
+    fn p_atan(self) -> f64;
+    fn p_cos(self) -> f64;
+    fn p_sin(self) -> f64;
+    fn p_asin(self) -> f64;
+    fn p_ln(self) -> f64;
+    fn p_cbrt(self) -> f64;
+    fn p_exp_m1(self) -> f64;
+    fn p_powf(self, e: f64) -> f64;
+}
+
+impl Portable for f64 {
+    fn p_atan(self) -> f64 {
+        libm::atan(self)
+    }
+    fn p_cos(self) -> f64 {
+        libm::cos(self)
+    }
+    fn p_sin(self) -> f64 {
+        libm::sin(self)
+    }
+    fn p_asin(self) -> f64 {
+        libm::asin(self)
+    }
+    fn p_ln(self) -> f64 {
+        libm::log(self)
+    }
+    fn p_cbrt(self) -> f64 {
+        libm::cbrt(self)
+    }
+    fn p_exp_m1(self) -> f64 {
+        libm::expm1(self)
+    }
+    fn p_powf(self, e: f64) -> f64 {
+        libm::pow(self, e)
+    }
+}

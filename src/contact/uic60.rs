@@ -7,6 +7,7 @@
 //! X3 = 72/2 mm, where the straight flank at 1:20 (lateral : vertical) begins.
 
 use super::profile::{Profile, ShapeSpec};
+use crate::contact::Portable;
 
 const R1: f64 = 300.0;
 const R2: f64 = 80.0;
@@ -22,10 +23,10 @@ const FLANK_DEPTH: f64 = 25.0;
 /// Centres of the arcs: (lateral, height) in mm, top of the rail at (0, 0), field side +.
 fn centres() -> [(f64, f64); 3] {
     let c1 = (0.0, -R1);
-    let f1 = (X1 / R1).asin();
-    let c2 = (c1.0 + (R1 - R2) * f1.sin(), c1.1 + (R1 - R2) * f1.cos());
-    let f2 = ((X2 - c2.0) / R2).asin();
-    let c3 = (c2.0 + (R2 - R3) * f2.sin(), c2.1 + (R2 - R3) * f2.cos());
+    let f1 = (X1 / R1).p_asin();
+    let c2 = (c1.0 + (R1 - R2) * f1.p_sin(), c1.1 + (R1 - R2) * f1.p_cos());
+    let f2 = ((X2 - c2.0) / R2).p_asin();
+    let c3 = (c2.0 + (R2 - R3) * f2.p_sin(), c2.1 + (R2 - R3) * f2.p_cos());
     [c1, c2, c3]
 }
 
@@ -77,7 +78,7 @@ mod tests {
         // same slope (the drawing's construction is tangent to within 0.1°).
         let q = p.eval(0.036 - 1e-12);
         assert!((q.z + 0.014304).abs() < 2e-6, "{}", q.z);
-        assert!((q.dz.atan() + 20f64.atan()).abs() < 2e-3, "{}", q.dz);
+        assert!((q.dz.p_atan() + 20f64.p_atan()).abs() < 2e-3, "{}", q.dz);
         // 14 mm below the top the head is 71.96 mm wide (the gauge is measured there).
         let (mut lo, mut hi) = (0.030, 0.036);
         for _ in 0..100 {
