@@ -37,6 +37,7 @@ use super::data_file::{read_data_file, resolve};
 use super::vehicle_track::irregularity::{RandomProfile, SampleKey};
 use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
 use crate::contact::table::{ContactSpline, ContactTable, TableRow};
+use crate::contact::{compute_table, ContactSettings, Profile};
 use crate::solver::substeps;
 use equations::{base, dof, Car, State, N_STATES};
 use integrate::{rk4_substep, RateBound, StepError, STABILITY_FACTOR};
@@ -45,7 +46,7 @@ use params::{wheelset, Params};
 use std::cell::OnceCell;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 use track::{Course, Irregularity, MeasuredTrack, Source};
 
 /// Lowest running speed (m/s): the creepages divide by the speed.
@@ -139,8 +140,13 @@ pub struct Vehicle {
     pub h_floor: f64,
     /// Irregularity parameters.
     pub irr: IrregularityParams,
-    /// Contact table file; empty = built in.
+    /// Contact table file; empty = built in, or computed from the profiles below.
     pub contact_table: String,
+    /// Wheel profile file (CSV: y, z in mm from the flange back); empty = S1002. With
+    /// `rail_profile`, the contact table is computed from the profiles at initialization.
+    pub wheel_profile: String,
+    /// Rail profile file (CSV: y, z in mm from the rail's centre line); empty = UIC60.
+    pub rail_profile: String,
     run: Option<Run>,
     resource_dir: Option<PathBuf>,
     /// Random samples of the last initialization, reused while their keys do not change.
@@ -180,6 +186,8 @@ impl Vehicle {
                 file: String::new(),
             },
             contact_table: String::new(),
+            wheel_profile: String::new(),
+            rail_profile: String::new(),
             run: None,
             resource_dir: None,
             samples: None,
@@ -263,8 +271,21 @@ impl Vehicle {
 
     /// The contact table `contact_table` names (the built-in one when empty), with its splines.
     fn load_table(&self) -> Result<SharedTable, ModelError> {
+        let profiles = !(self.wheel_profile.is_empty() && self.rail_profile.is_empty());
         if self.contact_table.is_empty() {
-            return builtin().cloned();
+            return if profiles {
+                self.profile_table()
+            } else {
+                builtin().cloned()
+            };
+        }
+        if profiles {
+            return Err(ModelError::Other(
+                "contact_table and wheel_profile / rail_profile are both set: the table is \
+                 either read from a file or computed from the profiles (leave contact_table \
+                 empty to compute it)"
+                    .into(),
+            ));
         }
         let text = read_data_file(
             "contact_table",
@@ -285,6 +306,72 @@ impl Vehicle {
         }
         let spline = Arc::new(ContactSpline::new(&table));
         Ok((Arc::new(table), spline))
+    }
+
+    /// The table computed from `wheel_profile` and `rail_profile` (S1002 and UIC60 where one
+    /// is empty) with the built-in table's settings (rails at 1:40, standard gauge) and
+    /// smoothing; computed once per process for the same two files' contents.
+    fn profile_table(&self) -> Result<SharedTable, ModelError> {
+        let dir = self.resource_dir.as_deref();
+        let read = |what: &str, name: &str| -> Result<String, ModelError> {
+            if name.is_empty() {
+                Ok(String::new())
+            } else {
+                read_data_file(what, name, dir).map_err(ModelError::Other)
+            }
+        };
+        let (wheel, rail) = (
+            read("wheel_profile", &self.wheel_profile)?,
+            read("rail_profile", &self.rail_profile)?,
+        );
+        type Cache = Mutex<Vec<((String, String), SharedTable)>>;
+        static CACHE: OnceLock<Cache> = OnceLock::new();
+        let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
+        let key = (wheel, rail);
+        if let Some((_, t)) = cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .find(|(k, _)| *k == key)
+        {
+            return Ok(t.clone());
+        }
+        let mut s = ContactSettings::default();
+        let shown = |name: &str| resolve(name, dir).display().to_string();
+        if !key.0.is_empty() {
+            s.wheel = Profile::wheel_from_csv(&key.0, s.rolling_circle).map_err(|e| {
+                ModelError::Other(format!(
+                    "wheel_profile '{}': {e}",
+                    shown(&self.wheel_profile)
+                ))
+            })?;
+        }
+        if !key.1.is_empty() {
+            s.rail = Profile::rail_from_csv(&key.1).map_err(|e| {
+                ModelError::Other(format!("rail_profile '{}': {e}", shown(&self.rail_profile)))
+            })?;
+        }
+        let raw = compute_table(&s).map_err(|e| {
+            ModelError::Other(format!(
+                "the contact table of wheel_profile / rail_profile: {e}"
+            ))
+        })?;
+        let table = crate::contact::smooth::smoothed(&raw, BUILTIN_SMOOTHING);
+        let spline = Arc::new(ContactSpline::new(&table));
+        let shared = (Arc::new(table), spline);
+        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
+        if c.len() >= 8 {
+            c.remove(0);
+        }
+        c.push((key, shared.clone()));
+        Ok(shared)
+    }
+
+    /// [`Self::load_table`] with the resources folder of `ctx` (tests).
+    #[cfg(test)]
+    fn load_table_for_test(&mut self, ctx: &InitContext) -> SharedTable {
+        self.resource_dir = ctx.resource_dir.clone();
+        self.load_table().unwrap()
     }
 
     /// The linear critical speed (m/s) at the current parameters, computed on first use.

@@ -868,3 +868,66 @@ fn contact_table_figures() {
         );
     }
 }
+
+#[test]
+fn profiles_given_as_files_give_the_table_of_the_built_in_profiles() {
+    // S1002 and UIC60 sampled into CSV files (y, z in mm, in the files' own frames) and
+    // given as wheel_profile / rail_profile: the table computed from them matches the
+    // built-in one (computed from the analytic profiles) to the resampling's accuracy.
+    let dir = std::env::temp_dir().join(format!("railuq-vehicle-profiles-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let rolling = crate::contact::s1002::ROLLING_CIRCLE_FROM_FLANGE_BACK;
+    let csv = |points: Vec<(f64, f64)>, shift: f64| -> String {
+        let mut t = String::from("y,z\n");
+        for (u, z) in points {
+            t.push_str(&format!("{},{}\n", (u + shift) * 1e3, z * 1e3));
+        }
+        t
+    };
+    std::fs::write(
+        dir.join("wheel.csv"),
+        csv(crate::contact::s1002::s1002().sample(4000), rolling),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("rail.csv"),
+        csv(crate::contact::uic60::uic60().sample(4000), 0.0),
+    )
+    .unwrap();
+    let ctx = InitContext {
+        start_time: 0.0,
+        resource_dir: Some(dir.clone()),
+    };
+    let mut m = Vehicle::default();
+    m.set_string(VR_WHEEL_PROFILE, "wheel.csv").unwrap();
+    m.set_string(VR_RAIL_PROFILE, "rail.csv").unwrap();
+    let (from_files, _) = m.load_table_for_test(&ctx);
+    let built_in = builtin_contact_table().unwrap();
+    let (a, b) = (from_files.rows(), built_in.rows());
+    assert_eq!(a.len(), b.len());
+    // On the tread (|y| <= 4 mm) the rolling radius agrees to 2 µm, the contact angle to 2 mrad.
+    for (x, y) in a.iter().zip(b).filter(|(x, _)| x.y.abs() <= 4e-3) {
+        assert!((x.r - y.r).abs() < 2e-6, "y {} r {} vs {}", x.y, x.r, y.r);
+        assert!(
+            (x.delta - y.delta).abs() < 2e-3,
+            "y {} δ {} vs {}",
+            x.y,
+            x.delta,
+            y.delta
+        );
+    }
+    m.initialize(&ctx).unwrap();
+    // A table and profiles at once are refused; a bad profile names its parameter, not its text.
+    let mut both = Vehicle::default();
+    both.set_string(VR_WHEEL_PROFILE, "wheel.csv").unwrap();
+    both.set_string(VR_CONTACT_TABLE, "t.csv").unwrap();
+    let e = both.initialize(&ctx).unwrap_err().to_string();
+    assert!(e.contains("both set"), "{e}");
+    std::fs::write(dir.join("bad.csv"), "y,z\n0,0\nSECRET,1\n").unwrap();
+    let mut bad = Vehicle::default();
+    bad.set_string(VR_RAIL_PROFILE, "bad.csv").unwrap();
+    let e = bad.initialize(&ctx).unwrap_err().to_string();
+    assert!(e.contains("rail_profile") && !e.contains("SECRET"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,6 +1,6 @@
 //! The vehicle's variables, one line each (see [`crate::models::table`]), and its description.
 //!
-//! Value references: Real parameters 0..60, Integer 70–71, String 80–81, calculated 90–91,
+//! Value references: Real parameters 0..60, Integer 70–71, String 80–83, calculated 90–91,
 //! outputs from 100. Sources: [MODELS] = MODELS.md §5, [ref] = the reference implementation
 //! (DYTSI, its Cooperrider input files), [assumed] = chosen here.
 #![forbid(unsafe_code)]
@@ -113,6 +113,8 @@ variables! {
     integer_parameter("seed", VR_SEED = 71, m.irr.seed, 1, any_integer, "Seed of the random phases of the irregularity"),
     string_parameter("contact_table", VR_CONTACT_TABLE = 80, m.contact_table, "", any_string, "Contact table file (CSV: y, N0, delta, a, b, aw, r, c11, c22, c23, zc, q0 in SI units, left wheel, y ascending in equal steps); a relative path is resolved in the FMU resources folder; empty = the built-in S1002/UIC60 1:40 table"),
     string_parameter("irregularity_file", VR_IRREGULARITY_FILE = 81, m.irr.file, "", any_string, "Measured track for irregularity = 10: lines of x [m], y [m] (alignment, left +), z [m] (vertical, up +); a relative path is resolved in the FMU resources folder"),
+    string_parameter("wheel_profile", VR_WHEEL_PROFILE = 82, m.wheel_profile, "", any_string, "Wheel profile file (CSV: y, z in mm, y from the flange back, positive toward the field side, z up; the rolling circle 70 mm from the flange back): with contact_table empty, the contact table is computed from it and rail_profile at initialization (rails at 1:40, standard gauge, smoothed over 0.05 mm, as the built-in one); empty = S1002; a relative path is resolved in the FMU resources folder"),
+    string_parameter("rail_profile", VR_RAIL_PROFILE = 83, m.rail_profile, "", any_string, "Rail profile file (CSV: y, z in mm, y from the rail's centre line, positive toward the field side, z up, uninclined): see wheel_profile; empty = UIC60"),
     calculated("v_cr_linear", VR_V_CR_LINEAR = 90, Some("m/s"), m.v_cr_linear().unwrap_or(f64::NAN), "Linear (Hopf) critical speed on straight track: eigenvalues of the Jacobian at the centred equilibrium, scan 5..300 m/s and bisection (clamped to that range); computed when first read"),
     calculated("Q_static", VR_Q_STATIC = 91, Some("N"), m.static_wheel_load(), "Static wheel load: g (m_c + 2 m_b + 4 m_w)/8"),
     output("speed", VR_SPEED = 100, Some("m/s"), m.speed(), "Running speed now"),
