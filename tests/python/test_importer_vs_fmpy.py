@@ -1,4 +1,4 @@
-"""Issue 13, importer: `uq-driver simulate` against fmpy on the same FMUs, with parameters of
+"""Importer: `uq-driver simulate` against fmpy on the same FMUs, with parameters of
 every type, input signals, an FMU that ends the simulation, a stop time off the grid, and
 VehicleTrack's measured track profile. Where fmpy and uq-driver take the same steps the
 trajectories must be equal bit for bit (the CSV numbers read back exactly)."""

@@ -155,7 +155,7 @@ mod tests {
 
     #[test]
     fn tiny_and_huge_numbers_are_written_short_not_as_long_decimals() {
-        // Issue 13: 2.2e-308 was written as a 326-character decimal.
+        // Regression: 2.2e-308 was written as a 326-character decimal.
         assert_eq!(shortest(2.2e-308), "2.2e-308");
         assert_eq!(shortest(f64::MIN_POSITIVE), "2.2250738585072014e-308");
         assert_eq!(shortest(5e-324), "5e-324");

@@ -240,7 +240,7 @@ mod tests {
 
     #[test]
     fn a_negative_cov_is_reported_as_cov_not_as_std() {
-        // Issue 12: cov = -0.1 was reported as "std must be positive (got -10)".
+        // Regression: cov = -0.1 was reported as "std must be positive (got -10)".
         let p = parse("name = \"K\"\nmean = 100\ncov = -0.1").unwrap();
         let e = p.distribution.to_distribution().unwrap_err().to_string();
         assert!(

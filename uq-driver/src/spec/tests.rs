@@ -193,7 +193,7 @@ fn correlations_are_checked_where_they_are_written() {
 
 #[test]
 fn a_stop_time_off_the_grid_gets_a_shorter_last_step_not_an_error() {
-    // Issue 13: stop − start not a whole number of steps was refused; fmpy ends with a
+    // Regression: stop − start not a whole number of steps was refused; fmpy ends with a
     // shorter step.
     let e = Experiment {
         start: 0.0,

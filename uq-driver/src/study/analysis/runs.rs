@@ -143,7 +143,7 @@ mod tests {
 
     #[test]
     fn blocks_read_in_steps_of_runs_hold_every_value_in_its_place() {
-        // Issue 15: a block is read a few runs at a time and transposed straight into the
+        // Regression: a block is read a few runs at a time and transposed straight into the
         // matrix. Every entry must be the run's value at that column: 601 points (not a
         // multiple of the chunk or step), some failed or not run, 2 outputs of 7 times,
         // blocks at either output, of any width.

@@ -622,7 +622,7 @@ mod tests {
 
     #[test]
     fn fused_gram_schmidt_loo_errors_equal_the_reference_bit_for_bit() {
-        // Issue 15: the nested LOO errors decide the chosen model, so fusing the
+        // Regression: the nested LOO errors decide the chosen model, so fusing the
         // Gram-Schmidt steps and keeping them in flat buffers must not change a bit, also
         // past a dependent column (a repeated one) and with more columns than samples.
         let (psi, mut y, _) = sparse_problem(60);
@@ -646,7 +646,7 @@ mod tests {
 
     #[test]
     fn a_design_prepared_once_gives_every_response_the_per_response_fit_bit_for_bit() {
-        // Issue 15: a time-resolved sparse chaos re-standardised the design, transposed it
+        // Regression: a time-resolved sparse chaos re-standardised the design, transposed it
         // twice per step and refactored the chosen columns for every time column. The
         // prepared design and the shared refits must not change a bit: the paths equal those
         // of the per-response LARS kept in `reference`, and the fits those refitted alone.

@@ -546,7 +546,7 @@ mod tests {
 
     #[test]
     fn shared_bootstrap_resamples_give_the_per_column_numbers_bit_for_bit() {
-        // Issue 15: the bootstrap of a time-resolved study drew every resample again for each
+        // Regression: the bootstrap of a time-resolved study drew every resample again for each
         // column and summed one column at a time. The shared draw and the lock-step sums must
         // not change a bit: 11 columns (not a multiple of the lanes), an odd base sample,
         // d = 3, a column with a large mean, a constant column (0/0 estimates), and the
@@ -602,7 +602,7 @@ mod tests {
 
     #[test]
     fn percentile_intervals_by_selection_equal_those_of_the_sorted_values() {
-        // Issue 15: the intervals take their order statistics by selection, not by sorting.
+        // Regression: the intervals take their order statistics by selection, not by sorting.
         // Ties, signed zeros, infinities and NaN (left out), odd and even counts, levels
         // that fall on an order statistic and between two.
         let mut s = 7u64;

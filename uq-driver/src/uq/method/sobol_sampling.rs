@@ -795,7 +795,7 @@ mod tests {
 
     #[test]
     fn moments_from_the_gathered_columns_are_those_of_the_selected_rows_bit_for_bit() {
-        // Issue 15: the moments are taken from each column as gathered for the indices (in
+        // Regression: the moments are taken from each column as gathered for the indices (in
         // parallel), no longer from a copy of the A and B rows of the whole matrix. Every
         // point run (rows in place) and every 5th point failed (rows gathered), columns of
         // several magnitudes and a constant one.

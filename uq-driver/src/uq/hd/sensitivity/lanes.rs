@@ -273,7 +273,7 @@ mod tests {
 
     #[test]
     fn resamples_in_lock_step_and_wider_vectors_give_the_baseline_bits() {
-        // Issue 15: the replicates are summed two at a time and dispatched to a version
+        // Regression: the replicates are summed two at a time and dispatched to a version
         // compiled for wider vector units. Each must give, bit for bit, what one resample at
         // a time in the baseline build gives, for every pass layout (d = 1: no second pass;
         // d = 2: a pass of two; d = 4: passes of three and three) and an odd resample count.
