@@ -69,19 +69,28 @@ LINKER = "CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_LINKER"
 
 
 def _zig_linker() -> None:
-    """Links with zig against an old glibc (see the module's documentation)."""
-    if LINKER in os.environ or os.environ.get("RAILUQ_ZIG", "auto") == "no":
-        return
-    if sys.platform != "linux" or platform.machine() not in ("x86_64", "AMD64"):
-        return
-    try:
-        import ziglang  # noqa: F401
-    except ImportError:
-        _say("no zig (the ziglang package): linking against the build machine's glibc")
-        return
-    os.environ[LINKER] = str(ROOT / ".cargo" / "zig-cc")
-    os.environ.setdefault("RAILUQ_ZIG_PYTHON", sys.executable)
-    _say(f"linking with zig against glibc {os.environ.get('RAILUQ_GLIBC', '2.17')}")
+    """Links with zig against an old glibc (see the module's documentation), and tags the
+    wheel for it."""
+    zig_cc = str(ROOT / ".cargo" / "zig-cc")
+    if LINKER not in os.environ and os.environ.get("RAILUQ_ZIG", "auto") != "no" \
+            and sys.platform == "linux" and platform.machine() in ("x86_64", "AMD64"):
+        try:
+            import ziglang  # noqa: F401
+        except ImportError:
+            _say("no zig (the ziglang package): linking against the build machine's glibc")
+        else:
+            os.environ[LINKER] = zig_cc
+            os.environ.setdefault("RAILUQ_ZIG_PYTHON", sys.executable)
+            _say(f"linking with zig against glibc {os.environ.get('RAILUQ_GLIBC', '2.17')}")
+    # The wheel's tag says what it needs (maturin checks the module's symbol versions against
+    # it): manylinux2014 is glibc 2.17. Only for zig's default floor: another RAILUQ_GLIBC, or
+    # another linker, gets maturin's own judgement.
+    linker = os.environ.get(LINKER)
+    zig_linked = linker is not None and Path(linker).resolve() == Path(zig_cc).resolve()
+    if zig_linked and os.environ.get("RAILUQ_GLIBC", "2.17") == "2.17":
+        args = os.environ.get("MATURIN_PEP517_ARGS", "")
+        if "--compatibility" not in args and "--manylinux" not in args:
+            os.environ["MATURIN_PEP517_ARGS"] = (args + " --compatibility manylinux2014").strip()
 
 
 def _put_fmus() -> None:

@@ -6,13 +6,16 @@ import json
 import tempfile
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Optional, Union
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 from . import _railuq
 
-Array = np.ndarray
+if TYPE_CHECKING:
+    import numpy as np
+
+    Array = np.ndarray
+else:
+    from ._lazy import numpy as np
 
 
 def _f64(values: Any) -> Array:

@@ -356,6 +356,55 @@ def test_python_m_railuq_is_the_command_line():
     assert "did you mean" in p.stderr
 
 
+def test_python_m_railuq_run_isolate_starts_workers_and_equals_the_command_line(tmp_path):
+    """`--isolate` from the package: its workers are the `railuq` command installed beside the
+    interpreter (the interpreter itself has no `worker` subcommand), and the numbers are the
+    command line's, bit for bit."""
+    scripts = __import__("sysconfig").get_path("scripts")
+    command = os.path.join(scripts, "railuq")
+    assert os.access(command, os.X_OK), f"the package installed no `railuq` command in {scripts}"
+    env = {k: v for k, v in os.environ.items() if k != "UQ_DRIVER_EXE"}
+    py = tmp_path / "py"
+    p = subprocess.run([sys.executable, "-m", "railuq", "run", "builtin:wheel-scm", "--isolate",
+                        "--out", str(py), "--no-report"], capture_output=True, text=True, env=env)
+    assert p.returncode == 0, p.stderr
+    cli = tmp_path / "cli"
+    driver("run", "builtin:wheel-scm", "--out", cli, "--no-report")
+    assert (py / "q.csv").read_bytes() == (cli / "q.csv").read_bytes()
+    # The `railuq` command is the same command line.
+    p = subprocess.run([command, "list"], capture_output=True, text=True, env=env)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout == driver("list").stdout
+
+
+def test_the_command_line_and_a_study_run_start_without_importing_numpy(tmp_path):
+    """numpy's import (about 0.1 s) is paid only when an array is asked for: not by the command
+    line (nor so by each --isolate worker), nor by a study's runs."""
+    code = ("import sys, railuq, railuq.__main__; "
+            "r = railuq.builtin('wheel-scm').run(progress=False, report=False); "
+            "assert 'numpy' not in sys.modules, 'imported by the run'; "
+            "r.mean('q'); assert 'numpy' in sys.modules; r.close()")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+
+
+def test_to_xarray_holds_the_statistics_of_to_pandas(tmp_path):
+    xr = pytest.importorskip("xarray") if not in_ci() else __import__("xarray")
+    with railuq.Study.from_dict(SAMPLED).run(out=tmp_path / "x", progress=False,
+                                             report=False) as r:
+        ds = r.to_xarray()
+        assert isinstance(ds, xr.Dataset) and ds.attrs["study"] == "wheel-lhs-py"
+        assert np.array_equal(ds["time"].to_numpy(), r.time)
+        assert np.array_equal(ds["q_mean"].to_numpy(), r.mean("q"))
+        assert np.array_equal(ds["q_std"].to_numpy(), r.std("q"))
+        assert ds["q_mean"].dims == ("time",)
+        df = r.to_pandas()
+        for name, stat in df.columns:
+            assert np.array_equal(ds[f"{name}_{stat}"].to_numpy(), df[(name, stat)].to_numpy())
+        assert float(ds["q_peak_mean"]) == r.mean("q_peak")
+        assert float(ds["q_peak_std"]) == r.std("q_peak")
+
+
 # ---------------------------------------------------------------- the binaries
 
 def zig_available():
@@ -386,6 +435,21 @@ def test_binaries_need_at_most_glibc_2_28():
             pytest.fail(message + " (CI is set: this is a failure, not a skip)")
         pytest.skip(message)
     assert not too_new, too_new
+
+
+def test_the_wheel_is_tagged_manylinux2014_when_zig_links_it():
+    """A wheel linked against glibc 2.17 says so in its name (pip on an old system installs
+    only wheels whose tag it accepts)."""
+    wheels = sorted((ROOT / "target" / "wheels").glob("railuq-*.whl"))
+    if not wheels:
+        pytest.fail("no wheel in target/wheels: `make wheel` builds it (make test does)")
+    if not zig_available():
+        message = "zig is not installed: the wheel is linked against the build machine's glibc"
+        if in_ci():
+            pytest.fail(message + " (CI is set: this is a failure, not a skip)")
+        pytest.skip(message)
+    (wheel,) = wheels
+    assert "manylinux_2_17_x86_64" in wheel.name or "manylinux2014_x86_64" in wheel.name, wheel
 
 
 def test_shipped_fmu_libraries_export_exactly_the_fmi_functions(tmp_path):

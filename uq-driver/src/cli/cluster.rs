@@ -57,7 +57,10 @@ pub(crate) fn slurm(a: SlurmArgs) -> Result<()> {
     let s = load_study(&a.study)?;
     check_plan_size(&s, &a.out, a.yes)?;
     shard::plan(&s, a.shards, &a.out)?;
-    let driver = std::env::current_exe().context("locating the uq-driver executable")?;
+    // `$UQ_DRIVER_EXE` when set (a host such as the Python package, whose own program is not
+    // uq-driver, names the command to run), else this program.
+    let driver =
+        crate::study::run::isolate::default_exe().context("locating the uq-driver executable")?;
     let o = shard::SlurmOptions {
         partition: a.partition,
         time: a.time,

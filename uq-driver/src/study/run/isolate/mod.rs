@@ -195,8 +195,9 @@ pub fn setup(fmu: &Fmu, iface: &Interface, times: &[f64], policy: InstancePolicy
     }
 }
 
-/// The uq-driver executable to start workers from: `$UQ_DRIVER_EXE` if set, else this
-/// program.
+/// The uq-driver executable to start workers (and Slurm's shard jobs) from: `$UQ_DRIVER_EXE`
+/// if set, else this program. A host whose program is not uq-driver (the Python package)
+/// sets `$UQ_DRIVER_EXE` to its own command line.
 pub fn default_exe() -> std::io::Result<PathBuf> {
     match std::env::var_os("UQ_DRIVER_EXE") {
         Some(p) => Ok(PathBuf::from(p)),
