@@ -96,6 +96,14 @@ fn correlated_normals() -> (String, f64, f64) {
 }
 
 /// `quantities.q.reliability` of the output folder `out`.
+/// Two parameters `x1`, `x2` of the same law (`law`: the keys after `name`).
+fn two_inputs(law: &str) -> String {
+    ["x1", "x2"]
+        .iter()
+        .map(|n| format!("[[parameters]]\nname = \"{n}\"\n{law}\n"))
+        .collect()
+}
+
 fn reliability(out: &Path) -> Vec<Value> {
     summary(out)["quantities"]["q"]["reliability"]
         .as_array()
@@ -212,14 +220,7 @@ fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
     // Two standard normal inputs: y is chi-square with 2 degrees of freedom,
     // P(y > b) = exp(-b/2) = 1e-4 at b = 2 ln 1e4 (a circle: FORM's single design point
     // does not describe it).
-    let inputs: String = ["x1", "x2"]
-        .iter()
-        .map(|n| {
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"
-            )
-        })
-        .collect();
+    let inputs = two_inputs("distribution = \"normal\"\nmean = 0\nstd = 1");
     let exact = 1e-4;
     let b = -2.0 * f64::ln(exact);
     let p = study(
@@ -256,14 +257,7 @@ fn a_limit_never_reached_gives_a_zero_probability_with_an_upper_bound() {
     }
     let dir = tempfile::tempdir().unwrap();
     // x1, x2 uniform on [0, 1]: their sum never exceeds 2.5.
-    let inputs: String = ["x1", "x2"]
-        .iter()
-        .map(|n| {
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 1\n"
-            )
-        })
-        .collect();
+    let inputs = two_inputs("distribution = \"uniform\"\nlow = 0\nhigh = 1");
     let p = study(
         dir.path(),
         "never",
@@ -423,14 +417,7 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
     let dir = tempfile::tempdir().unwrap();
     // y = x1 + x2, standard normal: a chaos of order 2 fits it exactly, yet a count of its
     // draws beyond the last few runs is extrapolation as far as the runs can tell.
-    let inputs: String = ["x1", "x2"]
-        .iter()
-        .map(|n| {
-            format!(
-                "[[parameters]]\nname = \"{n}\"\ndistribution = \"normal\"\nmean = 0\nstd = 1\n"
-            )
-        })
-        .collect();
+    let inputs = two_inputs("distribution = \"normal\"\nmean = 0\nstd = 1");
     let sd = 2f64.sqrt();
     // P = 0.3 (about 30 of the 100 runs beyond) and 0.02 (about 2 beyond); below: 0.3.
     let (wide, tail) = (sd * normal_isf(0.3), sd * normal_isf(0.02));

@@ -26,9 +26,7 @@ use super::adaptive::{
     check_continuous, each_target, standard_point, AdaptiveResult, BatchModel, LimitResult, Target,
 };
 use super::error::{InvalidSettings, MethodError};
-use super::traits::{
-    Adaptive, AdaptiveMethod, Evaluation, KindNotes, Method, MethodSummary, Problem,
-};
+use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::reliability::{
     self, Differences, LimitState, MultiStart, Point, ReliabilityError, Scheme,
@@ -273,21 +271,7 @@ impl Method for Form {
         self.check(problem, "FORM")
     }
 
-    fn summary(&self, _dim: usize) -> MethodSummary {
-        MethodSummary::new(self.kind(), self)
-    }
-
-    fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::Adaptive(AdaptiveMethod(self))
-    }
-
-    fn notes() -> KindNotes {
-        KindNotes {
-            name: Some("a FORM study"),
-            adaptive: true,
-            ..KindNotes::default()
-        }
-    }
+    adaptive_method_items!("a FORM study");
 }
 
 impl Adaptive for Form {

@@ -26,9 +26,7 @@ use super::adaptive::{
 use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
 use super::sorm::check_nested_form;
-use super::traits::{
-    Adaptive, AdaptiveMethod, Evaluation, KindNotes, Method, MethodSummary, Problem,
-};
+use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::reliability::{self, ReliabilityError};
 
@@ -129,21 +127,7 @@ impl Method for ImportanceSampling {
         }
     }
 
-    fn summary(&self, _dim: usize) -> MethodSummary {
-        MethodSummary::new(self.kind(), self)
-    }
-
-    fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::Adaptive(AdaptiveMethod(self))
-    }
-
-    fn notes() -> KindNotes {
-        KindNotes {
-            name: Some("an importance-sampling study"),
-            adaptive: true,
-            ..KindNotes::default()
-        }
-    }
+    adaptive_method_items!("an importance-sampling study");
 }
 
 impl Adaptive for ImportanceSampling {

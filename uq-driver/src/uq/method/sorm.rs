@@ -15,9 +15,7 @@ use serde::{Deserialize, Serialize};
 use super::adaptive::{each_target, AdaptiveResult, BatchModel, Target};
 use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
-use super::traits::{
-    Adaptive, AdaptiveMethod, Evaluation, KindNotes, Method, MethodSummary, Problem,
-};
+use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::reliability::{self, ReliabilityError, Scheme};
 
@@ -93,21 +91,7 @@ impl Method for Sorm {
         Ok(())
     }
 
-    fn summary(&self, _dim: usize) -> MethodSummary {
-        MethodSummary::new(self.kind(), self)
-    }
-
-    fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::Adaptive(AdaptiveMethod(self))
-    }
-
-    fn notes() -> KindNotes {
-        KindNotes {
-            name: Some("a SORM study"),
-            adaptive: true,
-            ..KindNotes::default()
-        }
-    }
+    adaptive_method_items!("a SORM study");
 }
 
 impl Adaptive for Sorm {

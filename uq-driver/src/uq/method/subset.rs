@@ -22,9 +22,7 @@ use super::adaptive::{
     each_target, generalised_beta, AdaptiveResult, BatchModel, FailedRuns, LimitResult, Target,
 };
 use super::error::{InvalidSettings, MethodError};
-use super::traits::{
-    Adaptive, AdaptiveMethod, Evaluation, KindNotes, Method, MethodSummary, Problem,
-};
+use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::reliability::{self, Spread};
 
@@ -106,21 +104,7 @@ impl Method for Subset {
         Ok(())
     }
 
-    fn summary(&self, _dim: usize) -> MethodSummary {
-        MethodSummary::new(self.kind(), self)
-    }
-
-    fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::Adaptive(AdaptiveMethod(self))
-    }
-
-    fn notes() -> KindNotes {
-        KindNotes {
-            name: Some("a subset-simulation study"),
-            adaptive: true,
-            ..KindNotes::default()
-        }
-    }
+    adaptive_method_items!("a subset-simulation study");
 }
 
 impl Adaptive for Subset {

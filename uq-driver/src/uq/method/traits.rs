@@ -230,6 +230,33 @@ pub trait Method: std::fmt::Debug + Send + Sync {
     }
 }
 
+/// The [`Method::summary`], [`Method::evaluation`] and [`Method::notes`] that every method of
+/// the adaptive path shares (a method that also implements [`Adaptive`]): its settings as
+/// written under `method`, evaluation by the adaptive session, and `$study`, the method's
+/// name in a sentence ("a FORM study"). Used inside `impl Method for …`.
+macro_rules! adaptive_method_items {
+    ($study:literal) => {
+        fn summary(&self, _dim: usize) -> $crate::uq::method::traits::MethodSummary {
+            $crate::uq::method::traits::MethodSummary::new(self.kind(), self)
+        }
+
+        fn evaluation(&self) -> $crate::uq::method::traits::Evaluation<'_> {
+            $crate::uq::method::traits::Evaluation::Adaptive(
+                $crate::uq::method::traits::AdaptiveMethod(self),
+            )
+        }
+
+        fn notes() -> $crate::uq::method::traits::KindNotes {
+            $crate::uq::method::traits::KindNotes {
+                name: Some($study),
+                adaptive: true,
+                ..$crate::uq::method::traits::KindNotes::default()
+            }
+        }
+    };
+}
+pub(crate) use adaptive_method_items;
+
 /// What the report and the terminal say of a method's results.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct KindNotes {
