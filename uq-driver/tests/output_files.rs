@@ -52,6 +52,7 @@ fn symlinks_planted_as_summary_json_and_points_csv_are_replaced_not_written_thro
         "q.csv",
         "q_band.svg",
         "index.html",
+        "guide.html",
     ] {
         let victim = dir.path().join(format!("victim-{name}"));
         std::fs::write(&victim, "precious\n").unwrap();
@@ -122,6 +123,32 @@ signal = "q"
         html.contains("href=\"%2570oints_pdf.csv\""),
         "link to the escaped file"
     );
+}
+
+#[test]
+fn every_figure_links_to_its_section_of_the_guide_page_written_beside_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
+    let out = dir.path().join("out");
+    let o = run_study(&study, &out, &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    let html = read(&out.join("index.html"));
+    let guide = read(&out.join("guide.html"));
+    let figures = html.matches("<figure>").count();
+    assert!(figures >= 3, "{html}");
+    assert_eq!(
+        html.matches("how to read it</a>").count(),
+        figures,
+        "a figure without its guide link: {html}"
+    );
+    for link in html.split("href=\"guide.html#").skip(1) {
+        let anchor = link.split('"').next().unwrap();
+        assert!(
+            guide.contains(&format!(" id=\"{anchor}\"")),
+            "guide.html has no section {anchor}"
+        );
+    }
+    assert!(html.contains("href=\"guide.html#band-mean--3σ-and-quantiles\""));
 }
 
 #[test]

@@ -41,7 +41,7 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
-const CSS: &str = "\
+pub(super) const CSS: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Helvetica,Arial,sans-serif;color:#222;\
 max-width:1100px;margin:0 auto;padding:24px;line-height:1.5;background:#fafafa}\
 h1{font-size:1.7em;border-bottom:2px solid #ddd;padding-bottom:.3em}\
@@ -103,10 +103,20 @@ impl ReportPage {
                 let src = escape_xml(&url_path(file));
                 let name = escape_xml(file);
                 if is_image(file) {
+                    // The guide's section on this kind of plot (guide.html, written beside).
+                    let how = super::guide::anchor_for(file, &s.images)
+                        .map(|a| {
+                            format!(
+                                " · <a href=\"{}#{}\">how to read it</a>",
+                                super::guide::FILE,
+                                escape_xml(&a)
+                            )
+                        })
+                        .unwrap_or_default();
                     let _ = writeln!(
                         out,
                         "<figure><a href=\"{src}\"><img src=\"{src}\" alt=\"{name}\" \
-                         loading=\"lazy\"></a><figcaption>{name}</figcaption></figure>"
+                         loading=\"lazy\"></a><figcaption>{name}{how}</figcaption></figure>"
                     );
                 } else {
                     links.push(format!("<a href=\"{src}\">{name}</a>"));
@@ -132,9 +142,18 @@ impl ReportPage {
         out
     }
 
-    /// Writes [`Self::to_html`] to `path` (usually `<out>/index.html`).
+    /// Writes [`Self::to_html`] to `path` (usually `<out>/index.html`), and beside it
+    /// `guide.html`, the guide's page on reading the report, which the figures link to.
     pub fn write(&self, path: &Path) -> Result<(), ReportError> {
-        write_bytes(path, self.to_html().as_bytes())
+        write_bytes(path, self.to_html().as_bytes())?;
+        match path.parent() {
+            Some(dir) => super::guide::write(if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            }),
+            None => Ok(()),
+        }
     }
 }
 

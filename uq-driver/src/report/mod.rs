@@ -20,6 +20,7 @@
 
 pub mod compare;
 pub mod csv;
+mod guide;
 pub use crate::text::file_name;
 pub mod heatmap;
 pub mod html;
