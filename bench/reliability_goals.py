@@ -223,12 +223,15 @@ def study_toml(fmu, case, name, seed, b, method):
     return "\n".join(lines) + "\n"
 
 
+SUBSET_BIG_N = 5000  # once, on the linear case at 1e-6: the runs the CoV goal of subset takes
 METHODS = {
     "FORM": 'kind = "form"',
     "SORM": 'kind = "sorm"',
     "IS": f'kind = "importance_sampling"\ntarget_cov = {IS_COV}\nmax_runs = {IS_RUNS}',
     "subset": f'kind = "subset"\nsamples_per_level = {SUBSET_N}\np0 = 0.1',
+    "subset-big": f'kind = "subset"\nsamples_per_level = {SUBSET_BIG_N}\np0 = 0.1',
 }
+TABLE_METHODS = ("FORM", "SORM", "IS", "subset")
 
 
 def run_driver(h, driver, work, fmu, case, name, seed, b, method):
@@ -248,9 +251,10 @@ def run_driver(h, driver, work, fmu, case, name, seed, b, method):
     wall = time.perf_counter() - t0
     s = json.loads((out / "summary.json").read_text())
     r = s["quantities"]["Y"]["reliability"][0]
+    rec = r.get("importance_sampling") or {}
     return {"p": r["p"], "ci": r["ci_95"], "cov": r["cov"], "beta": r["beta"],
             "runs": r["runs"], "time": wall, "warnings": r.get("warnings") or [],
-            "model_runs": s["model_runs"]}
+            "model_runs": s["model_runs"], "is_runs": rec.get("runs")}
 
 
 # ------------------------------------------------------------------ OpenTURNS
@@ -349,7 +353,7 @@ def ot_is(case, b, seed):
     return out
 
 
-def ot_subset(case, b, seed):
+def ot_subset(case, b, seed, n=SUBSET_N):
     import openturns as ot
     ot.RandomGenerator.SetSeed(seed)
     event, _, fn = ot_event(case, b)
@@ -357,7 +361,7 @@ def ot_subset(case, b, seed):
     algo = ot.SubsetSampling(event)
     algo.setConditionalProbability(0.1)
     algo.setBlockSize(100)
-    algo.setMaximumOuterSampling(SUBSET_N // 100)
+    algo.setMaximumOuterSampling(n // 100)
     algo.run()
     return sim_result(algo.getResult(), fn.n, time.perf_counter() - t0)
 
@@ -407,24 +411,35 @@ def bench_case(h, driver, work, fmu, case, refs):
     sec = h.Section(f"Small probabilities: {cfg['title']}",
                     ["exact P", "method", "tool", "P", "rel. error", "CoV", "95 % interval",
                      "covers?", "runs", "time (s)"])
-    verdicts = {}
+    verdicts, warned = {}, []
     for p_t in TARGETS:
         b, exact, _ = refs[p_t]
         tag = f"{case}-{p_t:.0e}"
         ud = {m: run_driver(h, driver, work, fmu, case, f"{tag}-{m}", 1, b, m)
-              for m in METHODS}
+              for m in TABLE_METHODS}
         otr = {"FORM": ot_form(case, b)[0], "SORM": ot_form(case, b, sorm=True)[0],
                "IS": ot_is(case, b, 1), "subset": ot_subset(case, b, 1)}
-        for m in METHODS:
+        rows = [(m, m) for m in TABLE_METHODS]
+        if case == "linear" and p_t == 1e-6:
+            ud["subset-big"] = run_driver(h, driver, work, fmu, case, f"{tag}-subset-big", 1,
+                                          b, "subset-big")
+            otr["subset-big"] = ot_subset(case, b, 1, SUBSET_BIG_N)
+            rows.append(("subset-big", f"subset, {SUBSET_BIG_N} per level"))
+        for m, label in rows:
             for tool, r in (("uq-driver", ud[m]), ("OpenTURNS", otr[m])):
-                name = m if not (m == "SORM" and tool == "OpenTURNS") else "SORM (Tvedt)"
+                name = label if not (m == "SORM" and tool == "OpenTURNS") else "SORM (Tvedt)"
                 if r.get("restarted"):
                     name += " ²"
                 sec.row(f"{exact:.4g} (b = {b:.6g})", *row_cells(tool, name, r, exact))
+            for w in ud[m].get("warnings", []):
+                warned.append(f"{label} at P ≈ {p_t:.0e}: {w}")
         verdicts[p_t] = {"b": b, "exact": exact, "ud": ud, "ot": otr}
+    if warned:
+        sec.note("uq-driver's warnings (summary.json, printed too): " + " — ".join(warned))
     sec.cmd(f"target/release/uq-driver run {h.rel(work)}/{case}-P-M.toml --out "
             f"{h.rel(work)}/{case}-P-M --fresh --threads {THREADS}   # P = 1e-03, 1e-04, 1e-06; "
-            f"M = {', '.join(METHODS)}")
+            f"M = {', '.join(TABLE_METHODS)}"
+            + ("; and linear-1e-06-subset-big" if case == "linear" else ""))
     return sec, verdicts
 
 
@@ -439,7 +454,7 @@ def goal_checks(case, verdicts):
         ok = worst <= FORM_TOL and runs <= FORM_RUNS_PER_INPUT * D
         out.append((f"FORM within {100 * FORM_TOL:.0f} % with ≤ {FORM_RUNS_PER_INPUT * D} runs",
                     ok, f"worst error {100 * worst:.2g} %, at most {runs} runs"))
-    errs, covs, runs, fails = [], [], [], 0
+    errs, covs, runs, fails, need, form_runs = [], [], [], 0, [], []
     for v in verdicts.values():
         r = v["ud"]["IS"]
         if "error" in r:
@@ -447,12 +462,22 @@ def goal_checks(case, verdicts):
             continue
         errs.append(abs(rel_err(r, v["exact"])))
         covs.append(r["cov"])
-        runs.append(r["runs"])
-    ok = not fails and max(errs) <= IS_TOL and max(covs) <= IS_COV + 1e-12 and max(runs) <= IS_RUNS
-    out.append((f"IS within {100 * IS_TOL:.0f} %, CoV ≤ {100 * IS_COV:.0f} %, ≤ {IS_RUNS} runs",
-                ok, ("failed at " + str(fails) + " of 3 P; " if fails else "") +
-                (f"worst error {100 * max(errs):.1f} %, worst CoV {100 * max(covs):.1f} %, "
-                 f"at most {max(runs)} runs (FORM's included)" if errs else "")))
+        runs.append(r["is_runs"])
+        form_runs.append(r["runs"] - r["is_runs"])
+        # IS's variance falls as 1/n: the runs at which its CoV would reach the target
+        need.append(r["is_runs"] * (r["cov"] / IS_COV) ** 2)
+    ok = (not fails and max(errs) <= IS_TOL and max(covs) <= IS_COV + 1e-12
+          and max(runs) <= IS_RUNS)
+    detail = ("failed at " + str(fails) + " of 3 P; " if fails else "")
+    if errs:
+        detail += (f"worst error {100 * max(errs):.1f} %, worst CoV {100 * max(covs):.1f} %, "
+                   f"at most {max(runs)} IS runs after FORM's {min(form_runs)}–"
+                   f"{max(form_runs)}")
+        if max(covs) > IS_COV + 1e-12:
+            detail += (f"; the CoV target would take about {max(need):.0f} IS runs "
+                       f"(n·(CoV/{IS_COV:g})²)")
+    out.append((f"IS after FORM within {100 * IS_TOL:.0f} %, CoV ≤ {100 * IS_COV:.0f} %, "
+                f"≤ {IS_RUNS} runs", ok, detail))
     v = verdicts[1e-6]
     r = v["ud"]["subset"]
     if "error" in r:
@@ -460,9 +485,13 @@ def goal_checks(case, verdicts):
     else:
         e = abs(rel_err(r, v["exact"]))
         ok = e <= SUBSET_TOL and r["cov"] <= SUBSET_COV and r["runs"] <= SUBSET_RUNS
+        detail = f"error {100 * e:.1f} %, CoV {100 * r['cov']:.1f} %, {r['runs']} runs"
+        big = v["ud"].get("subset-big")
+        if big and "error" not in big:
+            detail += (f"; with {SUBSET_BIG_N} per level: CoV {100 * big['cov']:.1f} %, error "
+                       f"{100 * rel_err(big, v['exact']):+.1f} %, {big['runs']} runs")
         out.append((f"subset at 1e-6 within {100 * SUBSET_TOL:.0f} %, CoV ≤ "
-                    f"{100 * SUBSET_COV:.0f} %, ≤ {SUBSET_RUNS} runs", ok,
-                    f"error {100 * e:.1f} %, CoV {100 * r['cov']:.1f} %, {r['runs']} runs"))
+                    f"{100 * SUBSET_COV:.0f} %, ≤ {SUBSET_RUNS} runs", ok, detail))
     return out
 
 
@@ -475,7 +504,8 @@ COVERAGE = (("IS", "linear", 1e-4), ("IS", "corr", 1e-4), ("subset", "linear", 1
 def bench_coverage(h, driver, work, fmu, refs):
     sec = h.Section("Small probabilities: coverage of the printed 95 % intervals over 20 seeds",
                     ["method", "case", "exact P", "tool", "intervals covering", "median P",
-                     "worst rel. error", "median CoV", "runs (median)", "time (s, all seeds)"])
+                     "worst rel. error", "median CoV", "median interval width (hi / lo)",
+                     "runs (median)", "time (s, all seeds)"])
     results = []
     for method, case, p_t in COVERAGE:
         b, exact, _ = refs[case][p_t]
@@ -498,6 +528,8 @@ def bench_coverage(h, driver, work, fmu, refs):
                     fmt_p(float(np.median(ps))) if ps else "—",
                     f"{100 * max(abs(p / exact - 1) for p in ps):.1f} %" if ps else "—",
                     f"{100 * float(np.median([r['cov'] for r in good])):.1f} %" if good else "—",
+                    f"{float(np.median([r['ci'][1] / r['ci'][0] if r['ci'][0] > 0 else math.inf for r in good])):.2f}"
+                    if good else "—",
                     f"{int(np.median([r['runs'] for r in good]))}" if good else "—",
                     f"{wall:.1f}")
             results.append((method, case, tool, n_cov))
@@ -509,7 +541,11 @@ def bench_coverage(h, driver, work, fmu, refs):
              f"getProbabilityDistribution().computeBilateralConfidenceInterval(0.95) (normal). For the correlated case the reference's own "
              f"standard error is well under 1 % of P (see its section), small beside the "
              f"intervals. With 20 seeds, a true 95 % interval covers ≥ 18 times with "
-             f"probability 0.92.")
+             f"probability 0.92. The interval's width (hi / lo, median over the seeds) "
+             f"shows how the coverage is bought: uq-driver's subset interval is log-normal on "
+             f"the CoV of fully correlated levels (its summary.json says \"conservative\"), "
+             f"OpenTURNS's is normal on its CoV; both IS intervals are on the estimated CoV "
+             f"(uq-driver log-normal, OpenTURNS normal).")
     ud = [(m, c, n) for m, c, tool, n in results if tool == "uq-driver"]
     met = all(n >= COVERAGE_GOAL for _, _, n in ud)
     sec.done("uq-driver's intervals cover the exact value in " +
@@ -553,9 +589,10 @@ def bench(h, work, driver, test_fmu_dir):
                 b, exact = limit_and_exact(case, p_t)
                 refs[case][p_t] = (b, exact, 0.0)
     t_ref = time.perf_counter() - t_ref
-    sections, checks = [], {}
+    sections, checks, all_v = [], {}, {}
     for case in CASES:
         sec, verdicts = bench_case(h, driver, work, fmu, case, refs[case])
+        all_v[case] = verdicts
         checks[case] = goal_checks(case, verdicts)
         notes = []
         if case == "corr":
@@ -593,10 +630,10 @@ def bench(h, work, driver, test_fmu_dir):
         sections.append(sec)
     cov_sec, cov_met = bench_coverage(h, driver, work, fmu, refs)
     sections.append(cov_sec)
-    return [summary_section(h, checks, cov_met, sections)] + sections
+    return [summary_section(h, checks, cov_met, sections, all_v)] + sections
 
 
-def summary_section(h, checks, cov_met, sections):
+def summary_section(h, checks, cov_met, sections, all_v):
     sec = h.Section("Small probabilities: the goals, uq-driver", ["case", "goal", "met?",
                                                                   "measured"])
     n, met = 0, 0
@@ -607,7 +644,41 @@ def summary_section(h, checks, cov_met, sections):
             met += ok
     sec.row("coverage", f"IS and subset intervals cover in ≥ {COVERAGE_GOAL}/20 seeds",
             h.goal(cov_met), "see the coverage section")
-    sec.note("The sections below hold every figure, OpenTURNS's beside uq-driver's.")
+    def errs(case, m):
+        return [rel_err(v["ud"][m], v["exact"]) for v in all_v[case].values()
+                if "error" not in v["ud"][m]]
+
+    def pct(xs):
+        return f"{100 * min(xs):+.0f} … {100 * max(xs):+.0f} %"
+
+    def orders(xs):
+        return f"{min(-math.log10(1 + x) for x in xs):.1f}–{max(-math.log10(1 + x) for x in xs):.1f}"
+    big = all_v["linear"][1e-6]["ud"]["subset-big"]
+    big_ot = all_v["linear"][1e-6]["ot"]["subset-big"]
+    is_cov = {c: max(v["ud"]["IS"]["cov"] for v in all_v[c].values()
+                     if "error" not in v["ud"]["IS"]) for c in CASES}
+    sec.note(
+        "The sections below hold every figure, OpenTURNS's beside uq-driver's. Why goals are "
+        "not met, from the figures: (1) subset simulation's CoV at 1e-6 is about "
+        "√(m (1 − p0)(1 + γ) / (p0 N)) for m = 6 levels of N samples (γ ≈ 1–2, the "
+        f"correlation of the Markov chains): with N = {SUBSET_N} per level (at most "
+        f"{SUBSET_N + 6 * (SUBSET_N - SUBSET_N // 10)} runs) that is 25–30 %, the same for "
+        f"OpenTURNS's SubsetSampling at the same N; with N = {SUBSET_BIG_N} (linear case, "
+        f"1e-6) uq-driver's CoV is still {100 * big['cov']:.1f} % in {big['runs']} runs "
+        f"(OpenTURNS {100 * big_ot['cov']:.1f} % in {big_ot['runs']}): the goal's ≤ 10 000 runs "
+        "and CoV ≤ 15 % are not reachable together by subset simulation with p0 = 0.1 as "
+        "designed. (2) Importance sampling centred at FORM's design point: 2 000 runs end at "
+        f"a CoV of {100 * is_cov['linear']:.1f} % (linear) and {100 * is_cov['product']:.1f} % "
+        "(product) at 1e-6, just above the 5 % target; where the limit state is curved in "
+        f"standard space (the correlated lognormal sum, FORM {pct(errs('corr', 'FORM'))} off) "
+        f"the weights spread and the CoV ends at up to {100 * is_cov['corr']:.1f} %; on the "
+        "sum of squares (a sphere in standard space: every direction is a design point) IS "
+        f"around one point samples a sliver of the failure domain and is {pct(errs('squares', 'IS'))} "
+        "off, with intervals that miss the exact value (uq-driver warns of a second design "
+        "point and that the CoV target was not reached, and names subset simulation); FORM "
+        f"alone is there {orders(errs('squares', 'FORM'))} orders of magnitude low, SORM "
+        f"{orders(errs('squares', 'SORM'))} (curvature corrections at one point cannot "
+        "represent a sphere).")
     sec.other = sum(s.other for s in sections) / len(sections)
     sec.done(f"uq-driver meets {met + cov_met} of {n + 1} goals.")
     return sec
