@@ -6,11 +6,13 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
-                                  [--only hd|vehicle]
+                                  [--only hd|vehicle|reliability]
 
 `--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
 target/bench/BENCHMARKS-hd.md, `--only vehicle` the full car's real-time factor alone into
-target/bench/BENCHMARKS-vehicle.md.
+target/bench/BENCHMARKS-vehicle.md, `--only reliability` the small-probability goals alone
+(bench/reliability_goals.py: FORM, SORM, importance sampling, subset simulation beside
+OpenTURNS; needs only uq-driver and a C compiler) into target/bench/BENCHMARKS-reliability.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals set for the comparisons are reported as met or not met. The only hard failures are missing
@@ -212,10 +214,22 @@ def fmu(name):
     return FMU_DIR / f"{name}.fmu"
 
 
-def check_prerequisites():
+def check_prerequisites(only=None):
     missing = []
     if not (DRIVER.is_file() and os.access(DRIVER, os.X_OK)):
         missing.append(f"{DRIVER} (build it: `make build`)")
+    if only == "reliability":  # uq-driver, the C test FMU (built here), numpy, OpenTURNS
+        if missing:
+            die("missing prerequisites:\n  " + "\n  ".join(missing))
+        try:
+            import fmpy  # noqa: F401
+            import numpy  # noqa: F401
+            import openturns  # noqa: F401
+            import scipy  # noqa: F401
+        except ImportError as e:
+            die(f"{e}: run this script with the project venv (`make venv`, then "
+                f".venv/bin/python; bench/requirements.txt)")
+        return
     for m in MODELS:
         if not fmu(m).is_file():
             missing.append(f"{fmu(m)} (build it: `make fmu`)")
@@ -978,6 +992,18 @@ def bench_hd_goals(work):
                           ROOT / "target" / "test-fmu")
 
 
+# ------------------------------------------------------------------ small probabilities
+
+def bench_reliability_goals(work):
+    """FORM, SORM, importance sampling and subset simulation on analytic limit states with
+    known tails (the Functions test FMU), runs counted, beside OpenTURNS, and the coverage of
+    their 95 % intervals over 20 seeds (bench/reliability_goals.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import reliability_goals
+    return reliability_goals.bench(sys.modules[__name__], work, DRIVER,
+                                   ROOT / "target" / "test-fmu")
+
+
 # ------------------------------------------------------------------ BENCHMARKS.md
 
 # ------------------------------------------------------------------ --isolate overhead
@@ -1101,8 +1127,9 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     ]
     for k, v in mach.items():
         lines.append(f"| {k} | {v} |")
-    lines.append(f"| FMU binary = target/release/librailuq.so | "
-                 f"{'yes' if lib_same else 'NO (rebuilt after make fmu)'} |")
+    if lib_same is not None:
+        lines.append(f"| FMU binary = target/release/librailuq.so | "
+                     f"{'yes' if lib_same else 'NO (rebuilt after make fmu)'} |")
     lines.append("")
     if not checks_ok:
         lines += ["**A correctness check FAILED (see section 2/3): the comparisons are not "
@@ -1112,7 +1139,7 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
-SECTIONS = ("hd", "vehicle")
+SECTIONS = ("hd", "vehicle", "reliability")
 
 
 def main():
@@ -1144,7 +1171,7 @@ def main():
     work = Path(args.work)
     t_start = time.perf_counter()
     try:
-        check_prerequisites()
+        check_prerequisites(args.only)
         work.mkdir(parents=True, exist_ok=True)
         env_fmu = os.environ.get("RAILUQ_FMU_DIR")
         os.environ["RAILUQ_FMU_DIR"] = str(FMU_DIR.resolve())  # the builtin studies' FMUs
@@ -1154,6 +1181,9 @@ def main():
         if args.only == "hd":
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
             sections, same_threads, same_iso = bench_hd_goals(work), True, True
+        elif args.only == "reliability":
+            lib_same = None  # no railuq FMU in this section
+            sections, same_threads, same_iso = bench_reliability_goals(work), True, True
         elif args.only == "vehicle":
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
             sections = [bench_vehicle_realtime(work, repeats)]
@@ -1190,8 +1220,9 @@ def all_sections(args, work, repeats, checks):
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
     s_hd = bench_hd_goals(work)
-    return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd, same_threads,
-            same_iso, lib_same)
+    s_rel = bench_reliability_goals(work)
+    return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd + s_rel,
+            same_threads, same_iso, lib_same)
 
 
 if __name__ == "__main__":

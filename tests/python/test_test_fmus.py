@@ -298,6 +298,15 @@ def test_linear_sum_and_sum_of_squares_at_random_points(functions_fmu):
                                                                            rel=1e-14)
 
 
+def test_product_at_random_lognormal_points(functions_fmu):
+    rng = np.random.default_rng(3)
+    with slave(functions_fmu) as s:
+        for x in np.exp(rng.normal(scale=0.5, size=(20, 8))):
+            values = {f"x{i + 1}": v for i, v in enumerate(x)}
+            assert s.evaluate("y", function=7, **values) == pytest.approx(math.prod(x),
+                                                                           rel=1e-14)
+
+
 def test_ishigami_at_random_points(functions_fmu):
     rng = np.random.default_rng(1)
     with slave(functions_fmu) as s:
@@ -439,12 +448,12 @@ def test_y_t_is_y_times_one_plus_t_under_fmpy(functions_fmu):
     np.testing.assert_allclose(res["f_x"], 4.5, rtol=1e-15)
 
 
-@pytest.mark.parametrize("function", [0, 7, -1])
+@pytest.mark.parametrize("function", [0, 8, -1])
 def test_an_unknown_function_is_refused_when_set(functions_fmu, function, capsys):
     with slave(functions_fmu) as s:
         with pytest.raises(FMICallException):
             s.set(function=function)
-    assert "outside [1, 6]" in capsys.readouterr().out
+    assert "outside [1, 7]" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------------

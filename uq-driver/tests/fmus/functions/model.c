@@ -11,6 +11,7 @@
  *                   obtained by hashing the Integer parameter `seed` (SplitMix64 + Box-Muller)
  *   5 linear        y = x1 + x2 + ... + x8 (closed-form tails for normal inputs)
  *   6 sum of squares y = x1^2 + x2^2 + ... + x8^2 (a chi-square for standard normal inputs)
+ *   7 product       y = x1 x2 ... x8 (lognormal inputs: ln y is normal, closed-form tails)
  * y is computed once at the end of initialization; the time-varying output is
  * y_t = y (1 + t). f_x and h_seed are outputs too (for the other functions f_x = y, h_seed = 0).
  * One fmi2DoStep is an addition and a multiplication.
@@ -24,7 +25,8 @@
 #define PI 3.14159265358979323846
 #define GUID "{d6f1c9a4-5b3e-4f1a-8c2d-railuq-test-functions}"
 
-enum { ISHIGAMI = 1, BOREHOLE = 2, G_FUNCTION = 3, TWO_LEVEL = 4, LINEAR = 5, SQUARES = 6 };
+enum { ISHIGAMI = 1, BOREHOLE = 2, G_FUNCTION = 3, TWO_LEVEL = 4, LINEAR = 5, SQUARES = 6,
+       PRODUCT = 7 };
 
 typedef struct {
     fmi2Integer function;
@@ -77,7 +79,7 @@ static const Variable VARIABLES[] = {
     REAL_PARAMETER("a8", 30, g_a[7]),
     REAL_PARAMETER("sigma_h", 31, sigma_h),
     {"function", TYPE_INTEGER, 0, KIND_FIXED_PARAMETER, offsetof(Data, function), 1, ISHIGAMI,
-     SQUARES},
+     PRODUCT},
     {"seed", TYPE_INTEGER, 1, KIND_FIXED_PARAMETER, offsetof(Data, seed), 0, 0, 0},
 };
 
@@ -159,6 +161,12 @@ static void calculate(Instance *inst) {
         int i;
         d->f_x = 0.0;
         for (i = 0; i < 8; i++) d->f_x += d->function == LINEAR ? d->x[i] : d->x[i] * d->x[i];
+        break;
+    }
+    case PRODUCT: {
+        int i;
+        d->f_x = 1.0;
+        for (i = 0; i < 8; i++) d->f_x *= d->x[i];
         break;
     }
     default: d->f_x = NAN; break;
