@@ -20,14 +20,23 @@ use crate::uq::random_inputs::{Correlation, CorrelationPair};
 impl Study {
     /// Loads `builtin:NAME` or a TOML file.
     pub fn load(spec: &str) -> Result<Study, StudyError> {
+        Study::load_with_settings(spec, &[])
+    }
+
+    /// [`Study::load`] with `KEY=VALUE` settings written into the study's TOML first
+    /// (`run --set`; see `overrides.rs` for the grammar): validated as the file's own keys,
+    /// and kept in [`Study::source`].
+    pub(crate) fn load_with_settings(spec: &str, sets: &[String]) -> Result<Study, StudyError> {
         if let Some(name) = spec.strip_prefix("builtin:") {
-            return Study::parse(builtin(name)?, spec, None);
+            let text = super::overrides::apply(builtin(name)?, spec, sets)?;
+            return Study::parse(&text, spec, None);
         }
         let path = Path::new(spec);
         let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
             path: path.to_path_buf(),
             source,
         })?;
+        let text = super::overrides::apply(&text, spec, sets)?;
         Study::parse(&text, spec, path.parent())
     }
 
@@ -152,6 +161,11 @@ fn study(
         experiment: e.get_ref().clone(),
         method: file.method.get_ref().clone(),
         parameters,
+        allow_negative: params
+            .iter()
+            .filter(|(_, p)| p.allow_negative)
+            .map(|(_, p)| p.name.clone())
+            .collect(),
         correlation,
         fixed: file.fixed.clone(),
         inputs: file

@@ -31,7 +31,8 @@ pub(crate) use surrogate::Surrogates;
 pub(crate) use runs::{QuantityRuns, Runs};
 
 use super::store::StoredRuns;
-use crate::qoi::{kde, QoiSpec};
+use crate::qoi::kde::{self, KdeKind};
+use crate::qoi::QoiSpec;
 use crate::results::{
     Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
 };
@@ -229,10 +230,18 @@ fn summarise(
     };
     let (lo, hi) = density_range(estimate, &quantiles, cols, &picked);
     let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
+    // A quantity whose every picked value is >= 0 is taken as non-negative: its densities
+    // are reflected at 0 and the grid starts there.
+    let non_negative = picked.iter().all(|&k| cols[k].min >= 0.0);
+    let start = if non_negative && lo - pad < 0.0 && hi + pad > 0.0 {
+        0.0
+    } else {
+        lo - pad
+    };
     let grid = if picked.is_empty() {
         Vec::new()
     } else {
-        kde::auto_grid(lo - pad, hi + pad, a.pdf_grid)
+        kde::auto_grid(start, hi + pad, a.pdf_grid)
     };
     let (g0, g1) = (
         grid.first().copied().unwrap_or(0.0),
@@ -245,12 +254,14 @@ fn summarise(
         .map(|(&k, col)| {
             if spread(&cols[k]) {
                 let h = cols[k].bandwidth;
-                if h < 2.0 * step {
-                    // Narrower than the grid: averages over the grid cells keep its mass.
-                    kde::gaussian_kde_cell_average(col, g0, g1, grid.len(), h)
+                // Narrower than the grid: averages over the grid cells keep its mass.
+                let kind = if h < 2.0 * step {
+                    KdeKind::CellAverages
                 } else {
-                    kde::gaussian_kde_binned(col, g0, g1, grid.len(), h)
-                }
+                    KdeKind::Points
+                };
+                let bound = (cols[k].min >= 0.0).then_some(0.0);
+                kde::bounded_kde(col, g0, g1, grid.len(), h, bound, kind)
             } else {
                 vec![f64::NAN; grid.len()]
             }
@@ -370,10 +381,21 @@ fn scalar_stats_counted(
         (Vec::new(), Vec::new())
     } else {
         let bw = c.bandwidth;
+        // Every value >= 0: a non-negative quantity, its density reflected at 0.
+        let bound = (c.min >= 0.0).then_some(0.0);
         let (lo, hi) = (c.min - 3.0 * bw, c.max + 3.0 * bw);
+        let lo = bound.map_or(lo, |b| lo.max(b));
         (
             kde::auto_grid(lo, hi, a.pdf_grid),
-            kde::gaussian_kde_binned(&density_samples, lo, hi, a.pdf_grid, bw),
+            kde::bounded_kde(
+                &density_samples,
+                lo,
+                hi,
+                a.pdf_grid,
+                bw,
+                bound,
+                KdeKind::Points,
+            ),
         )
     };
     let (smallest, largest) = runs
@@ -496,6 +518,7 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
             mean: vec![mean; order + 1],
             std: cumulative,
             std_of_order: of_order.iter().map(|v: &f64| v.sqrt()).collect(),
+            std_error_mean: Vec::new(),
         });
     }
     if valid.len() < 4 {
@@ -526,6 +549,39 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
         mean,
         std,
         std_of_order: Vec::new(),
+        std_error_mean: Vec::new(),
+    })
+}
+
+/// The nested estimate over the first n outer samples against the runs they hold (in design
+/// order, at about 30 values of n on a log scale): its mean, Std and the standard error of
+/// its mean between outer samples. So the axis counts the study's real runs, not the pooled
+/// draws its densities are taken from.
+pub(crate) fn outer_convergence(
+    c: &crate::uq::method::nested::split::Conditionals,
+    runs_of: &[usize],
+) -> Option<Convergence> {
+    use crate::uq::method::nested::split::Split;
+    let n = c.len();
+    if n < 4 || runs_of.len() != n {
+        return None;
+    }
+    let mut points: Vec<usize> = (0..=30)
+        .map(|i| (2.0 * (n as f64 / 2.0).powf(i as f64 / 30.0)).round() as usize)
+        .collect();
+    points.dedup();
+    let idx: Vec<usize> = (0..n).collect();
+    let splits: Vec<Split> = points.iter().map(|&m| Split::of(c, &idx[..m])).collect();
+    Some(Convergence {
+        axis: "runs".into(),
+        x: points
+            .iter()
+            .map(|&m| runs_of[..m].iter().sum::<usize>() as f64)
+            .collect(),
+        mean: splits.iter().map(|s| s.mean).collect(),
+        std: splits.iter().map(Split::std).collect(),
+        std_of_order: Vec::new(),
+        std_error_mean: splits.iter().map(|s| s.std_error_mean).collect(),
     })
 }
 
@@ -731,5 +787,33 @@ mod tests {
         assert_eq!(t[0], 0);
         assert_eq!(*t.last().unwrap(), 500);
         assert!(t.len() <= 101);
+    }
+
+    /// A nested study's convergence plot said "runs n" with an axis to 4 096 (its pooled
+    /// draws) for a 256-run study.
+    #[test]
+    fn nested_convergence_counts_the_studys_runs_not_its_pooled_draws() {
+        use crate::uq::method::nested::split::Conditionals;
+        // 16 outer samples of 16 runs each: 256 runs.
+        let m: Vec<f64> = (0..16).map(|k| (k as f64 * 0.7).sin()).collect();
+        let c = Conditionals {
+            mean: m.clone(),
+            var: vec![0.25; 16],
+            se2: vec![0.0; 16],
+        };
+        let conv = outer_convergence(&c, &[16; 16]).unwrap();
+        assert_eq!(conv.axis, "runs");
+        assert_eq!(conv.x.first(), Some(&32.0));
+        assert_eq!(conv.x.last(), Some(&256.0));
+        assert!(conv.x.windows(2).all(|w| w[0] < w[1]), "{:?}", conv.x);
+        assert!(conv.x.iter().all(|x| x % 16.0 == 0.0), "{:?}", conv.x);
+        // At all 16: the mean of the conditional means, Std² = mean inner var + var of means,
+        // standard error sd(means)/4.
+        let mean = m.iter().sum::<f64>() / 16.0;
+        let var_m = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 15.0;
+        assert!((conv.mean.last().unwrap() - mean).abs() < 1e-12);
+        assert!((conv.std.last().unwrap() - (0.25 + var_m).sqrt()).abs() < 1e-12);
+        assert!((conv.std_error_mean.last().unwrap() - (var_m / 16.0).sqrt()).abs() < 1e-12);
+        assert!(outer_convergence(&c, &[16; 15]).is_none());
     }
 }

@@ -24,8 +24,9 @@ use crate::results::{
 };
 use crate::spec::Study;
 use crate::study::analysis::{
-    nest_exceedance_count, output_stats, quantity_error, scalar_stats, series_error, surrogates_of,
-    Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
+    nest_exceedance_count, outer_convergence, output_stats, quantity_error, scalar_stats,
+    series_error, surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs, Settings,
+    CHAOS_ERROR,
 };
 use crate::study::store::StoredRuns;
 use crate::uq::method::nested::split::{self, Split};
@@ -132,6 +133,11 @@ fn output(
     let pooled = pooled_series(&cond, data, settings, nt);
     let mut stats: OutputStats = output_stats(name, times, &estimate, Some(&pooled), settings)?;
     stats.draws = draws_of(&cond);
+    // Over the outer samples and their runs, not over the pooled draws.
+    let at = stats
+        .convergence_time
+        .and_then(|t| times.iter().position(|&x| x == t));
+    stats.convergence = at.and_then(|k| outer_convergence(&cond.column(k), &runs_of(&cond)));
     let split = OutputSplit {
         name: name.to_owned(),
         times: times.to_vec(),
@@ -142,6 +148,15 @@ fn output(
         outer_samples: cond.present().len(),
     };
     Ok((stats, split, inner_chaos_warning(name, &cond, Some(times))))
+}
+
+/// The runs of each outer sample that has an estimate, in the order of
+/// [`Conditional::column`].
+fn runs_of(cond: &Conditional) -> Vec<usize> {
+    cond.present()
+        .iter()
+        .map(|&k| cond.data_rows[k].len())
+        .collect()
 }
 
 /// Where the densities of the conditional estimates come from.
@@ -262,6 +277,7 @@ fn quantity(
     let n = present.len() as f64;
     let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled))?;
     stats.draws = draws_of(&cond);
+    stats.convergence = outer_convergence(&c, &runs_of(&cond)).filter(|_| !stats.deterministic);
     stats.exceedance = exceedance
         .iter()
         .zip(&limits)
