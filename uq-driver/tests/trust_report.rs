@@ -60,7 +60,13 @@ fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
     assert!(!other.status.success(), "another seed resumed the store");
     // Keys are checked as the study file's own are.
     let e = run_study(&study, &dir.path().join("e1"), &["--set", "method.zzz=1"]);
-    assert!(stderr(&e).contains("unknown field `zzz`"), "{}", stderr(&e));
+    let text = stderr(&e);
+    assert!(text.contains("unknown field `zzz`"), "{text}");
+    // Named by the setting, not by a line of the rewritten text.
+    assert!(
+        text.contains("linear.toml (with --set method.zzz=1): unknown"),
+        "{text}"
+    );
     let e = run_study(
         &study,
         &dir.path().join("e2"),
