@@ -32,7 +32,7 @@ impl Design {
     /// A design whose values are the images of `points` under the inputs' map from `germ`
     /// ([`RandomInputs::to_physical`]: each input's isoprobabilistic map, correlated through the
     /// copula where the study correlates inputs). Which inputs must stay positive is not known
-    /// here (the FMU says it); [`Design::sign_warnings`] reports those that do not.
+    /// here (the FMU says it): the study reports those that reach values <= 0.
     pub fn mapped(
         germ: Germ,
         points: Vec<Vec<f64>>,
