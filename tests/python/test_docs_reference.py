@@ -119,10 +119,11 @@ def test_the_reference_documents_every_study_file_key_and_no_unknown_one(tmp_pat
 
 def test_the_keys_every_parameter_takes_are_accepted_and_a_wrong_one_refused(tmp_path):
     common = documented_keys()["parameters"]
-    assert common == {"name", "distribution", "level"}
-    body = '[[parameters]]\nname = "K"\ndistribution = "normal"\nlevel = "inner"\nmean = 1.0\nstd = 0.1\n'
+    assert common == {"name", "distribution", "level", "allow_negative"}
+    body = ('[[parameters]]\nname = "K"\ndistribution = "normal"\nlevel = "inner"\n'
+            'allow_negative = true\nmean = 1.0\nstd = 0.1\n')
     err = error_of(HEAD + body, tmp_path)  # refused later (no experiment, no FMU), not for a key
-    assert "unknown field" not in err and "level" not in err, err
+    assert "unknown field" not in err and "level" not in err and "allow_negative" not in err, err
     err = error_of(HEAD + body + "levle = 1\n", tmp_path)
     assert "unknown field `levle`" in err, err
 

@@ -86,7 +86,7 @@
 //! indices:
 //!
 //! ```
-//! use nalgebra::DMatrix;
+//! use uq_driver::nalgebra::DMatrix; // re-exported: no `nalgebra` in your Cargo.toml
 //! use uq_driver::uq::distributions::{Distribution, RandomParameter};
 //! use uq_driver::uq::method::{scm::Scm, ChaosBasis, Sampling};
 //! use uq_driver::uq::RandomInputs;
@@ -142,6 +142,11 @@
 //!
 //! `unsafe` code is confined to the FMI import layer ([`fmu`]) and `sys`; every other module
 //! is `#![forbid(unsafe_code)]`.
+
+/// The linear-algebra crate of the public API (a design's results are a
+/// [`nalgebra::DMatrix`], estimates and chaos coefficients too), re-exported so that a
+/// program uses the very version uq-driver was built with.
+pub use nalgebra;
 
 #[cfg(feature = "cli")]
 pub mod cli;

@@ -43,6 +43,7 @@ mod study_sampling;
 mod study_wheel;
 mod tampered_folders;
 mod test_fmus;
+mod trust_report;
 mod undefined_numbers;
 mod vehicle_studies;
 

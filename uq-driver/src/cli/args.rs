@@ -179,8 +179,25 @@ pub(crate) struct RunArgs {
     /// Write the CSV files and summary.json only: no plots, no index.html.
     #[arg(long)]
     pub(crate) no_report: bool,
+    /// The seed of every random stream, instead of the study file's `seed`.
+    #[arg(long, value_name = "N")]
+    pub(crate) seed: Option<u64>,
+    /// Set a study-file key before the study is validated: a dotted path and a TOML value,
+    /// e.g. method.order=3, parameters.k1.std=0.1, 'method.kind="lhs"' (repeatable; kept in
+    /// the stored study).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub(crate) set: Vec<String>,
     #[command(flatten)]
     pub(crate) safety: SafetyArgs,
+}
+
+impl RunArgs {
+    /// The `--set` settings, then `--seed` as `seed=N`.
+    pub(crate) fn settings(&self) -> Vec<String> {
+        let mut sets = self.set.clone();
+        sets.extend(self.seed.map(|n| format!("seed={n}")));
+        sets
+    }
 }
 
 /// How points are run: isolation, time limit, retries.

@@ -41,7 +41,12 @@ pub(crate) fn study_spec(arg: &str) -> Result<String> {
 /// Loads a study argument (file, builtin:NAME or NAME), warns about `cov` values that look
 /// like percentages and checks that its FMU (and every variant's) can be found.
 pub(crate) fn load_study(arg: &str) -> Result<Study> {
-    let s = Study::load(&study_spec(arg)?)?;
+    load_study_with(arg, &[])
+}
+
+/// [`load_study`] with `KEY=VALUE` settings written into the study first (`run --set`).
+pub(crate) fn load_study_with(arg: &str, sets: &[String]) -> Result<Study> {
+    let s = Study::load_with_settings(&study_spec(arg)?, sets)?;
     super::check_study(&s)?;
     Ok(s)
 }

@@ -342,7 +342,7 @@ fn dispatch(cmd: Command) -> Result<()> {
 
 /// `uq-driver run`.
 fn run(a: RunArgs) -> Result<()> {
-    let s = load_study(&a.study)?;
+    let s = load_study_with(&a.study, &a.settings())?;
     let mut opts = RunOptions {
         threads: a.threads,
         progress: std::io::stderr().is_terminal(),

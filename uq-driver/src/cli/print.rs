@@ -86,6 +86,9 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
                 count(q.n_valid, "valid run", "valid runs"),
                 q.definition.text
             );
+            if let Some(line) = split_line(q) {
+                println!("{line}");
+            }
             print_exceedances(q);
         }
     }
@@ -97,6 +100,33 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
         };
         println!("{} {points} failed (see points.csv)", s.failed_runs);
     }
+}
+
+/// A nested quantity's variance split (as on the page and in summary.json):
+/// `q: variance from the inner parameters (k1, k2) 62 % (95 % interval 55–70 %), from the
+/// outer parameters (seed) 38 % (30–45 %); 16 outer samples`.
+fn split_line(q: &ScalarStats) -> Option<String> {
+    let n = q.nested.as_ref()?;
+    let v = &n.variance_split;
+    let pct = |x: f64| format!("{:.0} %", 100.0 * x);
+    let names = |list: &[String]| match list.is_empty() {
+        true => String::new(),
+        false => format!(" ({})", list.join(", ")),
+    };
+    Some(format!(
+        "  {}: variance from the inner parameters{} {} (95 % interval {}–{}), from the outer \
+         parameters{} {} ({}–{}); {}",
+        q.name,
+        names(&n.conditional.inner_names),
+        pct(v.inner),
+        pct(v.inner_ci[0]),
+        pct(v.inner_ci[1]),
+        names(&n.conditional.outer_names),
+        pct(v.outer),
+        pct(v.outer_ci[0]),
+        pct(v.outer_ci[1]),
+        count(n.outer_samples, "outer sample", "outer samples")
+    ))
 }
 
 /// One line per probability of a reliability method

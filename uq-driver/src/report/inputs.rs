@@ -5,6 +5,7 @@
 
 use crate::results::numbers::{as_written, computed, written as num};
 use crate::uq::distributions::RandomParameter;
+use crate::uq::random_inputs::Correlation;
 
 /// One row of the inputs table: `[parameter, unit, distribution as written, mean, Std, CoV,
 /// support]`. Mean and Std read as a study file writes them, in one notation (`182300` and
@@ -148,6 +149,65 @@ pub fn written(p: &RandomParameter) -> String {
     }
 }
 
+/// The correlation matrix of the correlated inputs (`[[correlation]]`), as a header and rows:
+/// each cell the requested Pearson correlation of the two inputs' values (0 for a pair not
+/// given, 1 on the diagonal), and in brackets the correlation of their normal scores that the
+/// Gaussian copula (Nataf transformation) uses to give it. `None` for independent inputs.
+pub fn correlation_table(
+    c: &Correlation,
+    parameters: &[RandomParameter],
+) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+    let shown: Vec<usize> = (0..parameters.len())
+        .filter(|&i| c.correlated.get(i).copied().unwrap_or(false))
+        .collect();
+    let shown = if shown.is_empty() {
+        // Read back from summary.json (no flags): every input named by a pair.
+        (0..parameters.len())
+            .filter(|&i| {
+                c.pairs
+                    .iter()
+                    .any(|p| p.between.contains(&parameters[i].name))
+            })
+            .collect()
+    } else {
+        shown
+    };
+    if shown.is_empty() {
+        return None;
+    }
+    let requested = |a: &str, b: &str| -> f64 {
+        if a == b {
+            return 1.0;
+        }
+        c.pairs
+            .iter()
+            .find(|p| {
+                (p.between[0] == a && p.between[1] == b) || (p.between[0] == b && p.between[1] == a)
+            })
+            .map_or(0.0, |p| p.rho)
+    };
+    let z = &c.normal_correlation;
+    let mut header = vec![String::new()];
+    header.extend(shown.iter().map(|&i| parameters[i].name.clone()));
+    let rows = shown
+        .iter()
+        .map(|&i| {
+            let mut row = vec![parameters[i].name.clone()];
+            row.extend(shown.iter().map(|&j| {
+                let rho = requested(&parameters[i].name, &parameters[j].name);
+                match (i == j, z.get((i, j))) {
+                    (false, Some(&rz)) if rho != 0.0 || rz != 0.0 => {
+                        format!("{} [{}]", num(rho), computed(&[rz])[0])
+                    }
+                    _ => num(rho),
+                }
+            }));
+            row
+        })
+        .collect();
+    Some((header, rows))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,5 +259,32 @@ mod tests {
         let r = nominal_row(&k, Some("N/m"));
         assert_eq!(r[2], "1.773e6");
         assert!(r[3].ends_with("(not sampled)"), "{}", r[3]);
+    }
+
+    /// The correlations (Nataf) the study declared were not shown on the page.
+    #[test]
+    fn the_page_shows_the_declared_correlations() {
+        use crate::uq::random_inputs::CorrelationPair;
+        let params: Vec<RandomParameter> = ["a", "b", "c"]
+            .iter()
+            .map(|n| RandomParameter {
+                name: n.to_string(),
+                distribution: Distribution::lognormal_from_mean_std(1.0, 0.5).unwrap(),
+            })
+            .collect();
+        let pairs = vec![CorrelationPair {
+            between: ["c".into(), "a".into()],
+            rho: 0.5,
+        }];
+        let c = Correlation::new(&params, pairs).unwrap().unwrap();
+        let (header, rows) = correlation_table(&c, &params).unwrap();
+        assert_eq!(header, ["", "a", "c"]);
+        assert_eq!(rows[0][0], "a");
+        assert_eq!(rows[0][1], "1");
+        assert_eq!(rows[1][1], rows[0][2]);
+        // Lognormals: the normal scores need a correlation a little above 0.5.
+        let rz = c.normal_correlation[(0, 2)];
+        assert!(rz > 0.5 && rz < 0.6, "{rz}");
+        assert!(rows[0][2].starts_with("0.5 ["), "{}", rows[0][2]);
     }
 }

@@ -190,6 +190,28 @@ fn variants_section(summary: &SuiteSummary, variants: &[VariantResults], r: usiz
     }
 }
 
+/// Whether two variants' mean ± 3σ bands of an output coincide on a plot: the same times,
+/// and mean and bounds within 1e-6 of the band's largest magnitude everywhere.
+fn same_band(a: &OutputStats, b: &OutputStats) -> bool {
+    let scale = a
+        .upper_3sigma
+        .iter()
+        .chain(&a.lower_3sigma)
+        .map(|x| x.abs())
+        .filter(|x| x.is_finite())
+        .fold(0.0, f64::max);
+    let close = |x: &[f64], y: &[f64]| {
+        x.len() == y.len()
+            && x.iter()
+                .zip(y)
+                .all(|(p, q)| (p - q).abs() <= 1e-6 * scale || (p.is_nan() && q.is_nan()) || p == q)
+    };
+    a.times == b.times
+        && close(&a.mean, &b.mean)
+        && close(&a.upper_3sigma, &b.upper_3sigma)
+        && close(&a.lower_3sigma, &b.lower_3sigma)
+}
+
 /// `<V>_compare.csv`, `<V>_mean_diff.svg`, `<V>_std_diff.svg`, `<V>_bands.svg`.
 fn compare_output(
     dir: &Path,
@@ -223,6 +245,8 @@ fn compare_output(
         "time [s]",
         label(v, unit),
     );
+    // Each distinct band once: variants whose bands coincide share one legend entry.
+    let mut drawn: Vec<(usize, &OutputStats, Vec<&str>)> = Vec::new();
     for (i, (d, vs)) in variants.iter().zip(&summary.variants).enumerate() {
         let s = &d.outputs[o];
         let (name, t, color) = (&vs.name, &s.times, palette(i));
@@ -230,17 +254,25 @@ fn compare_output(
         cols.push(s.mean.clone());
         header.push(format!("std_{name}"));
         cols.push(s.std.clone());
-        bands.series.extend([
-            Series::new(format!("{name} mean"), t.clone(), s.mean.clone(), color),
-            Series::new(
-                format!("{name} ±3σ"),
-                t.clone(),
-                s.upper_3sigma.clone(),
-                color,
-            )
-            .dashed(),
-            Series::new("", t.clone(), s.lower_3sigma.clone(), color).dashed(),
-        ]);
+        if let Some((at, _, names)) = drawn.iter_mut().find(|(_, b, _)| same_band(b, s)) {
+            names.push(name.as_str());
+            let names = names.join(", ");
+            bands.series[*at].label = format!("{names} mean");
+            bands.series[*at + 1].label = format!("{names} ±3σ");
+        } else {
+            drawn.push((bands.series.len(), s, vec![name.as_str()]));
+            bands.series.extend([
+                Series::new(format!("{name} mean"), t.clone(), s.mean.clone(), color),
+                Series::new(
+                    format!("{name} ±3σ"),
+                    t.clone(),
+                    s.upper_3sigma.clone(),
+                    color,
+                )
+                .dashed(),
+                Series::new("", t.clone(), s.lower_3sigma.clone(), color).dashed(),
+            ]);
+        }
         if i != r {
             let dm: Vec<f64> = s.mean.iter().zip(&rs.mean).map(|(a, b)| a - b).collect();
             let ds: Vec<f64> = s.std.iter().zip(&rs.std).map(|(a, b)| a - b).collect();
@@ -544,5 +576,43 @@ mod tests {
         assert_eq!(probability_cell(&none), "< 0.221 (0 of 12)");
         let some = exceedance_count(&[1.0, 3.0, 1.0, 1.0], 2.0, Draws::Runs);
         assert_eq!(probability_cell(&some), "0.2500");
+    }
+
+    fn band(mean: f64, std: f64) -> OutputStats {
+        let times = vec![0.0, 1.0, 2.0];
+        let m = vec![mean; 3];
+        let sd = vec![std; 3];
+        let (lower_3sigma, upper_3sigma) = OutputStats::band(&m, &sd, 3.0);
+        OutputStats {
+            name: "y".into(),
+            times,
+            mean: m,
+            std: sd,
+            lower_3sigma,
+            upper_3sigma,
+            quantiles: Vec::new(),
+            std_pce: None,
+            std_error_mean: None,
+            sobol: None,
+            pdf_times: Vec::new(),
+            pdf_grid: Vec::new(),
+            pdf: Vec::new(),
+            draws: Draws::Runs,
+            chaos_error: None,
+            deterministic: false,
+            unit: None,
+            convergence: None,
+            convergence_time: None,
+        }
+    }
+
+    /// The suite page stacked ten identical mean ± 3σ bands, one per variant.
+    #[test]
+    fn the_suite_page_draws_identical_bands_once() {
+        let a = band(1.0, 0.1);
+        assert!(same_band(&a, &band(1.0, 0.1)));
+        assert!(same_band(&a, &band(1.0 + 1e-9, 0.1)));
+        assert!(!same_band(&a, &band(1.0, 0.2)));
+        assert!(!same_band(&a, &band(1.01, 0.1)));
     }
 }

@@ -263,6 +263,10 @@ pub struct Convergence {
     /// Chaos: the Std of the terms of each total order alone (its decay shows the
     /// convergence of the expansion); empty for runs.
     pub std_of_order: Vec<f64>,
+    /// The standard error of the mean at each x where the runs are not independent draws
+    /// (a nested study: between its whole outer samples, whose runs `x` counts); empty when
+    /// it is `Std/√n` of independent runs.
+    pub std_error_mean: Vec<f64>,
 }
 
 /// Outcome of one point of a design.

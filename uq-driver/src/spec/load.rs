@@ -20,15 +20,47 @@ use crate::uq::random_inputs::{Correlation, CorrelationPair};
 impl Study {
     /// Loads `builtin:NAME` or a TOML file.
     pub fn load(spec: &str) -> Result<Study, StudyError> {
-        if let Some(name) = spec.strip_prefix("builtin:") {
-            return Study::parse(builtin(name)?, spec, None);
+        Study::load_with_settings(spec, &[])
+    }
+
+    /// [`Study::load`] with `KEY=VALUE` settings written into the study's TOML first
+    /// (`run --set`; see `overrides.rs` for the grammar): validated as the file's own keys,
+    /// and kept in [`Study::source`].
+    pub(crate) fn load_with_settings(spec: &str, sets: &[String]) -> Result<Study, StudyError> {
+        let (text, base) = match spec.strip_prefix("builtin:") {
+            Some(name) => (builtin(name)?.to_owned(), None),
+            None => {
+                let path = Path::new(spec);
+                let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+                (text, path.parent())
+            }
+        };
+        let changed = super::overrides::apply(&text, spec, sets)?;
+        let error = match Study::parse(&changed, spec, base) {
+            Ok(study) => return Ok(study),
+            Err(e) if sets.is_empty() => return Err(e),
+            Err(e) => e,
+        };
+        // The file's own error, at its place in the file; else one of the settings', whose
+        // place in the rewritten text would mean nothing to the user.
+        match Study::parse(&text, spec, base) {
+            Err(own) if message_of(&own).is_some() && message_of(&own) == message_of(&error) => {
+                Err(own)
+            }
+            _ => Err(match error {
+                StudyError::Parse { message, .. } | StudyError::Invalid { message, .. } => {
+                    StudyError::Invalid {
+                        origin: format!("{spec} (with --set {})", sets.join(" --set ")),
+                        at: None,
+                        message,
+                    }
+                }
+                other => other,
+            }),
         }
-        let path = Path::new(spec);
-        let text = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Study::parse(&text, spec, path.parent())
     }
 
     /// Parses and validates a study; `base` is the folder relative FMU paths start from.
@@ -39,6 +71,14 @@ impl Study {
             message: e.message().to_owned(),
         })?;
         study(file, origin, base, text)
+    }
+}
+
+/// What a parse or validation error says, without its place.
+fn message_of(e: &StudyError) -> Option<&str> {
+    match e {
+        StudyError::Parse { message, .. } | StudyError::Invalid { message, .. } => Some(message),
+        _ => None,
     }
 }
 
@@ -152,6 +192,11 @@ fn study(
         experiment: e.get_ref().clone(),
         method: file.method.get_ref().clone(),
         parameters,
+        allow_negative: params
+            .iter()
+            .filter(|(_, p)| p.allow_negative)
+            .map(|(_, p)| p.name.clone())
+            .collect(),
         correlation,
         fixed: file.fixed.clone(),
         inputs: file

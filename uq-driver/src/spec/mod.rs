@@ -38,6 +38,7 @@ mod builtins;
 mod error;
 mod file;
 mod load;
+mod overrides;
 mod parameter;
 mod study;
 

@@ -16,6 +16,9 @@ pub struct ParameterSpec {
     /// `level = "outer" | "inner"` (default inner): in a nested study, whether the
     /// parameter is drawn by the outer design or by the inner method.
     pub level: Level,
+    /// `allow_negative = true`: values <= 0 are meant (no warning about a positive-mean
+    /// normal input reaching them, whatever the FMU declares).
+    pub allow_negative: bool,
 }
 
 /// The level of a random parameter in a two-level (nested) study.
@@ -160,6 +163,15 @@ impl<'de> Deserialize<'de> for ParameterSpec {
                 ))
             })?,
         };
+        let allow_negative = match table.remove("allow_negative") {
+            None => false,
+            Some(toml::Value::Boolean(b)) => b,
+            Some(_) => {
+                return Err(D::Error::custom(format!(
+                    "parameter '{name}': `allow_negative` must be true or false"
+                )))
+            }
+        };
         table
             .entry("distribution")
             .or_insert_with(|| "normal".into());
@@ -169,6 +181,7 @@ impl<'de> Deserialize<'de> for ParameterSpec {
             name,
             distribution,
             level,
+            allow_negative,
         })
     }
 }

@@ -36,6 +36,9 @@ pub struct Study {
     pub method: MethodSpec,
     /// Random parameters.
     pub parameters: Vec<RandomParameter>,
+    /// Random parameters whose values may be <= 0 (`allow_negative = true`): no warning when
+    /// a positive-mean normal one reaches them.
+    pub allow_negative: Vec<String>,
     /// Their correlation (`[[correlation]]`), if any.
     pub correlation: Option<Correlation>,
     /// Deterministic values.

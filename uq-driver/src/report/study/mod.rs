@@ -236,6 +236,21 @@ fn head_sections(r: &StudyReport, s: &Summary) -> Vec<Section> {
         images,
         table: Some(table),
     }];
+    let correlation = s.correlation.as_ref();
+    if let Some((header, rows)) =
+        correlation.and_then(|c| inputs::correlation_table(c, &s.parameters))
+    {
+        head.push(Section {
+            heading: "Correlation of the inputs".into(),
+            text: "The study's [[correlation]]: each cell is the Pearson correlation of the two \
+                   inputs' values it asked for (0: not given, independent), and in brackets \
+                   the correlation of their normal scores with which the Gaussian copula \
+                   (Nataf transformation) draws them."
+                .into(),
+            images: vec![],
+            table: Some(Table { header, rows }),
+        });
+    }
     if !s.warnings.is_empty() {
         let warnings: Vec<String> = s.warnings.iter().map(|w| plain_quotes(w)).collect();
         head.push(Section {
@@ -648,7 +663,12 @@ fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
                 "undefined: the quantity has no variance".into(),
             ]);
         }
-        for (i, n) in names.iter().enumerate().filter(|_| !undefined) {
+        let order = plots::by_importance(f, t);
+        let sorted = order
+            .iter()
+            .filter_map(|&i| Some((i, *names.get(i)?)))
+            .filter(|_| !undefined);
+        for (i, n) in sorted {
             rows.push(vec![
                 format!("Sobol' index of {n}: first order / total"),
                 format!(

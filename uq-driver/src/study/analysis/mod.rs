@@ -31,7 +31,8 @@ pub(crate) use surrogate::Surrogates;
 pub(crate) use runs::{QuantityRuns, Runs};
 
 use super::store::StoredRuns;
-use crate::qoi::{kde, QoiSpec};
+use crate::qoi::kde::{self, KdeKind};
+use crate::qoi::QoiSpec;
 use crate::results::{
     Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
 };
@@ -229,10 +230,18 @@ fn summarise(
     };
     let (lo, hi) = density_range(estimate, &quantiles, cols, &picked);
     let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
+    // A quantity whose every picked value is >= 0 is taken as non-negative: its densities
+    // are reflected at 0 and the grid starts there.
+    let non_negative = picked.iter().all(|&k| cols[k].min >= 0.0);
+    let start = if non_negative && lo - pad < 0.0 && hi + pad > 0.0 {
+        0.0
+    } else {
+        lo - pad
+    };
     let grid = if picked.is_empty() {
         Vec::new()
     } else {
-        kde::auto_grid(lo - pad, hi + pad, a.pdf_grid)
+        kde::auto_grid(start, hi + pad, a.pdf_grid)
     };
     let (g0, g1) = (
         grid.first().copied().unwrap_or(0.0),
@@ -245,12 +254,14 @@ fn summarise(
         .map(|(&k, col)| {
             if spread(&cols[k]) {
                 let h = cols[k].bandwidth;
-                if h < 2.0 * step {
-                    // Narrower than the grid: averages over the grid cells keep its mass.
-                    kde::gaussian_kde_cell_average(col, g0, g1, grid.len(), h)
+                // Narrower than the grid: averages over the grid cells keep its mass.
+                let kind = if h < 2.0 * step {
+                    KdeKind::CellAverages
                 } else {
-                    kde::gaussian_kde_binned(col, g0, g1, grid.len(), h)
-                }
+                    KdeKind::Points
+                };
+                let bound = (cols[k].min >= 0.0).then_some(0.0);
+                kde::bounded_kde(col, g0, g1, grid.len(), h, bound, kind)
             } else {
                 vec![f64::NAN; grid.len()]
             }
@@ -370,10 +381,21 @@ fn scalar_stats_counted(
         (Vec::new(), Vec::new())
     } else {
         let bw = c.bandwidth;
+        // Every value >= 0: a non-negative quantity, its density reflected at 0.
+        let bound = (c.min >= 0.0).then_some(0.0);
         let (lo, hi) = (c.min - 3.0 * bw, c.max + 3.0 * bw);
+        let lo = bound.map_or(lo, |b| lo.max(b));
         (
             kde::auto_grid(lo, hi, a.pdf_grid),
-            kde::gaussian_kde_binned(&density_samples, lo, hi, a.pdf_grid, bw),
+            kde::bounded_kde(
+                &density_samples,
+                lo,
+                hi,
+                a.pdf_grid,
+                bw,
+                bound,
+                KdeKind::Points,
+            ),
         )
     };
     let (smallest, largest) = runs
@@ -496,6 +518,7 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
             mean: vec![mean; order + 1],
             std: cumulative,
             std_of_order: of_order.iter().map(|v: &f64| v.sqrt()).collect(),
+            std_error_mean: Vec::new(),
         });
     }
     if valid.len() < 4 {
@@ -526,6 +549,7 @@ fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Converg
         mean,
         std,
         std_of_order: Vec::new(),
+        std_error_mean: Vec::new(),
     })
 }
 

@@ -19,8 +19,8 @@ use rayon::prelude::*;
 
 use crate::qoi::QoiSpec;
 use crate::results::{
-    ConditionalChaos, ConditionalTable, ExceedanceCount, ExceedanceInterval, NestedScalar,
-    OutputSplit, OutputStats, ScalarStats, VarianceSplit,
+    ConditionalChaos, ConditionalTable, Convergence, ExceedanceCount, ExceedanceInterval,
+    NestedScalar, OutputSplit, OutputStats, ScalarStats, VarianceSplit,
 };
 use crate::spec::Study;
 use crate::study::analysis::{
@@ -132,6 +132,11 @@ fn output(
     let pooled = pooled_series(&cond, data, settings, nt);
     let mut stats: OutputStats = output_stats(name, times, &estimate, Some(&pooled), settings)?;
     stats.draws = draws_of(&cond);
+    // Over the outer samples and their runs, not over the pooled draws.
+    let at = stats
+        .convergence_time
+        .and_then(|t| times.iter().position(|&x| x == t));
+    stats.convergence = at.and_then(|k| outer_convergence(&cond.column(k), &runs_of(&cond)));
     let split = OutputSplit {
         name: name.to_owned(),
         times: times.to_vec(),
@@ -142,6 +147,43 @@ fn output(
         outer_samples: cond.present().len(),
     };
     Ok((stats, split, inner_chaos_warning(name, &cond, Some(times))))
+}
+
+/// The nested estimate over the first n outer samples against the runs they hold (in design
+/// order, at about 30 values of n on a log scale): its mean, Std and the standard error of
+/// its mean between outer samples. So the axis counts the study's real runs, not the pooled
+/// draws its densities are taken from.
+fn outer_convergence(c: &split::Conditionals, runs_of: &[usize]) -> Option<Convergence> {
+    let n = c.len();
+    if n < 4 || runs_of.len() != n {
+        return None;
+    }
+    let mut points: Vec<usize> = (0..=30)
+        .map(|i| (2.0 * (n as f64 / 2.0).powf(i as f64 / 30.0)).round() as usize)
+        .collect();
+    points.dedup();
+    let idx: Vec<usize> = (0..n).collect();
+    let splits: Vec<Split> = points.iter().map(|&m| Split::of(c, &idx[..m])).collect();
+    Some(Convergence {
+        axis: "runs".into(),
+        x: points
+            .iter()
+            .map(|&m| runs_of[..m].iter().sum::<usize>() as f64)
+            .collect(),
+        mean: splits.iter().map(|s| s.mean).collect(),
+        std: splits.iter().map(Split::std).collect(),
+        std_of_order: Vec::new(),
+        std_error_mean: splits.iter().map(|s| s.std_error_mean).collect(),
+    })
+}
+
+/// The runs of each outer sample that has an estimate, in the order of
+/// [`Conditional::column`].
+fn runs_of(cond: &Conditional) -> Vec<usize> {
+    cond.present()
+        .iter()
+        .map(|&k| cond.data_rows[k].len())
+        .collect()
 }
 
 /// Where the densities of the conditional estimates come from.
@@ -262,6 +304,7 @@ fn quantity(
     let n = present.len() as f64;
     let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled))?;
     stats.draws = draws_of(&cond);
+    stats.convergence = outer_convergence(&c, &runs_of(&cond)).filter(|_| !stats.deterministic);
     stats.exceedance = exceedance
         .iter()
         .zip(&limits)
@@ -520,4 +563,37 @@ fn union_of_bases(chaoses: &[&crate::uq::pce::Pce]) -> ConditionalChaos {
         })
         .collect();
     (indices, coeffs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A nested study's convergence plot said "runs n" with an axis to 4 096 (its pooled
+    /// draws) for a 256-run study.
+    #[test]
+    fn nested_convergence_counts_the_studys_runs_not_its_pooled_draws() {
+        use crate::uq::method::nested::split::Conditionals;
+        // 16 outer samples of 16 runs each: 256 runs.
+        let m: Vec<f64> = (0..16).map(|k| (k as f64 * 0.7).sin()).collect();
+        let c = Conditionals {
+            mean: m.clone(),
+            var: vec![0.25; 16],
+            se2: vec![0.0; 16],
+        };
+        let conv = outer_convergence(&c, &[16; 16]).unwrap();
+        assert_eq!(conv.axis, "runs");
+        assert_eq!(conv.x.first(), Some(&32.0));
+        assert_eq!(conv.x.last(), Some(&256.0));
+        assert!(conv.x.windows(2).all(|w| w[0] < w[1]), "{:?}", conv.x);
+        assert!(conv.x.iter().all(|x| x % 16.0 == 0.0), "{:?}", conv.x);
+        // At all 16: the mean of the conditional means, Std² = mean inner var + var of means,
+        // standard error sd(means)/4.
+        let mean = m.iter().sum::<f64>() / 16.0;
+        let var_m = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 15.0;
+        assert!((conv.mean.last().unwrap() - mean).abs() < 1e-12);
+        assert!((conv.std.last().unwrap() - (0.25 + var_m).sqrt()).abs() < 1e-12);
+        assert!((conv.std_error_mean.last().unwrap() - (var_m / 16.0).sqrt()).abs() < 1e-12);
+        assert!(outer_convergence(&c, &[16; 15]).is_none());
+    }
 }

@@ -31,8 +31,8 @@ pub struct Design {
 impl Design {
     /// A design whose values are the images of `points` under the inputs' map from `germ`
     /// ([`RandomInputs::to_physical`]: each input's isoprobabilistic map, correlated through the
-    /// copula where the study correlates inputs), with a warning per parameter that reaches
-    /// non-positive values although its mean is positive.
+    /// copula where the study correlates inputs). Which inputs must stay positive is not known
+    /// here (the FMU says it): the study reports those that reach values <= 0.
     pub fn mapped(
         germ: Germ,
         points: Vec<Vec<f64>>,
@@ -40,16 +40,14 @@ impl Design {
         inputs: &RandomInputs,
     ) -> Design {
         let values = points.iter().map(|t| inputs.to_physical(germ, t)).collect();
-        let mut design = Design {
+        Design {
             germ,
             points,
             values,
             weights,
             warnings: Vec::new(),
             inputs: inputs.clone(),
-        };
-        design.warnings = design.sign_warnings();
-        design
+        }
     }
 
     /// The orthonormal family of each coordinate of the standard space (Hermite for a
@@ -126,13 +124,18 @@ impl Design {
         }
     }
 
-    /// One warning per positive-mean normal parameter that some points set to a value <= 0,
-    /// with the probability weight of those points. Only a normal input warns: its support
-    /// (the whole real line) was not chosen by the user, whereas every other family's support
-    /// is declared (bounds, or positive by construction), so values <= 0 there are intended.
-    fn sign_warnings(&self) -> Vec<String> {
+    /// One warning per positive-mean normal parameter that must stay positive (`positive(j)`
+    /// for the `j`-th input: the caller knows, e.g. from the FMU's declared minimum or unit)
+    /// and that some points set to a value <= 0, with the probability weight of those points.
+    /// Only a normal input warns: its support (the whole real line) was not chosen by the
+    /// user, whereas every other family's support is declared (bounds, or positive by
+    /// construction), so values <= 0 there are intended.
+    pub(crate) fn sign_warnings(&self, positive: impl Fn(usize) -> bool) -> Vec<String> {
         let mut warnings = Vec::new();
         for (j, p) in self.inputs.iter().enumerate() {
+            if !positive(j) {
+                continue;
+            }
             let Distribution::Normal { mean, .. } = p.distribution else {
                 continue;
             };
@@ -182,12 +185,14 @@ mod tests {
             &params,
         );
         assert_eq!(d.values, vec![vec![-1.0], vec![1.0], vec![3.0]]);
-        assert_eq!(d.warnings.len(), 1);
-        assert!(d.warnings[0].starts_with("1 of 3 points have k <= 0"));
-        assert!(d.warnings[0].contains("2.500e-1"), "{}", d.warnings[0]);
+        let w = d.sign_warnings(|_| true);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("1 of 3 points have k <= 0"));
+        assert!(w[0].contains("2.500e-1"), "{}", w[0]);
+        assert!(d.sign_warnings(|_| false).is_empty());
         let u = Design::mapped(Germ::Uniform, vec![vec![0.5]], None, &params);
         assert_eq!(u.values, vec![vec![1.0]]);
-        assert!(u.warnings.is_empty());
+        assert!(u.sign_warnings(|_| true).is_empty());
     }
 
     /// The "positive-mean Gaussian" warning fired for uniform [−1, 2], a normal truncated
@@ -210,7 +215,8 @@ mod tests {
             }]);
             let design = Design::mapped(Germ::Uniform, cube.clone(), None, &inputs);
             assert!(design.values[0][0] <= 0.0, "{d:?}: {:?}", design.values);
-            assert!(design.warnings.is_empty(), "{d:?}: {:?}", design.warnings);
+            let w = design.sign_warnings(|_| true);
+            assert!(w.is_empty(), "{d:?}: {w:?}");
         }
         // A normal input still warns, and its text no longer claims that failed points are run.
         let normal = RandomInputs::independent(vec![RandomParameter {
@@ -218,8 +224,9 @@ mod tests {
             distribution: Distribution::normal(1.0, 1.0).unwrap(),
         }]);
         let d = Design::mapped(Germ::Uniform, cube, None, &normal);
-        assert_eq!(d.warnings.len(), 1);
-        assert!(d.warnings[0].starts_with("1 of 3 points have k <= 0"));
-        assert!(!d.warnings[0].contains("not dropped"), "{}", d.warnings[0]);
+        let w = d.sign_warnings(|_| true);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("1 of 3 points have k <= 0"));
+        assert!(!w[0].contains("not dropped"), "{}", w[0]);
     }
 }

@@ -209,7 +209,8 @@ impl Sampling for SparseGrid {
         let grid = self.grid(&families)?;
         let germ = self.chaos.germ();
         // Nodes far in the tails (Genz–Keister: |z| up to 9 at level 4) that give a
-        // positive-mean input a value <= 0 are reported by `Design::mapped`, with their weight.
+        // positive-mean input a value <= 0 are reported by `Design::sign_warnings`, with their
+        // weight, where the input must stay positive.
         let mut design = Design::mapped(germ, grid.points, Some(grid.weights), inputs);
         if self.level == 0 {
             design.warnings.push(LEVEL_0.into());

@@ -25,21 +25,37 @@ pub(in crate::report::study) fn convergence(
         chaos_convergence(name, unit, c).write(&dir.join(&file))?;
         return Ok(vec![file]);
     }
+    // A nested study's estimate grows by whole outer samples: its standard error is the one
+    // between them, and its axis the runs those samples hold.
+    let nested = !c.std_error_mean.is_empty();
+    let axis = if nested {
+        "runs n (design order, whole outer samples)"
+    } else {
+        "runs n (design order)"
+    };
     let mut mean = LinePlot::new(
         format!("{name}: running mean over the first n runs"),
-        "runs n (design order)",
+        axis,
         label(&format!("mean {name}"), unit),
     );
     mean.log_x = true;
-    let se: Vec<f64> = c
-        .std
-        .iter()
-        .zip(&c.x)
-        .map(|(s, n)| 2.0 * s / n.sqrt())
-        .collect();
-    mean.bands.push(Band::new(
+    let se: Vec<f64> = if nested {
+        c.std_error_mean.iter().map(|e| 2.0 * e).collect()
+    } else {
+        c.std
+            .iter()
+            .zip(&c.x)
+            .map(|(s, n)| 2.0 * s / n.sqrt())
+            .collect()
+    };
+    let band = if nested {
+        "± 2 standard errors between the outer samples of the first n runs"
+    } else {
         "± 2 iid standard errors of the first n runs (Std/√n; a replicate estimate in the \
-         table may be smaller)",
+         table may be smaller)"
+    };
+    mean.bands.push(Band::new(
+        band,
         c.x.clone(),
         c.mean.iter().zip(&se).map(|(m, e)| m - e).collect(),
         c.mean.iter().zip(&se).map(|(m, e)| m + e).collect(),
@@ -49,7 +65,7 @@ pub(in crate::report::study) fn convergence(
         .push(Series::new("mean", c.x.clone(), c.mean.clone(), palette(0)));
     let mut std = LinePlot::new(
         format!("{name}: running Std over the first n runs"),
-        "runs n (design order)",
+        axis,
         label(&format!("Std {name}"), unit),
     );
     std.log_x = true;

@@ -276,7 +276,25 @@ pub(super) fn sobol_overall_bars(
 /// Indices per parameter with their intervals (`None` where there are none).
 type Indices<'a> = (&'a [f64], Vec<Option<(f64, f64)>>);
 
-/// Bars of first-order and total indices per parameter, with intervals where given.
+/// The parameters in the order their indices are shown: largest total index first (then
+/// largest first-order index; undefined indices last).
+pub(in crate::report::study) fn by_importance(first: &[f64], total: &[f64]) -> Vec<usize> {
+    let key = |v: &[f64], i: usize| v.get(i).copied().filter(|x| !x.is_nan());
+    let mut order: Vec<usize> = (0..first.len().max(total.len())).collect();
+    order.sort_by(|&a, &b| {
+        let desc = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => y.total_cmp(&x),
+            (Some(_), None) => std::cmp::Ordering::Less,
+            (None, Some(_)) => std::cmp::Ordering::Greater,
+            (None, None) => std::cmp::Ordering::Equal,
+        };
+        desc(key(total, a), key(total, b)).then(desc(key(first, a), key(first, b)))
+    });
+    order
+}
+
+/// Bars of first-order and total indices per parameter, with intervals where given, the
+/// parameters sorted by [`by_importance`].
 fn bars(
     title: &str,
     names: &[&str],
@@ -285,6 +303,25 @@ fn bars(
     interval_label: &str,
     file: &Path,
 ) -> Result<(), ReportError> {
+    let order = by_importance(first.0, total.0);
+    let pick = |v: &[f64]| -> Vec<f64> {
+        order
+            .iter()
+            .map(|&i| v.get(i).copied().unwrap_or(f64::NAN))
+            .collect()
+    };
+    let pick_ci = |v: &[Option<(f64, f64)>]| -> Vec<Option<(f64, f64)>> {
+        order.iter().map(|&i| v.get(i).copied().flatten()).collect()
+    };
+    let names: Vec<&str> = order
+        .iter()
+        .filter_map(|&i| names.get(i).copied())
+        .collect();
+    let (first_values, total_values) = (pick(first.0), pick(total.0));
+    let (first, total) = (
+        (&first_values[..], pick_ci(&first.1)),
+        (&total_values[..], pick_ci(&total.1)),
+    );
     BarChart {
         title: title.to_owned(),
         y_label: "share of the variance [-]".into(),
