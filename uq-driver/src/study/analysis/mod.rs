@@ -13,6 +13,7 @@ mod chaos_gap;
 mod columns;
 mod error;
 mod exceedance;
+mod functional;
 pub mod nested;
 mod runs;
 mod surrogate;
@@ -35,7 +36,7 @@ use crate::qoi::{kde, QoiSpec};
 use crate::results::{
     Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
 };
-use crate::spec::{Analysis, Study};
+use crate::spec::{Analysis, Functional, Study};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, Sampling, Sobol, Solution};
 use crate::uq::reliability::Side;
@@ -285,6 +286,7 @@ fn summarise(
         unit: None,
         convergence,
         convergence_time: k_max.map(|k| times[k]),
+        functional: None,
     })
 }
 
@@ -567,19 +569,16 @@ pub fn analyse_runs(
         });
     }
     let mut outputs = Vec::new();
-    let mut output_chaos = Vec::new();
+    let mut estimates = Vec::new();
+    // Per output, the hash of every column (a chaos fitted per column): a quantity equal to
+    // a column takes that column's estimate.
+    let mut hashes: Vec<Vec<u64>> = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let (estimate, stats) =
+        let (estimate, stats, h) =
             output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
         outputs.push(stats);
-        if let Some(pce) = estimate.chaos {
-            output_chaos.push(NamedChaos {
-                name: name.clone(),
-                times: Some(times.clone()),
-                pce,
-                error: estimate.chaos_error,
-            });
-        }
+        estimates.push(estimate);
+        hashes.push(h);
     }
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
@@ -594,9 +593,16 @@ pub fn analyse_runs(
             return Err(quantity_error(&name, q, &qr, None));
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate = method
-            .estimate(design, &qr.rows, &data)
-            .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
+        let equal = match qr.rows == runs.rows {
+            true => equal_column(&runs, &hashes, nt, &qr.valid)?,
+            false => None,
+        };
+        let estimate = match equal {
+            Some((o, t)) => functional::select(&estimates[o], &[t]),
+            None => method
+                .estimate(design, &qr.rows, &data)
+                .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?,
+        };
         // The running estimate takes the rows the reported mean and Std use.
         let moment_values = method.moment_rows(design, &qr.rows).map(|rows| {
             rows.iter()
@@ -620,6 +626,19 @@ pub fn analyse_runs(
             });
         }
     }
+    let output_chaos = study
+        .outputs
+        .iter()
+        .zip(estimates)
+        .filter_map(|(name, estimate)| {
+            Some(NamedChaos {
+                name: name.clone(),
+                times: Some(times.clone()),
+                pce: estimate.chaos?,
+                error: estimate.chaos_error,
+            })
+        })
+        .collect();
     Ok(Analysed {
         outputs,
         quantities,
@@ -628,31 +647,84 @@ pub fn analyse_runs(
     })
 }
 
+/// The output and column `(o, t)` whose runs are `values` bit for bit, among the columns
+/// whose hashes are known (`hashes[o][t]`, of `nt` columns each).
+fn equal_column(
+    runs: &Runs,
+    hashes: &[Vec<u64>],
+    nt: usize,
+    values: &[f64],
+) -> Result<Option<(usize, usize)>, AnalysisError> {
+    let h = functional::column_hash(values);
+    for (o, of_output) in hashes.iter().enumerate() {
+        for (t, _) in of_output.iter().enumerate().filter(|(_, &x)| x == h) {
+            let column = runs.column(o, nt, t)?;
+            if column
+                .iter()
+                .zip(values)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+            {
+                return Ok(Some((o, t)));
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// The estimate and the statistics of output `o`, estimated a block of time columns at a
-/// time (see [`blocks`]).
+/// time (see [`blocks`]), or on its principal components ([`functional`]); with the hash of
+/// every column where a chaos is fitted per column (else none).
 fn output_in_blocks(
     method: &dyn Sampling,
     design: &Design,
     runs: &Runs,
     (o, name, times): (usize, &str, &[f64]),
     settings: &Settings,
-) -> Result<(Estimate, OutputStats), AnalysisError> {
+) -> Result<(Estimate, OutputStats, Vec<u64>), AnalysisError> {
     let nt = times.len();
     let fail = |source| AnalysisError::Output {
         name: name.to_owned(),
         source,
     };
+    let a = settings.analysis;
+    let per_column = method.chaos_per_column() && !method.whole_series();
+    let pca = match per_column && a.functional == Functional::Pca && nt > 1 {
+        true => functional::pca_estimate(method, design, runs, (o, name, nt), a.retained_variance)?,
+        false => None,
+    };
     let mut cols = series_columns(nt, settings);
-    let mut parts = Vec::new();
-    for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
-        let data = runs.block(o, nt, j0, w)?;
-        let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
-        if estimate.draws == Draws::Runs {
-            cols.add(j0, &data);
+    let (estimate, fit, hashes) = match pca {
+        Some((estimate, fit, hashes)) => (estimate, Some(fit), hashes),
+        None => {
+            let (mut parts, mut fits, mut hashes) = (Vec::new(), 0, Vec::new());
+            for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
+                let data = runs.block(o, nt, j0, w)?;
+                let estimate = if per_column {
+                    let (e, k, h) =
+                        functional::estimate_distinct(method, design, &runs.rows, &data)
+                            .map_err(fail)?;
+                    fits += k;
+                    hashes.extend(h);
+                    e
+                } else {
+                    method.estimate(design, &runs.rows, &data).map_err(fail)?
+                };
+                if estimate.draws == Draws::Runs {
+                    cols.add(j0, &data);
+                }
+                parts.push(estimate);
+            }
+            let fit = per_column.then(|| crate::results::FunctionalFit {
+                method: "columns".into(),
+                modes: None,
+                fits,
+                retained_variance: None,
+                discarded_variance: None,
+                discarded_max: None,
+            });
+            (blocks::merge(parts).map_err(fail)?, fit, hashes)
         }
-        parts.push(estimate);
-    }
-    let estimate = blocks::merge(parts).map_err(fail)?;
+    };
     if estimate.draws == Draws::Chaos {
         chaos_columns(name, &estimate, settings, &mut cols)?;
     }
@@ -665,8 +737,9 @@ fn output_in_blocks(
             None => all,
         })
     };
-    let stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
-    Ok((estimate, stats))
+    let mut stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
+    stats.functional = fit;
+    Ok((estimate, stats, hashes))
 }
 
 /// Statistics of every output of an intrusive method's solution.

@@ -351,6 +351,14 @@ pub trait Sampling: Method {
     fn no_error_estimate(&self) -> Option<&'static str> {
         None
     }
+
+    /// Whether the estimator fits a chaos to each column on its own, so that a series may be
+    /// fitted on its principal components instead (`[analysis] functional = "pca"`) and
+    /// identical columns once (regression and sparse-grid chaoses; not a quadrature whose
+    /// moments come from the runs themselves).
+    fn chaos_per_column(&self) -> bool {
+        false
+    }
 }
 
 /// The size of the chaos a method's estimator fits (see [`Sampling::chaos_fit`]).

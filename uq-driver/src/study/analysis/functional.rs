@@ -1,0 +1,416 @@
+//! Functional outputs: a chaos method fits a series on the principal components
+//! (Karhunen–Loève modes) of its centred runs instead of column by column.
+//!
+//! The runs `Y` (n runs × T columns) are centred column by column, `Yc = Y − 1 μᵀ`, and
+//! decomposed `Yc = Σ_k z_k φ_kᵀ`: scores `z_k` over the runs (`‖z_k‖² = λ_k`), orthonormal
+//! modes `φ_k` over time. The first m modes keep the share `retained_variance` of the total
+//! `Σ_k λ_k = ‖Yc‖²`; the method fits one chaos per score column, and column t's chaos is
+//! `μ_t + Σ_k φ_k(t) z_k(ξ)`: the coefficients `C Φᵀ` on the union of the modes' bases, so
+//! the mean, Std, Sobol' indices and draws of every column come from the per-column code.
+//! Column t's truncation error is the share of its variance the modes miss, added to the
+//! modes' own error estimates weighted by their share of the column.
+//!
+//! The decomposition takes the smaller of two symmetric matrices: the Gram matrix `Yc Ycᵀ`
+//! (n × n) when n ≤ T, accumulated over the analysis's blocks of columns, or the covariance
+//! `Ycᵀ Yc` (T × T) when the series is one block. Sums over columns run over chunks of
+//! [`BLOCK_ALIGN`] columns in order, on one thread: the numbers depend neither on the thread
+//! count nor on the block width.
+//!
+//! The column-by-column fit fits identical columns (bit for bit over the runs) once
+//! ([`estimate_distinct`]).
+
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use super::blocks::{self, BLOCK_ALIGN};
+use super::runs::Runs;
+use super::AnalysisError;
+use crate::results::FunctionalFit;
+use crate::uq::method::{
+    ChaosError, Design, Estimate, InvalidSettings, MethodError, Sampling, Sobol, SobolIntervals,
+};
+use crate::uq::pce::Pce;
+
+/// The principal components of a series' centred runs kept by a truncation.
+#[derive(Debug)]
+pub(super) struct Modes {
+    /// Column means (T).
+    pub mean: Vec<f64>,
+    /// Scores over the runs (n × m): column k is `z_k`, `‖z_k‖² = λ_k`.
+    pub scores: DMatrix<f64>,
+    /// Orthonormal modes over the columns (T × m).
+    pub modes: DMatrix<f64>,
+    /// `λ_k` of the kept modes, descending.
+    pub eigenvalues: Vec<f64>,
+    /// Per column, the sum of its squared centred values (`(n − 1)` times its variance).
+    pub sq: Vec<f64>,
+    /// Distinct columns (bit for bit).
+    pub distinct: usize,
+    /// A hash of every column's values (as [`column_hash`]).
+    pub hashes: Vec<u64>,
+}
+
+impl Modes {
+    /// Per column, the part of [`Modes::sq`] the kept modes miss: `‖Yc_t‖² − Σ_k λ_k φ_k(t)²`
+    /// (at least 0).
+    pub fn discarded(&self) -> Vec<f64> {
+        (0..self.sq.len())
+            .map(|t| {
+                let kept: f64 = (0..self.eigenvalues.len())
+                    .map(|k| self.eigenvalues[k] * self.modes[(t, k)].powi(2))
+                    .sum();
+                (self.sq[t] - kept).max(0.0)
+            })
+            .collect()
+    }
+
+    /// The share of the total variance the kept modes miss.
+    pub fn discarded_share(&self) -> f64 {
+        let total: f64 = self.sq.iter().sum();
+        if total > 0.0 {
+            (self.discarded().iter().sum::<f64>() / total).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A hash of a column's values, bit for bit (equal columns, equal hashes).
+pub(super) fn column_hash(values: &[f64]) -> u64 {
+    // SipHash with fixed keys: the same value on every run of the program.
+    #[allow(deprecated)]
+    let mut h = std::hash::SipHasher::new();
+    for v in values {
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+/// The block centred column by column, with the column means, the sums of squares of the
+/// centred values and the hashes of the (uncentred) columns.
+fn centre(mut b: DMatrix<f64>) -> (DMatrix<f64>, Vec<f64>, Vec<f64>, Vec<u64>) {
+    let n = b.nrows();
+    let (mut mean, mut sq, mut hashes) = (Vec::new(), Vec::new(), Vec::new());
+    for mut c in b.column_iter_mut() {
+        hashes.push(column_hash(c.as_slice()));
+        let m = c.iter().sum::<f64>() / n.max(1) as f64;
+        c.add_scalar_mut(-m);
+        mean.push(m);
+        sq.push(c.norm_squared());
+    }
+    (b, mean, sq, hashes)
+}
+
+/// How many of the eigenvalues `lambda` (descending) keep the share `retained` of `total`
+/// (the sum of all): the fewest whose sum reaches it, never one at the rounding level of
+/// the largest (so `retained = 1` keeps the numerical rank). 0 when `total` is 0.
+pub(super) fn kept_modes(lambda: &[f64], total: f64, retained: f64) -> usize {
+    let largest = lambda.first().copied().unwrap_or(0.0);
+    if !(total > 0.0 && largest > 0.0) {
+        return 0;
+    }
+    let floor = largest * lambda.len() as f64 * f64::EPSILON * 16.0;
+    let mut sum = 0.0;
+    for (k, &l) in lambda.iter().enumerate() {
+        if l <= floor {
+            return k;
+        }
+        sum += l;
+        if sum >= retained * total {
+            return k + 1;
+        }
+    }
+    lambda.len()
+}
+
+/// The eigenvalues (descending, ties by index) and eigenvectors of a symmetric matrix.
+fn eigen_descending(g: DMatrix<f64>) -> (Vec<f64>, DMatrix<f64>) {
+    let e = SymmetricEigen::new(g);
+    let mut order: Vec<usize> = (0..e.eigenvalues.len()).collect();
+    order.sort_by(|&a, &b| {
+        e.eigenvalues[b]
+            .total_cmp(&e.eigenvalues[a])
+            .then(a.cmp(&b))
+    });
+    let values = order.iter().map(|&k| e.eigenvalues[k]).collect();
+    (values, e.eigenvectors.select_columns(&order))
+}
+
+/// The principal components of a series of `nt` columns over `n` runs, read in blocks of
+/// `width` columns by `read(j0, w)`, truncated to keep the share `retained` of its variance;
+/// `None` when nothing is to be kept (no variance) or the covariance route would need more
+/// than one block (more runs than columns, and the series does not fit one block).
+pub(super) fn decompose<E>(
+    n: usize,
+    nt: usize,
+    width: usize,
+    retained: f64,
+    read: &mut dyn FnMut(usize, usize) -> Result<DMatrix<f64>, E>,
+) -> Result<Option<Modes>, E> {
+    let width = width.max(1);
+    let single = width >= nt;
+    let (mut mean, mut sq, mut hashes) = (Vec::new(), Vec::new(), Vec::new());
+    let mut kept_block = None;
+    let (lambda, vectors, gram) = if n <= nt {
+        let mut g = DMatrix::<f64>::zeros(n, n);
+        for (j0, w) in blocks::blocks(nt, width) {
+            let (bc, m, s, h) = centre(read(j0, w)?);
+            for (c0, cw) in blocks::blocks(w, BLOCK_ALIGN) {
+                let chunk = bc.columns(c0, cw);
+                g.gemm(1.0, &chunk, &chunk.transpose(), 1.0);
+            }
+            mean.extend(m);
+            sq.extend(s);
+            hashes.extend(h);
+            if single {
+                kept_block = Some(bc);
+            }
+        }
+        let (l, v) = eigen_descending(g);
+        (l, v, true)
+    } else {
+        if !single {
+            return Ok(None);
+        }
+        let (bc, m, s, h) = centre(read(0, nt)?);
+        let c = bc.tr_mul(&bc);
+        (mean, sq, hashes) = (m, s, h);
+        kept_block = Some(bc);
+        let (l, v) = eigen_descending(c);
+        (l, v, false)
+    };
+    let total: f64 = sq.iter().sum();
+    let m = kept_modes(&lambda, total, retained);
+    if m == 0 {
+        return Ok(None);
+    }
+    let lambda: Vec<f64> = lambda[..m].to_vec();
+    let v = vectors.columns(0, m).into_owned();
+    let (scores, modes) = if gram {
+        // Yc = U S Vᵀ: scores U S, modes Ycᵀ U S⁻¹, a block of columns at a time.
+        let mut scores = v.clone();
+        let mut modes = DMatrix::<f64>::zeros(nt, m);
+        for (k, &l) in lambda.iter().enumerate() {
+            scores.column_mut(k).scale_mut(l.sqrt());
+        }
+        for (j0, w) in blocks::blocks(nt, width) {
+            let bc = match &kept_block {
+                Some(b) => b.clone(),
+                None => centre(read(j0, w)?).0,
+            };
+            let mut part = bc.tr_mul(&v);
+            for (k, &l) in lambda.iter().enumerate() {
+                part.column_mut(k).scale_mut(l.sqrt().recip());
+            }
+            modes.rows_mut(j0, w).copy_from(&part);
+        }
+        (scores, modes)
+    } else {
+        // Ycᵀ Yc = V Λ Vᵀ: modes V, scores Yc V.
+        let bc = kept_block.expect("one block");
+        (&bc * &v, v)
+    };
+    let distinct = {
+        let mut h = hashes.clone();
+        h.sort_unstable();
+        h.dedup();
+        h.len()
+    };
+    Ok(Some(Modes {
+        mean,
+        scores,
+        modes,
+        eigenvalues: lambda,
+        sq,
+        distinct,
+        hashes,
+    }))
+}
+
+/// The estimate of every column from the estimate of the modes' scores: each column's chaos
+/// `μ_t + Σ_k φ_k(t) z_k`, its moments and Sobol' indices, and its truncation error (where
+/// the method estimates the modes'): `(Σ_k φ_k(t)² e_k λ_k + d_t) / ‖Yc_t‖²`, the modes'
+/// relative errors `e_k` weighted by their variance in the column, plus the part `d_t` the
+/// modes miss.
+pub(super) fn combine(of_modes: Estimate, modes: &Modes) -> Result<Estimate, MethodError> {
+    let no_chaos = || MethodError::Invalid(InvalidSettings("the modes' fit has no chaos".into()));
+    let pce = with_constant(of_modes.chaos.ok_or_else(no_chaos)?)?;
+    let dim = pce.dim();
+    let c0 = pce.set().position(&vec![0; dim]).ok_or_else(no_chaos)?;
+    let mut coeffs = &pce.coeffs * modes.modes.transpose();
+    for (t, m) in modes.mean.iter().enumerate() {
+        coeffs[(c0, t)] += m;
+    }
+    let mut estimate = Estimate::from_chaos(Pce::new(pce.basis, coeffs)?);
+    let discarded = modes.discarded();
+    estimate.chaos_error = of_modes.chaos_error.map(|e| ChaosError {
+        kind: e.kind,
+        values: (0..modes.sq.len())
+            .map(|t| {
+                if modes.sq[t] <= 0.0 {
+                    return 0.0;
+                }
+                let fitted: f64 = (0..modes.eigenvalues.len())
+                    .map(|k| modes.modes[(t, k)].powi(2) * e.values[k] * modes.eigenvalues[k])
+                    .sum();
+                (fitted + discarded[t]) / modes.sq[t]
+            })
+            .collect(),
+    });
+    Ok(estimate)
+}
+
+/// `pce` on a basis that holds the constant term (added with zero coefficients if missing).
+fn with_constant(pce: Pce) -> Result<Pce, MethodError> {
+    let zero = vec![0; pce.dim()];
+    if pce.set().position(&zero).is_some() {
+        return Ok(pce);
+    }
+    let indices = pce.set().indices().to_vec();
+    let mut columns: Vec<(Vec<Vec<usize>>, Vec<f64>)> = pce
+        .coeffs
+        .column_iter()
+        .map(|c| (indices.clone(), c.iter().copied().collect()))
+        .collect();
+    let m = columns.len();
+    columns.push((vec![zero], vec![0.0]));
+    let joined = Pce::from_columns(pce.basis.families().to_vec(), &columns)?;
+    Ok(Pce::new(
+        joined.basis,
+        joined.coeffs.columns(0, m).into_owned(),
+    )?)
+}
+
+/// The estimate of an output fitted on its principal components (see the module
+/// documentation), with what summary.json says of the fit and the hash of every column;
+/// `None` where a column-by-column fit is to be used instead: nothing to decompose (see
+/// [`decompose`]), or as many modes as distinct columns (fitting those costs no more).
+pub(super) fn pca_estimate(
+    method: &dyn Sampling,
+    design: &Design,
+    runs: &Runs,
+    (o, name, nt): (usize, &str, usize),
+    retained: f64,
+) -> Result<Option<(Estimate, FunctionalFit, Vec<u64>)>, AnalysisError> {
+    let n = runs.rows.len();
+    let width = blocks::block_width(nt, n);
+    let Some(modes) = decompose(n, nt, width, retained, &mut |j0, w| {
+        runs.block(o, nt, j0, w)
+    })?
+    else {
+        return Ok(None);
+    };
+    let m = modes.eigenvalues.len();
+    if m >= modes.distinct {
+        return Ok(None);
+    }
+    let fail = |source| AnalysisError::Output {
+        name: name.to_owned(),
+        source,
+    };
+    let of_modes = method
+        .estimate(design, &runs.rows, &modes.scores)
+        .map_err(fail)?;
+    let estimate = combine(of_modes, &modes).map_err(fail)?;
+    let discarded = modes.discarded();
+    let largest = modes.sq.iter().copied().fold(0.0, f64::max);
+    // The worst column among those whose Std is above 1e-3 of the largest (below, the
+    // share of a rounding-level variance says nothing).
+    let worst = (0..nt)
+        .filter(|&t| modes.sq[t] > 1e-6 * largest)
+        .map(|t| discarded[t] / modes.sq[t])
+        .fold(0.0, f64::max);
+    let fit = FunctionalFit {
+        method: "pca".into(),
+        modes: Some(m),
+        fits: m,
+        retained_variance: Some(retained),
+        discarded_variance: Some(modes.discarded_share()),
+        discarded_max: Some(worst.min(1.0)),
+    };
+    Ok(Some((estimate, fit, modes.hashes)))
+}
+
+/// For every column of `data`, the index of the first column equal to it bit for bit
+/// (itself when it is the first), with the hash of every column.
+pub(super) fn first_equal(data: &DMatrix<f64>) -> (Vec<usize>, Vec<u64>) {
+    let hashes: Vec<u64> = data
+        .column_iter()
+        .map(|c| column_hash(c.as_slice()))
+        .collect();
+    let mut seen: HashMap<u64, Vec<usize>> = HashMap::new();
+    let mut first = Vec::with_capacity(hashes.len());
+    for (k, &h) in hashes.iter().enumerate() {
+        let same = |&j: &usize| {
+            data.column(j)
+                .iter()
+                .zip(data.column(k).iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        };
+        let found = seen.get(&h).and_then(|c| c.iter().copied().find(same));
+        match found {
+            Some(j) => first.push(j),
+            None => {
+                seen.entry(h).or_default().push(k);
+                first.push(k);
+            }
+        }
+    }
+    (first, hashes)
+}
+
+/// The method's estimate of every column of `data`, identical columns fitted once; with the
+/// number of columns fitted and the hash of every column.
+pub(super) fn estimate_distinct(
+    method: &dyn Sampling,
+    design: &Design,
+    rows: &[usize],
+    data: &DMatrix<f64>,
+) -> Result<(Estimate, usize, Vec<u64>), MethodError> {
+    let (first, hashes) = first_equal(data);
+    let distinct: Vec<usize> = (0..first.len()).filter(|&k| first[k] == k).collect();
+    if distinct.len() == data.ncols() {
+        return Ok((method.estimate(design, rows, data)?, distinct.len(), hashes));
+    }
+    let estimate = method.estimate(design, rows, &data.select_columns(&distinct))?;
+    // Column k is the fitted column at the place of its first equal.
+    let mut place = vec![0; first.len()];
+    for (i, &k) in distinct.iter().enumerate() {
+        place[k] = i;
+    }
+    let of: Vec<usize> = first.iter().map(|&j| place[j]).collect();
+    Ok((select(&estimate, &of), distinct.len(), hashes))
+}
+
+/// The estimate of the columns `of` of `e` (in that order, repeats allowed).
+pub(super) fn select(e: &Estimate, of: &[usize]) -> Estimate {
+    fn pick<T: Clone>(v: &[T], of: &[usize]) -> Vec<T> {
+        of.iter().map(|&k| v[k].clone()).collect()
+    }
+    Estimate {
+        mean: pick(&e.mean, of),
+        std: pick(&e.std, of),
+        std_error_mean: e.std_error_mean.as_ref().map(|v| pick(v, of)),
+        std_chaos: e.std_chaos.as_ref().map(|v| pick(v, of)),
+        chaos: e.chaos.as_ref().map(|p| Pce {
+            basis: p.basis.clone(),
+            coeffs: p.coeffs.select_columns(of),
+        }),
+        sobol: e.sobol.as_ref().map(|s| Sobol {
+            first: pick(&s.first, of),
+            total: pick(&s.total, of),
+            intervals: s.intervals.as_ref().map(|i| SobolIntervals {
+                level: i.level,
+                first: pick(&i.first, of),
+                total: pick(&i.total, of),
+            }),
+        }),
+        draws: e.draws,
+        chaos_error: e.chaos_error.as_ref().map(|c| ChaosError {
+            kind: c.kind,
+            values: pick(&c.values, of),
+        }),
+    }
+}
