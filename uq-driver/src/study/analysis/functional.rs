@@ -1,20 +1,25 @@
 //! Functional outputs: a chaos method fits a series on the principal components
 //! (Karhunen–Loève modes) of its centred runs instead of column by column.
 //!
-//! The runs `Y` (n runs × T columns) are centred column by column, `Yc = Y − 1 μᵀ`, and
-//! decomposed `Yc = Σ_k z_k φ_kᵀ`: scores `z_k` over the runs (`‖z_k‖² = λ_k`), orthonormal
-//! modes `φ_k` over time. The first m modes keep the share `retained_variance` of the total
-//! `Σ_k λ_k = ‖Yc‖²`; the method fits one chaos per score column, and column t's chaos is
-//! `μ_t + Σ_k φ_k(t) z_k(ξ)`: the coefficients `C Φᵀ` on the union of the modes' bases, so
-//! the mean, Std, Sobol' indices and draws of every column come from the per-column code.
-//! Column t's truncation error is the share of its variance the modes miss, added to the
-//! modes' own error estimates weighted by their share of the column.
+//! The runs `Y` (n runs × T columns) are centred column by column, `Yc = Y − 1 μᵀ`, and each
+//! column is scaled to unit variance (`W`; a column whose Std is at most 1e-3 of the largest
+//! as if at that level), so that a column of small variance, such as the start of a
+//! response, is represented as well as the large ones. The scaled runs are decomposed
+//! `Yc W = Σ_k z_k φ_kᵀ`: scores `z_k` over the runs (`‖z_k‖² = λ_k`), orthonormal modes
+//! `φ_k` over time. Enough leading modes are kept to hold the share `retained_variance` of
+//! the scaled variance `Σ_k λ_k`, and at least `1 − max(1 − retained_variance, 1e-3)` of
+//! every resolved column's own ([`COLUMN_DISCARD`]). The method fits one chaos per score
+//! column, and column t's chaos is `μ_t + Σ_k w_t⁻¹ φ_k(t) z_k(ξ)`: the coefficients on the
+//! union of the modes' bases, so the mean, Std, Sobol' indices and draws of every column
+//! come from the per-column code. Column t's truncation-error estimate is the share of its
+//! variance the modes miss, added to the modes' own estimates weighted by their variance in
+//! the column.
 //!
-//! The decomposition takes the smaller of two symmetric matrices: the Gram matrix `Yc Ycᵀ`
-//! (n × n) when n ≤ T, accumulated over the analysis's blocks of columns, or the covariance
-//! `Ycᵀ Yc` (T × T) when the series is one block. Sums over columns run over chunks of
-//! [`BLOCK_ALIGN`] columns in order, on one thread: the numbers depend neither on the thread
-//! count nor on the block width.
+//! The decomposition takes the smaller of two symmetric matrices: the Gram matrix
+//! `Yc W² Ycᵀ` (n × n) when n ≤ T, accumulated over the analysis's blocks of columns, or
+//! the covariance `W Ycᵀ Yc W` (T × T) when the series is one block. Sums over columns run
+//! over chunks of [`BLOCK_ALIGN`] columns in order, on one thread: the numbers depend
+//! neither on the thread count nor on the block width.
 //!
 //! The column-by-column fit fits identical columns (bit for bit over the runs) once
 //! ([`estimate_distinct`]).
@@ -40,9 +45,10 @@ pub(super) struct Modes {
     pub mean: Vec<f64>,
     /// Scores over the runs (n × m): column k is `z_k`, `‖z_k‖² = λ_k`.
     pub scores: DMatrix<f64>,
-    /// Orthonormal modes over the columns (T × m).
+    /// The modes over the columns in the series' units (T × m): `Yc ≈ scores modesᵀ`
+    /// (orthonormal modes of the scaled columns, each row times its column's scale).
     pub modes: DMatrix<f64>,
-    /// `λ_k` of the kept modes, descending.
+    /// `λ_k = ‖z_k‖²` of the kept modes, descending.
     pub eigenvalues: Vec<f64>,
     /// Per column, the sum of its squared centred values (`(n − 1)` times its variance).
     pub sq: Vec<f64>,
@@ -138,8 +144,43 @@ fn eigen_descending(g: DMatrix<f64>) -> (Vec<f64>, DMatrix<f64>) {
     (values, e.eigenvectors.select_columns(&order))
 }
 
+/// The largest share of a column's own variance the kept modes may miss, whatever
+/// `retained_variance` allows (where that allows less, its own share): a column of small
+/// variance beside large ones (the start of a response) keeps its Std within 0.05 %.
+pub(super) const COLUMN_DISCARD: f64 = 1e-3;
+
+/// A column whose Std is at most this fraction of the largest is not held to
+/// [`COLUMN_DISCARD`] (as the truncation-error warnings leave such columns out), and is
+/// scaled as if its Std were at this level.
+const RESOLVED_STD: f64 = 1e-3;
+
+/// The sum of squares of a scaled column above which it is held to [`COLUMN_DISCARD`]: the
+/// resolved columns have 1 (to rounding), the others less.
+const RESOLVED_SQ: f64 = 1.0 - 1e-9;
+
+/// The fewest leading modes that keep the share `1 − cap` of the variance of every column of
+/// `q` (rows: columns of the series; `q[(t, k)]² = λ_k φ_k(t)²`) whose sum of squares
+/// `sq[t]` is above `floor`.
+fn column_modes(q: &DMatrix<f64>, sq: &[f64], floor: f64, cap: f64) -> usize {
+    let mut need = 0;
+    for (t, &s) in sq.iter().enumerate() {
+        if s <= floor {
+            continue;
+        }
+        let mut left = s;
+        let mut k = 0;
+        while k < q.ncols() && left > cap * s {
+            left -= q[(t, k)].powi(2);
+            k += 1;
+        }
+        need = need.max(k);
+    }
+    need
+}
+
 /// The principal components of a series of `nt` columns over `n` runs, read in blocks of
-/// `width` columns by `read(j0, w)`, truncated to keep the share `retained` of its variance;
+/// `width` columns by `read(j0, w)`, truncated to keep the share `retained` of its variance
+/// and of each column's (at least `1 − COLUMN_DISCARD` of a column's: [`COLUMN_DISCARD`]);
 /// `None` when nothing is to be kept (no variance) or the covariance route would need more
 /// than one block (more runs than columns, and the series does not fit one block).
 pub(super) fn decompose<E>(
@@ -151,67 +192,103 @@ pub(super) fn decompose<E>(
 ) -> Result<Option<Modes>, E> {
     let width = width.max(1);
     let single = width >= nt;
+    let gram = n <= nt;
+    if !gram && !single {
+        return Ok(None);
+    }
+    // The column means, sums of squares and hashes; the series kept if it is one block.
     let (mut mean, mut sq, mut hashes) = (Vec::new(), Vec::new(), Vec::new());
     let mut kept_block = None;
-    let (lambda, vectors, gram) = if n <= nt {
+    for (j0, w) in blocks::blocks(nt, width) {
+        let (bc, m, s, h) = centre(read(j0, w)?);
+        mean.extend(m);
+        sq.extend(s);
+        hashes.extend(h);
+        if single {
+            kept_block = Some(bc);
+        }
+    }
+    // Every column scaled to unit variance, those at or below RESOLVED_STD of the largest
+    // Std as if at that level.
+    let largest = sq.iter().copied().fold(0.0, f64::max);
+    let floor = RESOLVED_STD * RESOLVED_STD * largest;
+    let scale: Vec<f64> = sq.iter().map(|&s| s.max(floor).sqrt()).collect();
+    let wsq: Vec<f64> = sq
+        .iter()
+        .zip(&scale)
+        .map(|(&s, &c)| if c > 0.0 { s / (c * c) } else { 0.0 })
+        .collect();
+    let mut block_of = |j0: usize, w: usize| -> Result<DMatrix<f64>, E> {
+        let mut b = match &kept_block {
+            Some(b) => b.columns(j0, w).into_owned(),
+            None => centre(read(j0, w)?).0,
+        };
+        for (k, mut c) in b.column_iter_mut().enumerate() {
+            let f = scale[j0 + k];
+            c.scale_mut(if f > 0.0 { f.recip() } else { 0.0 });
+        }
+        Ok(b)
+    };
+    let (lambda, vectors) = if gram {
         let mut g = DMatrix::<f64>::zeros(n, n);
         for (j0, w) in blocks::blocks(nt, width) {
-            let (bc, m, s, h) = centre(read(j0, w)?);
+            let b = block_of(j0, w)?;
             for (c0, cw) in blocks::blocks(w, BLOCK_ALIGN) {
-                let chunk = bc.columns(c0, cw);
+                let chunk = b.columns(c0, cw);
                 g.gemm(1.0, &chunk, &chunk.transpose(), 1.0);
             }
-            mean.extend(m);
-            sq.extend(s);
-            hashes.extend(h);
-            if single {
-                kept_block = Some(bc);
-            }
         }
-        let (l, v) = eigen_descending(g);
-        (l, v, true)
+        eigen_descending(g)
     } else {
-        if !single {
-            return Ok(None);
-        }
-        let (bc, m, s, h) = centre(read(0, nt)?);
-        let c = bc.tr_mul(&bc);
-        (mean, sq, hashes) = (m, s, h);
-        kept_block = Some(bc);
-        let (l, v) = eigen_descending(c);
-        (l, v, false)
+        let b = block_of(0, nt)?;
+        eigen_descending(b.tr_mul(&b))
     };
-    let total: f64 = sq.iter().sum();
-    let m = kept_modes(&lambda, total, retained);
+    let total: f64 = wsq.iter().sum();
+    let m0 = kept_modes(&lambda, total, 1.0);
+    let mut m = kept_modes(&lambda, total, retained);
     if m == 0 {
         return Ok(None);
     }
-    let lambda: Vec<f64> = lambda[..m].to_vec();
-    let v = vectors.columns(0, m).into_owned();
-    let (scores, modes) = if gram {
-        // Yc = U S Vᵀ: scores U S, modes Ycᵀ U S⁻¹, a block of columns at a time.
-        let mut scores = v.clone();
-        let mut modes = DMatrix::<f64>::zeros(nt, m);
-        for (k, &l) in lambda.iter().enumerate() {
-            scores.column_mut(k).scale_mut(l.sqrt());
+    let cap = (1.0 - retained).max(COLUMN_DISCARD);
+    let scale_by = |q: &mut DMatrix<f64>, f: &dyn Fn(f64) -> f64| {
+        for (k, &l) in lambda.iter().take(q.ncols()).enumerate() {
+            q.column_mut(k).scale_mut(f(l));
         }
+    };
+    // Yc W = U S Vᵀ (Gram: U, the eigenvectors) or W Ycᵀ Yc W = V Λ Vᵀ (covariance: V).
+    if gram {
+        // q = W Ycᵀ U, q_tk = s_k φ_k(t), over the modes above the rounding level.
+        let u = vectors.columns(0, m0);
         for (j0, w) in blocks::blocks(nt, width) {
-            let bc = match &kept_block {
-                Some(b) => b.clone(),
-                None => centre(read(j0, w)?).0,
-            };
-            let mut part = bc.tr_mul(&v);
-            for (k, &l) in lambda.iter().enumerate() {
-                part.column_mut(k).scale_mut(l.sqrt().recip());
-            }
+            let q = block_of(j0, w)?.tr_mul(&u);
+            m = m.max(column_modes(&q, &wsq[j0..j0 + w], RESOLVED_SQ, cap));
+        }
+    } else {
+        let mut q = vectors.columns(0, m0).into_owned();
+        scale_by(&mut q, &|l| l.max(0.0).sqrt());
+        m = m.max(column_modes(&q, &wsq, RESOLVED_SQ, cap));
+    }
+    let v = vectors.columns(0, m).into_owned();
+    let (scores, mut modes) = if gram {
+        // Scores U S, modes W Ycᵀ U S⁻¹, a block of columns at a time.
+        let mut scores = v.clone();
+        scale_by(&mut scores, &|l| l.sqrt());
+        let mut modes = DMatrix::<f64>::zeros(nt, m);
+        for (j0, w) in blocks::blocks(nt, width) {
+            let mut part = block_of(j0, w)?.tr_mul(&v);
+            scale_by(&mut part, &|l| l.sqrt().recip());
             modes.rows_mut(j0, w).copy_from(&part);
         }
         (scores, modes)
     } else {
-        // Ycᵀ Yc = V Λ Vᵀ: modes V, scores Yc V.
-        let bc = kept_block.expect("one block");
-        (&bc * &v, v)
+        // Modes V, scores Yc W V.
+        let b = block_of(0, nt)?;
+        (&b * &v, v)
     };
+    // In the series' own units: Yc_t ≈ Σ_k scale_t φ_k(t) z_k.
+    for (t, mut row) in modes.row_iter_mut().enumerate() {
+        row.scale_mut(scale[t]);
+    }
     let distinct = {
         let mut h = hashes.clone();
         h.sort_unstable();
@@ -222,7 +299,7 @@ pub(super) fn decompose<E>(
         mean,
         scores,
         modes,
-        eigenvalues: lambda,
+        eigenvalues: lambda[..m].to_vec(),
         sq,
         distinct,
         hashes,
