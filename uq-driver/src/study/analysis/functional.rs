@@ -491,3 +491,205 @@ pub(super) fn select(e: &Estimate, of: &[usize]) -> Estimate {
         }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use super::*;
+    use crate::uq::method::pce_regression::PceRegression;
+    use crate::uq::method::{Evaluation, Method, MethodSummary, Problem};
+    use crate::uq::random_inputs::RandomInputs;
+    use crate::uq::{Distribution, RandomParameter};
+
+    /// A series of `n` runs × `nt` columns of rank 3 (three fixed shapes over time times
+    /// functions of the runs), plus a column mean; `x` gives the runs' inputs.
+    fn rank_three(x: &[Vec<f64>], nt: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(x.len(), nt, |i, t| {
+            let s = t as f64 / nt as f64;
+            let (a, b) = (x[i][0], x[i][1]);
+            10.0 + s
+                + (a + 0.5 * b) * (6.0 * s).sin()
+                + a * b * (1.0 + s * s)
+                + (b * b - 1.0) * (3.0 * s).cos() * 0.3
+        })
+    }
+
+    fn points(n: usize) -> Vec<Vec<f64>> {
+        (0..n)
+            .map(|i| {
+                let u = (i as f64 + 0.5) / n as f64;
+                vec![
+                    2.0 * u - 1.0,
+                    ((i * 7919) % n) as f64 / n as f64 * 2.0 - 1.0,
+                ]
+            })
+            .collect()
+    }
+
+    fn decomposed(y: &DMatrix<f64>, width: usize, retained: f64) -> Modes {
+        let (n, nt) = y.shape();
+        decompose::<()>(n, nt, width, retained, &mut |j0, w| {
+            Ok(y.columns(j0, w).into_owned())
+        })
+        .unwrap()
+        .unwrap()
+    }
+
+    #[test]
+    fn kept_modes_reach_the_retained_share_and_stop_at_rounding() {
+        let l = [4.0, 2.0, 1.0, 1e-20];
+        assert_eq!(kept_modes(&l, 7.0, 1.0), 3);
+        assert_eq!(kept_modes(&l, 7.0, 0.8), 2);
+        assert_eq!(kept_modes(&l, 7.0, 0.5), 1);
+        assert_eq!(kept_modes(&[0.0, 0.0], 0.0, 1.0), 0);
+    }
+
+    /// A series of rank 3 keeps 3 modes, discards nothing, and its scores times its modes
+    /// give back the centred runs; the same numbers bit for bit in blocks of 32 columns.
+    #[test]
+    fn pca_of_a_rank_three_series_keeps_three_modes_and_discards_nothing() {
+        // More columns than runs (the Gram route), then more runs than columns (covariance).
+        for (n, nt) in [(40, 301), (150, 60)] {
+            let y = rank_three(&points(n), nt);
+            let m = decomposed(&y, nt, 1.0 - 1e-6);
+            assert_eq!(m.eigenvalues.len(), 3, "{n} × {nt}");
+            assert!(m.discarded_share() < 1e-12, "{}", m.discarded_share());
+            let mut centred = y.clone();
+            for (t, mut c) in centred.column_iter_mut().enumerate() {
+                c.add_scalar_mut(-m.mean[t]);
+            }
+            let back = &m.scores * m.modes.transpose();
+            let err = (&back - &centred).abs().max();
+            assert!(err < 1e-10 * centred.abs().max(), "{n} × {nt}: {err}");
+            assert_eq!(m.distinct, nt);
+            if n <= nt {
+                let blocked = decomposed(&y, 32, 1.0 - 1e-6);
+                assert_eq!(blocked.scores, m.scores);
+                assert_eq!(blocked.modes, m.modes);
+            }
+        }
+    }
+
+    /// A method that counts the columns it fits (least squares of order 2 underneath).
+    #[derive(Debug)]
+    struct Counting {
+        inner: PceRegression,
+        columns: AtomicUsize,
+    }
+
+    impl Method for Counting {
+        fn kind(&self) -> &'static str {
+            "pce_regression"
+        }
+        fn label(&self, dim: usize) -> String {
+            self.inner.label(dim)
+        }
+        fn validate(&self, problem: &Problem) -> Result<(), InvalidSettings> {
+            self.inner.validate(problem)
+        }
+        fn summary(&self, dim: usize) -> MethodSummary {
+            self.inner.summary(dim)
+        }
+        fn evaluation(&self) -> Evaluation<'_> {
+            Evaluation::Sampling(self)
+        }
+    }
+
+    impl Sampling for Counting {
+        fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
+            self.inner.make_design(inputs, seed)
+        }
+        fn make_estimate(
+            &self,
+            design: &Design,
+            rows: &[usize],
+            data: &DMatrix<f64>,
+        ) -> Result<Estimate, MethodError> {
+            self.columns.fetch_add(data.ncols(), Ordering::Relaxed);
+            self.inner.make_estimate(design, rows, data)
+        }
+        fn chaos_per_column(&self) -> bool {
+            true
+        }
+    }
+
+    fn counting(text: &str) -> (Counting, Design) {
+        let inner: PceRegression = toml::from_str(text).unwrap();
+        let inputs = RandomInputs::independent(
+            ["a", "b"]
+                .iter()
+                .map(|n| RandomParameter {
+                    name: (*n).into(),
+                    distribution: Distribution::uniform(-1.0, 1.0).unwrap(),
+                })
+                .collect(),
+        );
+        let design = inner.design(&inputs, 5).unwrap();
+        let m = Counting {
+            inner,
+            columns: AtomicUsize::new(0),
+        };
+        (m, design)
+    }
+
+    #[test]
+    fn identical_columns_are_fitted_once() {
+        let (m, design) = counting("samples = 30\norder = 2");
+        let x = &design.values;
+        let rows: Vec<usize> = (0..x.len()).collect();
+        let f = |k: usize| -> Vec<f64> {
+            x.iter()
+                .map(|v| v[0] * v[1] + k as f64 * v[0] * v[0])
+                .collect()
+        };
+        // Columns a, b, a, a, b, c.
+        let cols = [f(0), f(1), f(0), f(0), f(1), f(2)];
+        let data = DMatrix::from_fn(x.len(), cols.len(), |i, t| cols[t][i]);
+        let (e, fits, hashes) = estimate_distinct(&m, &design, &rows, &data).unwrap();
+        assert_eq!(fits, 3);
+        assert_eq!(m.columns.load(Ordering::Relaxed), 3);
+        assert_eq!(hashes[0], hashes[2]);
+        assert_ne!(hashes[0], hashes[1]);
+        // Every column as its own fit gives.
+        m.columns.store(0, Ordering::Relaxed);
+        let all = m.estimate(&design, &rows, &data).unwrap();
+        assert_eq!(m.columns.load(Ordering::Relaxed), 6);
+        assert_eq!(e.mean, all.mean);
+        assert_eq!(e.std, all.std);
+        assert_eq!(e.chaos_error, all.chaos_error);
+        assert_eq!(e.sobol, all.sobol);
+    }
+
+    /// Least squares is linear in the data: the chaos of the principal components of a rank-3
+    /// series, combined over time, is the chaos of every column (to rounding), from 3 fits.
+    #[test]
+    fn pca_chaos_of_a_low_rank_series_matches_the_column_fit() {
+        let (m, design) = counting("samples = 40\norder = 3");
+        let rows: Vec<usize> = (0..design.len()).collect();
+        let y = rank_three(&design.values, 200);
+        let modes = decomposed(&y, 200, 1.0 - 1e-6);
+        assert_eq!(modes.eigenvalues.len(), 3);
+        let of_modes = m.estimate(&design, &rows, &modes.scores).unwrap();
+        assert_eq!(m.columns.load(Ordering::Relaxed), 3);
+        let pca = combine(of_modes, &modes).unwrap();
+        let columns = m.estimate(&design, &rows, &y).unwrap();
+        let smax = columns.std.iter().copied().fold(0.0, f64::max);
+        for t in 0..200 {
+            assert!((pca.mean[t] - columns.mean[t]).abs() < 1e-10, "mean at {t}");
+            assert!(
+                (pca.std[t] - columns.std[t]).abs() < 1e-10 * smax,
+                "std at {t}"
+            );
+            let (s, c) = (
+                &pca.sobol.as_ref().unwrap().first[t],
+                &columns.sobol.as_ref().unwrap().first[t],
+            );
+            for (a, b) in s.iter().zip(c) {
+                assert!((a - b).abs() < 1e-8, "S1 at {t}: {a} {b}");
+            }
+            // A polynomial of order 3 in the inputs: no truncation error, no discarded part.
+            assert!(pca.chaos_error.as_ref().unwrap().values[t] < 1e-12);
+        }
+    }
+}
