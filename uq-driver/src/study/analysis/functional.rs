@@ -1,5 +1,6 @@
 //! Functional outputs: a chaos method fits a series on the principal components
-//! (Karhunen–Loève modes) of its centred runs instead of column by column.
+//! (Karhunen–Loève modes) of its centred runs instead of column by column (a design without
+//! quadrature weights: a regression chaos).
 //!
 //! The runs `Y` (n runs × T columns) are centred column by column, `Yc = Y − 1 μᵀ`, and each
 //! column is scaled to unit variance (`W`; a column whose Std is at most 1e-3 of the largest
@@ -373,10 +374,15 @@ pub(super) fn pca_estimate(
 ) -> Result<Option<(Estimate, FunctionalFit, Vec<u64>)>, AnalysisError> {
     let n = runs.rows.len();
     let width = blocks::block_width(nt, n);
-    let Some(modes) = decompose(n, nt, width, retained, &mut |j0, w| {
-        runs.block(o, nt, j0, w)
-    })?
-    else {
+    // A quadrature (a sparse grid) projects every column at the cost of a matrix product,
+    // and its weights, some of them negative, bound neither what a discarded component takes
+    // from its moments nor how the components' errors add up: its columns are fitted as
+    // they are.
+    if design.weights.is_some() {
+        return Ok(None);
+    }
+    let read = &mut |j0, w| runs.block(o, nt, j0, w);
+    let Some(modes) = decompose(n, nt, width, retained, read)? else {
         return Ok(None);
     };
     let m = modes.eigenvalues.len();

@@ -352,10 +352,10 @@ pub trait Sampling: Method {
         None
     }
 
-    /// Whether the estimator fits a chaos to each column on its own, so that a series may be
-    /// fitted on its principal components instead (`[analysis] functional = "pca"`) and
-    /// identical columns once (regression and sparse-grid chaoses; not a quadrature whose
-    /// moments come from the runs themselves).
+    /// Whether the estimator fits a chaos to each column on its own, so that identical columns
+    /// may be fitted once and a series on its principal components instead (`[analysis]
+    /// functional = "pca"`, for a design without quadrature weights): regression and
+    /// sparse-grid chaoses; not a quadrature whose moments come from the runs themselves.
     fn chaos_per_column(&self) -> bool {
         false
     }
