@@ -6,13 +6,15 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
-                                  [--only hd|vehicle|reliability]
+                                  [--only hd|vehicle|reliability|functional]
 
 `--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
 target/bench/BENCHMARKS-hd.md, `--only vehicle` the full car's real-time factor alone into
 target/bench/BENCHMARKS-vehicle.md, `--only reliability` the small-probability goals alone
 (bench/reliability_goals.py: FORM, SORM, importance sampling, subset simulation beside
-OpenTURNS; needs only uq-driver and a C compiler) into target/bench/BENCHMARKS-reliability.md.
+OpenTURNS; needs only uq-driver and a C compiler) into target/bench/BENCHMARKS-reliability.md,
+`--only functional` the series fitted per column against on principal components alone into
+target/bench/BENCHMARKS-functional.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals set for the comparisons are reported as met or not met. The only hard failures are missing
@@ -1004,6 +1006,99 @@ def bench_reliability_goals(work):
                                    ROOT / "target" / "test-fmu")
 
 
+# ------------------------------------------------------------------ functional outputs
+
+GOAL_FUNCTIONAL_S = 2.0        # analysis of the series on its principal components (s)
+GOAL_FUNCTIONAL_RATIO = 15.0   # faster than the fit of every column
+GOAL_FUNCTIONAL_DIFF = 0.005   # mean and Std within 0.5 % (of the series' largest Std)
+
+
+def functional_study(functional):
+    """builtin:vehicle-track-8d-pce with the series Zc_acc (3 001 columns) analysed
+    `functional` ("columns" or "pca")."""
+    text = (ROOT / "uq-driver/studies/vehicle-track-8d-pce.toml").read_text()
+    text = text.replace('fmu = "VehicleTrack.fmu"', f'fmu = "{fmu("VehicleTrack")}"')
+    text = text.replace("[[qoi]]", '[outputs]\nvariables = ["Zc_acc"]\n\n[[qoi]]', 1)
+    return text + f'\n[analysis]\nfunctional = "{functional}"\n'
+
+
+def bench_functional(work, repeats):
+    """The same chaos study, its series fitted column by column and on its principal
+    components: analysis time of each, and how far apart their statistics are."""
+    sec = Section("Functional outputs: a chaos per time column against one per principal "
+                  "component (VehicleTrack 8 inputs, order-3 LARS, 200 runs, 3 001 columns)",
+                  ["functional", "chaoses fitted", "analysis, best (s)", "analysis, median (s)"])
+    base = work / "functional"
+    base.mkdir(parents=True, exist_ok=True)
+    dirs = {f: base / f for f in ("columns", "pca")}
+    for f, d in dirs.items():
+        (base / f"vt-{f}.toml").write_text(functional_study(f))
+    # The runs once (analysis settings do not change the records), then each analysis alone
+    # on the resumed store.
+    if dirs["columns"].exists():
+        shutil.rmtree(dirs["columns"])
+    run_cmd([str(DRIVER), "run", str(base / "vt-columns.toml"), "--out", str(dirs["columns"]),
+             "--no-report"])
+    if dirs["pca"].exists():
+        shutil.rmtree(dirs["pca"])
+    shutil.copytree(dirs["columns"] / "store", dirs["pca"] / "store")
+    sec.cmd(f"target/release/uq-driver run {rel(base / 'vt-columns.toml')} --out "
+            f"{rel(dirs['columns'])} --no-report   # the 200 runs, then the analysis x{repeats}")
+    sec.cmd(f"cp -r {rel(dirs['columns'] / 'store')} {rel(dirs['pca'])}/ && target/release/"
+            f"uq-driver run {rel(base / 'vt-pca.toml')} --out {rel(dirs['pca'])} --no-report"
+            f"   # x{repeats}")
+    times = {f: [] for f in dirs}
+    for _ in range(repeats):
+        for f, d in dirs.items():
+            run_cmd([str(DRIVER), "run", str(base / f"vt-{f}.toml"), "--out", str(d),
+                     "--no-report"])
+            s = json.loads((d / "summary.json").read_text())
+            if s["runs_this_invocation"]:
+                die(f"{d}: the analysis reran {s['runs_this_invocation']} runs")
+            times[f].append(s["timing"]["analysis_s"])
+    fits = {}
+    for f, d in dirs.items():
+        s = json.loads((d / "summary.json").read_text())
+        fits[f] = s["outputs"]["Zc_acc"]["functional"]
+        b, m = best_median(times[f])
+        sec.row(f, fits[f]["fits"], fmt_s(b), fmt_s(m))
+    cols = {f: read_csv_cols(d / "Zc_acc.csv") for f, d in dirs.items()}
+    sob = {f: read_csv_cols(d / "Zc_acc_sobol.csv") for f, d in dirs.items()}
+    c, p = cols["columns"], cols["pca"]
+    smax = max(c["std"])
+    d_mean = max(abs(a - b) for a, b in zip(c["mean"], p["mean"])) / smax
+    d_std = max(abs(a - b) for a, b in zip(c["std"], p["std"])) / smax
+    resolved = [t for t, x in enumerate(c["std"]) if x > 1e-3 * smax]
+    d_std_rel = max(abs(c["std"][t] - p["std"][t]) / c["std"][t] for t in resolved)
+    def s1_diff(times):
+        return max(abs(sob["columns"][k][t] - sob["pca"][k][t])
+                   for k in sob["columns"] if k.startswith("S_") for t in times)
+    vouched = [t for t, x in enumerate(c["std"]) if x > 0.1 * smax and c["loo"][t] < 0.05]
+    d_s1 = s1_diff(vouched)
+    d_s1_all = s1_diff([t for t, x in enumerate(c["std"]) if x > 1e-2 * smax])
+    ratio = min(times["columns"]) / min(times["pca"])
+    fp = fits["pca"]
+    sec.note(f"{fp['modes']} principal components (retained_variance {fp['retained_variance']}; "
+             f"they miss {fp['discarded_variance']:.1e} of the series' variance and at most "
+             f"{fp['discarded_max']:.1e} of one column's). Largest difference over the 3 001 "
+             f"times, pca against columns, as a share of the series' largest Std: mean "
+             f"{100 * d_mean:.3f} %, Std {100 * d_std:.3f} %; the Std relative to its own value "
+             f"(times where it is above 1e-3 of the largest) {100 * d_std_rel:.2f} %; "
+             f"first-order Sobol' indices {d_s1:.4f} where the Std is above 10 % of the largest "
+             f"and the column fit's leave-one-out error below 5 % ({len(vouched)} times), "
+             f"{d_s1_all:.4f} where the Std is above 1 % of the largest. Both fits are "
+             f"estimates: where the column fit's own leave-one-out error is a few per cent, "
+             f"they differ by about as much.")
+    ok = (min(times["pca"]) <= GOAL_FUNCTIONAL_S and ratio >= GOAL_FUNCTIONAL_RATIO
+          and max(d_mean, d_std) <= GOAL_FUNCTIONAL_DIFF)
+    sec.done(f"Analysis on the principal components {fmt_s(min(times['pca']))} s against "
+             f"{fmt_s(min(times['columns']))} s column by column ({fmt_ratio(ratio)} faster), "
+             f"mean and Std within {100 * max(d_mean, d_std):.2f} % of the largest Std "
+             f"(goal ≤ {GOAL_FUNCTIONAL_S:g} s, ≥ {GOAL_FUNCTIONAL_RATIO:g}×, within "
+             f"{100 * GOAL_FUNCTIONAL_DIFF:g} %): {goal(ok)}.")
+    return sec
+
+
 # ------------------------------------------------------------------ BENCHMARKS.md
 
 # ------------------------------------------------------------------ --isolate overhead
@@ -1139,7 +1234,7 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
-SECTIONS = ("hd", "vehicle", "reliability")
+SECTIONS = ("hd", "vehicle", "reliability", "functional")
 
 
 def main():
@@ -1188,6 +1283,10 @@ def main():
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
             sections = [bench_vehicle_realtime(work, repeats)]
             same_threads, same_iso = True, True
+        elif args.only == "functional":
+            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
+            sections = [bench_functional(work, repeats)]
+            same_threads, same_iso = True, True
         else:
             sections, same_threads, same_iso, lib_same = all_sections(args, work, repeats,
                                                                       checks)
@@ -1219,10 +1318,11 @@ def all_sections(args, work, repeats, checks):
     s7 = bench_vt_stepping(work, s1.other)
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
+    s_functional = bench_functional(work, repeats)
     s_hd = bench_hd_goals(work)
     s_rel = bench_reliability_goals(work)
-    return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis + s_hd + s_rel,
-            same_threads, same_iso, lib_same)
+    return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis
+            + [s_functional] + s_hd + s_rel, same_threads, same_iso, lib_same)
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ mod declared_speed_range;
 mod description_hardening;
 mod fmu_import;
 mod fmu_robustness;
+mod functional_outputs;
 mod fuzz_corpus;
 mod hd_goals;
 mod hunting_speed;

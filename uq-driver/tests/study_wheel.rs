@@ -305,15 +305,33 @@ fn sparse_grid_level_3_matches_the_reference() {
 
 #[test]
 fn sparse_regression_chaos_on_100_runs_matches_the_reference() {
-    let (_dir, out, _) = run_builtin("wheel-pce-lars");
-    check_reference(
-        &out,
-        |s| (1e-3 * s, 1e-2 * s),
-        |csv, t, _, _| {
-            let loo = csv.at(t, "loo");
-            assert!((0.0..0.05).contains(&loo), "t = {t}: loo {loo}");
-        },
+    // As shipped: the series fitted on its principal components. Its mean is within 0.2 % of
+    // the Std of the reference (0.13 % at 5 s, where the fit of every column has 0.015 %).
+    let (dir, out, _) = run_builtin("wheel-pce-lars");
+    let loo_below_5_percent = |csv: &Csv, t: f64, _: f64, _: f64| {
+        let loo = csv.at(t, "loo");
+        assert!((0.0..0.05).contains(&loo), "t = {t}: loo {loo}");
+    };
+    check_reference(&out, |s| (2e-3 * s, 1e-2 * s), loo_below_5_percent);
+    let s = summary(&out);
+    assert_eq!(s["model_runs"], 100);
+    assert_eq!(s["outputs"]["q"]["functional"]["method"], "pca");
+    // Every column fitted on its own: within 0.1 % of the Std.
+    let text = uq_driver::spec::builtin("wheel-pce-lars").unwrap().replace(
+        "fmu = \"Wheel.fmu\"",
+        &format!("fmu = {:?}", utf8(&wheel_fmu())),
     );
-    let summary = summary(&out);
-    assert_eq!(summary["model_runs"], 100);
+    let file = dir.path().join("columns.toml");
+    std::fs::write(
+        &file,
+        format!("{text}\n[analysis]\nfunctional = \"columns\"\n"),
+    )
+    .unwrap();
+    let columns = dir.path().join("columns");
+    run_study_ok(&file, &columns, &[]);
+    check_reference(&columns, |s| (1e-3 * s, 1e-2 * s), loo_below_5_percent);
+    assert_eq!(
+        summary(&columns)["outputs"]["q"]["functional"]["method"],
+        "columns"
+    );
 }

@@ -603,6 +603,7 @@ mod tests {
             unit: None,
             convergence: None,
             convergence_time: None,
+            functional: None,
         }
     }
 

@@ -73,6 +73,31 @@ pub struct OutputStats {
     pub convergence: Option<Convergence>,
     /// The time of the convergence plot: where the Std is largest (s).
     pub convergence_time: Option<f64>,
+    /// How a chaos method fitted the series (principal components or columns).
+    pub functional: Option<FunctionalFit>,
+}
+
+/// How a chaos method fitted a series output (`summary.json`: `outputs.<V>.functional`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FunctionalFit {
+    /// `pca`: one chaos per principal component of the centred runs; `columns`: one per
+    /// distinct time column.
+    pub method: String,
+    /// Principal components kept (`pca`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Chaoses fitted: the modes, or the distinct columns (identical columns are fitted once).
+    pub fits: usize,
+    /// The share of the variance the components were to keep (`[analysis] retained_variance`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub retained_variance: Option<f64>,
+    /// The share of the series' variance (summed over its columns) the kept components miss.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discarded_variance: Option<f64>,
+    /// The largest share of one column's variance they miss (columns whose Std is above
+    /// 1e-3 of the largest); part of that column's truncation-error estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discarded_max: Option<f64>,
 }
 
 impl OutputStats {
@@ -346,6 +371,9 @@ pub struct OutputSummary {
     pub unit: Option<String>,
     /// Every run has the same value at every time (no density is drawn).
     pub deterministic: bool,
+    /// How a chaos method fitted the series (absent for the other methods).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub functional: Option<FunctionalFit>,
 }
 
 impl OutputSummary {
@@ -364,6 +392,7 @@ impl OutputSummary {
             time_of_max_std: s.times[imax],
             unit: s.unit.clone(),
             deterministic: s.deterministic,
+            functional: s.functional.clone(),
         }
     }
 }

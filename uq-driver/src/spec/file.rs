@@ -178,6 +178,25 @@ pub struct Analysis {
     pub quantiles: Vec<f64>,
     /// Unweighted designs (MC/LHS): continue when some points fail and report how many.
     pub allow_failures: bool,
+    /// How a chaos method fits a series output: on the principal components of its runs
+    /// (`pca`, the default) or column by column (`columns`).
+    pub functional: Functional,
+    /// The share of a series' variance over the runs that its principal components keep, in
+    /// (0, 1] (default 1 − 1e-6); the rest is the truncation error of the modes.
+    pub retained_variance: f64,
+}
+
+/// How a chaos method fits a series output (`[analysis] functional`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Functional {
+    /// One chaos per principal component (Karhunen–Loève mode) of the centred runs, as many
+    /// as keep `retained_variance` of the variance; each column's chaos is their sum
+    /// weighted by the modes, plus the column's mean.
+    #[default]
+    Pca,
+    /// One chaos per time column.
+    Columns,
 }
 
 /// Column name of a quantile level `p` (in [0, 1]): `q` and the percentage 100·p written
@@ -222,6 +241,8 @@ impl Default for Analysis {
             series_samples: 4_000,
             quantiles: vec![0.01, 0.5, 0.99],
             allow_failures: false,
+            functional: Functional::Pca,
+            retained_variance: 1.0 - 1e-6,
         }
     }
 }

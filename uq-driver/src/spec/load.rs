@@ -332,6 +332,17 @@ fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
              surrogate_samples >= 2, quantiles in [0, 1]",
         ));
     }
+    // NaN fails the range test too.
+    if !(a.retained_variance > 0.0 && a.retained_variance <= 1.0) {
+        return Err(cx.invalid(
+            None,
+            format!(
+                "analysis: retained_variance = {} must be in (0, 1] (the share of a series' \
+                 variance its principal components keep; default 0.999999)",
+                a.retained_variance
+            ),
+        ));
+    }
     // Each level names a column of `<V>.csv`: two levels with one name would be two
     // columns that cannot be told apart.
     let names: Vec<String> = a.quantiles.iter().map(|&p| quantile_column(p)).collect();

@@ -46,8 +46,8 @@ pub use crate::fmu::FixedValue;
 pub use builtins::{builtin, BUILTINS};
 pub use error::{Location, StudyError};
 pub use file::{
-    quantile_column, Analysis, CorrelationSpec, Experiment, Inputs, InvalidExperiment, Outputs,
-    PaperValue, StudyFile, Variant,
+    quantile_column, Analysis, CorrelationSpec, Experiment, Functional, Inputs, InvalidExperiment,
+    Outputs, PaperValue, StudyFile, Variant,
 };
 pub use load::{add_fmu_dir, fmu_candidates, fmu_search_path};
 pub use parameter::{DistributionSpec, InvalidParameter, Level, ParameterSpec};

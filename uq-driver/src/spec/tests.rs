@@ -331,6 +331,34 @@ fn quantile_levels_that_share_a_column_name_are_refused() {
 }
 
 #[test]
+fn retained_variance_outside_zero_to_one_is_refused() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let with = |a: &str| format!("{base}\n[analysis]\n{a}\n");
+    for v in ["0.0", "-0.5", "1.0000001", "2.0", "nan"] {
+        let err = Study::parse(&with(&format!("retained_variance = {v}")), "t.toml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("retained_variance"), "{v}: {err}");
+        assert!(err.contains("(0, 1]"), "{v}: {err}");
+    }
+    let err = Study::parse(&with("functional = \"modes\""), "t.toml", None)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("pca") && err.contains("columns"), "{err}");
+    let s = Study::parse(&with("retained_variance = 1.0"), "t.toml", None).unwrap();
+    assert_eq!(s.analysis.retained_variance, 1.0);
+    assert_eq!(s.analysis.functional, crate::spec::Functional::Pca);
+    let s = Study::parse(
+        &with("functional = \"columns\"\nretained_variance = 0.99"),
+        "t.toml",
+        None,
+    )
+    .unwrap();
+    assert_eq!(s.analysis.functional, crate::spec::Functional::Columns);
+    assert_eq!(s.analysis.retained_variance, 0.99);
+}
+
+#[test]
 fn quantity_settings_the_communication_grid_cannot_meet_are_refused_when_the_study_is_read() {
     let base = include_str!("../../studies/wheel-scm.toml");
     // wheel-scm: 0 to 5 s by 0.01 s (Nyquist 50 Hz).

@@ -11,8 +11,10 @@ use rayon::prelude::*;
 pub mod blocks;
 mod chaos_gap;
 mod columns;
+mod convergence;
 mod error;
 mod exceedance;
+mod functional;
 pub mod nested;
 mod runs;
 mod surrogate;
@@ -26,6 +28,7 @@ pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count
 
 use blocks::SeriesColumns;
 use columns::{column, Column};
+use convergence::convergence;
 pub(crate) use surrogate::Surrogates;
 
 pub(crate) use runs::{QuantityRuns, Runs};
@@ -33,10 +36,8 @@ pub(crate) use runs::{QuantityRuns, Runs};
 use super::store::StoredRuns;
 use crate::qoi::kde::{self, KdeKind};
 use crate::qoi::QoiSpec;
-use crate::results::{
-    Convergence, ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary,
-};
-use crate::spec::{Analysis, Study};
+use crate::results::{ExceedanceCount, OutputStats, ScalarChaosError, ScalarStats, SobolSummary};
+use crate::spec::{Analysis, Functional, Study};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::method::{Design, Draws, Estimate, Sampling, Sobol, Solution};
 use crate::uq::reliability::Side;
@@ -296,6 +297,7 @@ fn summarise(
         unit: None,
         convergence,
         convergence_time: k_max.map(|k| times[k]),
+        functional: None,
     })
 }
 
@@ -487,72 +489,6 @@ fn scalar_stats_counted(
     })
 }
 
-/// Mean and Std against the work spent: for a chaos, those of the expansion truncated at
-/// total order 0, 1, … (terms of a full-tensor projection do not depend on each other, so
-/// the truncation is the lower-order projection); for runs, the running estimates over the
-/// first n runs in design order (at about 30 values of n on a log scale).
-fn convergence(estimate: &Estimate, col: usize, valid: &[f64]) -> Option<Convergence> {
-    if let Some(pce) = &estimate.chaos {
-        // An orthonormal basis: each term's variance is its coefficient squared.
-        let set = pce.set();
-        let c0 = set.position(&vec![0; set.dim()]);
-        let mean = c0.map_or(0.0, |t| pce.coeffs[(t, col)]);
-        let order = set.order();
-        let mut of_order = vec![0.0_f64; order + 1];
-        for (t, k) in set.indices().iter().enumerate() {
-            if Some(t) != c0 {
-                let degree: usize = k.iter().sum();
-                of_order[degree] += pce.coeffs[(t, col)].powi(2);
-            }
-        }
-        let cumulative: Vec<f64> = of_order
-            .iter()
-            .scan(0.0_f64, |acc, v| {
-                *acc += v;
-                Some(acc.sqrt())
-            })
-            .collect();
-        return Some(Convergence {
-            axis: "chaos order".into(),
-            x: (0..=order).map(|o| o as f64).collect(),
-            mean: vec![mean; order + 1],
-            std: cumulative,
-            std_of_order: of_order.iter().map(|v: &f64| v.sqrt()).collect(),
-            std_error_mean: Vec::new(),
-        });
-    }
-    if valid.len() < 4 {
-        return None;
-    }
-    let n = valid.len();
-    let mut points: Vec<usize> = (0..=30)
-        .map(|i| (2.0 * (n as f64 / 2.0).powf(i as f64 / 30.0)).round() as usize)
-        .collect();
-    points.dedup();
-    let (mut mean, mut std) = (Vec::new(), Vec::new());
-    let (mut m, mut m2) = (0.0, 0.0);
-    let mut next = 0;
-    for (i, &x) in valid.iter().enumerate() {
-        // Welford's running mean and sum of squared deviations.
-        let d = x - m;
-        m += d / (i + 1) as f64;
-        m2 += d * (x - m);
-        if next < points.len() && i + 1 == points[next] {
-            mean.push(m);
-            std.push((m2 / i.max(1) as f64).sqrt());
-            next += 1;
-        }
-    }
-    Some(Convergence {
-        axis: "runs".into(),
-        x: points.iter().map(|&p| p as f64).collect(),
-        mean,
-        std,
-        std_of_order: Vec::new(),
-        std_error_mean: Vec::new(),
-    })
-}
-
 /// What an exceedance counted over the runs a method names as its independent draws
 /// ([`Sampling::moment_rows`], e.g. `A` and `B` of `sobol_sampling`) counts.
 const INDEPENDENT_RUNS: &str = "independent runs (A and B)";
@@ -591,19 +527,16 @@ pub fn analyse_runs(
         });
     }
     let mut outputs = Vec::new();
-    let mut output_chaos = Vec::new();
+    let mut estimates = Vec::new();
+    // Per output, the hash of every column (a chaos fitted per column): a quantity equal to
+    // a column takes that column's estimate.
+    let mut hashes: Vec<Vec<u64>> = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let (estimate, stats) =
+        let (estimate, stats, h) =
             output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
         outputs.push(stats);
-        if let Some(pce) = estimate.chaos {
-            output_chaos.push(NamedChaos {
-                name: name.clone(),
-                times: Some(times.clone()),
-                pce,
-                error: estimate.chaos_error,
-            });
-        }
+        estimates.push(estimate);
+        hashes.push(h);
     }
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
@@ -618,9 +551,16 @@ pub fn analyse_runs(
             return Err(quantity_error(&name, q, &qr, None));
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate = method
-            .estimate(design, &qr.rows, &data)
-            .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
+        let equal = match qr.rows == runs.rows {
+            true => equal_column(&runs, &hashes, nt, &qr.valid)?,
+            false => None,
+        };
+        let estimate = match equal {
+            Some((o, t)) => functional::select(&estimates[o], &[t]),
+            None => method
+                .estimate(design, &qr.rows, &data)
+                .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?,
+        };
         // The running estimate takes the rows the reported mean and Std use.
         let moment_values = method.moment_rows(design, &qr.rows).map(|rows| {
             rows.iter()
@@ -644,6 +584,19 @@ pub fn analyse_runs(
             });
         }
     }
+    let output_chaos = study
+        .outputs
+        .iter()
+        .zip(estimates)
+        .filter_map(|(name, estimate)| {
+            Some(NamedChaos {
+                name: name.clone(),
+                times: Some(times.clone()),
+                pce: estimate.chaos?,
+                error: estimate.chaos_error,
+            })
+        })
+        .collect();
     Ok(Analysed {
         outputs,
         quantities,
@@ -652,31 +605,84 @@ pub fn analyse_runs(
     })
 }
 
+/// The output and column `(o, t)` whose runs are `values` bit for bit, among the columns
+/// whose hashes are known (`hashes[o][t]`, of `nt` columns each).
+fn equal_column(
+    runs: &Runs,
+    hashes: &[Vec<u64>],
+    nt: usize,
+    values: &[f64],
+) -> Result<Option<(usize, usize)>, AnalysisError> {
+    let h = functional::column_hash(values);
+    for (o, of_output) in hashes.iter().enumerate() {
+        for (t, _) in of_output.iter().enumerate().filter(|(_, &x)| x == h) {
+            let column = runs.column(o, nt, t)?;
+            if column
+                .iter()
+                .zip(values)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+            {
+                return Ok(Some((o, t)));
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// The estimate and the statistics of output `o`, estimated a block of time columns at a
-/// time (see [`blocks`]).
+/// time (see [`blocks`]), or on its principal components ([`functional`]); with the hash of
+/// every column where a chaos is fitted per column (else none).
 fn output_in_blocks(
     method: &dyn Sampling,
     design: &Design,
     runs: &Runs,
     (o, name, times): (usize, &str, &[f64]),
     settings: &Settings,
-) -> Result<(Estimate, OutputStats), AnalysisError> {
+) -> Result<(Estimate, OutputStats, Vec<u64>), AnalysisError> {
     let nt = times.len();
     let fail = |source| AnalysisError::Output {
         name: name.to_owned(),
         source,
     };
+    let a = settings.analysis;
+    let per_column = method.chaos_per_column() && !method.whole_series();
+    let pca = match per_column && a.functional == Functional::Pca && nt > 1 {
+        true => functional::pca_estimate(method, design, runs, (o, name, nt), a.retained_variance)?,
+        false => None,
+    };
     let mut cols = series_columns(nt, settings);
-    let mut parts = Vec::new();
-    for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
-        let data = runs.block(o, nt, j0, w)?;
-        let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
-        if estimate.draws == Draws::Runs {
-            cols.add(j0, &data);
+    let (estimate, fit, hashes) = match pca {
+        Some((estimate, fit, hashes)) => (estimate, Some(fit), hashes),
+        None => {
+            let (mut parts, mut fits, mut hashes) = (Vec::new(), 0, Vec::new());
+            for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
+                let data = runs.block(o, nt, j0, w)?;
+                let estimate = if per_column {
+                    let (e, k, h) =
+                        functional::estimate_distinct(method, design, &runs.rows, &data)
+                            .map_err(fail)?;
+                    fits += k;
+                    hashes.extend(h);
+                    e
+                } else {
+                    method.estimate(design, &runs.rows, &data).map_err(fail)?
+                };
+                if estimate.draws == Draws::Runs {
+                    cols.add(j0, &data);
+                }
+                parts.push(estimate);
+            }
+            let fit = per_column.then(|| crate::results::FunctionalFit {
+                method: "columns".into(),
+                modes: None,
+                fits,
+                retained_variance: None,
+                discarded_variance: None,
+                discarded_max: None,
+            });
+            (blocks::merge(parts).map_err(fail)?, fit, hashes)
         }
-        parts.push(estimate);
-    }
-    let estimate = blocks::merge(parts).map_err(fail)?;
+    };
     if estimate.draws == Draws::Chaos {
         chaos_columns(name, &estimate, settings, &mut cols)?;
     }
@@ -689,8 +695,9 @@ fn output_in_blocks(
             None => all,
         })
     };
-    let stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
-    Ok((estimate, stats))
+    let mut stats = summarise(name, times, &estimate, cols, &run_column, settings)?;
+    stats.functional = fit;
+    Ok((estimate, stats, hashes))
 }
 
 /// Statistics of every output of an intrusive method's solution.

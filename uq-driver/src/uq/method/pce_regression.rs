@@ -336,6 +336,10 @@ impl Sampling for PceRegression {
         3
     }
 
+    fn chaos_per_column(&self) -> bool {
+        true
+    }
+
     fn chaos_fit(&self, parameters: &[RandomParameter]) -> Option<ChaosFit> {
         let dim = parameters.len();
         Some(if self.sparse {

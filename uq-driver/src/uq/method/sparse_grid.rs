@@ -259,6 +259,10 @@ impl Sampling for SparseGrid {
         1
     }
 
+    fn chaos_per_column(&self) -> bool {
+        true
+    }
+
     /// The grid's points, counted without building it.
     fn planned_runs_for(&self, parameters: &[RandomParameter]) -> Option<f64> {
         self.size(parameters).ok().map(|s| s.points)

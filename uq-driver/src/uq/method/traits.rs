@@ -378,6 +378,14 @@ pub trait Sampling: Method {
     fn no_error_estimate(&self) -> Option<&'static str> {
         None
     }
+
+    /// Whether the estimator fits a chaos to each column on its own, so that identical columns
+    /// may be fitted once and a series on its principal components instead (`[analysis]
+    /// functional = "pca"`, for a design without quadrature weights): regression and
+    /// sparse-grid chaoses; not a quadrature whose moments come from the runs themselves.
+    fn chaos_per_column(&self) -> bool {
+        false
+    }
 }
 
 /// The size of the chaos a method's estimator fits (see [`Sampling::chaos_fit`]).
