@@ -13,6 +13,7 @@ mod chaos_gap;
 mod columns;
 mod error;
 mod exceedance;
+mod given_data;
 pub mod nested;
 mod runs;
 mod surrogate;
@@ -25,6 +26,7 @@ pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
 
 use blocks::SeriesColumns;
+use crate::uq::given_data::Bins;
 use columns::{column, Column};
 pub(crate) use surrogate::Surrogates;
 
@@ -443,7 +445,11 @@ fn scalar_stats_counted(
         samples: valid,
         density_samples,
         sobol_first: sobol.as_ref().map(|s| s.first[0].clone()),
-        sobol_total: sobol.as_ref().map(|s| s.total[0].clone()),
+        // Given data: first-order indices only.
+        sobol_total: sobol
+            .as_ref()
+            .filter(|s| !s.given_data)
+            .map(|s| s.total[0].clone()),
         sobol: sobol.as_ref().map(|s| {
             let names: Vec<&str> = settings
                 .parameters
@@ -462,6 +468,8 @@ fn scalar_stats_counted(
             .then(|| counted_probabilities(&exceedance_counts, settings.kind)),
         exceedance_counts,
         morris: None,
+        rank_correlation: None,
+        run_inputs: None,
     })
 }
 
@@ -566,11 +574,19 @@ pub fn analyse_runs(
             ok: runs.rows.len(),
         });
     }
+    // A sample of the inputs' law: sensitivity from the runs themselves.
+    let given = method.samples_the_law();
+    let bins = given.then(|| Bins::of(&given_data::inputs_at(design, &runs.rows)));
     let mut outputs = Vec::new();
     let mut output_chaos = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let (estimate, stats) =
-            output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
+        let (estimate, stats) = output_in_blocks(
+            method,
+            (design, bins.as_ref()),
+            &runs,
+            (o, name, &times),
+            &settings,
+        )?;
         outputs.push(stats);
         if let Some(pce) = estimate.chaos {
             output_chaos.push(NamedChaos {
@@ -594,9 +610,17 @@ pub fn analyse_runs(
             return Err(quantity_error(&name, q, &qr, None));
         }
         let data = DMatrix::from_column_slice(qr.valid.len(), 1, &qr.valid);
-        let estimate = method
+        let mut estimate = method
             .estimate(design, &qr.rows, &data)
             .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
+        let inputs = given.then(|| given_data::inputs_at(design, &qr.rows));
+        let sensitivity = inputs.as_ref().and_then(|x| {
+            let names: Vec<&str> = study.parameters.iter().map(|p| p.name.as_str()).collect();
+            given_data::scalar(x, &qr.valid, &names, study.seed ^ qi as u64)
+        });
+        if let Some((sobol, _)) = &sensitivity {
+            estimate.sobol = Some(sobol.clone());
+        }
         // The running estimate takes the rows the reported mean and Std use.
         let moment_values = method.moment_rows(design, &qr.rows).map(|rows| {
             rows.iter()
@@ -610,6 +634,8 @@ pub fn analyse_runs(
         if let Some(values) = moment_values {
             stats.convergence = convergence(&estimate, 0, &values).filter(|_| !stats.deterministic);
         }
+        stats.rank_correlation = sensitivity.map(|s| s.1);
+        stats.run_inputs = inputs;
         quantities.push(stats);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
@@ -632,7 +658,7 @@ pub fn analyse_runs(
 /// time (see [`blocks`]).
 fn output_in_blocks(
     method: &dyn Sampling,
-    design: &Design,
+    (design, bins): (&Design, Option<&Bins>),
     runs: &Runs,
     (o, name, times): (usize, &str, &[f64]),
     settings: &Settings,
@@ -644,15 +670,28 @@ fn output_in_blocks(
     };
     let mut cols = series_columns(nt, settings);
     let mut parts = Vec::new();
+    let mut given = Vec::new();
     for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
         let data = runs.block(o, nt, j0, w)?;
         let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
         if estimate.draws == Draws::Runs {
             cols.add(j0, &data);
         }
+        if let Some(bins) = bins {
+            given.push(given_data::series_sobol(bins, &data));
+        }
         parts.push(estimate);
     }
-    let estimate = blocks::merge(parts).map_err(fail)?;
+    let mut estimate = blocks::merge(parts).map_err(fail)?;
+    if bins.is_some() {
+        let (first, total) = given.into_iter().map(|s| (s.first, s.total)).unzip::<_, _, Vec<_>, Vec<_>>();
+        estimate.sobol = Some(Sobol {
+            first: first.concat(),
+            total: total.concat(),
+            intervals: None,
+            given_data: true,
+        });
+    }
     if estimate.draws == Draws::Chaos {
         chaos_columns(name, &estimate, settings, &mut cols)?;
     }

@@ -1,0 +1,85 @@
+//! Sensitivity from the runs of a design that samples the inputs' law (Monte Carlo, Latin
+//! hypercube, quasi-Monte Carlo): first-order Sobol' indices from given data (`uq::given_data`)
+//! and rank correlations (`uq::rank_correlation`), on the physical input values of the runs.
+//!
+//! A scalar quantity gets its first-order indices with bootstrap intervals, Spearman's
+//! coefficients and PRCCs; a series gets its first-order indices at every time column (no
+//! intervals: a bootstrap per column would cost more than the rest of the analysis).
+
+use nalgebra::DMatrix;
+
+use crate::results::RankCorrelation;
+use crate::uq::given_data::{self, Bins, LEVEL, RESAMPLES};
+use crate::uq::method::{Design, Sobol, SobolIntervals};
+use crate::uq::rank_correlation::RankInputs;
+
+/// Offset of the bootstrap's random streams from the design's.
+const BOOTSTRAP_SEED: u64 = 0x6976_656e_0000_0000;
+
+/// The physical values of the inputs at the design points `rows`, `[input][run]`.
+pub(crate) fn inputs_at(design: &Design, rows: &[usize]) -> Vec<Vec<f64>> {
+    let d = design.values.first().map_or(0, Vec::len);
+    (0..d)
+        .map(|i| rows.iter().map(|&r| design.values[r][i]).collect())
+        .collect()
+}
+
+/// The first-order indices of every column of `data` (one row per run of `bins`), without
+/// intervals, as a [`Sobol`] marked as given data (total indices NaN: not estimated).
+pub(crate) fn series_sobol(bins: &Bins, data: &DMatrix<f64>) -> Sobol {
+    let first: Vec<Vec<f64>> = data
+        .column_iter()
+        .map(|col| bins.first_order(col.as_slice()))
+        .collect();
+    let total = first.iter().map(|f| vec![f64::NAN; f.len()]).collect();
+    Sobol {
+        first,
+        total,
+        intervals: None,
+        given_data: true,
+    }
+}
+
+/// A scalar quantity's sensitivity from its valid runs (`inputs[i][k]`, `values[k]`): its
+/// first-order indices with bootstrap intervals (a [`Sobol`] of one column marked as given
+/// data) and its rank correlations labelled by `names`; `None` below
+/// [`given_data::MIN_RUNS`] runs.
+pub(crate) fn scalar(
+    inputs: &[Vec<f64>],
+    values: &[f64],
+    names: &[&str],
+    seed: u64,
+) -> Option<(Sobol, RankCorrelation)> {
+    if values.len() < given_data::MIN_RUNS || inputs.is_empty() {
+        return None;
+    }
+    let bins = Bins::of(inputs);
+    let first = bins.first_order(values);
+    let ci = bins.intervals(values, RESAMPLES, LEVEL, seed ^ BOOTSTRAP_SEED);
+    let d = first.len();
+    let sobol = Sobol {
+        first: vec![first],
+        total: vec![vec![f64::NAN; d]],
+        intervals: Some(SobolIntervals {
+            level: LEVEL,
+            first: vec![ci],
+            total: vec![vec![(f64::NAN, f64::NAN); d]],
+        }),
+        given_data: true,
+    };
+    let (spearman, prcc) = RankInputs::of(inputs).of_output(values);
+    let label = |v: Vec<f64>| {
+        names
+            .iter()
+            .map(|n| n.to_string())
+            .zip(v)
+            .collect::<std::collections::BTreeMap<_, _>>()
+    };
+    Some((
+        sobol,
+        RankCorrelation {
+            spearman: label(spearman),
+            prcc: label(prcc),
+        },
+    ))
+}
