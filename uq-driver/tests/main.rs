@@ -23,6 +23,7 @@ mod description_hardening;
 mod fmu_import;
 mod fmu_robustness;
 mod fuzz_corpus;
+mod given_data_sensitivity;
 mod hd_goals;
 mod hunting_speed;
 mod importer_features;

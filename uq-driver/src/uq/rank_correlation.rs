@@ -119,8 +119,9 @@ mod tests {
         for i in 0..3 {
             let exact = 6.0 / PI * (a[i] * s[i] / sy / 2.0).asin();
             assert!((spearman[i] - exact).abs() < 0.01, "{i}: {} vs {exact}", spearman[i]);
-            // Partial on the ranks: the others' effect removed, nearly perfect.
-            assert!(prcc[i].abs() > 0.95 && prcc[i].signum() == a[i].signum(), "{prcc:?}");
+            // Partial on the ranks: the others' linear effect on the ranks removed (the ranks
+            // of normals are not linear in them: about 0.915 here).
+            assert!(prcc[i].abs() > 0.85 && prcc[i].signum() == a[i].signum(), "{prcc:?}");
         }
     }
 
