@@ -203,7 +203,9 @@ fn spearman_of_a_linear_function_of_normal_inputs_is_the_closed_form() {
             (s[i] / sy).powi(2)
         );
         assert!((spearman - exact).abs() < 0.03, "{p}: {spearman} vs {exact}");
-        assert!(prcc > 0.85, "{p}: PRCC {prcc}");
+        // The other inputs' effect on the ranks removed: a stronger association than
+        // Spearman's (not 1: the ranks of normals are not linear in them).
+        assert!(prcc > spearman && prcc > 0.5, "{p}: PRCC {prcc}, Spearman {spearman}");
         assert!((first - (s[i] / sy).powi(2)).abs() < 0.05, "{p}: S {first}");
     }
 }

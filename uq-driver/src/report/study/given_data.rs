@@ -111,17 +111,19 @@ fn by_importance(q: &ScalarStats, names: &[&str]) -> Vec<usize> {
 /// and its Spearman coefficient and PRCC.
 pub(super) fn rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
     let mut rows = Vec::new();
-    if !given_data(q) {
+    if !given_data(q) || q.deterministic {
         return rows;
     }
+    // NaN: a parameter (or the quantity) without spread.
+    let sig = |x: f64| if x.is_finite() { sig(x) } else { "undefined".into() };
     let s = q.sobol.as_ref();
     let level = s.and_then(|s| s.ci_level).unwrap_or(0.95);
     for n in names {
         let value = s.and_then(|s| s.first.get(*n)).copied().unwrap_or(f64::NAN);
         let ci = s.and_then(|s| s.first_ci.as_ref()?.get(*n));
-        let interval = ci.map_or(String::new(), |[lo, hi]| {
-            format!(" [{}, {}]", sig(*lo), sig(*hi))
-        });
+        let interval = ci
+            .filter(|[lo, hi]| lo.is_finite() && hi.is_finite())
+            .map_or(String::new(), |[lo, hi]| format!(" [{}, {}]", sig(*lo), sig(*hi)));
         rows.push(vec![
             format!(
                 "first-order Sobol' index of {n} (from the runs, {:.0} % interval)",
@@ -203,8 +205,8 @@ fn scatter_svg(q: &ScalarStats, names: &[&str], inputs: &[Vec<f64>], order: &[us
         let caption = format!(
             "{} (S = {}, ρ = {})",
             names[i],
-            s1.map_or("–".into(), sig),
-            rho.map_or("–".into(), sig)
+            s1.filter(|v| v.is_finite()).map_or("–".into(), sig),
+            rho.filter(|v| v.is_finite()).map_or("–".into(), sig)
         );
         let _ = writeln!(
             out,
