@@ -31,7 +31,13 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
     }
     let dir = tempfile::tempdir().unwrap();
     let names = ["x1", "x2", "x3"];
-    let out = run_functions(dir.path(), "ishigami", 1, &uniform(&names, -PI, PI), LHS_2000);
+    let out = run_functions(
+        dir.path(),
+        "ishigami",
+        1,
+        &uniform(&names, -PI, PI),
+        LHS_2000,
+    );
     // Closed form (a = 7, b = 0.1): V1 = (1 + b pi^4 / 5)^2 / 2, V2 = a^2 / 8, V3 = 0.
     let (a, b) = (7.0f64, 0.1f64);
     let var = a * a / 8.0 + b * PI.powi(4) / 5.0 + b * b * PI.powi(8) / 18.0 + 0.5;
@@ -53,7 +59,10 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
         assert!(lo <= s && s <= hi && hi - lo < 0.15, "{p}: [{lo}, {hi}]");
         covered += usize::from(lo - 1e-9 <= exact[i] && exact[i] <= hi + 1e-9);
     }
-    assert!(covered >= 2, "{covered} of 3 intervals cover the exact indices");
+    assert!(
+        covered >= 2,
+        "{covered} of 3 intervals cover the exact indices"
+    );
     // The fields: marked as given data, intervals as sobol_sampling writes them, no totals.
     let q = &summary(&out)["quantities"]["Y"];
     assert_eq!(q["sobol"]["estimator"], "given_data");
@@ -71,7 +80,11 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
     // Over time: first-order indices from the runs in Y_sobol.csv, no total columns.
     let csv = Csv::read(&out.join("y_sobol.csv"));
     assert!(csv.header.contains(&"S_x2".to_string()));
-    assert!(!csv.header.iter().any(|h| h.starts_with("ST_")), "{:?}", csv.header);
+    assert!(
+        !csv.header.iter().any(|h| h.starts_with("ST_")),
+        "{:?}",
+        csv.header
+    );
     assert!((csv.last("S_x2") - exact[1]).abs() < 0.05);
 }
 
@@ -90,7 +103,10 @@ fn the_page_of_an_lhs_study_has_the_scatter_plots_and_the_given_data_bars() {
         "kind = \"lhs\"\nsamples = 200",
     );
     let page = read(&out.join("index.html"));
-    assert!(page.contains("Y_scatter.svg"), "no scatter plot on the page");
+    assert!(
+        page.contains("Y_scatter.svg"),
+        "no scatter plot on the page"
+    );
     assert!(page.contains("estimated from the") && page.contains("given data"));
     assert!(page.contains("Spearman / PRCC"));
     let svg = read(&out.join("Y_scatter.svg"));
@@ -113,7 +129,13 @@ fn borehole_first_order(nh: usize, nl: usize) -> [f64; 8] {
     let (hx, hw) = benchmarks::gauss_hermite(nh);
     let (lx, lw) = benchmarks::gauss_legendre(nl);
     let sizes: Vec<usize> = (0..8).map(|i| if i < 2 { nh } else { nl }).collect();
-    let node = |i: usize, k: usize| if i < 2 { (hx[k], hw[k]) } else { (lx[k], lw[k]) };
+    let node = |i: usize, k: usize| {
+        if i < 2 {
+            (hx[k], hw[k])
+        } else {
+            (lx[k], lw[k])
+        }
+    };
     let mut cond: Vec<Vec<f64>> = sizes.iter().map(|&m| vec![0.0; m]).collect();
     let (mut m1, mut m2) = (0.0, 0.0);
     let total: usize = sizes.iter().product();
@@ -158,7 +180,10 @@ fn lhs_of_2000_runs_gives_the_borehole_first_order_indices_within_0_05_of_a_quad
     // Converged: a coarser rule agrees to 1e-4.
     let coarse = borehole_first_order(10, 4);
     for i in 0..8 {
-        assert!((reference[i] - coarse[i]).abs() < 1e-4, "{reference:?} {coarse:?}");
+        assert!(
+            (reference[i] - coarse[i]).abs() < 1e-4,
+            "{reference:?} {coarse:?}"
+        );
     }
     // The known ordering: rw dominates (about 0.66), then L, Hu, Hl (about 0.09–0.10).
     assert!(reference[0] > 0.6 && reference[6] > 0.08, "{reference:?}");
@@ -171,7 +196,11 @@ fn lhs_of_2000_runs_gives_the_borehole_first_order_indices_within_0_05_of_a_quad
             "borehole, lhs 2000 runs, given data: S_{p} = {s:.4} [{lo:.4}, {hi:.4}] (quadrature {:.4})",
             reference[i]
         );
-        assert!((s - reference[i]).abs() < 0.05, "S_{p} = {s} vs {}", reference[i]);
+        assert!(
+            (s - reference[i]).abs() < 0.05,
+            "S_{p} = {s} vs {}",
+            reference[i]
+        );
     }
 }
 
@@ -202,10 +231,16 @@ fn spearman_of_a_linear_function_of_normal_inputs_is_the_closed_form() {
             "linear, lhs 2000 runs: Spearman_{p} = {spearman:.4} (exact {exact:.4}), PRCC {prcc:.4}, S {first:.4} (exact {:.4})",
             (s[i] / sy).powi(2)
         );
-        assert!((spearman - exact).abs() < 0.03, "{p}: {spearman} vs {exact}");
+        assert!(
+            (spearman - exact).abs() < 0.03,
+            "{p}: {spearman} vs {exact}"
+        );
         // The other inputs' effect on the ranks removed: a stronger association than
         // Spearman's (not 1: the ranks of normals are not linear in them).
-        assert!(prcc > spearman && prcc > 0.5, "{p}: PRCC {prcc}, Spearman {spearman}");
+        assert!(
+            prcc > spearman && prcc > 0.5,
+            "{p}: PRCC {prcc}, Spearman {spearman}"
+        );
         assert!((first - (s[i] / sy).powi(2)).abs() < 0.05, "{p}: S {first}");
     }
 }

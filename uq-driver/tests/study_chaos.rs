@@ -31,7 +31,13 @@ sigma_h = 0.0
 }
 
 /// Runs [`study`] into `<name>.out`; returns that folder.
-pub(crate) fn run_functions(dir: &Path, name: &str, function: u32, parameters: &str, method: &str) -> PathBuf {
+pub(crate) fn run_functions(
+    dir: &Path,
+    name: &str,
+    function: u32,
+    parameters: &str,
+    method: &str,
+) -> PathBuf {
     run_beside(&study(dir, name, function, parameters, method), &[])
 }
 

@@ -240,7 +240,11 @@ mod tests {
         // a = 7, b = 0.1, x_i ~ U(-pi, pi): V1 = (1 + b pi^4 / 5)^2 / 2, V2 = a^2 / 8, V3 = 0.
         let (a, b) = (7.0f64, 0.1f64);
         let v = a * a / 8.0 + b * PI.powi(4) / 5.0 + b * b * PI.powi(8) / 18.0 + 0.5;
-        let exact = [0.5 * (1.0 + b * PI.powi(4) / 5.0).powi(2) / v, a * a / 8.0 / v, 0.0];
+        let exact = [
+            0.5 * (1.0 + b * PI.powi(4) / 5.0).powi(2) / v,
+            a * a / 8.0 / v,
+            0.0,
+        ];
         assert!((exact[0] - 0.3139).abs() < 1e-4 && (exact[1] - 0.4424).abs() < 1e-4);
         // 8 000 runs: the estimator's standard deviation is about 0.007 (0.014 at 2 000).
         let x = inputs(8000, &[(-PI, PI); 3], 11);
@@ -255,7 +259,13 @@ mod tests {
         let s = bins.first_order(&y);
         let ci = bins.intervals(&y, 200, 0.95, 3);
         for i in 0..3 {
-            assert!((s[i] - exact[i]).abs() < 0.03, "S{}: {} vs {}", i + 1, s[i], exact[i]);
+            assert!(
+                (s[i] - exact[i]).abs() < 0.03,
+                "S{}: {} vs {}",
+                i + 1,
+                s[i],
+                exact[i]
+            );
             assert!(ci[i].0 <= s[i] + 1e-12 && s[i] <= ci[i].1 + 1e-12, "{ci:?}");
             assert!(ci[i].1 - ci[i].0 < 0.15, "{ci:?}");
         }
@@ -273,7 +283,12 @@ mod tests {
         let s = Bins::of(&x).first_order(&y);
         for i in 0..5 {
             let exact = a[i] * a[i] / total;
-            assert!((s[i] - exact).abs() < 0.02, "S{}: {} vs {exact}", i + 1, s[i]);
+            assert!(
+                (s[i] - exact).abs() < 0.02,
+                "S{}: {} vs {exact}",
+                i + 1,
+                s[i]
+            );
         }
     }
 
@@ -307,7 +322,9 @@ mod tests {
         // n = 2000; corrected, the indices are 0 up to noise.
         let x = inputs(2000, &[(0.0, 1.0); 4], 7);
         let mut stream = rng::stream(99, 0);
-        let y: Vec<f64> = (0..2000).map(|_| rng::standard_normal(&mut stream)).collect();
+        let y: Vec<f64> = (0..2000)
+            .map(|_| rng::standard_normal(&mut stream))
+            .collect();
         let s = Bins::of(&x).first_order(&y);
         for v in s {
             assert!(v < 0.01, "{v}");
@@ -347,7 +364,13 @@ mod tests {
         let y: Vec<f64> = (0..10_000).map(|j| f(&at(&x, j))).collect();
         let s = Bins::of(&x).first_order(&y);
         for i in 0..3 {
-            assert!((s[i] - exact[i]).abs() < 0.03, "S{}: {} vs {}", i + 1, s[i], exact[i]);
+            assert!(
+                (s[i] - exact[i]).abs() < 0.03,
+                "S{}: {} vs {}",
+                i + 1,
+                s[i],
+                exact[i]
+            );
         }
     }
 

@@ -43,8 +43,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 impl RankInputs {
     /// The ranks of `inputs[i][j]` (input `i`, run `j`).
     pub(crate) fn of(inputs: &[Vec<f64>]) -> RankInputs {
-        let ranks: Vec<Option<Vec<f64>>> =
-            inputs.iter().map(|x| standardised_ranks(x)).collect();
+        let ranks: Vec<Option<Vec<f64>>> = inputs.iter().map(|x| standardised_ranks(x)).collect();
         let d = ranks.len();
         let inverse = ranks.iter().all(Option::is_some).then(|| {
             let r: Vec<&Vec<f64>> = ranks.iter().flatten().collect();
@@ -113,15 +112,24 @@ mod tests {
         let x: Vec<Vec<f64>> = (0..3)
             .map(|i| pts.iter().map(|p| s[i] * norm_ppf(p[i])).collect())
             .collect();
-        let y: Vec<f64> = (0..n).map(|j| (0..3).map(|i| a[i] * x[i][j]).sum()).collect();
+        let y: Vec<f64> = (0..n)
+            .map(|j| (0..3).map(|i| a[i] * x[i][j]).sum())
+            .collect();
         let sy = (0..3).map(|i| (a[i] * s[i]).powi(2)).sum::<f64>().sqrt();
         let (spearman, prcc) = RankInputs::of(&x).of_output(&y);
         for i in 0..3 {
             let exact = 6.0 / PI * (a[i] * s[i] / sy / 2.0).asin();
-            assert!((spearman[i] - exact).abs() < 0.01, "{i}: {} vs {exact}", spearman[i]);
+            assert!(
+                (spearman[i] - exact).abs() < 0.01,
+                "{i}: {} vs {exact}",
+                spearman[i]
+            );
             // Partial on the ranks: the others' linear effect on the ranks removed (the ranks
             // of normals are not linear in them: about 0.915 here).
-            assert!(prcc[i].abs() > 0.85 && prcc[i].signum() == a[i].signum(), "{prcc:?}");
+            assert!(
+                prcc[i].abs() > 0.85 && prcc[i].signum() == a[i].signum(),
+                "{prcc:?}"
+            );
         }
     }
 
@@ -143,7 +151,8 @@ mod tests {
         let ry = ranks(&y);
         for i in 0..3 {
             let others: Vec<usize> = (0..3).filter(|&k| k != i).collect();
-            let design = DMatrix::from_fn(n, 3, |j, c| if c == 0 { 1.0 } else { rx[others[c - 1]][j] });
+            let design =
+                DMatrix::from_fn(n, 3, |j, c| if c == 0 { 1.0 } else { rx[others[c - 1]][j] });
             let resid = |v: &[f64]| {
                 let b = nalgebra::DVector::from_column_slice(v);
                 let svd = design.clone().svd(true, true);

@@ -47,7 +47,7 @@ pub(super) fn section(
         "\n\nSensitivity of {name}, estimated from the {n} runs themselves (given data, not a \
          design made for it): first-order Sobol' indices by binning each parameter's values \
          into {m} equally likely bins (the variance of the bin means, corrected for their \
-         noise, over the variance of {name}), with {p:.0} % percentile-bootstrap intervals \
+         noise, over the variance of {name}), with {p:.0} % bootstrap intervals \
          ({RESAMPLES} resamples); no total indices. Under correlated parameters an index is the \
          share of the variance that knowing that parameter alone removes, what it carries of \
          the parameters it is correlated with included. Rank correlations (Spearman, PRCC) are \
@@ -115,7 +115,13 @@ pub(super) fn rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
         return rows;
     }
     // NaN: a parameter (or the quantity) without spread.
-    let sig = |x: f64| if x.is_finite() { sig(x) } else { "undefined".into() };
+    let sig = |x: f64| {
+        if x.is_finite() {
+            sig(x)
+        } else {
+            "undefined".into()
+        }
+    };
     let s = q.sobol.as_ref();
     let level = s.and_then(|s| s.ci_level).unwrap_or(0.95);
     for n in names {
@@ -123,7 +129,9 @@ pub(super) fn rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
         let ci = s.and_then(|s| s.first_ci.as_ref()?.get(*n));
         let interval = ci
             .filter(|[lo, hi]| lo.is_finite() && hi.is_finite())
-            .map_or(String::new(), |[lo, hi]| format!(" [{}, {}]", sig(*lo), sig(*hi)));
+            .map_or(String::new(), |[lo, hi]| {
+                format!(" [{}, {}]", sig(*lo), sig(*hi))
+            });
         rows.push(vec![
             format!(
                 "first-order Sobol' index of {n} (from the runs, {:.0} % interval)",
@@ -162,7 +170,10 @@ fn scatter_svg(q: &ScalarStats, names: &[&str], inputs: &[Vec<f64>], order: &[us
         w = c(width),
         h = c(height)
     );
-    let unit = q.unit.as_deref().map_or(String::new(), |u| format!(" [{u}]"));
+    let unit = q
+        .unit
+        .as_deref()
+        .map_or(String::new(), |u| format!(" [{u}]"));
     let _ = writeln!(
         out,
         "<text x=\"{}\" y=\"20\" font-size=\"14\" text-anchor=\"middle\">{}</text>",

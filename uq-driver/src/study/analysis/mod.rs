@@ -25,8 +25,8 @@ pub use error::AnalysisError;
 pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
 
-use blocks::SeriesColumns;
 use crate::uq::given_data::Bins;
+use blocks::SeriesColumns;
 use columns::{column, Column};
 pub(crate) use surrogate::Surrogates;
 
@@ -576,7 +576,10 @@ pub fn analyse_runs(
     }
     // A sample of the inputs' law: sensitivity from the runs themselves.
     let given = method.samples_the_law();
-    let bins = given.then(|| Bins::of(&given_data::inputs_at(design, &runs.rows)));
+    // Over time only up to a length: a row of indices per time costs memory (see
+    // `given_data::MAX_SERIES_TIMES`).
+    let bins = (given && nt <= given_data::MAX_SERIES_TIMES)
+        .then(|| Bins::of(&given_data::inputs_at(design, &runs.rows)));
     let mut outputs = Vec::new();
     let mut output_chaos = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
@@ -684,7 +687,10 @@ fn output_in_blocks(
     }
     let mut estimate = blocks::merge(parts).map_err(fail)?;
     if bins.is_some() {
-        let (first, total) = given.into_iter().map(|s| (s.first, s.total)).unzip::<_, _, Vec<_>, Vec<_>>();
+        let (first, total) = given
+            .into_iter()
+            .map(|s| (s.first, s.total))
+            .unzip::<_, _, Vec<_>, Vec<_>>();
         estimate.sobol = Some(Sobol {
             first: first.concat(),
             total: total.concat(),

@@ -71,7 +71,8 @@ pub struct Sobol {
     /// Confidence intervals of the indices, where the method has them.
     pub intervals: Option<SobolIntervals>,
     /// First-order indices estimated from given data (a sample of the inputs' law, by
-    /// binning): `total` is not estimated (NaN), nor are its intervals.
+    /// binning): `total` is not estimated (NaN, or an empty row per column of a series),
+    /// nor are its intervals.
     pub given_data: bool,
 }
 

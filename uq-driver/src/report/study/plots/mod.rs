@@ -218,7 +218,10 @@ pub(super) fn sobol_bars(
     let ti = of(summary.and_then(|s| s.total_ci.as_ref()));
     let level = summary.and_then(|s| s.ci_level);
     let title = if given_data {
-        format!("First-order Sobol' indices of {} (estimated from the runs)", q.name)
+        format!(
+            "First-order Sobol' indices of {} (estimated from the runs)",
+            q.name
+        )
     } else {
         format!("Sobol' indices of {}", q.name)
     };
@@ -230,7 +233,7 @@ pub(super) fn sobol_bars(
         (total, ti),
         &if given_data {
             format!(
-                "{} (percentile bootstrap, {RESAMPLES} resamples)",
+                "{} (bootstrap of the runs, {RESAMPLES} resamples)",
                 interval_label(method, level)
             )
         } else {
