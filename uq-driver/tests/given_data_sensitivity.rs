@@ -244,3 +244,33 @@ fn spearman_of_a_linear_function_of_normal_inputs_is_the_closed_form() {
         assert!((first - (s[i] / sy).powi(2)).abs() < 0.05, "{p}: S {first}");
     }
 }
+
+#[test]
+fn correlated_inputs_give_the_first_order_indices_of_the_physical_inputs() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    // y = x1 + x2 (the other six at 0), x1, x2 ~ N(0, 1) with correlation 0.5:
+    // E[y | x1] = 1.5 x1, Var y = 3, so S1 = S2 = 2.25 / 3 = 0.75 (adding up to 1.5), and
+    // corr(x_i, y) = 1.5 / sqrt(3): Spearman (6 / pi) asin(0.75 / sqrt(3)).
+    let params = "[[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
+                  [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n\
+                  [[correlation]]\nbetween = [\"x1\", \"x2\"]\nrho = 0.5\n";
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_functions(dir.path(), "correlated", 5, params, LHS_2000);
+    let sum = summary(&out);
+    let q = &sum["quantities"]["Y"];
+    let spearman_exact = 6.0 / PI * (0.75 / 3f64.sqrt()).asin();
+    for p in ["x1", "x2"] {
+        let s = q["sobol"]["first"][p].as_f64().unwrap();
+        let rho = q["rank_correlation"]["spearman"][p].as_f64().unwrap();
+        println!("correlated, lhs 2000 runs: S_{p} = {s:.4} (exact 0.75), Spearman {rho:.4} (exact {spearman_exact:.4})");
+        assert!((s - 0.75).abs() < 0.05, "S_{p} = {s}");
+        assert!((rho - spearman_exact).abs() < 0.03, "Spearman {p} = {rho}");
+    }
+    let warnings = sum["warnings"].to_string();
+    assert!(
+        warnings.contains("those of the physical parameters"),
+        "{warnings}"
+    );
+}

@@ -28,6 +28,8 @@
 //! removes), but it includes what `X_i` carries of the inputs it is correlated with, and the
 //! indices need not add up to at most 1.
 
+use rayon::prelude::*;
+
 use crate::uq::rng;
 
 /// Bootstrap resamples of a scalar quantity's intervals.
@@ -126,7 +128,7 @@ impl Bins {
             .zip(w)
             .map(|(v, &c)| f64::from(c) * (v - mean).powi(2))
             .sum();
-        if !(sst > 0.0) || !sst.is_finite() {
+        if sst <= 0.0 || !sst.is_finite() {
             return nan;
         }
         let mut sum = vec![0.0; self.count];
@@ -182,15 +184,21 @@ impl Bins {
         }
         let ones = vec![1u32; n];
         let here = self.shares(y, &ones);
+        // Resample k from its own stream (seed, k): in parallel, the same for any thread count.
+        let replicates: Vec<Vec<(f64, f64)>> = (0..resamples)
+            .into_par_iter()
+            .map(|k| {
+                let mut stream = rng::stream(seed, k as u64);
+                let mut w = vec![0u32; n];
+                for _ in 0..n {
+                    w[rng::uniform_below(&mut stream, n as u64) as usize] += 1;
+                }
+                self.shares(y, &w)
+            })
+            .collect();
         let mut draws = vec![Vec::with_capacity(resamples); d];
-        let mut stream = rng::stream(seed, 0);
-        let mut w = vec![0u32; n];
-        for _ in 0..resamples {
-            w.fill(0);
-            for _ in 0..n {
-                w[rng::uniform_below(&mut stream, n as u64) as usize] += 1;
-            }
-            for (i, (s, _)) in self.shares(y, &w).into_iter().enumerate() {
+        for r in replicates {
+            for (i, (s, _)) in r.into_iter().enumerate() {
                 draws[i].push(s);
             }
         }

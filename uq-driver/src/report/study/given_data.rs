@@ -53,7 +53,7 @@ pub(super) fn section(
          the parameters it is correlated with included. Rank correlations (Spearman, PRCC) are \
          in the table.",
         name = q.name,
-        n = q.samples.len(),
+        n = crate::results::group_digits(q.samples.len()),
         m = bin_count(q.samples.len()),
         p = 100.0 * level,
     );
@@ -282,7 +282,7 @@ fn padded(v: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
             (a.min(x), b.max(x))
         });
-    if !(lo < hi) {
+    if lo >= hi || !lo.is_finite() || !hi.is_finite() {
         let m = if lo.is_finite() { lo } else { 0.0 };
         return (m - 0.5, m + 0.5);
     }
