@@ -12,6 +12,7 @@
 use nalgebra::DMatrix;
 
 use crate::results::RankCorrelation;
+use crate::uq::distributions::RandomParameter;
 use crate::uq::given_data::{self, Bins, LEVEL, RESAMPLES};
 use crate::uq::method::{Design, Sobol, SobolIntervals};
 use crate::uq::rank_correlation::RankInputs;
@@ -29,33 +30,55 @@ pub(crate) fn inputs_at(design: &Design, rows: &[usize]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// The first-order indices of every column of `data` (one row per run of `bins`), without
-/// intervals, as a [`Sobol`] marked as given data (total indices not estimated: an empty
-/// row per column, which allocates nothing on a long series).
-pub(crate) fn series_sobol(bins: &Bins, data: &DMatrix<f64>) -> Sobol {
-    let first: Vec<Vec<f64>> = data
-        .column_iter()
-        .map(|col| bins.first_order(col.as_slice()))
-        .collect();
-    let total = vec![Vec::new(); first.len()];
-    Sobol {
-        first,
-        total,
-        intervals: None,
-        given_data: true,
+/// The first-order indices of a series, estimated a block of time columns at a time.
+pub(crate) struct SeriesIndices<'a> {
+    bins: &'a Bins,
+    first: Vec<Vec<f64>>,
+}
+
+impl<'a> SeriesIndices<'a> {
+    /// No column yet; runs binned by `bins`.
+    pub(crate) fn new(bins: &'a Bins) -> SeriesIndices<'a> {
+        SeriesIndices {
+            bins,
+            first: Vec::new(),
+        }
+    }
+
+    /// The indices of every column of `data` (one row per run of the bins), in order.
+    pub(crate) fn add(&mut self, data: &DMatrix<f64>) {
+        let bins = self.bins;
+        self.first.extend(
+            data.column_iter()
+                .map(|col| bins.first_order(col.as_slice())),
+        );
+    }
+
+    /// The indices of the columns added, without intervals, as a [`Sobol`] marked as given
+    /// data (total indices not estimated: an empty row per column, which allocates nothing
+    /// on a long series).
+    pub(crate) fn sobol(self) -> Sobol {
+        let total = vec![Vec::new(); self.first.len()];
+        Sobol {
+            first: self.first,
+            total,
+            intervals: None,
+            given_data: true,
+        }
     }
 }
 
 /// A scalar quantity's sensitivity from its valid runs (`inputs[i][k]`, `values[k]`): its
 /// first-order indices with bootstrap intervals (a [`Sobol`] of one column marked as given
-/// data) and its rank correlations labelled by `names`; `None` below
+/// data) and its rank correlations labelled by the names of `parameters`; `None` below
 /// [`given_data::MIN_RUNS`] runs.
 pub(crate) fn scalar(
     inputs: &[Vec<f64>],
     values: &[f64],
-    names: &[&str],
+    parameters: &[RandomParameter],
     seed: u64,
 ) -> Option<(Sobol, RankCorrelation)> {
+    let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
     if values.len() < given_data::MIN_RUNS || inputs.is_empty() {
         return None;
     }

@@ -618,8 +618,7 @@ pub fn analyse_runs(
             .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?;
         let inputs = given.then(|| given_data::inputs_at(design, &qr.rows));
         let sensitivity = inputs.as_ref().and_then(|x| {
-            let names: Vec<&str> = study.parameters.iter().map(|p| p.name.as_str()).collect();
-            given_data::scalar(x, &qr.valid, &names, study.seed ^ qi as u64)
+            given_data::scalar(x, &qr.valid, &study.parameters, study.seed ^ qi as u64)
         });
         if let Some((sobol, _)) = &sensitivity {
             estimate.sobol = Some(sobol.clone());
@@ -673,30 +672,21 @@ fn output_in_blocks(
     };
     let mut cols = series_columns(nt, settings);
     let mut parts = Vec::new();
-    let mut given = Vec::new();
+    let mut given = bins.map(given_data::SeriesIndices::new);
     for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
         let data = runs.block(o, nt, j0, w)?;
         let estimate = method.estimate(design, &runs.rows, &data).map_err(fail)?;
         if estimate.draws == Draws::Runs {
             cols.add(j0, &data);
         }
-        if let Some(bins) = bins {
-            given.push(given_data::series_sobol(bins, &data));
+        if let Some(g) = &mut given {
+            g.add(&data);
         }
         parts.push(estimate);
     }
     let mut estimate = blocks::merge(parts).map_err(fail)?;
-    if bins.is_some() {
-        let (first, total) = given
-            .into_iter()
-            .map(|s| (s.first, s.total))
-            .unzip::<_, _, Vec<_>, Vec<_>>();
-        estimate.sobol = Some(Sobol {
-            first: first.concat(),
-            total: total.concat(),
-            intervals: None,
-            given_data: true,
-        });
+    if let Some(g) = given {
+        estimate.sobol = Some(g.sobol());
     }
     if estimate.draws == Draws::Chaos {
         chaos_columns(name, &estimate, settings, &mut cols)?;
