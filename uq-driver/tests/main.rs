@@ -24,6 +24,7 @@ mod fmu_import;
 mod fmu_robustness;
 mod functional_outputs;
 mod fuzz_corpus;
+mod given_data_sensitivity;
 mod hd_goals;
 mod hunting_speed;
 mod importer_features;

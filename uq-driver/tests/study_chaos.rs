@@ -31,7 +31,13 @@ sigma_h = 0.0
 }
 
 /// Runs [`study`] into `<name>.out`; returns that folder.
-fn run_functions(dir: &Path, name: &str, function: u32, parameters: &str, method: &str) -> PathBuf {
+pub(crate) fn run_functions(
+    dir: &Path,
+    name: &str,
+    function: u32,
+    parameters: &str,
+    method: &str,
+) -> PathBuf {
     run_beside(&study(dir, name, function, parameters, method), &[])
 }
 
@@ -140,7 +146,7 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
 }
 
 /// The borehole inputs: rw normal, r log-normal (ln r normal), six uniform.
-fn borehole_parameters() -> String {
+pub(crate) fn borehole_parameters() -> String {
     let (mu, s) = benchmarks::LN_R;
     let mean_r = (mu + 0.5 * s * s).exp();
     let std_r = mean_r * (s * s).exp_m1().sqrt();

@@ -89,6 +89,7 @@ pub(crate) fn print_study(r: &StudyResult, out: &Path, no_report: bool) {
             if let Some(line) = split_line(q) {
                 println!("{line}");
             }
+            print_given_data_ranking(q);
             print_exceedances(q);
         }
     }
@@ -127,6 +128,47 @@ fn split_line(q: &ScalarStats) -> Option<String> {
         pct(v.outer_ci[1]),
         count(n.outer_samples, "outer sample", "outer samples")
     ))
+}
+
+/// One line of the most influential parameters of a quantity whose first-order indices were
+/// estimated from the runs (`mc`, `lhs`, `qmc`):
+/// `  Y: first-order indices from the runs: x2 0.44 [0.41, 0.47], x1 0.31 [...], x3 0.01 [...]`.
+fn print_given_data_ranking(q: &ScalarStats) {
+    let Some(s) = q.sobol.as_ref().filter(|s| s.estimator.is_some()) else {
+        return;
+    };
+    let mut ranked: Vec<(&String, f64)> = s
+        .first
+        .iter()
+        .filter(|(_, v)| v.is_finite())
+        .map(|(n, v)| (n, *v))
+        .collect();
+    if ranked.is_empty() {
+        return;
+    }
+    ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(b.0)));
+    let top: Vec<String> = ranked
+        .iter()
+        .take(3)
+        .map(|(n, v)| {
+            let ci = s.first_ci.as_ref().and_then(|c| c.get(*n));
+            match ci {
+                Some([lo, hi]) => format!("{n} {} [{}, {}]", sig(*v), sig(*lo), sig(*hi)),
+                None => format!("{n} {}", sig(*v)),
+            }
+        })
+        .collect();
+    let more = ranked.len().saturating_sub(3);
+    let more = if more > 0 {
+        format!(" (+{more} more)")
+    } else {
+        String::new()
+    };
+    println!(
+        "  {}: first-order indices from the runs: {}{more}",
+        q.name,
+        top.join(", ")
+    );
 }
 
 /// One line per probability of a reliability method

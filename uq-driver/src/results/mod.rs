@@ -188,6 +188,26 @@ pub struct ScalarStats {
     /// Morris's screening measures (a `morris` study).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub morris: Option<MorrisScreening>,
+    /// Spearman's and partial rank correlation coefficients of the quantity with each
+    /// parameter, from the runs (designs that sample the inputs' law: `mc`, `lhs`, `qmc`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rank_correlation: Option<RankCorrelation>,
+    /// The physical parameter values of the runs of `samples` (`[parameter][run]`), for the
+    /// scatter plots (designs that sample the inputs' law).
+    #[serde(skip)]
+    pub run_inputs: Option<Vec<Vec<f64>>>,
+}
+
+/// Rank correlations of a scalar quantity with each parameter, by parameter name
+/// (`quantities.NAME.rank_correlation` in `summary.json`; `null` where undefined: a
+/// parameter or a quantity without spread).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RankCorrelation {
+    /// Spearman's coefficient (the correlation of the ranks).
+    pub spearman: BTreeMap<String, f64>,
+    /// The partial rank correlation coefficient (the other parameters' linear effect on
+    /// the ranks removed).
+    pub prcc: BTreeMap<String, f64>,
 }
 
 /// A scalar quantity's chaos truncation error in `summary.json`:
@@ -206,7 +226,8 @@ pub struct ScalarChaosError {
 pub struct SobolSummary {
     /// First-order index of each parameter.
     pub first: BTreeMap<String, f64>,
-    /// Total index of each parameter.
+    /// Total index of each parameter (empty, and not written, for given-data estimates).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub total: BTreeMap<String, f64>,
     /// `[low, high]` interval of each first-order index, where estimated.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -217,6 +238,11 @@ pub struct SobolSummary {
     /// Confidence level of the intervals.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ci_level: Option<f64>,
+    /// How the indices were estimated where it is not from the method's own design:
+    /// `"given_data"` (first-order indices from a sample of the inputs' law, by binning,
+    /// with bootstrap intervals; no total indices).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<&'static str>,
 }
 
 impl SobolSummary {
@@ -237,12 +263,19 @@ impl SobolSummary {
                 .collect()
         };
         let ci = sobol.intervals.as_ref();
+        // Given data: first-order indices only.
+        let total = !sobol.given_data;
         SobolSummary {
             first: label(&sobol.first[col]),
-            total: label(&sobol.total[col]),
+            total: if total {
+                label(&sobol.total[col])
+            } else {
+                BTreeMap::new()
+            },
             first_ci: ci.map(|c| label_ci(&c.first[col])),
-            total_ci: ci.map(|c| label_ci(&c.total[col])),
+            total_ci: ci.filter(|_| total).map(|c| label_ci(&c.total[col])),
             ci_level: ci.map(|c| c.level),
+            estimator: sobol.given_data.then_some("given_data"),
         }
     }
 }

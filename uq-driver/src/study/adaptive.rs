@@ -296,6 +296,8 @@ fn adaptive_stats(name: &str, q: &QoiSpec, values: &[f64]) -> ScalarStats {
         nested: None,
         reliability: None,
         morris: None,
+        rank_correlation: None,
+        run_inputs: None,
     }
 }
 

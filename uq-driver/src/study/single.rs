@@ -204,6 +204,22 @@ fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
     let correlated = study.correlation.is_some();
     let indices = a.outputs.iter().any(|o| o.sobol.is_some())
         || a.quantities.iter().any(|q| q.sobol.is_some());
+    let given_data = a
+        .outputs
+        .iter()
+        .filter_map(|o| o.sobol.as_ref())
+        .all(|s| s.given_data)
+        && a.quantities
+            .iter()
+            .filter_map(|q| q.sobol.as_ref())
+            .all(|s| s.estimator.is_some());
+    if correlated && indices && given_data {
+        // Estimated from the runs: indices of the physical parameters, whatever their order.
+        return Some(
+            "the inputs are correlated: the first-order Sobol' indices estimated from the runs              are those of the physical parameters, Var(E[Y | X_i]) / Var(Y): each includes what              the parameter carries of the parameters it is correlated with, so they may add up              to more than 1 and do not depend on the order of [[parameters]]"
+                .into(),
+        );
+    }
     (correlated && indices).then(|| {
         let order: Vec<&str> = study.parameters.iter().map(|p| p.name.as_str()).collect();
         format!(

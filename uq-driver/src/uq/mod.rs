@@ -13,6 +13,9 @@
 //! - `pce`: polynomial chaos on the Askey families (projection, moments, Sobol' indices);
 //! - `galerkin`: the stochastic Galerkin system of a linear second-order model;
 //! - `moments`: sample and quadrature moments, quantiles, exceedance probabilities;
+//! - `given_data`: first-order Sobol' indices from any sample of the inputs' law (binning
+//!   estimator, bootstrap intervals);
+//! - `rank_correlation`: Spearman's and partial rank correlation coefficients from a sample;
 //! - [`method`]: the UQ methods, one module each (design + estimator);
 //! - `reliability`: small failure probabilities (FORM, SORM, importance sampling, subset
 //!   simulation) and Morris screening, on a batch-evaluated limit state in standard space;
@@ -23,12 +26,14 @@
 
 pub mod distributions;
 pub(crate) mod galerkin;
+pub(crate) mod given_data;
 pub(crate) mod hd;
 pub mod method;
 pub(crate) mod moments;
 pub(crate) mod pce;
 pub(crate) mod quadrature;
 pub(crate) mod random_inputs;
+pub(crate) mod rank_correlation;
 pub(crate) mod reliability;
 pub(crate) mod rng;
 pub(crate) mod sampling;

@@ -65,21 +65,24 @@ pub(super) fn column(rows: &[Vec<f64>], j: usize) -> Vec<f64> {
 }
 
 /// `<V>_sobol.csv`: `time,S_<p>...,ST_<p>...`, then, where the method gives confidence
-/// intervals, `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...`.
+/// intervals, `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...` (first-order indices from given
+/// data: `time,S_<p>...` only).
 pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(), ReportError> {
     let Some(Sobol {
         first,
         total,
         intervals,
+        given_data,
     }) = &s.sobol
     else {
         return Ok(());
     };
     let mut header = vec!["time".to_string()];
-    header.extend(sobol_columns(names, intervals.is_some()));
+    header.extend(sobol_columns(names, intervals.is_some(), !given_data));
+    let totals = if *given_data { 0 } else { names.len() };
     let mut data: Vec<Vec<f64>> = (0..names.len())
         .map(|j| column(first, j))
-        .chain((0..names.len()).map(|j| column(total, j)))
+        .chain((0..totals).map(|j| column(total, j)))
         .collect();
     if let Some(ci) = intervals {
         for rows in [&ci.first, &ci.total] {
@@ -101,8 +104,11 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
 
 /// The index columns of `<V>_sobol.csv` after `time`: `S_<p>...,ST_<p>...`, then with
 /// intervals `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...`.
-fn sobol_columns(names: &[&str], intervals: bool) -> Vec<String> {
+fn sobol_columns(names: &[&str], intervals: bool, total: bool) -> Vec<String> {
     let mut header: Vec<String> = names.iter().map(|n| format!("S_{n}")).collect();
+    if !total {
+        return header;
+    }
     header.extend(names.iter().map(|n| format!("ST_{n}")));
     if intervals {
         for label in ["S", "ST"] {
@@ -125,7 +131,7 @@ pub(super) fn sobol_overall_csv(
     let Some((first, total)) = overall_sobol(s) else {
         return Ok(());
     };
-    let header = sobol_columns(names, false);
+    let header = sobol_columns(names, false, true);
     let values: Vec<[f64; 1]> = first.iter().chain(&total).map(|&v| [v]).collect();
     let cols: Vec<&[f64]> = values.iter().map(|v| &v[..]).collect();
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
@@ -259,13 +265,13 @@ pub(super) fn units_csv(
         if let Some(sobol) = &s.sobol {
             let file = format!("{}_sobol.csv", stem(&s.name));
             push(&file, "time", Some("s"));
-            for col in sobol_columns(names, sobol.intervals.is_some()) {
+            for col in sobol_columns(names, sobol.intervals.is_some(), !sobol.given_data) {
                 push(&file, &col, Some(DIMENSIONLESS));
             }
         }
         if overall_sobol(s).is_some() {
             let file = format!("{}_sobol_overall.csv", stem(&s.name));
-            for col in sobol_columns(names, false) {
+            for col in sobol_columns(names, false, true) {
                 push(&file, &col, Some(DIMENSIONLESS));
             }
         }

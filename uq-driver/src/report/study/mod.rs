@@ -3,6 +3,7 @@
 //! `files`, plots in `plots`, the page's sections here).
 
 mod files;
+mod given_data;
 mod plots;
 mod reliability;
 mod system;
@@ -509,6 +510,9 @@ fn quantity_section(
         if plots::sobol_bars(dir, q, names, &summary.method)? {
             images.push(format!("{}_sobol.svg", stem(name)));
         }
+        let (said, scatter) = given_data::section(dir, q, names)?;
+        text.push_str(&said);
+        images.extend(scatter);
         if let Some(c) = &q.convergence {
             images.extend(plots::convergence(dir, name, unit, c)?);
             text.push_str(&format!(
@@ -679,6 +683,7 @@ fn statistics_rows(q: &ScalarStats, names: &[&str]) -> Vec<Vec<String>> {
             ]);
         }
     }
+    rows.extend(given_data::rows(q, names));
     rows
 }
 

@@ -114,6 +114,7 @@ pub fn merge(mut parts: Vec<Estimate>) -> Result<Estimate, MethodError> {
             })
             .unwrap_or_default(),
         }),
+        given_data: s0.given_data,
     });
     let chaos_error = first.chaos_error.as_ref().map(|e0| ChaosError {
         kind: e0.kind,

@@ -489,6 +489,7 @@ pub(super) fn select(e: &Estimate, of: &[usize]) -> Estimate {
                 first: pick(&i.first, of),
                 total: pick(&i.total, of),
             }),
+            given_data: s.given_data,
         }),
         draws: e.draws,
         chaos_error: e.chaos_error.as_ref().map(|c| ChaosError {

@@ -15,6 +15,7 @@ mod convergence;
 mod error;
 mod exceedance;
 mod functional;
+mod given_data;
 pub mod nested;
 mod runs;
 mod surrogate;
@@ -26,6 +27,7 @@ pub use error::AnalysisError;
 pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
 
+use crate::uq::given_data::Bins;
 use blocks::SeriesColumns;
 use columns::{column, Column};
 use convergence::convergence;
@@ -467,7 +469,11 @@ fn scalar_stats_counted(
         samples: valid,
         density_samples,
         sobol_first: sobol.as_ref().map(|s| s.first[0].clone()),
-        sobol_total: sobol.as_ref().map(|s| s.total[0].clone()),
+        // Given data: first-order indices only.
+        sobol_total: sobol
+            .as_ref()
+            .filter(|s| !s.given_data)
+            .map(|s| s.total[0].clone()),
         sobol: sobol.as_ref().map(|s| {
             let names: Vec<&str> = settings
                 .parameters
@@ -486,6 +492,8 @@ fn scalar_stats_counted(
             .then(|| counted_probabilities(&exceedance_counts, settings.kind)),
         exceedance_counts,
         morris: None,
+        rank_correlation: None,
+        run_inputs: None,
     })
 }
 
@@ -526,14 +534,25 @@ pub fn analyse_runs(
             ok: runs.rows.len(),
         });
     }
+    // A sample of the inputs' law: sensitivity from the runs themselves.
+    let given = method.samples_the_law();
+    // Over time only up to a length: a row of indices per time costs memory (see
+    // `given_data::MAX_SERIES_TIMES`).
+    let bins = (given && nt <= given_data::MAX_SERIES_TIMES)
+        .then(|| Bins::of(&given_data::inputs_at(design, &runs.rows)));
     let mut outputs = Vec::new();
     let mut estimates = Vec::new();
     // Per output, the hash of every column (a chaos fitted per column): a quantity equal to
     // a column takes that column's estimate.
     let mut hashes: Vec<Vec<u64>> = Vec::new();
     for (o, name) in study.outputs.iter().enumerate() {
-        let (estimate, stats, h) =
-            output_in_blocks(method, design, &runs, (o, name, &times), &settings)?;
+        let (estimate, stats, h) = output_in_blocks(
+            method,
+            (design, bins.as_ref()),
+            &runs,
+            (o, name, &times),
+            &settings,
+        )?;
         outputs.push(stats);
         estimates.push(estimate);
         hashes.push(h);
@@ -555,12 +574,19 @@ pub fn analyse_runs(
             true => equal_column(&runs, &hashes, nt, &qr.valid)?,
             false => None,
         };
-        let estimate = match equal {
+        let mut estimate = match equal {
             Some((o, t)) => functional::select(&estimates[o], &[t]),
             None => method
                 .estimate(design, &qr.rows, &data)
                 .map_err(|source| quantity_error(&name, q, &qr, Some(source)))?,
         };
+        let inputs = given.then(|| given_data::inputs_at(design, &qr.rows));
+        let sensitivity = inputs.as_ref().and_then(|x| {
+            given_data::scalar(x, &qr.valid, &study.parameters, study.seed ^ qi as u64)
+        });
+        if let Some((sobol, _)) = &sensitivity {
+            estimate.sobol = Some(sobol.clone());
+        }
         // The running estimate takes the rows the reported mean and Std use.
         let moment_values = method.moment_rows(design, &qr.rows).map(|rows| {
             rows.iter()
@@ -574,6 +600,8 @@ pub fn analyse_runs(
         if let Some(values) = moment_values {
             stats.convergence = convergence(&estimate, 0, &values).filter(|_| !stats.deterministic);
         }
+        stats.rank_correlation = sensitivity.map(|s| s.1);
+        stats.run_inputs = inputs;
         quantities.push(stats);
         if let Some(pce) = estimate.chaos {
             quantity_chaos.push(NamedChaos {
@@ -634,7 +662,7 @@ fn equal_column(
 /// every column where a chaos is fitted per column (else none).
 fn output_in_blocks(
     method: &dyn Sampling,
-    design: &Design,
+    (design, bins): (&Design, Option<&Bins>),
     runs: &Runs,
     (o, name, times): (usize, &str, &[f64]),
     settings: &Settings,
@@ -655,6 +683,7 @@ fn output_in_blocks(
         Some((estimate, fit, hashes)) => (estimate, Some(fit), hashes),
         None => {
             let (mut parts, mut fits, mut hashes) = (Vec::new(), 0, Vec::new());
+            let mut given = bins.map(given_data::SeriesIndices::new);
             for (j0, w) in blocks::blocks(nt, blocks::block_width(nt, runs.rows.len())) {
                 let data = runs.block(o, nt, j0, w)?;
                 let estimate = if per_column {
@@ -670,6 +699,9 @@ fn output_in_blocks(
                 if estimate.draws == Draws::Runs {
                     cols.add(j0, &data);
                 }
+                if let Some(g) = &mut given {
+                    g.add(&data);
+                }
                 parts.push(estimate);
             }
             let fit = per_column.then(|| crate::results::FunctionalFit {
@@ -680,7 +712,11 @@ fn output_in_blocks(
                 discarded_variance: None,
                 discarded_max: None,
             });
-            (blocks::merge(parts).map_err(fail)?, fit, hashes)
+            let mut estimate = blocks::merge(parts).map_err(fail)?;
+            if let Some(g) = given {
+                estimate.sobol = Some(g.sobol());
+            }
+            (estimate, fit, hashes)
         }
     };
     if estimate.draws == Draws::Chaos {

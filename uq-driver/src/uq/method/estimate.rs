@@ -70,6 +70,10 @@ pub struct Sobol {
     pub total: Vec<Vec<f64>>,
     /// Confidence intervals of the indices, where the method has them.
     pub intervals: Option<SobolIntervals>,
+    /// First-order indices estimated from given data (a sample of the inputs' law, by
+    /// binning): `total` is not estimated (NaN, or an empty row per column of a series),
+    /// nor are its intervals.
+    pub given_data: bool,
 }
 
 /// Confidence intervals `(low, high)` of Sobol' indices, each `[column][parameter]`.
@@ -90,6 +94,7 @@ impl Sobol {
             first,
             total,
             intervals: None,
+            given_data: false,
         }
     }
 

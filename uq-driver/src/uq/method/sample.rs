@@ -160,6 +160,12 @@ impl<T: UnitCubeSample> Sampling for T {
     fn draws_from_chaos(&self) -> bool {
         false
     }
+
+    /// Any subset of the points is a sample of the inputs' law (the analysis estimates
+    /// first-order Sobol' indices and rank correlations from it).
+    fn samples_the_law(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -340,6 +340,7 @@ impl Sampling for SobolSampling {
                 first: columns.iter().map(|c| c.first.clone()).collect(),
                 total: columns.iter().map(|c| c.total.clone()).collect(),
                 intervals,
+                given_data: false,
             }),
             ..moments
         })

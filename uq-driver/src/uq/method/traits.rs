@@ -358,7 +358,14 @@ pub trait Sampling: Method {
 
     /// Whether the estimates carry Sobol' indices over time (counted in the memory estimate).
     fn estimates_sobol(&self) -> bool {
-        self.draws_from_chaos()
+        self.draws_from_chaos() || self.samples_the_law()
+    }
+
+    /// Whether the runs are an equally weighted sample of the inputs' law (Monte Carlo, Latin
+    /// hypercube, quasi-Monte Carlo), from which first-order Sobol' indices and rank
+    /// correlations are estimated as given data.
+    fn samples_the_law(&self) -> bool {
+        false
     }
 
     /// The size of the chaos the estimator fits, for a method whose arrays grow with the

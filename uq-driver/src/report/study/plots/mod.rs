@@ -15,6 +15,7 @@ use super::super::{
 use super::quantile_column;
 use crate::qoi::QoiSpec;
 use crate::results::{sig, OutputStats, ScalarStats, Summary};
+use crate::uq::given_data::RESAMPLES;
 use crate::uq::method::MethodSummary;
 
 mod convergence;
@@ -191,8 +192,15 @@ pub(super) fn sobol_bars(
     names: &[&str],
     method: &MethodSummary,
 ) -> Result<bool, ReportError> {
-    let (Some(first), Some(total)) = (&q.sobol_first, &q.sobol_total) else {
+    let Some(first) = &q.sobol_first else {
         return Ok(false);
+    };
+    // Indices from given data have no total index: first-order bars only.
+    let given_data = q.sobol.as_ref().and_then(|s| s.estimator).is_some();
+    let total = match &q.sobol_total {
+        Some(t) => t.as_slice(),
+        None if given_data => &[],
+        None => return Ok(false),
     };
     if first.iter().chain(total).all(|x| x.is_nan()) {
         // No variance: the indices are undefined, there is nothing to draw.
@@ -209,14 +217,28 @@ pub(super) fn sobol_bars(
     let fi = of(summary.and_then(|s| s.first_ci.as_ref()));
     let ti = of(summary.and_then(|s| s.total_ci.as_ref()));
     let level = summary.and_then(|s| s.ci_level);
-    let title = format!("Sobol' indices of {}", q.name);
+    let title = if given_data {
+        format!(
+            "First-order Sobol' indices of {} (estimated from the runs)",
+            q.name
+        )
+    } else {
+        format!("Sobol' indices of {}", q.name)
+    };
     let file = dir.join(format!("{}_sobol.svg", stem(&q.name)));
     bars(
         &title,
         names,
         (first, fi),
         (total, ti),
-        &interval_label(method, level),
+        &if given_data {
+            format!(
+                "{} (bootstrap of the runs, {RESAMPLES} resamples)",
+                interval_label(method, level)
+            )
+        } else {
+            interval_label(method, level)
+        },
         &file,
     )?;
     Ok(true)
@@ -293,8 +315,8 @@ pub(in crate::report::study) fn by_importance(first: &[f64], total: &[f64]) -> V
     order
 }
 
-/// Bars of first-order and total indices per parameter, with intervals where given, the
-/// parameters sorted by [`by_importance`].
+/// Bars of first-order and total indices per parameter, with intervals where given (no
+/// total bars when `total` is empty), the parameters sorted by [`by_importance`].
 fn bars(
     title: &str,
     names: &[&str],
@@ -305,6 +327,9 @@ fn bars(
 ) -> Result<(), ReportError> {
     let order = by_importance(first.0, total.0);
     let pick = |v: &[f64]| -> Vec<f64> {
+        if v.is_empty() {
+            return Vec::new();
+        }
         order
             .iter()
             .map(|&i| v.get(i).copied().unwrap_or(f64::NAN))
@@ -340,7 +365,10 @@ fn bars(
                 values: total.0.to_vec(),
                 intervals: total.1,
             },
-        ],
+        ]
+        .into_iter()
+        .filter(|g| !g.values.is_empty())
+        .collect(),
         y_range: Some((0.0, 1.0)),
         interval_label: interval_label.to_owned(),
     }

@@ -148,7 +148,10 @@ pub(in crate::report::study) fn sobol_over_time(
     s: &OutputStats,
     names: &[&str],
 ) -> Result<(), ReportError> {
-    let Some(Sobol { first, .. }) = &s.sobol else {
+    let Some(Sobol {
+        first, given_data, ..
+    }) = &s.sobol
+    else {
         return Ok(());
     };
     let v = &s.name;
@@ -159,7 +162,9 @@ pub(in crate::report::study) fn sobol_over_time(
         .map(|d| *d > LITTLE_VARIANCE * LITTLE_VARIANCE * max_var)
         .collect();
     let window = s.times.len().div_ceil(times.len().max(1));
-    let title = if window > 1 {
+    let title = if *given_data {
+        format!("First-order Sobol' indices of {v} over time, estimated from the runs")
+    } else if window > 1 {
         format!("Sobol' indices of {v} over time, in variance-weighted windows of {window} steps")
     } else {
         format!("Sobol' indices of {v} over time (first order stacked, interactions on top)")
