@@ -29,6 +29,7 @@ const SCALAR: &str = "Scalar quantities: density, exceedance, indices";
 const SPEED: &str = "Critical speed: signal against speed";
 const NESTED: &str = "Two-level (nested) studies";
 const SUITES: &str = "Suites and comparisons";
+const SCATTER: &str = "Sensitivity from the runs: scatter plots";
 const RELIABILITY: &str = "Small probabilities: design point and convergence";
 const MORRIS: &str = "Morris screening";
 
@@ -47,6 +48,7 @@ const ENDINGS: &[(&str, &str)] = &[
     ("_mean_diff.svg", SUITES),
     ("_std_diff.svg", SUITES),
     ("_std_log.svg", STD),
+    ("_scatter.svg", SCATTER),
     ("_bands.svg", SUITES),
     ("_morris.svg", MORRIS),
     ("_split.svg", NESTED),
