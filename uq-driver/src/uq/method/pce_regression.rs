@@ -385,7 +385,7 @@ fn kfold_error(
     }
     let mean = y.iter().sum::<f64>() / n as f64;
     let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return None;
     }
     let mut order_of: Vec<usize> = (0..n).collect();

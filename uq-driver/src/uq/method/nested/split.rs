@@ -220,7 +220,7 @@ pub fn jackknife_t(c: &Conditionals) -> Option<JackknifeT> {
         return None;
     }
     let all = Split::all(c);
-    if !(all.total() > 0.0) {
+    if all.total().is_nan() || all.total() <= 0.0 {
         return None;
     }
     let left_out: Vec<Split> = (0..n)
@@ -237,7 +237,7 @@ pub fn jackknife_t(c: &Conditionals) -> Option<JackknifeT> {
         ((n - 1) as f64 / n as f64 * v.iter().map(|x| (x - m).powi(2)).sum::<f64>()).sqrt()
     };
     let totals: Vec<f64> = left_out.iter().map(|s| s.total()).collect();
-    if totals.iter().any(|&v| !(v > 0.0)) {
+    if totals.iter().any(|&v| v.is_nan() || v <= 0.0) {
         return None;
     }
     let logs: Vec<f64> = totals.iter().map(|v| v.ln()).collect();
