@@ -116,7 +116,7 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
                                 .times
                                 .get(k)
                                 .map_or(String::new(), |t| format!(" at t = {t} s"));
-                            let raw = e.check.as_ref().map(|_| e.values[k]);
+                            let raw = Some(e.values[k]).filter(|&r| e.check.is_some() && r != v);
                             error_warning(&o.name, &at, e.kind.name(), v, raw)
                         }
                     });
@@ -140,7 +140,7 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
                     && e.check.unwrap_or(e.value) > CHAOS_ERROR =>
             {
                 let v = e.check.unwrap_or(e.value);
-                let raw = e.check.map(|_| e.value);
+                let raw = Some(e.value).filter(|&r| e.check.is_some() && r != v);
                 out.push(error_warning(&q.name, "", e.kind, v, raw));
             }
             Some(_) => {}
@@ -185,27 +185,26 @@ pub(crate) fn series_error(e: &ChaosError, std: &[f64]) -> Option<(f64, Option<u
 }
 
 /// The warning of a chaos whose estimated truncation error is `value` (`raw`: the estimate
-/// of kind `kind` where `value` is its check).
+/// of kind `kind` where `value` is its check and differs from it).
 fn error_warning(name: &str, at: &str, kind: &str, value: f64, raw: Option<f64>) -> String {
-    let what = match (kind, raw) {
+    let how = match (kind, raw) {
         ("level_difference", Some(raw)) => format!(
-            "the difference between its last two levels, {:.1} % of the variance, \
-             extrapolated to its own level",
+            " extrapolated to its own level (the difference between its last two levels, the \
+             error of the level below, is {:.1} %)",
             100.0 * raw
         ),
         ("loo", Some(raw)) => format!(
-            "{}-fold cross-validation with the basis selected again in each fold; its \
-             leave-one-out error, {:.1} %, is optimistic for a selected basis",
-            FOLDS,
+            " by {FOLDS}-fold cross-validation with the basis selected again in each fold \
+             (the leave-one-out error, optimistic for a selected basis, says {:.1} %)",
             100.0 * raw
         ),
-        _ => kind.to_owned(),
+        _ => String::new(),
     };
     format!(
-        "{name}{at}: the chaos's own truncation-error estimate ({what}) is {:.1} % of the \
-         variance: its mean, Std, quantiles, P(q > limit) and Sobol' indices may be far off, \
-         and their intervals cover only the sampling of the chaos, not this error; raise the \
-         level, order or number of runs",
+        "{name}{at}: the chaos's own truncation-error estimate ({kind}) is {:.1} % of the \
+         variance{how}: its mean, Std, quantiles, P(q > limit) and Sobol' indices may be far \
+         off, and their intervals cover only the sampling of the chaos, not this error; raise \
+         the level, order or number of runs",
         100.0 * value
     )
 }

@@ -376,8 +376,9 @@ fn inner_chaos_warning(name: &str, cond: &Conditional, times: Option<&[f64]>) ->
         _ => String::new(),
     };
     Some(format!(
-        "{name}: the inner chaos's own truncation-error estimate ({}) exceeds {} % of the \
-         conditional variance in {} of {present} outer samples (largest {:.1} % at outer \
+        "{name}: the inner chaos's own truncation-error estimate ({}; as the warnings judge \
+         it: a sparse grid's extrapolated to its level, a sparse regression's checked by \
+         k-fold cross-validation) exceeds {} % of the conditional variance in {} of {present} outer samples (largest {:.1} % at outer \
          sample {k}{at}): the conditional mean, Std, P(q > limit | outer) and Sobol' indices \
          of those samples may be far off, and the intervals over the outer samples do not \
          cover this error; raise the inner order or number of runs (per outer sample: the \
