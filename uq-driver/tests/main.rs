@@ -33,6 +33,7 @@ mod instance_lifecycle;
 mod isolation;
 mod large_studies;
 mod library;
+mod nested_intervals;
 mod output_files;
 mod qoi_min_max;
 mod reliability;

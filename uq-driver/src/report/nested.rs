@@ -469,8 +469,9 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
     }
     Some(Section {
         heading: "Two-level split".into(),
-        text: "Each nested variant over both levels (95 % bootstrap intervals over the outer \
-               samples): the marginal mean and Std; the Std's two parts, the root of the mean \
+        text: "Each nested variant over both levels (95 % intervals over the outer samples: \
+               bootstrap, for the Std and the shares joined with Student's t from the \
+               jackknife): the marginal mean and Std; the Std's two parts, the root of the mean \
                conditional variance (the inner parameters alone, e.g. the vehicle) and of the \
                variance of the conditional means (the outer parameters, e.g. the track); their \
                shares of the variance; P(q > limit) over both levels (the mean of the \

@@ -218,6 +218,11 @@ pub struct ScalarChaosError {
     pub kind: &'static str,
     /// The relative error.
     pub value: f64,
+    /// The second estimate the warnings judge instead, where `value` is known to be biased
+    /// (a sparse grid's level difference extrapolated to its own level; a sparse
+    /// regression's k-fold cross-validation error where larger than its leave-one-out one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub check: Option<f64>,
 }
 
 /// Sobol' indices of a scalar quantity by parameter name (`quantities.NAME.sobol` in

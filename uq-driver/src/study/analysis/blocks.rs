@@ -119,6 +119,9 @@ pub fn merge(mut parts: Vec<Estimate>) -> Result<Estimate, MethodError> {
     let chaos_error = first.chaos_error.as_ref().map(|e0| ChaosError {
         kind: e0.kind,
         values: cat(&parts, |p| p.chaos_error.as_ref().map(|e| &e.values)).unwrap_or_default(),
+        check: cat(&parts, |p| {
+            p.chaos_error.as_ref().and_then(|e| e.check.as_ref())
+        }),
     });
     let chaos = match first.chaos {
         Some(_) => {

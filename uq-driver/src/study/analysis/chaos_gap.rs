@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use super::Analysed;
 use crate::report::units::with_unit;
 use crate::results::numbers::computed;
+use crate::uq::method::pce_regression::FOLDS;
 use crate::uq::method::{ChaosError, ChaosErrorKind};
 
 /// A chaos whose own truncation-error estimate (relative to the variance) exceeds this at some
@@ -115,7 +116,8 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
                                 .times
                                 .get(k)
                                 .map_or(String::new(), |t| format!(" at t = {t} s"));
-                            error_warning(&o.name, &at, e.kind.name(), v)
+                            let raw = Some(e.values[k]).filter(|&r| e.check.is_some() && r != v);
+                            error_warning(&o.name, &at, e.kind.name(), v, raw)
                         }
                     });
                 }
@@ -133,8 +135,13 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
                     out.push(top_order_warning(&q.name, "", e.value));
                 }
             }
-            Some(e) if e.value.is_finite() && e.value > CHAOS_ERROR => {
-                out.push(error_warning(&q.name, "", e.kind, e.value));
+            Some(e)
+                if e.check.unwrap_or(e.value).is_finite()
+                    && e.check.unwrap_or(e.value) > CHAOS_ERROR =>
+            {
+                let v = e.check.unwrap_or(e.value);
+                let raw = Some(e.value).filter(|&r| e.check.is_some() && r != v);
+                out.push(error_warning(&q.name, "", e.kind, v, raw));
             }
             Some(_) => {}
             None => missing |= q.std > 0.0,
@@ -154,7 +161,8 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
 /// quadrature's, so it says whether the chaos itself has converged) over the whole series,
 /// weighted by the variance as the Sobol' indices of a series are (no column); any other
 /// estimate at its largest over the columns whose Std is resolved (above 1e-3 of the
-/// largest), with that column.
+/// largest), with that column; where the estimate has a [`ChaosError::check`], that is
+/// judged instead.
 pub(crate) fn series_error(e: &ChaosError, std: &[f64]) -> Option<(f64, Option<usize>)> {
     if e.kind == ChaosErrorKind::OrderDifference {
         let (mut shared, mut total) = (0.0, 0.0);
@@ -167,7 +175,7 @@ pub(crate) fn series_error(e: &ChaosError, std: &[f64]) -> Option<(f64, Option<u
         return (total > 0.0).then(|| (shared / total, None));
     }
     let resolved = resolved(std);
-    e.values
+    e.judged()
         .iter()
         .zip(std)
         .enumerate()
@@ -176,12 +184,27 @@ pub(crate) fn series_error(e: &ChaosError, std: &[f64]) -> Option<(f64, Option<u
         .map(|(k, (&v, _))| (v, Some(k)))
 }
 
-fn error_warning(name: &str, at: &str, kind: &str, value: f64) -> String {
+/// The warning of a chaos whose estimated truncation error is `value` (`raw`: the estimate
+/// of kind `kind` where `value` is its check and differs from it).
+fn error_warning(name: &str, at: &str, kind: &str, value: f64, raw: Option<f64>) -> String {
+    let how = match (kind, raw) {
+        ("level_difference", Some(raw)) => format!(
+            " extrapolated to its own level (the difference between its last two levels, the \
+             error of the level below, is {:.1} %)",
+            100.0 * raw
+        ),
+        ("loo", Some(raw)) => format!(
+            " by {FOLDS}-fold cross-validation with the basis selected again in each fold \
+             (the leave-one-out error, optimistic for a selected basis, says {:.1} %)",
+            100.0 * raw
+        ),
+        _ => String::new(),
+    };
     format!(
         "{name}{at}: the chaos's own truncation-error estimate ({kind}) is {:.1} % of the \
-         variance: its mean, Std, quantiles, P(q > limit) and Sobol' indices may be far off, \
-         and their intervals cover only the sampling of the chaos, not this error; raise the \
-         level, order or number of runs",
+         variance{how}: its mean, Std, quantiles, P(q > limit) and Sobol' indices may be far \
+         off, and their intervals cover only the sampling of the chaos, not this error; raise \
+         the level, order or number of runs",
         100.0 * value
     )
 }

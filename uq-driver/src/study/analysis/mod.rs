@@ -19,6 +19,8 @@ mod given_data;
 pub mod nested;
 mod runs;
 mod surrogate;
+#[cfg(test)]
+mod truncation_checks;
 
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use error::quantity_error;
@@ -486,6 +488,7 @@ fn scalar_stats_counted(
         chaos_error: estimate.chaos_error.as_ref().map(|e| ScalarChaosError {
             kind: e.kind.name(),
             value: e.values[0],
+            check: e.check.as_ref().map(|c| c[0]),
         }),
         nested: None,
         reliability: (!exceedance_counts.is_empty())

@@ -182,6 +182,18 @@ pub fn level_difference_from(
     values: &DMatrix<f64>,
     coarse: &LevelSet,
 ) -> Result<Vec<f64>, ProjectionError> {
+    let (cgrid, cvals) = restrict(grid, values, coarse)?;
+    let coarse_pce = sparse_pseudo_spectral(&cgrid, &cvals)?;
+    Ok(relative_difference(fine, &coarse_pce))
+}
+
+/// The grid of the coarser level set `coarse` (its points among `grid`'s, as for nested rules)
+/// with its rows of `values` (one row per point of `grid`).
+pub fn restrict(
+    grid: &SparseGrid,
+    values: &DMatrix<f64>,
+    coarse: &LevelSet,
+) -> Result<(SparseGrid, DMatrix<f64>), ProjectionError> {
     let cgrid = SparseGrid::new(&grid.rules, coarse)?;
     let index: HashMap<Vec<i64>, usize> = grid
         .points
@@ -196,9 +208,13 @@ pub fn level_difference_from(
             .ok_or_else(|| ProjectionError::NotNested(p.clone()))?;
         cvals.set_row(j, &values.row(i));
     }
-    let coarse_pce = sparse_pseudo_spectral(&cgrid, &cvals)?;
-    let mut out = Vec::with_capacity(values.ncols());
-    for o in 0..values.ncols() {
+    Ok((cgrid, cvals))
+}
+
+/// Per output, `Σ (c_fine − c_coarse)² / Var_fine` over the union of the two bases.
+fn relative_difference(fine: &Pce, coarse_pce: &Pce) -> Vec<f64> {
+    let mut out = Vec::with_capacity(fine.outputs());
+    for o in 0..fine.outputs() {
         let mut diff = 0.0;
         let mut var = 0.0;
         let mut mean = 0.0;
@@ -233,7 +249,7 @@ pub fn level_difference_from(
             f64::INFINITY
         });
     }
-    Ok(out)
+    out
 }
 
 fn point_key(p: &[f64]) -> Vec<i64> {

@@ -126,5 +126,6 @@ pub(crate) fn order_difference(pce: &Pce) -> Option<ChaosError> {
     Some(ChaosError {
         kind: ChaosErrorKind::OrderDifference,
         values,
+        check: None,
     })
 }

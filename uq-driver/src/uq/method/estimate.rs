@@ -58,6 +58,20 @@ pub struct ChaosError {
     pub kind: ChaosErrorKind,
     /// Per column (relative to the variance; 0 for a column without variance).
     pub values: Vec<f64>,
+    /// Per column, a second estimate where `values` is known to be biased, which the
+    /// warnings judge instead: for `level_difference` at a level `L >= 2`, the level
+    /// difference extrapolated to level `L` itself (`values` is the error of level `L − 1`);
+    /// for `loo` of a sparse (LARS-selected) regression, the larger of it and the k-fold
+    /// cross-validation error with the selection redone in each fold (the leave-one-out error
+    /// of a selected basis is optimistic).
+    pub check: Option<Vec<f64>>,
+}
+
+impl ChaosError {
+    /// The values the warnings judge: `check` where there is one, else `values`.
+    pub fn judged(&self) -> &[f64] {
+        self.check.as_deref().unwrap_or(&self.values)
+    }
 }
 
 /// First-order and total Sobol' indices, each `[column][parameter]`, with confidence

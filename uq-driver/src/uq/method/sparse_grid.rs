@@ -25,7 +25,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
 use super::traits::{ChaosFit, Evaluation, Method, MethodSummary, Problem, Sampling};
 use crate::uq::distributions::RandomParameter;
-use crate::uq::hd::pseudo_spectral::{level_difference_from, sparse_pseudo_spectral};
+use crate::uq::hd::pseudo_spectral::{level_difference_from, restrict, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
 use crate::uq::hd::smolyak::{total_level_size as count, GridSize, LevelSet, SparseGrid as Grid};
 use crate::uq::pce::Family;
@@ -150,6 +150,28 @@ impl SparseGrid {
     }
 }
 
+/// The level difference `d_L` (between levels `L` and `L − 1`, the error of level `L − 1`)
+/// extrapolated to level `L` from the one before, `d_(L−1)`: `d_L · min(1, d_L / d_(L−1))`,
+/// the next term of a geometric decay of the differences (`d_L` itself where `d_(L−1)` is 0
+/// or not finite). At level 2, `d_1` is about 1 (level 0 is the centre value alone), so the
+/// estimate is about `d_2²`: a converged level-2 grid (a 15-input quadratic with pairwise
+/// products, which it holds exactly: `d_2` = 0.068, a true error of 6e-29, judged 0.002) no
+/// longer reads as 7 % off, while a 20-input G-function (`d_2` = 1.45, true error 1.77) still
+/// does. A converged grid whose last level changed more than about 22 % of the variance is
+/// still judged off: from its own runs it cannot be told from one that has not converged.
+fn extrapolate(now: &[f64], before: &[f64]) -> Vec<f64> {
+    now.iter()
+        .zip(before)
+        .map(|(&d, &b)| {
+            if b > 0.0 && b.is_finite() && d.is_finite() {
+                d * (d / b).min(1.0)
+            } else {
+                d
+            }
+        })
+        .collect()
+}
+
 fn grid_error(e: impl std::fmt::Display) -> MethodError {
     MethodError::Invalid(InvalidSettings(format!("sparse grid: {e}")))
 }
@@ -241,11 +263,23 @@ impl Sampling for SparseGrid {
         let pce = sparse_pseudo_spectral(&grid, data).map_err(grid_error)?;
         let nested = grid.rules.iter().all(RuleKind::is_nested);
         let chaos_error = if self.level >= 1 && nested {
-            let coarse = LevelSet::total(families.len(), self.level - 1).map_err(grid_error)?;
+            let d = families.len();
+            let coarse = LevelSet::total(d, self.level - 1).map_err(grid_error)?;
             let values = level_difference_from(&pce, &grid, data, &coarse).map_err(grid_error)?;
+            let check = if self.level >= 2 {
+                let (cgrid, cvals) = restrict(&grid, data, &coarse).map_err(grid_error)?;
+                let cpce = sparse_pseudo_spectral(&cgrid, &cvals).map_err(grid_error)?;
+                let coarser = LevelSet::total(d, self.level - 2).map_err(grid_error)?;
+                let before =
+                    level_difference_from(&cpce, &cgrid, &cvals, &coarser).map_err(grid_error)?;
+                Some(extrapolate(&values, &before))
+            } else {
+                None
+            };
             Some(ChaosError {
                 kind: ChaosErrorKind::LevelDifference,
                 values,
+                check,
             })
         } else {
             None

@@ -13,14 +13,24 @@
 //! The sample variance of the *estimated* conditional means is biased upwards by the inner
 //! sampling error: `E[var_k(m_k)] = Var(μ) + E[Var(m_k | outer)]`, and `s_k²` is the inner
 //! estimator's own unbiased estimate of `Var(m_k | outer)` (Monte Carlo: `v_k / n`; a
-//! replicated design: from the replicates), provided the inner errors of different outer
+//! replicated design: from the replicates; an unreplicated Latin hypercube: from the residual
+//! of an additive fit, see `nested::lhs`), provided the inner errors of different outer
 //! samples are independent, which is why every outer sample gets its own inner design. The
 //! corrected `outer` can come out negative when the track matters little; the fractions then
 //! count it as 0 (the raw value is kept).
 //!
-//! Confidence intervals come from the percentile bootstrap over the outer samples (the pairs
-//! `(m_k, v_k, s_k²)` resampled together), which carries both the outer and the inner
-//! sampling error, since the conditional estimates of different outer samples are independent.
+//! Confidence intervals resample the outer samples (the triples `(m_k, v_k, s_k²)` together),
+//! which carries both the outer and the inner sampling error, since the conditional estimates
+//! of different outer samples are independent. The mean and the exceedance probabilities use
+//! the percentile bootstrap (Student's t where wider). The Std and the two fractions use
+//! Student's t on a transformed scale with the jackknife standard error over the outer
+//! samples ([`jackknife_t`]): `ln(total variance)` for the Std, `logit(outer fraction)` for
+//! the fractions, `N − 1` degrees of freedom, joined with the percentile bootstrap interval
+//! (the hull of the two). A percentile bootstrap of a variance over few outer samples is too
+//! narrow: it covered the true Std in 85 % and the true outer share in 87 % of 400 simulated
+//! studies of 16 outer × 16 inner Monte Carlo samples (y = h + x1 + x2², outer share 1/3),
+//! the jackknife t in 93 % and 96 % (with a skewed outer level, an exponential h: 83 % and
+//! 73 % against 89 % and 90 %; below 32 outer samples the analysis says so).
 
 use crate::uq::moments;
 use crate::uq::rng;
@@ -136,9 +146,10 @@ pub struct Intervals {
     pub exceedance: Vec<[f64; 2]>,
 }
 
-/// Bootstrap intervals of the split of `c` and of the means of the conditional exceedance
+/// Intervals of the split of `c` and of the means of the conditional exceedance
 /// probabilities `exceedance[l][k]` (one list per limit, aligned with `c`): `resamples`
-/// resamples of the outer samples, resample `b` drawn from the stream `(seed, b)`.
+/// bootstrap resamples of the outer samples, resample `b` drawn from the stream `(seed, b)`;
+/// the Std and the fractions joined with their [`jackknife_t`] intervals.
 pub fn bootstrap(
     c: &Conditionals,
     exceedance: &[Vec<f64>],
@@ -170,13 +181,83 @@ pub fn bootstrap(
     };
     let mut it = stats.iter_mut();
     let mut next = || interval(it.next().expect("one list per statistic"));
-    Intervals {
+    let mut out = Intervals {
         mean: next(),
         std: next(),
         inner: next(),
         outer: next(),
         exceedance: (0..exceedance.len()).map(|_| next()).collect(),
+    };
+    if let Some(j) = jackknife_t(c) {
+        let hull = |a: [f64; 2], b: [f64; 2]| [a[0].min(b[0]), a[1].max(b[1])];
+        out.std = hull(out.std, j.std);
+        out.outer = hull(out.outer, j.outer);
+        out.inner = hull(out.inner, [1.0 - j.outer[1], 1.0 - j.outer[0]]);
     }
+    out
+}
+
+/// The Student-t intervals of the Std and of the outer fraction from the jackknife over the
+/// outer samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JackknifeT {
+    /// Of the marginal Std.
+    pub std: [f64; 2],
+    /// Of the outer fraction (the inner one is its complement).
+    pub outer: [f64; 2],
+}
+
+/// The [`LEVEL`] intervals of the Std and the outer fraction of `c`: `θ ± t(N − 1) · se_jack`
+/// on the scale `ln(total variance)` (Std: the square root of the ends) and
+/// `logit(outer fraction)`, `se_jack² = (N − 1)/N · Σ (θ_(−k) − θ̄)²` from the estimates
+/// leaving out one outer sample at a time. Where the outer fraction (or one left-out value)
+/// is 0 or 1 the logit is undefined: the interval of the fraction itself, clipped to
+/// `[0, 1]`. `None` below 3 outer samples or without variance.
+pub fn jackknife_t(c: &Conditionals) -> Option<JackknifeT> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let n = c.len();
+    if n < 3 {
+        return None;
+    }
+    let all = Split::all(c);
+    if all.total().is_nan() || all.total() <= 0.0 {
+        return None;
+    }
+    let left_out: Vec<Split> = (0..n)
+        .map(|k| {
+            let idx: Vec<usize> = (0..n).filter(|&i| i != k).collect();
+            Split::of(c, &idx)
+        })
+        .collect();
+    let t = StudentsT::new(0.0, 1.0, (n - 1) as f64)
+        .ok()?
+        .inverse_cdf(1.0 - (1.0 - LEVEL) / 2.0);
+    let se = |v: &[f64]| -> f64 {
+        let m = v.iter().sum::<f64>() / n as f64;
+        ((n - 1) as f64 / n as f64 * v.iter().map(|x| (x - m).powi(2)).sum::<f64>()).sqrt()
+    };
+    let totals: Vec<f64> = left_out.iter().map(|s| s.total()).collect();
+    if totals.iter().any(|&v| v.is_nan() || v <= 0.0) {
+        return None;
+    }
+    let logs: Vec<f64> = totals.iter().map(|v| v.ln()).collect();
+    let half = t * se(&logs);
+    let lt = all.total().ln();
+    let std = [(lt - half).exp().sqrt(), (lt + half).exp().sqrt()];
+    let f = all.fractions().1;
+    let fs: Vec<f64> = left_out.iter().map(|s| s.fractions().1).collect();
+    let inside = |x: f64| x > 0.0 && x < 1.0;
+    let outer = if inside(f) && fs.iter().all(|&x| inside(x)) {
+        let logit = |x: f64| (x / (1.0 - x)).ln();
+        let expit = |x: f64| 1.0 / (1.0 + (-x).exp());
+        let ls: Vec<f64> = fs.iter().map(|&x| logit(x)).collect();
+        let half = t * se(&ls);
+        [expit(logit(f) - half), expit(logit(f) + half)]
+    } else {
+        let half = t * se(&fs);
+        [(f - half).max(0.0), (f + half).min(1.0)]
+    };
+    Some(JackknifeT { std, outer })
 }
 
 /// How an interval over the outer samples was found (`ci_kind` in `summary.json`).
