@@ -323,19 +323,25 @@ pub(super) fn combine(of_modes: Estimate, modes: &Modes) -> Result<Estimate, Met
     }
     let mut estimate = Estimate::from_chaos(Pce::new(pce.basis, coeffs)?);
     let discarded = modes.discarded();
-    estimate.chaos_error = of_modes.chaos_error.map(|e| ChaosError {
-        kind: e.kind,
-        values: (0..modes.sq.len())
+    // Each column's error: its modes' errors weighted by their share of it, plus the variance
+    // the kept modes miss, relative to the column's variance.
+    let per_column = |of_mode: &[f64]| -> Vec<f64> {
+        (0..modes.sq.len())
             .map(|t| {
                 if modes.sq[t] <= 0.0 {
                     return 0.0;
                 }
                 let fitted: f64 = (0..modes.eigenvalues.len())
-                    .map(|k| modes.modes[(t, k)].powi(2) * e.values[k] * modes.eigenvalues[k])
+                    .map(|k| modes.modes[(t, k)].powi(2) * of_mode[k] * modes.eigenvalues[k])
                     .sum();
                 (fitted + discarded[t]) / modes.sq[t]
             })
-            .collect(),
+            .collect()
+    };
+    estimate.chaos_error = of_modes.chaos_error.map(|e| ChaosError {
+        kind: e.kind,
+        values: per_column(&e.values),
+        check: e.check.as_deref().map(per_column),
     });
     Ok(estimate)
 }
@@ -495,6 +501,7 @@ pub(super) fn select(e: &Estimate, of: &[usize]) -> Estimate {
         chaos_error: e.chaos_error.as_ref().map(|c| ChaosError {
             kind: c.kind,
             values: pick(&c.values, of),
+            check: c.check.as_ref().map(|v| pick(v, of)),
         }),
     }
 }
