@@ -163,7 +163,7 @@ pub(crate) fn to_html() -> String {
          <footer>From the railuq user guide (Getting started: Reading the report), as this \
          uq-driver was built. <a href=\"index.html\">Back to the report</a>.</footer>\n\
          </body>\n</html>\n",
-        super::html::CSS
+        super::style::CSS
     )
 }
 

@@ -27,6 +27,7 @@ pub mod html;
 pub mod inputs;
 pub mod nested;
 pub mod study;
+mod style;
 pub mod suite;
 pub mod svg;
 pub mod units;
