@@ -6,7 +6,7 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
-                                  [--only hd|vehicle|reliability|functional]
+                                  [--only hd|vehicle|reliability|functional|python]
 
 `--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
 target/bench/BENCHMARKS-hd.md, `--only vehicle` the full car's real-time factor alone into
@@ -14,7 +14,8 @@ target/bench/BENCHMARKS-vehicle.md, `--only reliability` the small-probability g
 (bench/reliability_goals.py: FORM, SORM, importance sampling, subset simulation beside
 OpenTURNS; needs only uq-driver and a C compiler) into target/bench/BENCHMARKS-reliability.md,
 `--only functional` the series fitted per column against on principal components alone into
-target/bench/BENCHMARKS-functional.md.
+target/bench/BENCHMARKS-functional.md, `--only python` the Python package against the command
+line alone into target/bench/BENCHMARKS-python.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals set for the comparisons are reported as met or not met. The only hard failures are missing
@@ -1234,7 +1235,7 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
-SECTIONS = ("hd", "vehicle", "reliability", "functional")
+SECTIONS = ("hd", "vehicle", "reliability", "functional", "python")
 
 
 def main():
@@ -1282,6 +1283,10 @@ def main():
         elif args.only == "vehicle":
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
             sections = [bench_vehicle_realtime(work, repeats)]
+            same_threads, same_iso = True, True
+        elif args.only == "python":
+            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
+            sections = [bench_python(work, max(repeats, 5))]
             same_threads, same_iso = True, True
         elif args.only == "functional":
             lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)

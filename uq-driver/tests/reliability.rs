@@ -11,7 +11,7 @@ use serde_json::Value;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
+    run, run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
 };
 
 /// `P(Z > z)` of a standard normal, by the Lentz continued fraction of Mills' ratio for
@@ -138,6 +138,11 @@ fn form_and_sorm_give_the_exact_probability_of_a_linear_sum_of_correlated_normal
         );
         let out = dir.path().join(kind);
         let text = run_study_ok(&p, &out, &[]);
+        // Its runs are not samples of the inputs' law: no density file (one with a header
+        // and no rows was written).
+        assert!(!out.join("q_pdf.csv").exists(), "{kind}: q_pdf.csv written");
+        let units = std::fs::read_to_string(out.join("units.csv")).unwrap_or_default();
+        assert!(!units.contains("q_pdf.csv"), "{units}");
         let r = reliability(&out);
         assert_eq!(r.len(), 2, "{r:?}");
         for (e, exact, direction, limit) in [(&r[0], pa, "above", a), (&r[1], pb, "below", b)] {
@@ -461,4 +466,41 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
         }
     }
     assert!(text.contains("no interval"), "{text}");
+}
+
+#[test]
+fn a_reliability_study_is_refused_by_plan_shards_and_told_to_run_on_one_machine() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = two_inputs("distribution = \"normal\"\nmean = 0\nstd = 1");
+    for kind in ["form", "importance_sampling", "subset"] {
+        let p = study(
+            dir.path(),
+            kind,
+            5,
+            &inputs,
+            &[3.0],
+            &[],
+            &format!("kind = \"{kind}\""),
+        );
+        let out = dir.path().join(format!("{kind}-shards"));
+        let o = run(&[
+            "plan",
+            p.to_str().unwrap(),
+            "--shards",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{kind}: planned in shards");
+        assert!(err.contains("cannot be split into shards"), "{err}");
+        assert!(err.contains("uq-driver run"), "{err}");
+        assert!(
+            !out.join("plan.json").exists(),
+            "{kind}: a plan was written"
+        );
+    }
 }

@@ -103,6 +103,14 @@ pub fn shard_points(len: usize, n: usize, k: usize) -> Vec<usize> {
     (k..len).step_by(n.max(1)).collect()
 }
 
+/// "a" or "an" before `word` (by its first letter: `an importance_sampling study`).
+fn article(word: &str) -> &'static str {
+    match word.chars().next() {
+        Some('a' | 'e' | 'i' | 'o' | 'u') => "an",
+        _ => "a",
+    }
+}
+
 /// The study's sampling method, or a usage error for a method that runs no design.
 fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
     match study.method().evaluation() {
@@ -112,9 +120,10 @@ fn sampling(study: &Study) -> Result<&dyn Sampling, ShardError> {
             study.method().kind()
         ))),
         Evaluation::Adaptive(_) => Err(ShardError::Usage(format!(
-            "a {} study chooses its points from the values of the runs before (batch after \
+            "{} {} study chooses its points from the values of the runs before (batch after \
              batch): it cannot be split into shards planned in advance; run it with `uq-driver \
              run` (each batch runs in parallel on the threads of one machine)",
+            article(study.method().kind()),
             study.method().kind()
         ))),
     }

@@ -151,9 +151,10 @@ pub(super) fn overall_sobol(s: &OutputStats) -> Option<(Vec<f64>, Vec<f64>)> {
         .integrated(&s.times, &s.std)
 }
 
-/// `<q>_pdf.csv`: `x,density`; none for a deterministic quantity (no density).
+/// `<q>_pdf.csv`: `x,density`; none for a deterministic quantity, nor for one without a
+/// density (an adaptive study's: its runs are not samples of the inputs' law).
 pub(super) fn scalar_pdf_csv(dir: &Path, q: &ScalarStats) -> Result<(), ReportError> {
-    if q.deterministic {
+    if q.deterministic || q.pdf.is_empty() {
         return Ok(());
     }
     write_columns(
@@ -284,7 +285,7 @@ pub(super) fn units_csv(
     }
     for q in quantities {
         let u = q.unit.as_deref();
-        if !q.deterministic {
+        if !q.deterministic && !q.pdf.is_empty() {
             let file = format!("{}_pdf.csv", stem(&q.name));
             push(&file, "x", u);
             push(&file, "density", per(u).as_deref());
