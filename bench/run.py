@@ -1274,24 +1274,19 @@ def main():
         mach = machine()
         print("railuq benchmarks: " + ", ".join(f"{k}: {v}" for k, v in mach.items()), flush=True)
         checks = []
-        if args.only == "hd":
-            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
-            sections, same_threads, same_iso = bench_hd_goals(work), True, True
-        elif args.only == "reliability":
-            lib_same = None  # no railuq FMU in this section
-            sections, same_threads, same_iso = bench_reliability_goals(work), True, True
-        elif args.only == "vehicle":
-            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
-            sections = [bench_vehicle_realtime(work, repeats)]
-            same_threads, same_iso = True, True
-        elif args.only == "python":
-            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
-            sections = [bench_python(work, max(repeats, 5))]
-            same_threads, same_iso = True, True
-        elif args.only == "functional":
-            lib_same = all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
-            sections = [bench_functional(work, repeats)]
-            same_threads, same_iso = True, True
+        if args.only:
+            # One section alone: its sections (a list), and whether it uses the railuq FMUs.
+            alone = {
+                "hd": (lambda: bench_hd_goals(work), True),
+                "reliability": (lambda: bench_reliability_goals(work), False),
+                "vehicle": (lambda: [bench_vehicle_realtime(work, repeats)], True),
+                "python": (lambda: [bench_python(work, max(repeats, 5))], True),
+                "functional": (lambda: [bench_functional(work, repeats)], True),
+            }
+            section, uses_fmus = alone[args.only]
+            lib_same = (all(fmu_binary_sha(m) == sha256(LIB) for m in MODELS)
+                        if uses_fmus else None)
+            sections, same_threads, same_iso = section(), True, True
         else:
             sections, same_threads, same_iso, lib_same = all_sections(args, work, repeats,
                                                                       checks)

@@ -69,18 +69,12 @@ pub(crate) fn anchor_for(file: &str, section_files: &[String]) -> Option<String>
             .iter()
             .any(|f| f.rsplit('/').next() == Some(&format!("{stem}_band.svg")))
     };
+    // An output's plot over time, or a scalar quantity's.
+    let of = |stem: &str, over: &'static str| if over_time(stem) { over } else { SCALAR };
     let heading = if let Some(stem) = name.strip_suffix("_pdf.svg") {
-        if over_time(stem) {
-            HEATMAP
-        } else {
-            SCALAR
-        }
+        of(stem, HEATMAP)
     } else if let Some(stem) = name.strip_suffix("_sobol.svg") {
-        if over_time(stem) {
-            SOBOL
-        } else {
-            SCALAR
-        }
+        of(stem, SOBOL)
     } else if name.contains("_vs_") && name.ends_with(".svg") {
         SPEED
     } else {
@@ -90,7 +84,8 @@ pub(crate) fn anchor_for(file: &str, section_files: &[String]) -> Option<String>
 }
 
 /// A heading's anchor: ASCII letters lower-cased, letters, digits, `-` and `_` kept, white
-/// space made `-`, the rest dropped (as mdBook makes them, so that the anchors are those of the published guide).
+/// space made `-`, the rest dropped (as mdBook makes them, so that the anchors are those of
+/// the published guide).
 fn slug(heading: &str) -> String {
     heading
         .chars()
@@ -106,9 +101,15 @@ fn slug(heading: &str) -> String {
         .collect()
 }
 
+/// The page as HTML (rendered once per process: every report page writes it beside itself).
+pub(crate) fn to_html() -> &'static str {
+    static PAGE_HTML: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    PAGE_HTML.get_or_init(render)
+}
+
 /// The page as HTML: headings with their anchors; pictures of the guide (not in a report
 /// folder) left out; links to other pages of the guide kept as their text.
-pub(crate) fn to_html() -> String {
+fn render() -> String {
     let mut body = String::new();
     let mut heading: Option<(HeadingLevel, String)> = None;
     let mut events = Vec::new();
@@ -187,7 +188,7 @@ mod tests {
     #[test]
     fn every_plot_ending_points_at_a_heading_of_the_page() {
         let page = to_html();
-        let ids = ids(&page);
+        let ids = ids(page);
         for (end, heading) in ENDINGS {
             assert!(
                 ids.contains(&slug(heading)),

@@ -202,6 +202,14 @@ impl LimitResult {
         }
     }
 
+    /// The FORM analysis this result holds (SORM and importance sampling build on it), or
+    /// an error when there is none.
+    pub(crate) fn form_analysis(&self) -> Result<&FormResult, ReliabilityError> {
+        self.form
+            .as_ref()
+            .ok_or_else(|| ReliabilityError::Invalid("FORM gave no design point".into()))
+    }
+
     /// Takes FORM's design point, importance factors and index.
     pub(crate) fn with_form(&mut self, f: &FormResult) {
         self.beta = Some(f.beta);

@@ -28,7 +28,7 @@ use super::form::Form;
 use super::sorm::check_nested_form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, ReliabilityError};
+use crate::uq::reliability;
 
 /// `kind = "importance_sampling"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -166,9 +166,7 @@ impl Adaptive for ImportanceSampling {
                 Some(c) => (LimitResult::new(t, "importance_sampling", first), c.clone()),
                 None => {
                     let out = self.form.analyse(g, t, first, inputs, seed)?;
-                    let c = out.form.as_ref().map(|f| f.u_star.clone()).ok_or_else(|| {
-                        ReliabilityError::Invalid("FORM gave no design point".into())
-                    })?;
+                    let c = out.form_analysis()?.u_star.clone();
                     (out, c)
                 }
             };

@@ -17,7 +17,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, ReliabilityError, Scheme};
+use crate::uq::reliability::{self, Scheme};
 
 /// `kind = "sorm"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -125,10 +125,7 @@ impl Adaptive for Sorm {
         };
         each_target(model, inputs, targets, |g, t, first| {
             let mut out = self.form.analyse(g, t, first, inputs, seed)?;
-            let mut f = out
-                .form
-                .clone()
-                .ok_or_else(|| ReliabilityError::Invalid("FORM gave no design point".into()))?;
+            let mut f = out.form_analysis()?.clone();
             // The Hessian's runs follow every run of the FORM analysis.
             f.next_run = out.next_run();
             let s = reliability::sorm(g, &f, &settings)?;
