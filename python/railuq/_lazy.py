@@ -4,18 +4,17 @@ so they start without paying numpy's import (about 0.1 s)."""
 from __future__ import annotations
 
 import importlib
-from typing import Any
 
 
 class _Module:
     def __init__(self, name: str) -> None:
         self._name = name
 
-    def __getattr__(self, attr: str) -> Any:
+    def __getattr__(self, attr: str) -> object:
         return getattr(importlib.import_module(self._name), attr)
 
     def __repr__(self) -> str:
         return f"<{self._name}, imported on first use>"
 
 
-numpy: Any = _Module("numpy")
+numpy = _Module("numpy")

@@ -2,19 +2,22 @@
 runs."""
 from __future__ import annotations
 
-import difflib
 import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Optional, Union
 
 from . import _railuq
 from ._errors import StudyError
 from ._progress import Display, forward_messages
 from ._results import Results, SuiteResults
 
-PathLike = Union[str, "os.PathLike[str]"]
+# typing, logging, tempfile and difflib are imported where they are used: `import railuq`
+# stays cheap (the Python path's cost over the command line is measured in `make bench`).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any, Optional, Union
+
+    PathLike = Union[str, os.PathLike[str]]
 
 
 def builtins() -> list[str]:
@@ -30,6 +33,8 @@ def builtin(name: str) -> "Study":
     name = name[len("builtin:"):] if name.startswith("builtin:") else name
     names = builtins()
     if name not in names:
+        import difflib
+
         close = difflib.get_close_matches(name, names, n=1)
         hint = f"\nhint: did you mean '{close[0]}'?" if close else ""
         raise StudyError(f"no built-in study '{name}' (railuq.builtins() lists them){hint}")
@@ -177,6 +182,8 @@ class Study:
         """
         tmp = None
         if out is None:
+            import tempfile
+
             tmp = tempfile.TemporaryDirectory(prefix=f"railuq-{self.name}-")
             out_dir = Path(tmp.name)
         else:
