@@ -469,6 +469,91 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
 }
 
 #[test]
+fn a_chaos_tail_beyond_its_runs_names_its_design_point_and_sampling_there_finds_the_exact_p() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // y = x1 · … · x8 with ln xᵢ ~ N(0, s²), s = 0.7/√8: ln y ~ N(0, 0.7²), so
+    // P(y > L) = Φ(−ln L / 0.7) exactly; at 1e-4 none of 400 runs lies beyond, on average
+    // 0.04 of them.
+    let s = 0.7 / 8f64.sqrt();
+    let (mean, std) = (
+        (s * s / 2.0).exp(),
+        (s * s / 2.0).exp() * (s * s).exp_m1().sqrt(),
+    );
+    let inputs: String = (1..=8)
+        .map(|i| {
+            format!(
+                "[[parameters]]\nname = \"x{i}\"\ndistribution = \"lognormal\"\nmean = {mean}\n\
+                 std = {std}\n"
+            )
+        })
+        .collect();
+    let (exact, beta) = (1e-4, normal_isf(1e-4));
+    let limit = (0.7 * beta).exp();
+    let p = study(
+        dir.path(),
+        "chaos",
+        7,
+        &inputs,
+        &[limit],
+        &[],
+        "kind = \"pce_regression\"\nsamples = 400\norder = 4\nsparse = true",
+    );
+    let out = dir.path().join("chaos");
+    run_study_ok(&p, &out, &[]);
+    let e = &reliability(&out)[0];
+    assert_eq!(e["method"], "chaos");
+    assert!(e["ci_95"].is_null(), "{e}");
+    let guide = &e["chaos_design_point"];
+    // The exact design point: every uᵢ = β/√8 (xᵢ = exp(s uᵢ)). The chaos's tail falls off
+    // faster than the model's (β 4.18 against 3.72 here: its P is 7× too small), so its point
+    // lies further out, but in the same direction: the centre where the model is sampled.
+    let b = f(&guide["beta"]);
+    assert!(
+        b > 0.0 && (b - beta).abs() < 0.25 * beta,
+        "the chaos's β {b} against {beta}"
+    );
+    let u: Vec<f64> = (1..=8)
+        .map(|i| f(&guide["design_point"][format!("x{i}")]).ln() / s)
+        .collect();
+    let cosine = u.iter().sum::<f64>() / 8f64.sqrt() / u.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(
+        cosine > 0.99,
+        "the chaos's design point {u:?} is off the direction (1, …, 1)"
+    );
+    // The warning's centre, pasted as it is into an importance-sampling study of the model.
+    let w = e["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_str)
+        .find(|w| w.contains("centre = {"))
+        .unwrap_or_else(|| panic!("no centre suggested: {e}"));
+    let centre = &w[w.find("centre = {").unwrap()..];
+    let centre = &centre[..centre.find('}').unwrap() + 1];
+    let p = study(
+        dir.path(),
+        "is",
+        7,
+        &inputs,
+        &[limit],
+        &[],
+        &format!("kind = \"importance_sampling\"\ntarget_cov = 0.1\n{centre}"),
+    );
+    let out = dir.path().join("is");
+    run_study_ok(&p, &out, &[]);
+    let e = &reliability(&out)[0];
+    let (got, cov) = (f(&e["p"]), f(&e["cov"]));
+    assert!(cov <= 0.1 + 1e-12, "cov {cov}");
+    assert!(
+        (got - exact).abs() < 4.0 * cov * got,
+        "{got} ± {cov} for {exact}"
+    );
+}
+
+#[test]
 fn a_reliability_study_is_refused_by_plan_shards_and_told_to_run_on_one_machine() {
     if test_fmus::built().is_none() {
         return;

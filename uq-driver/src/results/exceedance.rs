@@ -55,9 +55,25 @@ pub struct ExceedanceCount {
     /// `above`: the count is of draws above the limit (`P(q > limit)`, the quantity's
     /// `limits`); `below`: below it (`P(q < limit)`, its `limits_below`).
     pub direction: &'static str,
+    /// With `beyond_runs` or `runs_in_tail`: the chaos's own design point as the TOML inline
+    /// table `{ NAME = VALUE, ... }`, the `centre` of an `importance_sampling` study that
+    /// samples the model where the chaos fails (its `chaos_design_point` in `summary.json`).
+    #[serde(skip)]
+    pub(crate) chaos_centre: Option<String>,
 }
 
 impl ExceedanceCount {
+    /// How to get the probability from model runs instead of the chaos's tail.
+    fn model_runs_instead(&self) -> String {
+        match &self.chaos_centre {
+            Some(c) => format!(
+                "importance_sampling with `centre = {c}`, the chaos's own design point, \
+                 estimates it from model runs there"
+            ),
+            None => "importance_sampling estimates it from model runs".into(),
+        }
+    }
+
     /// E.g. `0 of 10 000 runs exceeded 2.5 (95 % upper bound 3.0e-4)` or
     /// `12 of 1 000 runs exceeded 2.5: P = 0.012 (95 % interval 0.0062–0.021)`; nested:
     /// `617 of 2 000 runs over 50 outer samples exceeded 1.5: P = 0.308 (95 % interval, bootstrap
@@ -164,19 +180,19 @@ impl ExceedanceCount {
             return format!(
                 "{head}: P = {}, no interval (only {} of the {} model runs lie beyond the \
                  limit: the chaos's tail there is mostly extrapolation, which its \
-                 truncation-error estimate does not cover; importance_sampling estimates it \
-                 from model runs)",
+                 truncation-error estimate does not cover; {})",
                 sig(self.p),
                 group_digits(k),
-                group_digits(n)
+                group_digits(n),
+                self.model_runs_instead()
             );
         }
         if self.beyond_runs.is_some() && self.ci_kind == "none_extrapolation" {
             return format!(
                 "{head}: P = {}, no interval (the chaos's truncation-error estimate says \
-                 nothing of its tail beyond the runs; importance_sampling estimates it from \
-                 model runs)",
-                sig(self.p)
+                 nothing of its tail beyond the runs; {})",
+                sig(self.p),
+                self.model_runs_instead()
             );
         }
         if self.exceeded == 0 {

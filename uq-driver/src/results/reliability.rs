@@ -54,6 +54,11 @@ pub struct LimitProbability {
     /// The method's own result (the report's plots).
     #[serde(skip)]
     pub(crate) result: Option<Box<LimitResult>>,
+    /// Counted over draws of a chaos beyond (or nearly beyond) its model runs: the chaos's
+    /// extrapolation, given no interval (the analysis then looks for the chaos's own design
+    /// point).
+    #[serde(skip)]
+    pub(crate) tail_extrapolated: bool,
 }
 
 /// `above` or `below`.
@@ -124,6 +129,7 @@ impl LimitProbability {
             details,
             warnings: r.warnings.clone(),
             result: Some(Box::new(r.clone())),
+            tail_extrapolated: false,
         }
     }
 
@@ -161,6 +167,7 @@ impl LimitProbability {
             details: serde_json::Map::new(),
             warnings: Vec::new(),
             result: None,
+            tail_extrapolated: false,
         }
     }
 

@@ -180,7 +180,8 @@ fn analyse(
             (n.analysed, n.splits, n.warnings)
         }
         None => {
-            let analysed = analysis::analyse_runs(study, method, design, records)?;
+            let mut analysed = analysis::analyse_runs(study, method, design, records)?;
+            analysis::guide_tails(&mut analysed, &design.inputs, design.germ);
             // Inputs with an Askey family of their own that the design maps through the normal.
             let askey_hint =
                 design.germ == Germ::Normal && ChaosBasis::some_own_family(&design.inputs);

@@ -52,6 +52,7 @@ pub fn count_on_side(draws: &[f64], limit: f64, side: Side, source: Draws) -> Ex
         beyond_runs: None,
         runs_in_tail: None,
         direction: crate::results::direction(side),
+        chaos_centre: None,
     }
 }
 
@@ -93,6 +94,7 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
             if let Some([k, n]) = e.runs_in_tail {
                 p.upper_95 = None;
                 p.cov = None;
+                p.tail_extrapolated = true;
                 p.warnings.push(format!(
                     "counted over draws of the chaos surrogate with only {k} of the {n} model \
                      runs beyond the limit: the chaos's tail there is mostly extrapolation, \
@@ -104,6 +106,7 @@ pub fn counted_probabilities(counts: &[ExceedanceCount], method: &str) -> Vec<Li
                 // The draws' binomial CoV is not the error of the chaos's tail either.
                 p.upper_95 = None;
                 p.cov = None;
+                p.tail_extrapolated = true;
                 p.warnings.push(format!(
                     "counted over draws of the chaos surrogate with the limit outside the range \
                      of the model runs ({lo} to {hi}): the chaos's extrapolation, which its \

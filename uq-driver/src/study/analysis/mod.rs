@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 pub mod blocks;
 mod chaos_gap;
+mod chaos_guide;
 mod columns;
 mod convergence;
 mod error;
@@ -24,6 +25,7 @@ mod surrogate;
 mod truncation_checks;
 
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
+pub(crate) use chaos_guide::guide_tails;
 pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
 #[cfg(test)]
