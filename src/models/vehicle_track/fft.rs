@@ -181,6 +181,20 @@ impl FftPath {
         v
     }
 
+    /// The instruction set this path runs on here, as recorded in the model's
+    /// `solver.kernel`: `Auto` resolved as rustfft's planner resolves it (AVX with FMA, else
+    /// SSE4.1, else Neon, else scalar).
+    pub fn isa_name(self) -> &'static str {
+        match self {
+            FftPath::Auto if rustfft::FftPlannerAvx::<f64>::new().is_ok() => "avx+fma",
+            FftPath::Auto if rustfft::FftPlannerSse::<f64>::new().is_ok() => "sse4.1",
+            FftPath::Auto if rustfft::FftPlannerNeon::<f64>::new().is_ok() => "neon",
+            FftPath::Auto | FftPath::Scalar => "scalar",
+            FftPath::Sse => "sse4.1",
+            FftPath::Avx => "avx+fma",
+        }
+    }
+
     fn plan(self, len: usize) -> Result<Arc<dyn rustfft::Fft<f64>>, String> {
         let dir = rustfft::FftDirection::Forward;
         let unsupported = || format!("FFT path {self:?} is not supported by this CPU");

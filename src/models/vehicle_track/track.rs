@@ -102,6 +102,27 @@ impl Kernel {
         v.push(Kernel::Plain);
         v
     }
+
+    /// What this kernel runs on here, as the FMU's `solver.kernel` reports it: the
+    /// architecture, the instruction set of the stepping loops (the one
+    /// [`crate::solver::simd::Simd::dispatch`] calls: `avx2+fma` or, on x86-64 without them,
+    /// `sse2`) and that of the FFT, e.g. `x86_64: loops avx2+fma, FFT avx+fma`; the plain
+    /// reference: `x86_64: plain reference kernel`. AVX2 and SSE2 loops agree to about 1e-13
+    /// only, so a result is reproduced bit for bit on the same kernel.
+    pub fn describe(self) -> String {
+        let arch = std::env::consts::ARCH;
+        let (isa, fft) = match self {
+            Kernel::Fast => (Simd::best().isa(), FftPath::Auto),
+            Kernel::Custom { isa, fft } => (isa, fft),
+            Kernel::Plain => return format!("{arch}: plain reference kernel"),
+        };
+        let loops = match isa {
+            Isa::Avx2 => "avx2+fma",
+            Isa::Baseline if cfg!(target_arch = "x86_64") => "sse2",
+            Isa::Baseline => "baseline",
+        };
+        format!("{arch}: loops {loops}, FFT {}", fft.isa_name())
+    }
 }
 
 /// Modes per block of the wheels' mode shapes (see [`Track::set_wheels`]).
