@@ -52,6 +52,8 @@ fn variable_table_is_sorted_unique_and_exports() {
             }
             Start::Integer(Some(s)) => assert_eq!(m.get_integer(v.vr).unwrap(), s),
             Start::String(Some(s)) => assert_eq!(m.get_string(v.vr).unwrap(), s),
+            // A calculated String (the solver kernel): computed, never empty.
+            Start::String(None) => assert!(!m.get_string(v.vr).unwrap().is_empty(), "{}", v.name),
             _ => unreachable!(),
         }
     }
