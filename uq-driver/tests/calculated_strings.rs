@@ -50,6 +50,18 @@ fn nominal_summary(
     experiment: &str,
     output: &str,
 ) -> Value {
+    nominal_summary_with(dir, model, (param, low, high), experiment, output, &[])
+}
+
+/// [`nominal_summary`] with more options of `run`.
+fn nominal_summary_with(
+    dir: &Path,
+    model: &str,
+    (param, low, high): (&str, f64, f64),
+    experiment: &str,
+    output: &str,
+    extra: &[&str],
+) -> Value {
     let fmu = built_fmu(model);
     let text = format!(
         "{}[method]\nkind = \"nominal\"\n{}[outputs]\nvariables = [\"{output}\"]\n",
@@ -58,7 +70,7 @@ fn nominal_summary(
     );
     let study = write_toml(dir, model, &text);
     let out = dir.join(format!("{model}-out"));
-    run_study_ok(&study, &out, &[]);
+    run_study_ok(&study, &out, extra);
     read_json(&out.join("summary.json"))
 }
 
@@ -77,6 +89,22 @@ fn summary_json_records_the_vehicle_track_solver_kernel() {
         serde_json::json!({ "solver.kernel": expected_kernel() }),
         "{s}"
     );
+}
+
+#[test]
+fn summary_json_of_isolated_runs_records_no_calculated_strings() {
+    // Under --isolate the FMU never runs in uq-driver's own process, so nothing is read: the
+    // field stays empty rather than being read in another process than the runs ran in.
+    let dir = tempfile::tempdir().unwrap();
+    let s = nominal_summary_with(
+        dir.path(),
+        "VehicleTrack",
+        ("irregularity_scale", 0.9, 1.1),
+        "stop = 0.02\nstep = 0.002",
+        "P1",
+        &["--isolate"],
+    );
+    assert_eq!(s["fmu"]["calculated_strings"], serde_json::json!({}), "{s}");
 }
 
 #[test]
