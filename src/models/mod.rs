@@ -191,6 +191,19 @@ impl Variable {
         }
     }
 
+    /// A String calculated parameter (fixed, computed at initialization, no start value):
+    /// what the model found out about the machine it runs on, for the record.
+    pub const fn calculated_string(
+        name: &'static str,
+        vr: u32,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            start: Start::String(None),
+            ..Variable::calculated_parameter(name, vr, None, description)
+        }
+    }
+
     /// The same variable with a lower bound.
     pub const fn with_min(self, min: Option<f64>) -> Variable {
         Variable { min, ..self }

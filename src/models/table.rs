@@ -207,6 +207,7 @@ pub fn any_string(_name: &'static str, _value: &str) -> SetResult {
 ///     integer_parameter("seed", VR_SEED = 44, m.p.seed, 1, any_integer, "Seed ..."),
 ///     string_parameter("file", VR_FILE = 46, m.p.file, "", any_string, "CSV ..."),
 ///     calculated("G", VR_G = 50, None, m.hertz(), "Hertz constant"),
+///     calculated_string("solver.kernel", VR_KERNEL = 53, m.kernel_name(), "Kernel ..."),
 ///     output("q", VR_Q = 10, Some("m"), m.y[0], "Displacement"),
 /// }
 /// ```
@@ -215,8 +216,9 @@ pub fn any_string(_name: &'static str, _value: &str) -> SetResult {
 /// the setter after the check `check(name, value)`); `real_parameter` takes an optional
 /// trailing `min = x` and then `max = y` (the XML `min` and `max` attributes; the check
 /// must refuse values outside them). Outputs and calculated parameters give an
-/// expression of the model `m`. The macro defines the `VR_…` constants, `TABLE` (a
-/// [`Table`]) and `VARIABLES` (the [`Variable`] list).
+/// expression of the model `m` (a `calculated_string` one of type `String`). The macro
+/// defines the `VR_…` constants, `TABLE` (a [`Table`]) and `VARIABLES` (the [`Variable`]
+/// list).
 macro_rules! variables {
     (
         static $table:ident: [$model:ty as $m:ident];
@@ -288,6 +290,13 @@ macro_rules! variables {
         $crate::models::table::Binding {
             var: $crate::models::Variable::calculated_parameter($name, $vr, $unit, $desc),
             access: $crate::models::table::Access::Real(|$m: &$model| $get, None),
+        }
+    };
+    (@bind $model:ty, $m:ident, calculated_string ($name:literal, $vr_name:ident = $vr:literal,
+        $get:expr, $desc:literal)) => {
+        $crate::models::table::Binding {
+            var: $crate::models::Variable::calculated_string($name, $vr, $desc),
+            access: $crate::models::table::Access::String(|$m: &$model| $get, None),
         }
     };
     (@bind $model:ty, $m:ident, output ($name:literal, $vr_name:ident = $vr:literal,

@@ -16,6 +16,7 @@
 mod support;
 
 mod analysis_blocks;
+mod calculated_strings;
 mod chaos_sizes;
 mod cli_options;
 mod declared_speed_range;

@@ -52,6 +52,8 @@ fn variable_table_is_sorted_unique_and_exports() {
             }
             Start::Integer(Some(s)) => assert_eq!(m.get_integer(v.vr).unwrap(), s),
             Start::String(Some(s)) => assert_eq!(m.get_string(v.vr).unwrap(), s),
+            // A calculated String (the solver kernel): computed, never empty.
+            Start::String(None) => assert!(!m.get_string(v.vr).unwrap().is_empty(), "{}", v.name),
             _ => unreachable!(),
         }
     }
@@ -633,4 +635,65 @@ fn a_speed_in_km_per_hour_is_refused() {
     assert_eq!((v.min, v.max), (Some(0.0), Some(160.0)));
     // 574.8 km/h, the record, lies inside the range.
     assert!(574.8 / 3.6 < v.max.unwrap());
+}
+
+/// `solver.kernel` names the instruction sets the stepping loops and the FFT run on: the
+/// ones the dispatcher picks for the default kernel (derived here from the CPU's features),
+/// those of a kernel forced on a path, and the plain reference; before and after the
+/// initialization alike.
+#[test]
+fn solver_kernel_names_the_instruction_sets_the_dispatcher_picks() {
+    let arch = std::env::consts::ARCH;
+    #[cfg(target_arch = "x86_64")]
+    let (loops, fft) = {
+        use std::arch::is_x86_feature_detected as has;
+        let loops = if has!("avx2") && has!("fma") {
+            "avx2+fma"
+        } else {
+            "sse2"
+        };
+        let fft = if has!("avx") && has!("fma") {
+            "avx+fma"
+        } else if has!("sse4.1") {
+            "sse4.1"
+        } else {
+            "scalar"
+        };
+        (loops, fft)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let (loops, fft) = ("baseline", super::fft::FftPath::Auto.isa_name());
+    let mut m = small(63, 63);
+    let before = m.get_string(VR_SOLVER_KERNEL).unwrap();
+    assert_eq!(before, format!("{arch}: loops {loops}, FFT {fft}"));
+    m.initialize(&InitContext::default()).unwrap();
+    assert_eq!(m.get_string(VR_SOLVER_KERNEL).unwrap(), before);
+    // What the stepping loop of the initialized track dispatches to.
+    let isa = m.sim().unwrap().track.simd().isa();
+    assert_eq!(isa == crate::solver::simd::Isa::Avx2, loops == "avx2+fma");
+    let var = INFO.variable(VR_SOLVER_KERNEL).unwrap();
+    assert_eq!(var.name, "solver.kernel");
+    assert_eq!(var.causality, crate::models::Causality::CalculatedParameter);
+    assert_eq!(var.start, Start::String(None));
+    assert!(m.set_string(VR_SOLVER_KERNEL, "sse2").is_err());
+
+    let mut forced = small(63, 63);
+    forced.set_kernel(Kernel::Custom {
+        isa: crate::solver::simd::Isa::Baseline,
+        fft: super::fft::FftPath::Scalar,
+    });
+    let baseline = if cfg!(target_arch = "x86_64") {
+        "sse2"
+    } else {
+        "baseline"
+    };
+    assert_eq!(
+        forced.get_string(VR_SOLVER_KERNEL).unwrap(),
+        format!("{arch}: loops {baseline}, FFT scalar")
+    );
+    forced.set_kernel(Kernel::Plain);
+    assert_eq!(
+        forced.get_string(VR_SOLVER_KERNEL).unwrap(),
+        format!("{arch}: plain reference kernel")
+    );
 }

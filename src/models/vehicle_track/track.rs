@@ -102,6 +102,27 @@ impl Kernel {
         v.push(Kernel::Plain);
         v
     }
+
+    /// What this kernel runs on here, as the FMU's `solver.kernel` reports it: the
+    /// architecture, the instruction set of the stepping loops (the one
+    /// [`crate::solver::simd::Simd::dispatch`] calls: `avx2+fma` or, on x86-64 without them,
+    /// `sse2`) and that of the FFT, e.g. `x86_64: loops avx2+fma, FFT avx+fma`; the plain
+    /// reference: `x86_64: plain reference kernel`. AVX2 and SSE2 loops agree to about 1e-13
+    /// only, so a result is reproduced bit for bit on the same kernel.
+    pub fn describe(self) -> String {
+        let arch = std::env::consts::ARCH;
+        let (isa, fft) = match self {
+            Kernel::Fast => (Simd::best().isa(), FftPath::Auto),
+            Kernel::Custom { isa, fft } => (isa, fft),
+            Kernel::Plain => return format!("{arch}: plain reference kernel"),
+        };
+        let loops = match isa {
+            Isa::Avx2 => "avx2+fma",
+            Isa::Baseline if cfg!(target_arch = "x86_64") => "sse2",
+            Isa::Baseline => "baseline",
+        };
+        format!("{arch}: loops {loops}, FFT {}", fft.isa_name())
+    }
 }
 
 /// Modes per block of the wheels' mode shapes (see [`Track::set_wheels`]).
@@ -130,7 +151,6 @@ pub struct Track {
     dst_fine: DstI,
     bins: Vec<f64>,
     r: Vec<f64>,
-    modal: Vec<f64>,
     frs: Vec<f64>,
     /// Ballast shear forces per unit mass between blocks i−1 and i, i = 0..=N (ends 0).
     shear: Vec<f64>,
@@ -209,7 +229,6 @@ impl Track {
             dst_fine,
             bins: vec![0.0; n],
             r: vec![0.0; n],
-            modal: vec![0.0; nm],
             frs: vec![0.0; n],
             shear: vec![0.0; n + 1],
             fine: vec![0.0; 2 * n + 1],
@@ -413,10 +432,25 @@ impl Track {
             }
             self.bins[nm..].fill(0.0);
         } else {
-            for ((w, &a), &ad) in self.modal.iter_mut().zip(q).zip(qd) {
-                *w = t.kp * a + t.cp * ad;
+            // Folded as it is computed (the same sums as `fold` of the modal vector, one pass,
+            // no modal scratch): bin j of the sleeper grid gets mode j + 1, less mode
+            // 2N + 1 − j (its mirror beyond mode N + 1) where NM reaches it.
+            let folded = nm - n - 1;
+            let plain = n - folded;
+            let (bins_plain, bins_folded) = self.bins.split_at_mut(plain);
+            for ((b, &a), &ad) in bins_plain.iter_mut().zip(q).zip(qd) {
+                *b = t.kp * a + t.cp * ad;
             }
-            fold(&self.modal, &mut self.bins);
+            // Bin plain + u (u = 0..folded) takes mode plain + u + 1 and mode 2N + 1 − plain − u
+            // (0-based 2N − plain − u: descending from nm − 1 to n + 1).
+            let (q_mid, q_mirror) = (&q[plain..n], &q[n + 1..nm]);
+            let (qd_mid, qd_mirror) = (&qd[plain..n], &qd[n + 1..nm]);
+            for u in 0..folded {
+                let v = folded - 1 - u;
+                let own = t.kp * q_mid[u] + t.cp * qd_mid[u];
+                let mirror = t.kp * q_mirror[v] + t.cp * qd_mirror[v];
+                bins_folded[u] = own - mirror;
+            }
         }
         self.dst.transform(&self.bins, &mut self.r);
         let (inv_ms, inv_mb) = (1.0 / t.ms, 1.0 / t.mb);

@@ -101,7 +101,7 @@ fn flag(name: &'static str, value: i32) -> SetResult {
     Ok(None)
 }
 
-// Value references: Real parameters 0..40, Integer 40..=45, String 46, calculated 50..=52,
+// Value references: Real parameters 0..40, Integer 40..=45, String 46, calculated 50..=53,
 // outputs from 100. `m` is the model; its Real parameters live in `m.p.reals[vr]`.
 variables! {
     static TABLE: [VehicleTrack as m];
@@ -152,6 +152,7 @@ variables! {
     calculated("G", VR_HERTZ_G = 50, None, hertz_constant(m.p.r(VR_R)), "Hertz constant G = 4.57e-8 R^-0.149 in m/N^(2/3)"),
     calculated("track_length", VR_TRACK_LENGTH = 51, Some("m"), (m.p.n_sleepers as f64 + 1.0) * m.p.r(VR_LS), "Computing length l = (n_sleepers + 1) ls"),
     calculated("P_static", VR_P_STATIC = 52, Some("N"), m.p.static_load(), "Static wheel load g (Mc/8 + Mt/4 + Mw/2)"),
+    calculated_string("solver.kernel", VR_SOLVER_KERNEL = 53, m.kernel.describe(), "Instruction sets the track's equations run on here, chosen at run time from the CPU: architecture, stepping loops (avx2+fma, else sse2 on x86-64) and FFT, e.g. 'x86_64: loops avx2+fma, FFT avx+fma'; results of two kernels agree to about 1e-13 only, so record it with a result"),
     output("Zc", VR_ZC = 100, Some("m"), m.state(|s| s.zhai.x[vehicle::ZC]), "Carbody vertical displacement (down)"),
     output("Zc_acc", VR_ZC_ACC = 101, Some("m/s2"), m.state(|s| s.zhai.a[vehicle::ZC]), "Carbody vertical acceleration at the carbody centre (centre of mass), from the equations of motion; above the bogies, where ride standards measure: Zc_acc_front, Zc_acc_rear"),
     output("beta_c", VR_BETA_C = 102, Some("rad"), m.state(|s| s.zhai.x[vehicle::BC]), "Carbody pitch"),

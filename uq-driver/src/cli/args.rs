@@ -355,7 +355,8 @@ pub(crate) struct SimulateArgs {
     #[arg(long)]
     pub(crate) step: Option<f64>,
     /// CSV file to write (default, or `-`: standard output; a device or a named pipe is
-    /// written into, never replaced).
+    /// written into, never replaced); beside a file, FILE.meta.json: the FMU, the experiment,
+    /// the values set and the FMU's String calculated parameters.
     #[arg(long, short)]
     pub(crate) out: Option<PathBuf>,
     /// Instantiate the FMU with loggingOn = true (many FMUs log only then) and print its

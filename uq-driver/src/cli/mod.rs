@@ -158,7 +158,7 @@ pub fn simulate(
         out: None,
         fmu_logging: false,
     };
-    simulation(&a, set, false)
+    simulation(&a, set, false).map(|(sim, _)| sim)
 }
 
 /// The checks `uq-driver run` makes on a study it loaded, before running it: every FMU it

@@ -72,7 +72,12 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         .map(|(n, v)| (n.clone(), FixedValue::Text(v.clone())))
         .collect();
     let to_stdout = out_path(a.out.as_deref()).is_none();
-    let sim = simulation(&a, &params, to_stdout)?;
+    let (sim, meta) = simulation(&a, &params, to_stdout)?;
+    for (name, value) in &sim.calculated_strings {
+        message(&format!(
+            "uq-driver: note: the FMU reports {name} = \"{value}\""
+        ));
+    }
     let mut text = String::from("time");
     for n in &sim.names {
         text.push(',');
@@ -87,7 +92,71 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<()> {
         }
         text.push('\n');
     }
-    emit(&text, a.out.as_deref())
+    emit(&text, a.out.as_deref())?;
+    // Beside a CSV written to a file (not to a device or a pipe): what produced it.
+    if let Some(p) = out_path(a.out.as_deref()).filter(|p| p.is_file()) {
+        let mut side = p.as_os_str().to_owned();
+        side.push(".meta.json");
+        let side = std::path::PathBuf::from(side);
+        let text = simulation_metadata(&a, &params, &sim, &meta);
+        out_file::write(&side, text.as_bytes())
+            .with_context(|| format!("writing {}", side.display()))?;
+    }
+    Ok(())
+}
+
+/// What `simulate --out FILE` writes to `FILE.meta.json`: the FMU (path, model name, GUID,
+/// SHA-256, its String calculated parameters, e.g. the instruction sets a model's solver ran
+/// on), the experiment and the values set (as given on the command line).
+fn simulation_metadata(
+    a: &SimulateArgs,
+    params: &[(String, FixedValue)],
+    sim: &Simulation,
+    meta: &SimulationMeta,
+) -> String {
+    let set: serde_json::Map<String, serde_json::Value> = params
+        .iter()
+        .map(|(n, v)| {
+            let text = match v {
+                FixedValue::Text(t) => t.clone(),
+                other => other.to_string(),
+            };
+            (n.clone(), serde_json::json!(text))
+        })
+        .collect();
+    let strings: serde_json::Map<String, serde_json::Value> = sim
+        .calculated_strings
+        .iter()
+        .map(|(n, v)| (n.clone(), serde_json::json!(v)))
+        .collect();
+    let sha256 = crate::study::plan::fingerprint::sha256_file(&a.fmu).unwrap_or_default();
+    let json = serde_json::json!({
+        "fmu": {
+            "path": a.fmu.display().to_string(),
+            "model_name": meta.model_name,
+            "guid": meta.guid,
+            "sha256": sha256,
+            "calculated_strings": strings,
+        },
+        "experiment": {
+            "start": meta.experiment.start,
+            "stop": meta.experiment.stop,
+            "step": meta.experiment.step,
+        },
+        "set": set,
+        "ended_at": sim.ended_at,
+        "versions": {"uq_driver": env!("CARGO_PKG_VERSION"), "fmi": "2.0"},
+    });
+    let mut text = serde_json::to_string_pretty(&json).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+/// What [`simulation`] used besides its result: the FMU's identity and the experiment.
+pub(crate) struct SimulationMeta {
+    model_name: String,
+    guid: String,
+    experiment: Experiment,
 }
 
 /// The run of `uq-driver simulate` (and of [`super::simulate`]): `params` set before
@@ -99,7 +168,7 @@ pub(crate) fn simulation(
     a: &SimulateArgs,
     params: &[(String, FixedValue)],
     redirect_stdout: bool,
-) -> Result<Simulation> {
+) -> Result<(Simulation, SimulationMeta)> {
     let fmu = Fmu::open(&a.fmu)?;
     let de = fmu.description().default_experiment.unwrap_or_default();
     let start = a.start.or(de.start_time).unwrap_or(0.0);
@@ -212,7 +281,12 @@ pub(crate) fn simulation(
         k += 1;
         keep[k - 1]
     });
-    Ok(sim)
+    let meta = SimulationMeta {
+        model_name: md.model_name.clone(),
+        guid: md.guid.clone(),
+        experiment,
+    };
+    Ok((sim, meta))
 }
 
 /// The communication step fmpy's `simulate_fmu` takes for a Co-Simulation FMU without a

@@ -545,6 +545,13 @@ impl ScalarVariable {
                 || self.effective_initial() == Some(Initial::Exact))
     }
 
+    /// A String of causality `calculatedParameter`: a text the FMU computes at initialization
+    /// (summary.json and `simulate` record these, see [`super::Instance::get_calculated_strings`]).
+    pub fn is_calculated_string(&self) -> bool {
+        self.causality == Causality::CalculatedParameter
+            && matches!(self.kind, VariableKind::String { .. })
+    }
+
     /// Whether `fmi2Set*` may set this variable after initialization, at communication points
     /// (FMI 2.0: inputs and tunable parameters only).
     pub fn settable_after_init(&self) -> bool {

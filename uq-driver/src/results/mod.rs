@@ -369,6 +369,10 @@ pub struct FmuInfo {
     pub generation_tool: Option<String>,
     /// SHA-256 of the FMU.
     pub sha256: String,
+    /// The FMU's String calculated parameters, name → value, read once after initializing an
+    /// instance with its default parameters (e.g. VehicleTrack's `solver.kernel`: the
+    /// instruction sets its solver runs on); empty when it has none.
+    pub calculated_strings: BTreeMap<String, String>,
 }
 
 /// Versions of the driver and of FMI.

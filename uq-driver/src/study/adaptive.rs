@@ -37,7 +37,7 @@ use crate::results::{
     FmuInfo, LimitProbability, MorrisScreening, PointStatus, PointTable, ScalarStats,
 };
 use crate::spec::Study;
-use crate::study::facts::{summary, RunFacts};
+use crate::study::facts::{calculated_strings, summary, RunFacts};
 use crate::study::outcome::{StudyResult, StudyRunError};
 use crate::study::plan::{fingerprint, ranges};
 use crate::study::progress;
@@ -218,6 +218,7 @@ fn finish(
             guid: md.guid.clone(),
             generation_tool: md.generation_tool.clone(),
             sha256: fmu_sha256,
+            calculated_strings: calculated_strings(fmu, &study.experiment, opts.isolate.is_some()),
         }),
         model_runs: runs,
         runs_new: runs.saturating_sub(resumed),

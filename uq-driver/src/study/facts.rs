@@ -2,11 +2,46 @@
 
 use std::collections::BTreeMap;
 
+use crate::fmu::{Fmu, FmuError};
 use crate::results::{
     FmuInfo, OutputStats, OutputSummary, RecordLayout, ScalarStats, Summary, Timing, Versions,
 };
-use crate::spec::Study;
+use crate::spec::{Experiment, Study};
+use crate::study::run::instances::instance_name;
 use crate::uq::method::MethodSummary;
+
+/// The FMU's String calculated parameters for `summary.json` (`fmu.calculated_strings`),
+/// read from an instance of their own in this process (the one writing the summary): the
+/// FMU's default parameters, initialized at the start time of `experiment`. Empty when the
+/// FMU declares none, and under `--isolate` (`isolated`: the FMU never runs in uq-driver's own
+/// process); when that instance fails, a note says why and the field stays empty.
+pub(crate) fn calculated_strings(
+    fmu: &Fmu,
+    experiment: &Experiment,
+    isolated: bool,
+) -> BTreeMap<String, String> {
+    let md = fmu.description();
+    if isolated || !md.variables.iter().any(|v| v.is_calculated_string()) {
+        return BTreeMap::new();
+    }
+    let read = || -> Result<Vec<(String, String)>, FmuError> {
+        let mut inst = fmu.instantiate(&instance_name(), false)?;
+        inst.setup_experiment(None, experiment.start, Some(experiment.stop))?;
+        inst.enter_initialization_mode()?;
+        inst.exit_initialization_mode()?;
+        inst.get_calculated_strings()
+    };
+    match read() {
+        Ok(values) => values.into_iter().collect(),
+        Err(e) => {
+            crate::study::progress::message(&format!(
+                "uq-driver: note: the FMU's String calculated parameters (for summary.json) \
+                 could not be read from an instance with its default parameters: {e}"
+            ));
+            BTreeMap::new()
+        }
+    }
+}
 
 /// Facts of a run for the summary.
 pub(crate) struct RunFacts {

@@ -11,7 +11,7 @@ use crate::report::{self, ReportError, StudyReport};
 use crate::results::{FmuInfo, OutputSplit, PointStatus, PointTable};
 use crate::spec::Study;
 use crate::study::analysis::{self, Analysed, AnalysisError};
-use crate::study::facts::{summary, RunFacts};
+use crate::study::facts::{calculated_strings, summary, RunFacts};
 use crate::study::outcome::{StudyResult, StudyRunError};
 use crate::study::plan::ranges;
 use crate::study::plan::size;
@@ -112,6 +112,7 @@ pub(crate) fn finish(
             guid: md.guid.clone(),
             generation_tool: md.generation_tool.clone(),
             sha256: outcome.fmu_sha256.clone(),
+            calculated_strings: calculated_strings(fmu, &study.experiment, opts.isolate.is_some()),
         }),
         model_runs: design.len(),
         runs_new: outcome.n_new,

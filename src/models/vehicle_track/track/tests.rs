@@ -170,3 +170,36 @@ fn contiguous_fold_equals_the_sine_identity_bit_for_bit() {
         }
     }
 }
+
+#[test]
+fn pad_input_folded_as_computed_gives_the_bits_of_the_folded_modal_vector() {
+    // The stepping kernel folds Kp q + Cp q' onto the sleeper grid as it computes it; the rail
+    // at the sleepers (the sine transform of those bins) must be the bits of the transform of
+    // `fold` applied to the modal vector, for every count of folded modes.
+    for (n, nm) in [(63, 64), (63, 65), (63, 100), (63, 127), (255, 511)] {
+        let mut t = Track::new(paper_track(n, nm)).unwrap();
+        let dim = t.dim();
+        let y: Vec<f64> = (0..dim)
+            .map(|i| ((i * 37 % 101) as f64 - 50.3) * 1e-6)
+            .collect();
+        let yd: Vec<f64> = (0..dim)
+            .map(|i| ((i * 53 % 97) as f64 - 48.1) * 1e-4)
+            .collect();
+        t.set_wheels(&[10.0, 12.5, 27.9, 30.4]);
+        let mut acc = vec![0.0; dim];
+        t.accelerations(&y, &yd, &[7e4, 7e4, 7e4, 7e4], &mut acc);
+        let tp = t.p;
+        let modal: Vec<f64> = (0..nm).map(|k| tp.kp * y[k] + tp.cp * yd[k]).collect();
+        let mut bins = vec![f64::NAN; n];
+        fold(&modal, &mut bins);
+        let mut want = vec![0.0; n];
+        DstI::new(n).unwrap().transform(&bins, &mut want);
+        for i in 0..n {
+            assert_eq!(
+                t.r[i].to_bits(),
+                want[i].to_bits(),
+                "n {n} nm {nm} sleeper {i}"
+            );
+        }
+    }
+}

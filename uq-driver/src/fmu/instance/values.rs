@@ -111,6 +111,25 @@ impl Instance {
         Ok(())
     }
 
+    /// The String variables of causality `calculatedParameter` (in description order) with
+    /// their values: what an FMU computes at initialization to describe itself, such as the
+    /// instruction set its solver picked on this machine. Read them after initialization.
+    pub fn get_calculated_strings(&mut self) -> Result<Vec<(String, String)>, FmuError> {
+        let (names, vrs): (Vec<String>, Vec<u32>) = self
+            .description()
+            .variables
+            .iter()
+            .filter(|v| v.is_calculated_string())
+            .map(|v| (v.name.clone(), v.value_reference))
+            .unzip();
+        if vrs.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut values = vec![String::new(); vrs.len()];
+        self.get_string(&vrs, &mut values)?;
+        Ok(names.into_iter().zip(values).collect())
+    }
+
     /// Looks up a variable of the given base type that may be set in the current state.
     fn settable(&self, name: &str, base_type: &'static str) -> Result<u32, FmuError> {
         let var = self.lookup(name, base_type)?;

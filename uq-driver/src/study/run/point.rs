@@ -268,6 +268,10 @@ pub struct Simulation {
     pub skipped: Vec<(String, String)>,
     /// When the FMU ended the simulation before the stop time, the time (s).
     pub ended_at: Option<f64>,
+    /// The FMU's String calculated parameters (name, value) read after the run (see
+    /// [`crate::fmu::Instance::get_calculated_strings`]), e.g. the instruction sets a model's
+    /// solver ran on; empty when it has none.
+    pub calculated_strings: Vec<(String, String)>,
 }
 
 /// One deterministic run of `fmu` with `params` set before initialization, `inputs` (a CSV
@@ -301,6 +305,17 @@ pub fn simulate_with(
     };
     let mut slot = Slot::new(policy, logging_on);
     let trace = simulate_point(fmu, &mut slot, &iface, &[], times, &[])?;
+    let calculated_strings = match slot.current().map(|inst| inst.get_calculated_strings()) {
+        Some(Ok(values)) => values,
+        Some(Err(e)) => {
+            crate::study::progress::message(&format!(
+                "uq-driver: note: the FMU's String calculated parameters could not be read \
+                 after the run: {e}"
+            ));
+            Vec::new()
+        }
+        None => Vec::new(),
+    };
     let nt = times.len();
     let mut out_times = times[..trace.recorded].to_vec();
     let mut series: Vec<Vec<f64>> = trace
@@ -329,6 +344,7 @@ pub fn simulate_with(
         series,
         skipped: iface.skipped,
         ended_at,
+        calculated_strings,
     })
 }
 
