@@ -109,6 +109,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "vehicle-curve-safety",
         include_str!("../../studies/vehicle-curve-safety.toml"),
     ),
+    (
+        "vehicle-curve-derailment-probability",
+        include_str!("../../studies/vehicle-curve-derailment-probability.toml"),
+    ),
 ];
 
 /// The text of a built-in study.
