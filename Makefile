@@ -199,6 +199,7 @@ paper: build fmu
 	$(DRIVER) run builtin:vehicle-curve-safety --out out/vehicle-curve-safety
 	$(DRIVER) run builtin:bogie-instability-probability --out out/bogie-instability-probability --yes
 	$(DRIVER) run builtin:vehicle-curve-derailment-probability --out out/vehicle-curve-derailment-probability --yes
+	$(DRIVER) run builtin:vehicle-curve-derailment-lhs --out out/vehicle-curve-derailment-lhs
 	@echo "reports: out/paper-*/index.html"
 
 # Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser, the

@@ -66,6 +66,7 @@ fn the_long_vehicle_studies_plan_against_the_vehicle_fmu() {
     for (name, points) in [
         ("vehicle-critical-speed", 256),
         ("vehicle-curve-safety", 200),
+        ("vehicle-curve-derailment-lhs", 2000),
     ] {
         let plan = dir.path().join(name);
         run_ok(&[

@@ -113,6 +113,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "vehicle-curve-derailment-probability",
         include_str!("../../studies/vehicle-curve-derailment-probability.toml"),
     ),
+    (
+        "vehicle-curve-derailment-lhs",
+        include_str!("../../studies/vehicle-curve-derailment-lhs.toml"),
+    ),
 ];
 
 /// The text of a built-in study.
