@@ -805,6 +805,7 @@ mod tests {
             signal: "x".into(),
             from: 1.5,
             to: None,
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };
@@ -814,6 +815,7 @@ mod tests {
             signal: "x".into(),
             from: 0.5,
             to: Some(2.5),
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };
@@ -826,6 +828,7 @@ mod tests {
             signal: "x".into(),
             from: 10.0,
             to: None,
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };
