@@ -202,6 +202,8 @@ paper: build fmu
 	# at 65 m/s (P about 6 %) beside a 400-point Latin hypercube counting 65 and 60 m/s.
 	$(DRIVER) run builtin:bogie-instability-probability --set 'qoi.v_hunt.limits_below=[65.0]' --out out/bogie-instability-at-65 --yes
 	$(DRIVER) run builtin:bogie-instability-probability --set 'method={ kind = "lhs", samples = 400 }' --set 'qoi.v_hunt.limits_below=[60.0, 65.0]' --out out/bogie-instability-lhs --yes
+	$(DRIVER) run builtin:vehicle-curve-derailment-probability --out out/vehicle-curve-derailment-probability --yes
+	$(DRIVER) run builtin:vehicle-curve-derailment-lhs --out out/vehicle-curve-derailment-lhs
 	@echo "reports: out/paper-*/index.html"
 
 # Coverage-guided fuzzing (libFuzzer on stable Rust) of the modelDescription parser, the

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    built_fmu, edit, read, run, run_study, run_study_ok, stderr, succeeded, test_fmus, utf8,
-    write_toml,
+    built_fmu, edit, read, read_json, run, run_study, run_study_ok, stderr, succeeded, test_fmus,
+    utf8, write_toml,
 };
 
 fn features() -> Option<PathBuf> {
@@ -242,6 +242,96 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
         summary.contains(&format!("\"failed_runs\": {failed}")),
         "{summary}"
     );
+}
+
+/// A study of the Features FMU over `stop_at` uniform on [0.5, 2] (runs with stop_at < 1 end
+/// before the stop time 1 s) at u = 1, with `rest` appended (its quantities, outputs).
+fn early_study(dir: &Path, fmu: &Path, rest: &str) -> PathBuf {
+    write_toml(
+        dir,
+        "s",
+        &format!(
+            "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+             [method]\nkind = \"mc\"\nsamples = 16\n\
+             [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
+             [fixed]\nu = 1\n{rest}",
+            utf8(fmu)
+        ),
+    )
+}
+
+#[test]
+fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit() {
+    // A derailment ends the Vehicle's run: for P(Y/Q > 0.8) such a run must count as an
+    // exceedance, not drop out as a failed point.
+    let Some(fmu) = features() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let study = early_study(
+        dir.path(),
+        &fmu,
+        "[[qoi]]\nkind = \"max\"\nname = \"peak\"\nsignal = \"u_integral\"\n\
+         if_ended = 100.0\nlimits = [50.0]\n",
+    );
+    let out = dir.path().join("out");
+    run_study_ok(&study, &out, &[]);
+    let points = Csv::read(&out.join("points.csv"));
+    let (runs, stop_at) = (points.col("run"), points.col("stop_at"));
+    let peaks = Csv::read(&out.join("peak_samples.csv")).numbers();
+    assert_eq!(peaks.len(), 16);
+    let mut ended = 0;
+    for row in &peaks {
+        let s = stop_at[runs.iter().position(|&r| r == row[0]).unwrap()];
+        if s < 1.0 - 1e-9 {
+            ended += 1;
+            assert_eq!(row[1], 100.0, "stop_at {s}");
+        } else {
+            // u = 1 integrated over the whole second.
+            assert!((row[1] - 1.0).abs() < 1e-12, "stop_at {s}: {}", row[1]);
+        }
+    }
+    assert!(ended > 0 && ended < 16, "{ended}");
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["failed_runs"], 0, "{summary}");
+    let counts = &summary["quantities"]["peak"]["exceedance_counts"][0];
+    assert_eq!(counts["count"], ended, "{counts}");
+    let text = summary["quantities"]["peak"]["definition"]["text"]
+        .as_str()
+        .unwrap();
+    assert!(
+        text.contains("100 in a run the FMU ends before the stop time"),
+        "{text}"
+    );
+}
+
+#[test]
+fn if_ended_on_some_quantities_only_or_with_stored_series_is_refused() {
+    let Some(fmu) = features() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let peak =
+        "[[qoi]]\nkind = \"max\"\nname = \"peak\"\nsignal = \"u_integral\"\nif_ended = 100.0\n";
+    for (rest, expected) in [
+        (
+            format!("{peak}[[qoi]]\nkind = \"final\"\nname = \"last\"\nsignal = \"u_integral\"\n"),
+            "quantity 'peak' sets if_ended but 'last' does not",
+        ),
+        (
+            format!("{peak}[outputs]\nvariables = [\"u_integral\"]\n"),
+            "quantity 'peak' sets if_ended, but the study stores output series",
+        ),
+        (
+            "[[qoi]]\nkind = \"max\"\nname = \"peak\"\nsignal = \"u_integral\"\nif_ended = nan\n"
+                .to_owned(),
+            "if_ended must be finite",
+        ),
+    ] {
+        let study = early_study(dir.path(), &fmu, &rest);
+        let o = run_study(&study, &dir.path().join("out"), &[]);
+        let err = stderr(&o);
+        assert!(
+            !o.status.success() && err.contains(expected),
+            "{rest}: {err}"
+        );
+    }
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! The built-in studies of the full car (the Vehicle FMU): `vehicle-nominal` run as shipped
 //! (its two critical speeds in summary.json, against figures measured outside uq-driver);
 //! `vehicle-critical-speed` and `vehicle-curve-safety`, which take minutes and run in
-//! `make paper`, planned against the FMU as shipped and the curve study run on a few points.
+//! `make paper`, planned against the FMU as shipped and the curve study run on a few points;
+//! `vehicle-curve-derailment-probability` cut down, and a derailed run counted by `if_ended`.
 
 use std::path::Path;
 
@@ -65,6 +66,7 @@ fn the_long_vehicle_studies_plan_against_the_vehicle_fmu() {
     for (name, points) in [
         ("vehicle-critical-speed", 256),
         ("vehicle-curve-safety", 200),
+        ("vehicle-curve-derailment-lhs", 2000),
     ] {
         let plan = dir.path().join(name);
         run_ok(&[
@@ -114,4 +116,85 @@ fn vehicle_curve_safety_reports_its_running_safety_quantities() {
             "{name}: {q}"
         );
     }
+}
+
+/// The built-in `vehicle-curve-derailment-probability` with `edits` applied to its text (each
+/// `(from, to)` must occur), run into a folder of `dir`.
+fn derailment_study(dir: &Path, edits: &[(&str, &str)]) -> std::path::PathBuf {
+    let mut text = run_ok(&["show", "vehicle-curve-derailment-probability"]);
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, to);
+    }
+    let study = dir.join("derail.toml");
+    std::fs::write(&study, text).unwrap();
+    let out = dir.join("out");
+    run_ok(&["run", utf8(&study), "--out", utf8(&out), "--yes"]);
+    out
+}
+
+#[test]
+fn a_derailed_vehicle_run_takes_the_if_ended_value_beyond_the_nadal_limit() {
+    // At 18 m/s into a 100 m curve entered over 1 s a wheelset climbs the flange and leaves
+    // the contact table at about 2.1 s (measured with `uq-driver simulate`): the FMU ends the
+    // run, which counts as Y/Q = 10 > 0.8 instead of a failed point.
+    built_fmu("Vehicle");
+    let dir = tempfile::tempdir().unwrap();
+    let out = derailment_study(
+        dir.path(),
+        &[
+            ("kind = \"importance_sampling\"", "kind = \"nominal\""),
+            ("target_cov = 0.2\nmax_runs = 400\nbatch = 50\n", ""),
+            ("quantities = [\"max_YQ\"]\n", ""),
+            (
+                "[method.form]\nstep = 0.5\nmax_iterations = 15\ntolerance_g = 0.05\n\
+                 tolerance_u = 0.05\n",
+                "",
+            ),
+            ("stop = 8.0", "stop = 4.0"),
+            ("v = 26.0", "v = 18.0"),
+            ("R = 250.0", "R = 100.0"),
+            ("transition = 3.0", "transition = 1.0"),
+            ("from = 3.0", "from = 1.0"),
+        ],
+    );
+    assert_eq!(summary(&out)["failed_runs"], 0);
+    assert_eq!(mean(&out, "max_YQ"), 10.0);
+}
+
+#[test]
+fn vehicle_curve_derailment_probability_runs_form_and_importance_sampling_cut_down() {
+    // The study as shipped, cut to one FORM iteration (its first step is that of the full
+    // study: 11 runs of 8 s and the step) and 20 importance-sampling runs (about 10 s on 2
+    // cores): it parses, runs, and reports its probability in the terms of the reliability
+    // methods. A cut to shorter runs does not do: Y/Q over 3-4 s is nearly flat in the
+    // inputs, and FORM's first step goes to negative stiffnesses. The figures of the full
+    // study are in the guide.
+    built_fmu("Vehicle");
+    let dir = tempfile::tempdir().unwrap();
+    let out = derailment_study(
+        dir.path(),
+        &[
+            ("max_iterations = 15", "max_iterations = 1"),
+            ("max_runs = 400\nbatch = 50", "max_runs = 20\nbatch = 10"),
+        ],
+    );
+    let r = &quantity(&out, "max_YQ")["reliability"][0];
+    assert_eq!(r["limit"], 0.8, "{r}");
+    assert_eq!(r["direction"], "above", "{r}");
+    assert_eq!(r["method"], "importance_sampling", "{r}");
+    let p = r["p"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&p), "{r}");
+    assert!(r["beta"].as_f64().unwrap().is_finite(), "{r}");
+    let design = r["design_point"].as_object().unwrap();
+    assert_eq!(design.len(), 10, "{r}");
+    let mu = design["mu"].as_f64().unwrap();
+    assert!(mu > 0.0, "{r}");
+    let importance: f64 = r["importance"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_f64().unwrap())
+        .sum();
+    assert!((importance - 1.0).abs() < 1e-9, "{r}");
 }

@@ -82,6 +82,12 @@ pub enum QoiSpec {
         /// End of the interval (s; default the stop time).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         to: Option<f64>,
+        /// The value the quantity takes in a run the FMU ends before the stop time
+        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
+        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
+        /// settings when unset, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        if_ended: Option<f64>,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -102,6 +108,12 @@ pub enum QoiSpec {
         /// End of the interval (s; default the stop time).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         to: Option<f64>,
+        /// The value the quantity takes in a run the FMU ends before the stop time
+        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
+        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
+        /// settings when unset, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        if_ended: Option<f64>,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -121,6 +133,12 @@ pub enum QoiSpec {
         /// End of the interval (s; default the stop time).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         to: Option<f64>,
+        /// The value the quantity takes in a run the FMU ends before the stop time
+        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
+        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
+        /// settings when unset, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        if_ended: Option<f64>,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -141,6 +159,12 @@ pub enum QoiSpec {
         /// End of the interval (s; default the stop time).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         to: Option<f64>,
+        /// The value the quantity takes in a run the FMU ends before the stop time
+        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
+        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
+        /// settings when unset, so the study hash of existing studies is unchanged.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        if_ended: Option<f64>,
         /// Exceedance limits.
         #[serde(default)]
         limits: Vec<f64>,
@@ -330,6 +354,18 @@ impl QoiSpec {
         }
     }
 
+    /// The value it takes in a run the FMU ends before the stop time (`if_ended`; only the
+    /// window kinds `max_abs`, `min`, `max`, `range` have the setting).
+    pub(crate) fn if_ended(&self) -> Option<f64> {
+        match self {
+            QoiSpec::MaxAbs { if_ended, .. }
+            | QoiSpec::Min { if_ended, .. }
+            | QoiSpec::Max { if_ended, .. }
+            | QoiSpec::Range { if_ended, .. } => *if_ended,
+            _ => None,
+        }
+    }
+
     /// The signal whose unit the quantity has (`None`: dimensionless, as the Sperling index).
     pub fn unit_signal(&self) -> Option<&str> {
         match self {
@@ -481,6 +517,10 @@ impl QoiSpec {
                 )
             }
         };
+        let text = match self.if_ended() {
+            Some(v) => format!("{text}; {v} in a run the FMU ends before the stop time"),
+            None => text,
+        };
         QuantityDefinition {
             kind,
             settings,
@@ -511,12 +551,26 @@ impl QoiSpec {
                     None
                 }
             }
-            QoiSpec::MaxAbs { from, to, .. }
-            | QoiSpec::Min { from, to, .. }
-            | QoiSpec::Max { from, to, .. }
-            | QoiSpec::Range { from, to, .. } => to
-                .is_some_and(|t| t <= *from)
-                .then_some("`to` must be after `from`"),
+            QoiSpec::MaxAbs {
+                from, to, if_ended, ..
+            }
+            | QoiSpec::Min {
+                from, to, if_ended, ..
+            }
+            | QoiSpec::Max {
+                from, to, if_ended, ..
+            }
+            | QoiSpec::Range {
+                from, to, if_ended, ..
+            } => {
+                if to.is_some_and(|t| t <= *from) {
+                    Some("`to` must be after `from`")
+                } else if if_ended.is_some_and(|v| !v.is_finite()) {
+                    Some("if_ended must be finite")
+                } else {
+                    None
+                }
+            }
             QoiSpec::Final { .. } => None,
             QoiSpec::HuntingSpeed(h) => {
                 return match h.problem() {
@@ -626,6 +680,32 @@ impl QoiSpec {
     }
 }
 
+/// Why `qois` cannot take their `if_ended` values (`None`: they can, or none is set). A run the
+/// FMU ended early has no series after the end and no value of the other quantities, so when
+/// one quantity sets `if_ended` every quantity must (and none may be a `hunting_speed`, whose
+/// runs are its own), and the study may store no series (`outputs`: statistics over time need
+/// every run on the whole grid).
+pub(crate) fn ended_value_problem(qois: &[QoiSpec], outputs: &[String]) -> Option<String> {
+    let set = qois.iter().find(|q| q.if_ended().is_some())?;
+    if let Some(q) = qois.iter().find(|q| q.if_ended().is_none()) {
+        return Some(format!(
+            "quantity '{}' sets if_ended but '{}' does not: a run the FMU ends early has no \
+             value of '{}'; set if_ended on every quantity (max_abs, min, max and range have it)",
+            set.name(),
+            q.name(),
+            q.name()
+        ));
+    }
+    (!outputs.is_empty()).then(|| {
+        format!(
+            "quantity '{}' sets if_ended, but the study stores output series ([outputs] \
+             variables = {outputs:?}), which a run the FMU ends early does not cover; leave them \
+             out (the quantities' signals are read without being stored)",
+            set.name()
+        )
+    })
+}
+
 /// How a scalar quantity is computed from each run (`definition` in `summary.json`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct QuantityDefinition {
@@ -725,6 +805,7 @@ mod tests {
             signal: "x".into(),
             from: 1.5,
             to: None,
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };
@@ -734,6 +815,7 @@ mod tests {
             signal: "x".into(),
             from: 0.5,
             to: Some(2.5),
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };
@@ -746,6 +828,7 @@ mod tests {
             signal: "x".into(),
             from: 10.0,
             to: None,
+            if_ended: None,
             limits: vec![],
             limits_below: vec![],
         };

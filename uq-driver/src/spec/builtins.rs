@@ -109,6 +109,14 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "vehicle-curve-safety",
         include_str!("../../studies/vehicle-curve-safety.toml"),
     ),
+    (
+        "vehicle-curve-derailment-probability",
+        include_str!("../../studies/vehicle-curve-derailment-probability.toml"),
+    ),
+    (
+        "vehicle-curve-derailment-lhs",
+        include_str!("../../studies/vehicle-curve-derailment-lhs.toml"),
+    ),
 ];
 
 /// The text of a built-in study.

@@ -314,6 +314,10 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
             .and_then(|()| q.check_grid(e.start, e.stop, e.step))
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
+    let qois: Vec<QoiSpec> = file.qoi.iter().map(|q| q.get_ref().clone()).collect();
+    if let Some(problem) = crate::qoi::scalar::ended_value_problem(&qois, &file.outputs.variables) {
+        return Err(cx.invalid(None, problem));
+    }
     // Their files: two names must not write the same one (checked before any run).
     crate::text::file_name::check_distinct(&names).map_err(|m| cx.invalid(None, m))?;
     Ok(())

@@ -142,6 +142,9 @@ impl Study {
                 .and_then(|()| q.check_grid(e.start, e.stop, e.step))
                 .map_err(|err| invalid(err.to_string()))?;
         }
+        if let Some(problem) = crate::qoi::scalar::ended_value_problem(&self.qoi, &self.outputs) {
+            return Err(invalid(problem));
+        }
         let times = self.times();
         self.method()
             .validate(&self.problem(&times))

@@ -163,7 +163,9 @@ pub(super) fn ended_by_fmu(inst: &mut Instance, error: &FmuError, current: f64) 
 /// values: the stored outputs (output-major: all times of output 0, then output 1, …), then
 /// (value, code) of each scalar quantity (a `hunting_speed` entry gives two, from its own
 /// constant-speed runs on the same instance after the point's run). A run the FMU ends
-/// before the stop time is a failed point ([`PointError::EndedEarly`]).
+/// before the stop time is a failed point ([`PointError::EndedEarly`]), unless every quantity
+/// gives its value for such a run (`if_ended`) and no series is stored: then the quantities
+/// take those values (code Ok).
 pub fn run_point(
     fmu: &Fmu,
     slot: &mut Slot,
@@ -178,6 +180,14 @@ pub fn run_point(
     })?;
     if let Some((time, _)) = trace.ended {
         slot.discard();
+        // Every quantity then has its value for such a run and no series is stored (the
+        // study was refused otherwise: `ended_value_problem`).
+        if iface.n_stored == 0 && !iface.qois.is_empty() {
+            let values: Option<Vec<f64>> = iface.qois.iter().map(QoiSpec::if_ended).collect();
+            if let Some(values) = values {
+                return Ok(values.into_iter().flat_map(|v| [v, 0.0]).collect());
+            }
+        }
         return Err(PointError::EndedEarly {
             time,
             stop: times[nt - 1],
