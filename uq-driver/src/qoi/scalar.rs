@@ -84,8 +84,9 @@ pub enum QoiSpec {
         to: Option<f64>,
         /// The value the quantity takes in a run the FMU ends before the stop time
         /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
-        /// settings when unset, so the study hash of existing studies is unchanged.
+        /// (every quantity of the study must then set it, and the study may store no
+        /// series). Left out of the serialized settings when unset, so the study hash of
+        /// existing studies is unchanged.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         if_ended: Option<f64>,
         /// Exceedance limits.
@@ -110,8 +111,9 @@ pub enum QoiSpec {
         to: Option<f64>,
         /// The value the quantity takes in a run the FMU ends before the stop time
         /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
-        /// settings when unset, so the study hash of existing studies is unchanged.
+        /// (every quantity of the study must then set it, and the study may store no
+        /// series). Left out of the serialized settings when unset, so the study hash of
+        /// existing studies is unchanged.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         if_ended: Option<f64>,
         /// Exceedance limits.
@@ -135,8 +137,9 @@ pub enum QoiSpec {
         to: Option<f64>,
         /// The value the quantity takes in a run the FMU ends before the stop time
         /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
-        /// settings when unset, so the study hash of existing studies is unchanged.
+        /// (every quantity of the study must then set it, and the study may store no
+        /// series). Left out of the serialized settings when unset, so the study hash of
+        /// existing studies is unchanged.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         if_ended: Option<f64>,
         /// Exceedance limits.
@@ -161,8 +164,9 @@ pub enum QoiSpec {
         to: Option<f64>,
         /// The value the quantity takes in a run the FMU ends before the stop time
         /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// ([`ended_value_problem`] says where it may be set). Left out of the serialized
-        /// settings when unset, so the study hash of existing studies is unchanged.
+        /// (every quantity of the study must then set it, and the study may store no
+        /// series). Left out of the serialized settings when unset, so the study hash of
+        /// existing studies is unchanged.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         if_ended: Option<f64>,
         /// Exceedance limits.
