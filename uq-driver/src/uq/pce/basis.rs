@@ -528,9 +528,10 @@ mod tests {
             for deg in 0..=order {
                 let mut all = Vec::new();
                 rec(&mut Vec::new(), dim, deg, &mut all);
-                out.extend(all.into_iter().filter(|a| {
-                    a.iter().map(|&x| (x as f64).powf(q)).sum::<f64>() <= bound
-                }));
+                out.extend(
+                    all.into_iter()
+                        .filter(|a| a.iter().map(|&x| (x as f64).powf(q)).sum::<f64>() <= bound),
+                );
             }
             out
         }
