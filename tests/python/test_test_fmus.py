@@ -466,12 +466,12 @@ def test_y_t_is_y_times_one_plus_t_under_fmpy(functions_fmu):
     np.testing.assert_allclose(res["f_x"], 4.5, rtol=1e-15)
 
 
-@pytest.mark.parametrize("function", [0, 8, -1])
+@pytest.mark.parametrize("function", [0, 9, -1])
 def test_an_unknown_function_is_refused_when_set(functions_fmu, function, capsys):
     with slave(functions_fmu) as s:
         with pytest.raises(FMICallException):
             s.set(function=function)
-    assert "outside [1, 7]" in capsys.readouterr().out
+    assert "outside [1, 8]" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------------
