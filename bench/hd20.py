@@ -190,7 +190,7 @@ def bench(h, work, driver, test_fmu_dir, repeats):
         ot_err = max(abs(a - b) for a, b in zip(ests[-1]["first"], exact))
         sec.row(label, f"OpenTURNS {openturns.__version__} LARS", y.shape[1], h.fmt_s(ot_wall),
                 h.fmt_s(ot_cpu), f"{ot_err:.4f}")
-        ratios[label] = b / ot_wall
+        ratios[label] = (ot_wall / b, ot_cpu / cpus[k])
     sec.note(
         f"uq-driver: the Functions test FMU (function = 8, a = {', '.join(f'{a:g}' for a in A20[:6])}, "
         f"99 × 14; xᵢ ~ U(0, 1)), `pce_regression` with design = \"qmc\" (seed {SEED}), "
@@ -207,8 +207,9 @@ def bench(h, work, driver, test_fmu_dir, repeats):
         f"OpenTURNS is measured once and shown for both uq-driver fits. The S1 error is "
         f"the largest over the 20 inputs against the closed form (of the last time for the "
         f"series; y_t = y (1 + t) has y's indices).")
-    met = ratios["Y (scalar)"] <= 1.0
-    sec.done("Analysis time over OpenTURNS' fit time: "
-             + ", ".join(f"{k} {h.fmt_ratio(v)}" for k, v in ratios.items())
+    met = ratios["Y (scalar)"][0] >= 1.0
+    sec.done("OpenTURNS' fit time over uq-driver's analysis time (wall; CPU): "
+             + ", ".join(f"{k} {h.fmt_ratio(w)}; {h.fmt_ratio(c)}"
+                         for k, (w, c) in ratios.items())
              + f". Goal ({GOAL}, scalar): {h.goal(met)}.")
     return [sec]
