@@ -6,7 +6,7 @@ Run from the repository root by `make bench` (which first builds the release bin
 FMUs and the Python venv), or directly:
 
     .venv/bin/python bench/run.py [--repeats N] [--md FILE] [--work DIR] [--quick]
-                                  [--only hd|vehicle|reliability|functional|python]
+                                  [--only hd|hd20|vehicle|reliability|functional|python]
 
 `--only hd` runs the high-dimensional goals alone (bench/hd_goals.py) into
 target/bench/BENCHMARKS-hd.md, `--only vehicle` the full car's real-time factor alone into
@@ -15,7 +15,9 @@ target/bench/BENCHMARKS-vehicle.md, `--only reliability` the small-probability g
 OpenTURNS; needs only uq-driver and a C compiler) into target/bench/BENCHMARKS-reliability.md,
 `--only functional` the series fitted per column against on principal components alone into
 target/bench/BENCHMARKS-functional.md, `--only python` the Python package against the command
-line alone into target/bench/BENCHMARKS-python.md.
+line alone into target/bench/BENCHMARKS-python.md, `--only hd20` the 20-input chaos beside
+OpenTURNS on the same points alone (bench/hd20.py; needs uq-driver and a C compiler) into
+target/bench/BENCHMARKS-hd20.md.
 
 Every comparison is measured side by side in this one run. Nothing here asserts a speed: the
 goals set for the comparisons are reported as met or not met. The only hard failures are missing
@@ -221,7 +223,7 @@ def check_prerequisites(only=None):
     missing = []
     if not (DRIVER.is_file() and os.access(DRIVER, os.X_OK)):
         missing.append(f"{DRIVER} (build it: `make build`)")
-    if only == "reliability":  # uq-driver, the C test FMU (built here), numpy, OpenTURNS
+    if only in ("reliability", "hd20"):  # uq-driver, the C test FMU (built here), OpenTURNS
         if missing:
             die("missing prerequisites:\n  " + "\n  ".join(missing))
         try:
@@ -995,6 +997,14 @@ def bench_hd_goals(work):
                           ROOT / "target" / "test-fmu")
 
 
+def bench_hd20(work, repeats):
+    """The 20-input chaos's analysis time beside OpenTURNS' LARS on the same points
+    (bench/hd20.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import hd20
+    return hd20.bench(sys.modules[__name__], work, DRIVER, ROOT / "target" / "test-fmu", repeats)
+
+
 # ------------------------------------------------------------------ small probabilities
 
 def bench_reliability_goals(work):
@@ -1235,7 +1245,7 @@ def write_markdown(path, mach, sections, total_wall, argv, checks_ok, lib_same):
     Path(path).write_text("\n".join(lines).rstrip() + "\n")
 
 
-SECTIONS = ("hd", "vehicle", "reliability", "functional", "python")
+SECTIONS = ("hd", "hd20", "vehicle", "reliability", "functional", "python")
 
 
 def main():
@@ -1278,6 +1288,7 @@ def main():
             # One section alone: its sections (a list), and whether it uses the railuq FMUs.
             alone = {
                 "hd": (lambda: bench_hd_goals(work), True),
+                "hd20": (lambda: bench_hd20(work, repeats), False),
                 "reliability": (lambda: bench_reliability_goals(work), False),
                 "vehicle": (lambda: [bench_vehicle_realtime(work, repeats)], True),
                 "python": (lambda: [bench_python(work, max(repeats, 5))], True),
@@ -1319,7 +1330,7 @@ def all_sections(args, work, repeats, checks):
     s_iso, same_iso = bench_isolate(work, repeats)
     s_analysis = bench_analysis_report(work, repeats, checks, args.all_builtins)
     s_functional = bench_functional(work, repeats)
-    s_hd = bench_hd_goals(work)
+    s_hd = bench_hd_goals(work) + bench_hd20(work, repeats)
     s_rel = bench_reliability_goals(work)
     return ([s1, s2, s3, s3b, s4, s5, s6, s6b, s7, s_parse, s_iso] + s_analysis
             + [s_functional] + s_hd + s_rel, same_threads, same_iso, lib_same)

@@ -307,6 +307,24 @@ def test_product_at_random_lognormal_points(functions_fmu):
                                                                            rel=1e-14)
 
 
+def test_twenty_input_g_function_at_random_points(functions_fmu):
+    rng = np.random.default_rng(4)
+    a = np.concatenate([[0.0, 0.5, 1.0, 2.0, 4.5, 9.0], np.full(14, 99.0)])
+    with slave(functions_fmu) as s:
+        for x in rng.uniform(size=(20, 20)):
+            values = {f"x{i + 1}": v for i, v in enumerate(x)}
+            coeffs = {f"a{i + 1}": v for i, v in enumerate(a)}
+            want = np.prod((np.abs(4 * x - 2) + a) / (1 + a))
+            assert s.evaluate("y", function=8, **values, **coeffs) == pytest.approx(
+                want, rel=1e-14)
+        # The default coefficients: a1..a8 as the eight-input g-function's, a9..a20 = 99.
+        x = rng.uniform(size=20)
+        a = np.array([0.0, 1.0, 4.5, 9.0] + [99.0] * 16)
+        want = np.prod((np.abs(4 * x - 2) + a) / (1 + a))
+        values = {f"x{i + 1}": v for i, v in enumerate(x)}
+        assert s.evaluate("y", function=8, **values) == pytest.approx(want, rel=1e-14)
+
+
 def test_ishigami_at_random_points(functions_fmu):
     rng = np.random.default_rng(1)
     with slave(functions_fmu) as s:
@@ -448,12 +466,12 @@ def test_y_t_is_y_times_one_plus_t_under_fmpy(functions_fmu):
     np.testing.assert_allclose(res["f_x"], 4.5, rtol=1e-15)
 
 
-@pytest.mark.parametrize("function", [0, 8, -1])
+@pytest.mark.parametrize("function", [0, 9, -1])
 def test_an_unknown_function_is_refused_when_set(functions_fmu, function, capsys):
     with slave(functions_fmu) as s:
         with pytest.raises(FMICallException):
             s.set(function=function)
-    assert "outside [1, 7]" in capsys.readouterr().out
+    assert "outside [1, 8]" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------------

@@ -277,23 +277,23 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    // The Functions FMU declares function with min = 1, max = 7.
-    let body = function4(X1_X2, false).replace("function = 4", "function = 8");
+    // The Functions FMU declares function with min = 1, max = 8.
+    let body = function4(X1_X2, false).replace("function = 4", "function = 9");
     let s = study(
         dir.path(),
-        "f8",
+        "f9",
         "Functions",
         0.1,
         &body,
         "kind = \"mc\"\nsamples = 16",
     );
-    let out = dir.path().join("f8.out");
+    let out = dir.path().join("f9.out");
     let o = run_study(&s, &out, &[]);
     assert!(!o.status.success());
     let err = stderr(&o);
     assert!(
-        err.contains("'function' is an Integer declared with min = 1, max = 7")
-            && err.contains("the value 8 given for it is outside that range"),
+        err.contains("'function' is an Integer declared with min = 1, max = 8")
+            && err.contains("the value 9 given for it is outside that range"),
         "{err}"
     );
     assert!(!err.contains("points failed"), "{err}");

@@ -100,13 +100,17 @@ impl PathDesign {
         }
     }
 
-    /// `x_k . x_j` for every `k`.
+    /// `x_k . x_j` for every `k` (summed as nalgebra's `dot`, in the vector units chosen at
+    /// run time: the same bits).
     fn gram_row(&self, j: usize) -> &[f64] {
         self.gram[j].get_or_init(|| {
-            let xj = self.x.column(j);
-            (0..self.x.ncols())
-                .map(|k| self.x.column(k).dot(&xj))
-                .collect()
+            let n = self.x.nrows();
+            let xs = self.x.as_slice();
+            let xj = &xs[j * n..(j + 1) * n];
+            if n == 0 {
+                return vec![0.0; self.x.ncols()];
+            }
+            xs.chunks_exact(n).map(|xk| kernels::dot(xk, xj)).collect()
         })
     }
 }
@@ -709,6 +713,24 @@ mod tests {
                         sparse_regression_on(&design, &psi, y, PathKind::Lars, Some(&cache));
                     assert_eq!(shared, alone, "degree {degree}, response {i}, pass {pass}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn gram_rows_in_vector_units_equal_nalgebra_dot_products_bit_for_bit() {
+        // Regression: the Gram rows of a 20-input order-10 design (3 240 columns) were a
+        // quarter of the analysis, summed by nalgebra one column at a time. The kernel must
+        // give the same bits, with rows not a multiple of the block too.
+        for n in [7, 60, 61, 203] {
+            let (psi, _, _) = sparse_problem(n);
+            let design = PathDesign::new(&psi, Some(0));
+            for j in [0, 1, 17, 284] {
+                let want: Vec<u64> = (0..design.x.ncols())
+                    .map(|k| design.x.column(k).dot(&design.x.column(j)).to_bits())
+                    .collect();
+                let got: Vec<u64> = design.gram_row(j).iter().map(|v| v.to_bits()).collect();
+                assert_eq!(got, want, "n = {n}, column {j}");
             }
         }
     }

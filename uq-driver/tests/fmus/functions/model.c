@@ -12,6 +12,7 @@
  *   5 linear        y = x1 + x2 + ... + x8 (closed-form tails for normal inputs)
  *   6 sum of squares y = x1^2 + x2^2 + ... + x8^2 (a chi-square for standard normal inputs)
  *   7 product       y = x1 x2 ... x8 (lognormal inputs: ln y is normal, closed-form tails)
+ *   8 g-function 20 y = prod_{i=1..20} (|4 x_i - 2| + a_i) / (1 + a_i) (twenty inputs)
  * y is computed once at the end of initialization; the time-varying output is
  * y_t = y (1 + t). f_x and h_seed are outputs too (for the other functions f_x = y, h_seed = 0).
  * One fmi2DoStep is an addition and a multiplication.
@@ -26,14 +27,14 @@
 #define GUID "{d6f1c9a4-5b3e-4f1a-8c2d-railuq-test-functions}"
 
 enum { ISHIGAMI = 1, BOREHOLE = 2, G_FUNCTION = 3, TWO_LEVEL = 4, LINEAR = 5, SQUARES = 6,
-       PRODUCT = 7 };
+       PRODUCT = 7, G_FUNCTION_20 = 8 };
 
 typedef struct {
     fmi2Integer function;
-    double x[8];
+    double x[20];
     double a, b;                            /* Ishigami */
     double rw, r, Tu, Hu, Tl, Hl, L, Kw;    /* borehole */
-    double g_a[8];                          /* g-function coefficients a1..a8 */
+    double g_a[20];                         /* g-function coefficients a1..a20 */
     fmi2Integer seed;                       /* two-level */
     double sigma_h;
     double y, y_t, f_x, h_seed;             /* outputs */
@@ -44,7 +45,7 @@ typedef struct {
 #define REAL_OUTPUT(name, vr, field) \
     {name, TYPE_REAL, vr, KIND_OUTPUT, offsetof(Data, field), 0, 0, 0}
 
-/* Value references: Real 0..33, Integer 0..1 (as in modelDescription.xml). */
+/* Value references: Real 0..55, Integer 0..1 (as in modelDescription.xml). */
 static const Variable VARIABLES[] = {
     {"time", TYPE_REAL, 0, KIND_INDEPENDENT, 0, 0, 0, 0},
     REAL_OUTPUT("y", 1, y),
@@ -78,8 +79,32 @@ static const Variable VARIABLES[] = {
     REAL_PARAMETER("a7", 29, g_a[6]),
     REAL_PARAMETER("a8", 30, g_a[7]),
     REAL_PARAMETER("sigma_h", 31, sigma_h),
+    REAL_PARAMETER("x9", 32, x[8]),
+    REAL_PARAMETER("x10", 33, x[9]),
+    REAL_PARAMETER("x11", 34, x[10]),
+    REAL_PARAMETER("x12", 35, x[11]),
+    REAL_PARAMETER("x13", 36, x[12]),
+    REAL_PARAMETER("x14", 37, x[13]),
+    REAL_PARAMETER("x15", 38, x[14]),
+    REAL_PARAMETER("x16", 39, x[15]),
+    REAL_PARAMETER("x17", 40, x[16]),
+    REAL_PARAMETER("x18", 41, x[17]),
+    REAL_PARAMETER("x19", 42, x[18]),
+    REAL_PARAMETER("x20", 43, x[19]),
+    REAL_PARAMETER("a9", 44, g_a[8]),
+    REAL_PARAMETER("a10", 45, g_a[9]),
+    REAL_PARAMETER("a11", 46, g_a[10]),
+    REAL_PARAMETER("a12", 47, g_a[11]),
+    REAL_PARAMETER("a13", 48, g_a[12]),
+    REAL_PARAMETER("a14", 49, g_a[13]),
+    REAL_PARAMETER("a15", 50, g_a[14]),
+    REAL_PARAMETER("a16", 51, g_a[15]),
+    REAL_PARAMETER("a17", 52, g_a[16]),
+    REAL_PARAMETER("a18", 53, g_a[17]),
+    REAL_PARAMETER("a19", 54, g_a[18]),
+    REAL_PARAMETER("a20", 55, g_a[19]),
     {"function", TYPE_INTEGER, 0, KIND_FIXED_PARAMETER, offsetof(Data, function), 1, ISHIGAMI,
-     PRODUCT},
+     G_FUNCTION_20},
     {"seed", TYPE_INTEGER, 1, KIND_FIXED_PARAMETER, offsetof(Data, seed), 0, 0, 0},
 };
 
@@ -88,9 +113,9 @@ static void set_defaults(void *data) {
     Data *d = (Data *)data;
     int i;
     d->function = ISHIGAMI;
-    for (i = 0; i < 8; i++) {
+    for (i = 0; i < 20; i++) {
         d->x[i] = 0.0;
-        d->g_a[i] = g_a[i];
+        d->g_a[i] = i < 8 ? g_a[i] : 99.0;
     }
     d->a = 7.0;
     d->b = 0.1;
@@ -119,10 +144,10 @@ static double borehole(const Data *d) {
     return 2.0 * PI * d->Tu * (d->Hu - d->Hl) / denominator;
 }
 
-static double g_function(const Data *d) {
+static double g_function(const Data *d, int inputs) {
     double y = 1.0;
     int i;
-    for (i = 0; i < 8; i++) y *= (fabs(4.0 * d->x[i] - 2.0) + d->g_a[i]) / (1.0 + d->g_a[i]);
+    for (i = 0; i < inputs; i++) y *= (fabs(4.0 * d->x[i] - 2.0) + d->g_a[i]) / (1.0 + d->g_a[i]);
     return y;
 }
 
@@ -151,7 +176,8 @@ static void calculate(Instance *inst) {
     switch (d->function) {
     case ISHIGAMI: d->f_x = ishigami(d); break;
     case BOREHOLE: d->f_x = borehole(d); break;
-    case G_FUNCTION: d->f_x = g_function(d); break;
+    case G_FUNCTION: d->f_x = g_function(d, 8); break;
+    case G_FUNCTION_20: d->f_x = g_function(d, 20); break;
     case TWO_LEVEL:
         d->f_x = d->x[0] + d->x[1] * d->x[1];
         d->h_seed = hashed_normal(d->seed);
@@ -184,8 +210,8 @@ static fmi2Status initialize(Instance *inst) {
                   d->rw, d->r, d->Tl, d->Kw);
         return fmi2Error;
     }
-    if (d->function == G_FUNCTION) {
-        for (i = 0; i < 8; i++) {
+    if (d->function == G_FUNCTION || d->function == G_FUNCTION_20) {
+        for (i = 0; i < (d->function == G_FUNCTION ? 8 : 20); i++) {
             if (!(d->g_a[i] >= 0.0)) {
                 LOG_ERROR(inst, "g-function: a%d = %g, the coefficients must be >= 0", i + 1,
                           d->g_a[i]);
