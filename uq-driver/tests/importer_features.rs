@@ -275,7 +275,7 @@ fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
     let points = Csv::read(&out.join("points.csv"));
-    let (runs, stop_at) = (points.col("run"), points.col("stop_at"));
+    let (runs, stop_at) = (points.col("index"), points.col("stop_at"));
     let peaks = Csv::read(&out.join("peak_samples.csv")).numbers();
     assert_eq!(peaks.len(), 16);
     let mut ended = 0;
@@ -293,7 +293,7 @@ fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit
     let summary = read_json(&out.join("summary.json"));
     assert_eq!(summary["failed_runs"], 0, "{summary}");
     let counts = &summary["quantities"]["peak"]["exceedance_counts"][0];
-    assert_eq!(counts["count"], ended, "{counts}");
+    assert_eq!(counts["exceeded"], ended, "{counts}");
     let text = summary["quantities"]["peak"]["definition"]["text"]
         .as_str()
         .unwrap();
