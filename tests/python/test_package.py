@@ -284,6 +284,8 @@ def test_surrogate_equals_uq_driver_surrogate_eval_and_sample(tmp_path):
 def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeypatch):
     study = railuq.Study.from_dict(dict(SAMPLED, name="wheel-lhs-stop",
                                         method={"kind": "lhs", "samples": 5000}))
+    import threading
+
     from railuq import _progress
 
     seen = []
@@ -294,7 +296,9 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
         update(self, done, total, messages)
         if 0 < done < total and len(seen) < 1000 and not getattr(self, "sent", False):
             self.sent = True
-            os.kill(os.getpid(), signal.SIGINT)  # a real Ctrl-C, seen by the run's next tick
+            # A real Ctrl-C, sent to the main thread: os.kill may hand it to a worker thread,
+            # whose handler can miss the tick that would raise it, and the study then ends.
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
 
     monkeypatch.setattr(_progress.Display, "update", interrupting)
     out = tmp_path / "py"
