@@ -296,10 +296,13 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
         update(self, done, total, messages)
         if 0 < done < total and len(seen) < 1000 and not getattr(self, "sent", False):
             self.sent = True
-            # A real Ctrl-C, sent to the main thread: os.kill may hand it to a worker thread,
-            # whose handler can miss the tick that would raise it, and the study then ends.
+            # A real Ctrl-C, sent to the main thread, whose handler raises KeyboardInterrupt.
             signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
 
+    # Python's own SIGINT handler, as in a terminal or Jupyter: a process started in the
+    # background by a shell without job control (`make test &`) inherits SIGINT ignored, and
+    # Python then installs no handler at all.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     monkeypatch.setattr(_progress.Display, "update", interrupting)
     out = tmp_path / "py"
     with pytest.raises(KeyboardInterrupt):
@@ -319,6 +322,7 @@ def test_ctrl_c_stops_a_study_cleanly_and_a_second_run_resumes(tmp_path, monkeyp
     assert 0 < resumed_total < 5000, "the second run did not resume the first one's points"
     assert r.summary["runs_resumed"] == 5000 - resumed_total
     assert_same_statistics(r, cli_study(tmp_path, study))
+    signal.signal(signal.SIGINT, previous)
 
 
 def test_a_running_study_releases_the_gil(tmp_path):
