@@ -9,6 +9,7 @@
 #![forbid(unsafe_code)]
 
 pub mod critical_speed;
+pub(crate) mod ended;
 pub mod evaluate;
 pub mod hunting_speed;
 pub mod kde;

@@ -315,7 +315,7 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
             .map_err(|e| cx.invalid(Some(span), e.to_string()))?;
     }
     let qois: Vec<QoiSpec> = file.qoi.iter().map(|q| q.get_ref().clone()).collect();
-    if let Some(problem) = crate::qoi::scalar::ended_value_problem(&qois, &file.outputs.variables) {
+    if let Some(problem) = crate::qoi::ended::ended_value_problem(&qois, &file.outputs.variables) {
         return Err(cx.invalid(None, problem));
     }
     // Their files: two names must not write the same one (checked before any run).

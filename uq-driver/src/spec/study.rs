@@ -142,7 +142,7 @@ impl Study {
                 .and_then(|()| q.check_grid(e.start, e.stop, e.step))
                 .map_err(|err| invalid(err.to_string()))?;
         }
-        if let Some(problem) = crate::qoi::scalar::ended_value_problem(&self.qoi, &self.outputs) {
+        if let Some(problem) = crate::qoi::ended::ended_value_problem(&self.qoi, &self.outputs) {
             return Err(invalid(problem));
         }
         let times = self.times();
