@@ -16,44 +16,8 @@ use crate::uq::distributions::Germ;
 use crate::uq::pce::Pce;
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::reliability::{
-    form, Abort, Form, FormResult, LimitState, Outcome, Point, Side, Threshold,
+    form, Abort, Form, FormResult, Outcome, PhysicalLimitState, Side, Threshold,
 };
-
-/// The limit state of one column of a chaos, in the independent standard normal space of
-/// the study's inputs: `u → x` (each input's `F⁻¹(Φ(·))`, through the Gaussian copula),
-/// `x → ξ` (the chaos's germ), `q = chaos(ξ)`, `g` from the threshold.
-struct ChaosLimitState<'a> {
-    inputs: &'a RandomInputs,
-    germ: Germ,
-    pce: &'a Pce,
-    threshold: Threshold,
-}
-
-impl ChaosLimitState<'_> {
-    fn g(&self, u: &[f64]) -> Outcome {
-        let x = self.inputs.to_physical(Germ::Normal, u);
-        let q = self.pce.eval_column(0, &self.inputs.to_germ(self.germ, &x));
-        if q.is_finite() {
-            Ok(self.threshold.g(q))
-        } else {
-            Err(format!("the chaos is not finite at {x:?}"))
-        }
-    }
-}
-
-impl LimitState for ChaosLimitState<'_> {
-    fn dim(&self) -> usize {
-        self.inputs.len()
-    }
-
-    fn evaluate(&mut self, batch: &[Point]) -> Result<Vec<Outcome>, Abort> {
-        Ok(batch.iter().map(|p| self.g(&p.u)).collect())
-    }
-
-    fn physical(&self, u: &[f64]) -> Option<Vec<f64>> {
-        Some(self.inputs.to_physical(Germ::Normal, u))
-    }
-}
 
 /// FORM's design point of `pce` (its first column) for `threshold`, when the search
 /// converges to a point with a finite β.
@@ -63,12 +27,22 @@ fn design_point(
     germ: Germ,
     threshold: Threshold,
 ) -> Option<FormResult> {
-    let mut g = ChaosLimitState {
-        inputs,
-        germ,
-        pce,
-        threshold,
+    // `u → x` (each input's `F⁻¹(Φ(·))`, through the Gaussian copula), `x → ξ` (the chaos's
+    // germ), `q = chaos(ξ)`.
+    let chaos = |batch: &[(u64, Vec<f64>)]| -> Result<Vec<Outcome>, Abort> {
+        Ok(batch
+            .iter()
+            .map(|(_, x)| {
+                let q = pce.eval_column(0, &inputs.to_germ(germ, x));
+                if q.is_finite() {
+                    Ok(q)
+                } else {
+                    Err(format!("the chaos is not finite at {x:?}"))
+                }
+            })
+            .collect())
     };
+    let mut g = PhysicalLimitState::new(inputs, threshold, chaos);
     let r = form(&mut g, &Form::default(), 0).ok()?;
     (r.converged && r.beta.is_finite() && r.x_star.is_some()).then_some(r)
 }

@@ -67,9 +67,11 @@ pub use error::ReliabilityError;
 pub use form::{form, Form, FormResult};
 pub use gradient::{Differences, Scheme};
 pub use importance::{importance_sampling, ImportanceSampling, ImportanceSamplingResult};
-pub use model::{Abort, LimitState, OnFailure, Outcome, Point, Side, Threshold};
+pub use model::{
+    Abort, LimitState, OnFailure, Outcome, PhysicalLimitState, Point, Side, Threshold,
+};
 #[cfg(test)]
-pub use model::{PhysicalLimitState, Replay, StoredRun};
+pub use model::{Replay, StoredRun};
 pub use morris::{Morris, MorrisDesign, MorrisResult};
 pub use multistart::{form_multistart, MultiStart, MultiStartResult};
 pub use sorm::{sorm, Sorm, SormResult};

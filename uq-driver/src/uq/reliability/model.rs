@@ -8,9 +8,7 @@ use serde::{Deserialize, Serialize};
 
 pub use super::error::Abort;
 use super::error::ReliabilityError;
-#[cfg(test)]
 use crate::uq::distributions::Germ;
-#[cfg(test)]
 use crate::uq::random_inputs::RandomInputs;
 
 /// The result of one run: the value of the limit state `g` (or of the quantity, for a
@@ -99,7 +97,6 @@ impl Threshold {
     }
 }
 
-#[cfg(test)]
 /// A model of the physical inputs made a limit state in standard normal space:
 /// `x = T(u)` by [`RandomInputs::to_physical`] with [`Germ::Normal`] (each input's
 /// `F^-1(Phi(.))`, correlated inputs through the Gaussian copula), `q = model(x)`, and `g`
@@ -114,7 +111,6 @@ pub struct PhysicalLimitState<'a, F> {
     model: F,
 }
 
-#[cfg(test)]
 impl<'a, F> PhysicalLimitState<'a, F>
 where
     F: FnMut(&[(u64, Vec<f64>)]) -> Result<Vec<Outcome>, Abort>,
@@ -129,7 +125,6 @@ where
     }
 }
 
-#[cfg(test)]
 impl<F> LimitState for PhysicalLimitState<'_, F>
 where
     F: FnMut(&[(u64, Vec<f64>)]) -> Result<Vec<Outcome>, Abort>,
