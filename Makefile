@@ -152,11 +152,15 @@ test: venv lint win64-toolchain build fmu docs
 # The FMU crate's tests run on a debug build that carries the test-only panic trigger
 # (tests/fmi_abi.rs); the packaged FMUs in target/fmu come from the release build without it.
 # The Vehicle's dynamics tests (tens of simulated seconds each) run in release mode, as do the
-# driver's tests: they run real studies.
+# driver's tests: they run real studies. The release run of the Vehicle's tests names the same
+# packages as `build` (`--workspace --exclude railuq-python`, running only the railuq tests the
+# filter selects): cargo unifies the dependencies' features over the packages named, and
+# `-p railuq` alone compiled about twenty dependencies (nalgebra, rustfft, syn, ...) a second
+# time in release.
 test-rust:
 	env $(ZIG_ENV) $(CARGO) build -p railuq --lib --features test-panic
 	env $(ZIG_ENV) $(CARGO) test -p railuq --features test-panic
-	env $(ZIG_ENV) $(CARGO) test --release -p railuq --lib models::vehicle::
+	env $(ZIG_ENV) $(CARGO) test --release --workspace --exclude railuq-python --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
 	  env $(ZIG_ENV) $(CARGO) test --release -p uq-driver -p out-file -p in-file
 
