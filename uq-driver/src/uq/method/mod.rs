@@ -52,7 +52,7 @@ pub use error::{InvalidSettings, MethodError};
 pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
     details, hyperbolic_terms, AdaptiveMethod, ChaosFit, Evaluation, Intrusive, KindNotes, Method,
-    MethodSummary, Problem, Sampling, Solution,
+    MethodSummary, Problem, RunResults, Sampling, Solution,
 };
 
 // The method modules: declared here, not by the macro below, so that rustfmt reaches them.

@@ -9,13 +9,14 @@
 //! replicates, point `i` belongs to replicate `i / samples`; the mean is the mean of the
 //! replicate means and its standard error `sd(replicate means) / sqrt(R)`, an honest one.
 
-use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, RunResults, Sampling,
+};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -141,12 +142,8 @@ impl<T: UnitCubeSample> Sampling for T {
     }
 
     /// Any subset of the points is a valid (smaller) sample: failed points may be left out.
-    fn make_estimate(
-        &self,
-        _design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { rows, data, .. } = results;
         Ok(match self.replicates() {
             None => Estimate::from_sample(data),
             Some(_) => Estimate::from_replicates(data, rows, self.samples()),

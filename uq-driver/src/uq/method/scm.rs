@@ -10,14 +10,15 @@
 //! which converges slowly for bounded inputs: F⁻¹(Φ(z)) flattens in the tails). A study whose
 //! inputs all have a Hermite germ gets the same design either way.
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::chaos::{continuous_inputs, order_difference, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
-use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, RunResults, Sampling,
+};
 use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
@@ -159,12 +160,8 @@ impl Sampling for Scm {
     }
 
     /// Needs every node: a missing weighted node would bias every moment.
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
         let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
@@ -185,6 +182,8 @@ impl Sampling for Scm {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use std::f64::consts::PI;
 
     use super::*;

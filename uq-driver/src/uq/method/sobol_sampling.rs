@@ -45,7 +45,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::qmc::{check_sobol_points, Qmc, DEFAULT_REPLICATES};
 use super::sample::UnitCubeSample;
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, RunResults, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::random_inputs::RandomInputs;
@@ -317,12 +317,8 @@ impl Sampling for SobolSampling {
         Ok(design)
     }
 
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let n = self.samples;
         let d = design.points.first().map_or(0, Vec::len);
         let blocks = PickFreezeRows::new(n, d, rows);

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate};
-use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{Evaluation, Method, MethodSummary, Problem, RunResults, Sampling};
 use super::MethodSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
@@ -533,12 +533,8 @@ impl Sampling for Nested {
 
     /// The marginal mean (its standard error from the spread of the conditional means over
     /// the outer samples) and the marginal Std (from the corrected variance split).
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let blocks = self.blocks(design)?;
         let cond = self.conditional(&blocks, rows, data)?;
         marginal(&cond, data.ncols())
