@@ -23,7 +23,8 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::adaptive::{
-    check_continuous, each_target, standard_point, AdaptiveResult, BatchModel, LimitResult, Target,
+    check_continuous, per_target_items, standard_point, AnalyseTarget, LimitResult, PerTarget,
+    Target,
 };
 use super::error::{InvalidSettings, MethodError};
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
@@ -283,21 +284,20 @@ impl Adaptive for Form {
         targets as f64 * self.expected_runs_per_target(dim)
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for Form {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
         inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
-        each_target(model, inputs, targets, |g, t, first| {
-            self.analyse(g, t, first, inputs, seed)
-        })
+    ) -> Result<impl AnalyseTarget, MethodError> {
+        Ok(
+            move |g: &mut dyn LimitState, t: &Target, first| {
+                self.analyse(g, t, first, inputs, seed)
+            },
+        )
     }
 }
 

@@ -21,14 +21,14 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::adaptive::{
-    each_target, standard_point, AdaptiveResult, BatchModel, FailedRuns, LimitResult, Target,
+    per_target_items, standard_point, AnalyseTarget, FailedRuns, LimitResult, PerTarget, Target,
 };
 use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
 use super::sorm::check_nested_form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability;
+use crate::uq::reliability::{self, LimitState};
 
 /// `kind = "importance_sampling"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -144,24 +144,21 @@ impl Adaptive for ImportanceSampling {
         targets as f64 * (form + self.max_runs as f64)
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for ImportanceSampling {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
         inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
+    ) -> Result<impl AnalyseTarget, MethodError> {
         let settings = self.numerics();
         let centre = match &self.centre {
             Some(c) => Some(standard_point(inputs, c, "`centre`")?),
             None => None,
         };
-        each_target(model, inputs, targets, |g, t, first| {
+        Ok(move |g: &mut dyn LimitState, t: &Target, first| {
             let (mut out, c) = match &centre {
                 Some(c) => (LimitResult::new(t, "importance_sampling", first), c.clone()),
                 None => {
