@@ -190,16 +190,19 @@ impl Family {
         for k in 0..vals.len() {
             vals[k] = p;
             ders[k] = dp;
-            let (a, b) = self.recurrence(k);
-            let sb = if k == 0 { 0.0 } else { b.sqrt() };
-            let s1 = self.recurrence(k + 1).1.sqrt();
-            let next = ((t - a) * p - sb * pm) / s1;
-            let dnext = (p + (t - a) * dp - sb * dpm) / s1;
-            pm = p;
-            p = next;
-            dpm = dp;
-            dp = dnext;
+            [pm, p, dpm, dp] = self.step_with_derivative(k, t, [pm, p, dpm, dp]);
         }
+    }
+
+    /// One step of the orthonormal recurrence and of its derivative: from
+    /// `[p_{k-1}, p_k, p_{k-1}', p_k']` at `t` to `[p_k, p_{k+1}, p_k', p_{k+1}']`.
+    fn step_with_derivative(&self, k: usize, t: f64, [pm, p, dpm, dp]: [f64; 4]) -> [f64; 4] {
+        let (a, b) = self.recurrence(k);
+        let sb = if k == 0 { 0.0 } else { b.sqrt() };
+        let s1 = self.recurrence(k + 1).1.sqrt();
+        let next = ((t - a) * p - sb * pm) / s1;
+        let dnext = (p + (t - a) * dp - sb * dpm) / s1;
+        [p, next, dp, dnext]
     }
 
     /// The orthonormal polynomial `p_n(t)`.
@@ -270,15 +273,7 @@ impl Family {
         let (mut pm, mut p) = (0.0, 1.0);
         let (mut dpm, mut dp) = (0.0, 0.0);
         for k in 0..n {
-            let (a, b) = self.recurrence(k);
-            let sb = if k == 0 { 0.0 } else { b.sqrt() };
-            let s1 = self.recurrence(k + 1).1.sqrt();
-            let next = ((t - a) * p - sb * pm) / s1;
-            let dnext = (p + (t - a) * dp - sb * dpm) / s1;
-            pm = p;
-            p = next;
-            dpm = dp;
-            dp = dnext;
+            [pm, p, dpm, dp] = self.step_with_derivative(k, t, [pm, p, dpm, dp]);
         }
         (p, dp)
     }
