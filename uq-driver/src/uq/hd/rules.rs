@@ -531,4 +531,4 @@ fn clenshaw_curtis(n: usize) -> NodesWeights {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

@@ -311,19 +311,8 @@ pub(crate) fn sparse_grid_size(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::pce::askey::Family;
+    use crate::uq::hd::rules::tests::moment;
     use std::collections::HashSet;
-
-    /// Exact E[prod t_i^{m_i}] for the germ of each rule.
-    fn moment(kind: RuleKind, m: usize) -> f64 {
-        if m % 2 == 1 {
-            return 0.0;
-        }
-        match kind.family() {
-            Family::Hermite => (1..m).step_by(2).map(|k| k as f64).product(),
-            _ => 1.0 / (m as f64 + 1.0),
-        }
-    }
 
     /// All exponent vectors with total degree <= p.
     fn monomials(d: usize, p: usize) -> Vec<Vec<usize>> {

@@ -17,7 +17,8 @@ use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
 use super::traits::{
-    DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, RunResults, Sampling,
+    DesignSize, Evaluation, HashEntry, KindNotes, Method, MethodSummary, Problem, RunResults,
+    Sampling,
 };
 use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
@@ -104,10 +105,7 @@ impl Method for Scm {
     /// SCM follows each input's Askey family since `chaos` became one of its keys: where that
     /// changes the design (an input with a non-Hermite germ) the hash says so, so that a store
     /// of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
-    fn hash_entry(
-        &self,
-        parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, parameters: &[RandomParameter]) -> Option<HashEntry> {
         (self.chaos == ChaosBasis::Askey && ChaosBasis::some_own_family(parameters))
             .then(|| ("scm_germ", serde_json::json!("askey")))
     }

@@ -180,6 +180,9 @@ pub(crate) trait Adaptive: Method {
     ) -> Result<AdaptiveResult, MethodError>;
 }
 
+/// An entry of the study's hash: its key and value.
+pub(crate) type HashEntry = (&'static str, serde_json::Value);
+
 /// A UQ method as the study runner and the report see it.
 pub trait Method: std::fmt::Debug + Send + Sync {
     /// The `kind` in study files and summaries.
@@ -200,10 +203,7 @@ pub trait Method: std::fmt::Debug + Send + Sync {
 
     /// What besides its settings makes the results of this method on `parameters` differ,
     /// as an entry of the study's hash (so that a store of another design is not resumed).
-    fn hash_entry(
-        &self,
-        _parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, _parameters: &[RandomParameter]) -> Option<HashEntry> {
         None
     }
 

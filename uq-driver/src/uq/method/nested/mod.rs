@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate};
-use super::traits::{Evaluation, Method, MethodSummary, Problem, RunResults, Sampling};
+use super::traits::{Evaluation, HashEntry, Method, MethodSummary, Problem, RunResults, Sampling};
 use super::MethodSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
@@ -460,10 +460,7 @@ impl Method for Nested {
     }
 
     /// The inner method's entry: it draws the designs the runs come from.
-    fn hash_entry(
-        &self,
-        parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, parameters: &[RandomParameter]) -> Option<HashEntry> {
         self.inner.method().hash_entry(parameters)
     }
 
