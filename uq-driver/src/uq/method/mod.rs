@@ -240,9 +240,7 @@ mod tests {
             "kind = \"pce_regression\"\nsamples = 20\norder = 4\nsparse = true\ndesign = \"qmc\"",
         ] {
             let spec: MethodSpec = toml::from_str(text).unwrap();
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text} runs a design");
-            };
+            let m = sampling(&spec);
             let design = m.design(&params, 7).unwrap();
             let values: Vec<f64> = design.values.iter().map(|v| f(v)).collect();
             let data = DMatrix::from_column_slice(values.len(), 1, &values);
@@ -315,9 +313,7 @@ mod tests {
     #[test]
     fn a_weighted_design_refuses_a_missing_point() {
         let spec: MethodSpec = toml::from_str("kind = \"scm\"\nnodes = 2").unwrap();
-        let Evaluation::Sampling(m) = spec.method().evaluation() else {
-            panic!("scm runs a design");
-        };
+        let m = sampling(&spec);
         let params = RandomInputs::independent(vec![RandomParameter {
             name: "K".into(),
             distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
@@ -349,6 +345,14 @@ mod tests {
         toml::from_str(text).unwrap()
     }
 
+    /// The sampling method `spec` selects (a panic for any other).
+    fn sampling(spec: &MethodSpec) -> &dyn Sampling {
+        let Evaluation::Sampling(m) = spec.method().evaluation() else {
+            panic!("{spec:?}: a sampling method");
+        };
+        m
+    }
+
     /// `SobolSampling::estimate` with `data` three rows short of `rows`
     /// panicked (range end index out of range); `Lhs::estimate` with three rows too many or
     /// too few, and `Scm::estimate` with rows that are not design indices, returned `Ok`
@@ -367,9 +371,7 @@ mod tests {
             "kind = \"sparse_grid\"\nlevel = 2",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             let design = m.design(&inputs, 7).unwrap();
             let n = design.len();
             let rows: Vec<usize> = (0..n).collect();
@@ -453,9 +455,7 @@ mod tests {
             "kind = \"pce_regression\"\nsamples = 40\norder = 2",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             match m.design(&discrete, 1) {
                 Err(MethodError::Invalid(e)) => assert!(e.0.contains("integer_uniform"), "{e}"),
                 other => panic!("{text}: {other:?}"),
@@ -476,9 +476,7 @@ mod tests {
         }
         // A sampling method takes the discrete input.
         let lhs = sampling_of("kind = \"lhs\"\nsamples = 30");
-        let Evaluation::Sampling(m) = lhs.method().evaluation() else {
-            panic!("lhs: a sampling method");
-        };
+        let m = sampling(&lhs);
         m.design(&discrete, 1).unwrap();
     }
 
@@ -500,9 +498,7 @@ mod tests {
             "kind = \"nominal\"",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             match m.design(&inputs, 1) {
                 Err(e @ MethodError::InvalidInput { .. }) => {
                     assert!(e.to_string().contains("'u'"), "{e}")

@@ -392,24 +392,19 @@ impl Method for Nested {
             correlation: problem.correlation.cloned(),
         };
         let levels = self.levels(&inputs)?;
-        let outer = Problem {
-            parameters: &levels.outer_inputs.parameters,
-            correlation: levels.outer_inputs.correlation.as_ref(),
-            ..*problem
+        // Each level's method on the study restricted to the level's inputs.
+        let check = |level: &str, spec: &MethodSpec, inputs: &RandomInputs| {
+            let restricted = Problem {
+                parameters: &inputs.parameters,
+                correlation: inputs.correlation.as_ref(),
+                ..*problem
+            };
+            spec.method()
+                .validate(&restricted)
+                .map_err(|e| InvalidSettings(format!("{level}: {e}")))
         };
-        self.outer
-            .method()
-            .validate(&outer)
-            .map_err(|e| InvalidSettings(format!("outer: {e}")))?;
-        let inner = Problem {
-            parameters: &levels.inner_inputs.parameters,
-            correlation: levels.inner_inputs.correlation.as_ref(),
-            ..*problem
-        };
-        self.inner
-            .method()
-            .validate(&inner)
-            .map_err(|e| InvalidSettings(format!("inner: {e}")))
+        check("outer", &self.outer, &levels.outer_inputs)?;
+        check("inner", &self.inner, &levels.inner_inputs)
     }
 
     fn summary(&self, dim: usize) -> MethodSummary {
