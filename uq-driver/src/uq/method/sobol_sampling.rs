@@ -285,7 +285,7 @@ impl SobolSampling {
                 };
                 let blocks = (0..r)
                     .into_par_iter()
-                    .map(|k| qmc.block(per, 2 * d, seed, Some(k)))
+                    .map(|k| qmc.block(2 * d, seed, Some(k)))
                     .collect::<Result<Vec<_>, _>>()?;
                 blocks.into_iter().flatten().collect()
             }
