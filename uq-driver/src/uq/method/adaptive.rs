@@ -506,13 +506,17 @@ pub(crate) mod tests {
         }
     }
 
+    /// The one target `P(name > limit)`.
+    pub(crate) fn above(name: &str, limit: f64) -> Vec<Target> {
+        targets(&[(name.to_string(), vec![limit], vec![])], &[]).unwrap()
+    }
+
     /// `d` standard normal inputs named `x1..xd`.
     pub(crate) fn standard_inputs(d: usize) -> RandomInputs {
         RandomInputs::independent(
             (1..=d)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: Distribution::normal(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("x{i}"), Distribution::normal(0.0, 1.0).unwrap())
                 })
                 .collect(),
         )
@@ -537,14 +541,8 @@ pub(crate) mod tests {
     #[test]
     fn a_standard_point_maps_physical_values_back_and_refuses_gaps() {
         let inputs = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "k".into(),
-                distribution: Distribution::normal(10.0, 2.0).unwrap(),
-            },
-            RandomParameter {
-                name: "c".into(),
-                distribution: Distribution::lognormal(0.0, 0.5).unwrap(),
-            },
+            RandomParameter::new("k", Distribution::normal(10.0, 2.0).unwrap()),
+            RandomParameter::new("c", Distribution::lognormal(0.0, 0.5).unwrap()),
         ]);
         let values = [("k".to_string(), 14.0), ("c".to_string(), 1.0)]
             .into_iter()

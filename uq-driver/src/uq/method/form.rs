@@ -304,7 +304,7 @@ impl PerTarget for Form {
 #[cfg(test)]
 mod tests {
     use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::distributions::{Distribution, RandomParameter};
     use crate::uq::special::{norm_isf, norm_sf};
@@ -313,9 +313,11 @@ mod tests {
     fn a_linear_quantity_in_8_inputs_gives_the_exact_probability_within_20_runs_per_input() {
         // q = sum c_i x_i with x_i ~ N(m_i, s_i): q ~ N(sum c m, sum c^2 s^2), exactly.
         let params: Vec<RandomParameter> = (0..8)
-            .map(|i| RandomParameter {
-                name: format!("x{i}"),
-                distribution: Distribution::normal(1.0 + i as f64, 0.5 + 0.1 * i as f64).unwrap(),
+            .map(|i| {
+                RandomParameter::new(
+                    format!("x{i}"),
+                    Distribution::normal(1.0 + i as f64, 0.5 + 0.1 * i as f64).unwrap(),
+                )
             })
             .collect();
         let inputs = RandomInputs::independent(params.clone());
@@ -371,8 +373,7 @@ mod tests {
     #[test]
     fn a_sum_of_squares_warns_of_a_second_design_point() {
         let inputs = standard_inputs(4);
-        let q = vec![("r2".to_string(), vec![16.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("r2", 16.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             // Off-centre by a little, so that the gradient at the median is not zero.
             vec![Ok(x.iter().map(|v| (v - 0.01).powi(2)).sum())]
@@ -397,8 +398,7 @@ mod tests {
     #[test]
     fn a_failed_run_is_a_typed_error_naming_the_target_and_the_inputs() {
         let inputs = standard_inputs(2);
-        let q = vec![("q".to_string(), vec![3.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("q", 3.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             if x[0] > 1.5 {
                 vec![Err("the solver diverged".into())]
@@ -450,10 +450,10 @@ mod tests {
         ] {
             assert!(bad.validate(&problem).is_err(), "{bad:?}");
         }
-        let discrete = RandomInputs::independent(vec![RandomParameter {
-            name: "n".into(),
-            distribution: Distribution::integer_uniform(1, 4).unwrap(),
-        }]);
+        let discrete = RandomInputs::independent(vec![RandomParameter::new(
+            "n",
+            Distribution::integer_uniform(1, 4).unwrap(),
+        )]);
         let e = Form::default()
             .validate(&Problem::of_inputs(&discrete))
             .unwrap_err();

@@ -182,8 +182,7 @@ impl PerTarget for ImportanceSampling {
 
 #[cfg(test)]
 mod tests {
-    use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::special::norm_isf;
 
@@ -192,8 +191,7 @@ mod tests {
         let inputs = standard_inputs(8);
         for p in [1e-3, 1e-6] {
             let b = 8f64.sqrt() * norm_isf(p);
-            let q = vec![("s".to_string(), vec![b], vec![])];
-            let t = targets(&q, &[]).unwrap();
+            let t = above("s", b);
             let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok(x.iter().sum::<f64>())]);
             let r = ImportanceSampling::default()
                 .run(&mut model, &inputs, &t, &["s".into()], 3)
@@ -216,8 +214,7 @@ mod tests {
     fn a_user_centre_skips_form_and_still_gives_an_unbiased_estimate() {
         // P(x1 > 3) = Phi(-3), sampled around (2.8, 0.3), off the design point (3, 0).
         let inputs = standard_inputs(2);
-        let q = vec![("x1".to_string(), vec![3.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("x1", 3.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok(x[0] + 0.0 * x[1])]);
         let settings = ImportanceSampling {
             centre: Some(

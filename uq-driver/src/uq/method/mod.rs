@@ -210,14 +210,8 @@ mod tests {
     fn every_sampling_method_estimates_the_analytic_fixture() {
         let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
         let params = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "K".into(),
-                distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
-            },
-            RandomParameter {
-                name: "C".into(),
-                distribution: crate::uq::Distribution::normal(b, t).unwrap(),
-            },
+            RandomParameter::new("K", crate::uq::Distribution::normal(a, s_k).unwrap()),
+            RandomParameter::new("C", crate::uq::Distribution::normal(b, t).unwrap()),
         ]);
         let f = |v: &[f64]| v[0] + v[0] * v[1] + v[1] * v[1];
         let mean = a + a * b + b * b + t * t;
@@ -314,10 +308,10 @@ mod tests {
     fn a_weighted_design_refuses_a_missing_point() {
         let spec: MethodSpec = toml::from_str("kind = \"scm\"\nnodes = 2").unwrap();
         let m = sampling(&spec);
-        let params = RandomInputs::independent(vec![RandomParameter {
-            name: "K".into(),
-            distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
-        }]);
+        let params = RandomInputs::independent(vec![RandomParameter::new(
+            "K",
+            crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+        )]);
         let design = m.design(&params, 0).unwrap();
         let data = DMatrix::from_element(1, 3, 1.0);
         let e = m.estimate(&design, &[1], &data).unwrap_err();
@@ -333,9 +327,11 @@ mod tests {
     fn normal_inputs(dim: usize) -> RandomInputs {
         RandomInputs::independent(
             (0..dim)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(
+                        format!("x{i}"),
+                        crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+                    )
                 })
                 .collect(),
         )
@@ -441,14 +437,8 @@ mod tests {
     #[test]
     fn chaos_methods_refuse_a_discrete_input_in_design_and_estimate() {
         let discrete = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "n".into(),
-                distribution: crate::uq::Distribution::integer_uniform(1, 3).unwrap(),
-            },
-            RandomParameter {
-                name: "x".into(),
-                distribution: crate::uq::Distribution::normal(0.0, 1.0).unwrap(),
-            },
+            RandomParameter::new("n", crate::uq::Distribution::integer_uniform(1, 3).unwrap()),
+            RandomParameter::new("x", crate::uq::Distribution::normal(0.0, 1.0).unwrap()),
         ]);
         for text in [
             "kind = \"scm\"\nnodes = 4",

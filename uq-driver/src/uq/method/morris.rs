@@ -140,9 +140,8 @@ mod tests {
         // probability level), so mu* = |c_i| and sigma = 0; y2 = x1 x2 interacts.
         let inputs = RandomInputs::independent(
             (1..=3)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: Distribution::uniform(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("x{i}"), Distribution::uniform(0.0, 1.0).unwrap())
                 })
                 .collect(),
         );

@@ -522,14 +522,8 @@ mod tests {
 
     fn inputs() -> RandomInputs {
         RandomInputs::independent(vec![
-            RandomParameter {
-                name: "a".into(),
-                distribution: Distribution::normal(1.0, 0.5).unwrap(),
-            },
-            RandomParameter {
-                name: "b".into(),
-                distribution: Distribution::beta(2.0, 3.0, 0.0, 2.0).unwrap(),
-            },
+            RandomParameter::new("a", Distribution::normal(1.0, 0.5).unwrap()),
+            RandomParameter::new("b", Distribution::beta(2.0, 3.0, 0.0, 2.0).unwrap()),
         ])
     }
 

@@ -174,9 +174,8 @@ mod tests {
     fn unit_params(d: usize) -> RandomInputs {
         RandomInputs::independent(
             (0..d)
-                .map(|i| RandomParameter {
-                    name: format!("u{i}"),
-                    distribution: Distribution::uniform(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("u{i}"), Distribution::uniform(0.0, 1.0).unwrap())
                 })
                 .collect(),
         )

@@ -194,10 +194,7 @@ mod tests {
     fn inputs(law: Distribution) -> RandomInputs {
         RandomInputs::independent(
             (0..3)
-                .map(|i| RandomParameter {
-                    name: format!("x{}", i + 1),
-                    distribution: law.clone(),
-                })
+                .map(|i| RandomParameter::new(format!("x{}", i + 1), law.clone()))
                 .collect(),
         )
     }

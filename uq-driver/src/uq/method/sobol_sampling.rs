@@ -626,9 +626,11 @@ mod tests {
     fn uniform_params(d: usize, low: f64, high: f64) -> RandomInputs {
         RandomInputs::independent(
             (0..d)
-                .map(|i| RandomParameter {
-                    name: format!("x{}", i + 1),
-                    distribution: Distribution::uniform(low, high).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(
+                        format!("x{}", i + 1),
+                        Distribution::uniform(low, high).unwrap(),
+                    )
                 })
                 .collect(),
         )

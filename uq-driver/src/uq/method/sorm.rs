@@ -138,8 +138,7 @@ impl PerTarget for Sorm {
 
 #[cfg(test)]
 mod tests {
-    use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::special::norm_sf;
 
@@ -159,8 +158,7 @@ mod tests {
         }
         let exact = s * h / 3.0;
         let inputs = standard_inputs(3);
-        let q = vec![("q".to_string(), vec![b], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("q", b);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             vec![Ok(x[0] + k * (x[1] * x[1] + x[2] * x[2]) / 2.0)]
         });

@@ -320,10 +320,7 @@ mod tests {
         RandomInputs::independent(
             ds.into_iter()
                 .enumerate()
-                .map(|(i, d)| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: d,
-                })
+                .map(|(i, d)| RandomParameter::new(format!("x{i}"), d))
                 .collect(),
         )
     }

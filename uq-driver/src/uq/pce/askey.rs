@@ -15,10 +15,11 @@
 //! coefficients returned by [`Family::recurrence`]; the orthonormal polynomials obey
 //! `sqrt(beta_{n+1}) p_{n+1} = (t - alpha_n) p_n - sqrt(beta_n) p_{n-1}`.
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::uq::distributions::Distribution;
+use crate::uq::quadrature::sorted_eigenvalues;
 
 /// Largest number of nodes of a Gauss rule from [`Family::gauss`].
 pub const MAX_GAUSS_NODES: usize = 200;
@@ -236,12 +237,7 @@ impl Family {
                 jac[(k + 1, k)] = s;
             }
         }
-        let mut x: Vec<f64> = SymmetricEigen::new(jac)
-            .eigenvalues
-            .iter()
-            .copied()
-            .collect();
-        x.sort_by(f64::total_cmp);
+        let mut x = sorted_eigenvalues(jac);
         let mut vals = vec![0.0; n + 1];
         for xi in x.iter_mut() {
             // Newton on p_n, derivative from the Christoffel–Darboux-free finite recurrence.

@@ -41,10 +41,7 @@ impl Linear {
 /// with probability `p`: `ln y ~ N(0, 0.7^2)`, so `limit = exp(0.7 Phi^-1(1 - p))`.
 pub(super) fn lognormal_response(p: f64) -> (RandomInputs, f64) {
     let parameters = (0..8)
-        .map(|i| RandomParameter {
-            name: format!("x{i}"),
-            distribution: Distribution::normal(0.0, 1.0).unwrap(),
-        })
+        .map(|i| RandomParameter::new(format!("x{i}"), Distribution::normal(0.0, 1.0).unwrap()))
         .collect();
     (
         RandomInputs::independent(parameters),

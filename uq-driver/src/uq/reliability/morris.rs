@@ -328,10 +328,7 @@ mod tests {
             dists
                 .into_iter()
                 .enumerate()
-                .map(|(i, distribution)| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution,
-                })
+                .map(|(i, distribution)| RandomParameter::new(format!("x{i}"), distribution))
                 .collect(),
         )
     }
