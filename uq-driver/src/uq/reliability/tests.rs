@@ -41,14 +41,7 @@ fn lower_tails_of_a_linear_response() {
         let f = form(&mut m, &Form::default(), 0).unwrap();
         assert!((f.probability - exact).abs() < 1e-3 * exact, "FORM {f:?}");
         assert!((q(f.x_star.as_ref().unwrap()) - limit).abs() < 1e-6);
-        let is = importance_sampling(
-            &mut m,
-            &ImportanceSampling::default(),
-            &f.u_star,
-            1,
-            f.next_run,
-        )
-        .unwrap();
+        let is = fixtures::sampling_at_design_point(&mut m, &f, 1, f.next_run);
         assert!((is.probability - exact).abs() < 0.1 * exact, "IS {is:?}");
         let s = subset_simulation(&mut m, &Subset::default(), 1, is.next_run).unwrap();
         assert!(
@@ -141,14 +134,7 @@ fn correlated_lognormal_inputs_through_the_nataf_transformation() {
         sorm_err < 0.5 * form_err && sorm_err < 0.03,
         "SORM {so:?} vs {exact:.4e}"
     );
-    let is = importance_sampling(
-        &mut m,
-        &ImportanceSampling::default(),
-        &f.u_star,
-        2,
-        so.next_run,
-    )
-    .unwrap();
+    let is = fixtures::sampling_at_design_point(&mut m, &f, 2, so.next_run);
     let [a, b] = is.interval.unwrap();
     assert!(a <= exact && exact <= b, "IS {is:?} vs {exact:.4e}");
     let ss = subset_simulation(&mut m, &Subset::default(), 2, is.next_run).unwrap();
