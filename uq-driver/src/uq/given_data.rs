@@ -266,14 +266,8 @@ mod tests {
         assert_eq!(bins.count, 89);
         let s = bins.first_order(&y);
         let ci = bins.intervals(&y, 200, 0.95, 3);
+        assert_within(&s, &exact, 0.03);
         for i in 0..3 {
-            assert!(
-                (s[i] - exact[i]).abs() < 0.03,
-                "S{}: {} vs {}",
-                i + 1,
-                s[i],
-                exact[i]
-            );
             assert!(ci[i].0 <= s[i] + 1e-12 && s[i] <= ci[i].1 + 1e-12, "{ci:?}");
             assert!(ci[i].1 - ci[i].0 < 0.15, "{ci:?}");
         }
@@ -371,14 +365,14 @@ mod tests {
         let x = inputs(10_000, &[(1.0, 2.0); 3], 21);
         let y: Vec<f64> = (0..10_000).map(|j| f(&at(&x, j))).collect();
         let s = Bins::of(&x).first_order(&y);
-        for i in 0..3 {
-            assert!(
-                (s[i] - exact[i]).abs() < 0.03,
-                "S{}: {} vs {}",
-                i + 1,
-                s[i],
-                exact[i]
-            );
+        assert_within(&s, &exact, 0.03);
+    }
+
+    /// Each first-order index `s[i]` within `tol` of `exact[i]`.
+    fn assert_within(s: &[f64], exact: &[f64], tol: f64) {
+        assert_eq!(s.len(), exact.len());
+        for (i, (s, e)) in s.iter().zip(exact).enumerate() {
+            assert!((s - e).abs() < tol, "S{}: {} vs {}", i + 1, s, e);
         }
     }
 

@@ -107,6 +107,28 @@ fn recurrence(n: usize, x: f64, step: impl Fn(usize, f64, f64, f64) -> f64) -> R
     }
 }
 
+/// The eigenvalues of the symmetric (Jacobi) matrix `m`, ascending: the nodes of its Gauss
+/// rule.
+pub(crate) fn sorted_eigenvalues(m: DMatrix<f64>) -> Vec<f64> {
+    let mut x: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
+    x.sort_by(f64::total_cmp);
+    x
+}
+
+/// Makes the ascending `x` exactly symmetric about 0 (each pair of mirror nodes at its mean
+/// distance, a middle node at 0).
+pub(crate) fn symmetrize_nodes(x: &mut [f64]) {
+    let n = x.len();
+    for i in 0..n / 2 {
+        let a = 0.5 * (x[n - 1 - i] - x[i]);
+        x[i] = -a;
+        x[n - 1 - i] = a;
+    }
+    if n % 2 == 1 {
+        x[n / 2] = 0.0;
+    }
+}
+
 /// Nodes (ascending) and weights of an `n`-point Gauss rule from its Jacobi
 /// matrix (zero diagonal, off-diagonal `beta(k)`, `k = 1..n`), polished with
 /// `eval` (orthonormal recurrence) and `deriv_coef` (`p_n' = c p_{n-1}` at the
@@ -127,12 +149,7 @@ fn symmetric_gauss_rule(
         jacobi[(k - 1, k)] = b;
         jacobi[(k, k - 1)] = b;
     }
-    let mut x: Vec<f64> = SymmetricEigen::new(jacobi)
-        .eigenvalues
-        .iter()
-        .copied()
-        .collect();
-    x.sort_by(f64::total_cmp);
+    let mut x = sorted_eigenvalues(jacobi);
     // Newton polish: p_n(x) = 0.
     for xi in x.iter_mut() {
         for _ in 0..3 {
@@ -151,15 +168,7 @@ fn symmetric_gauss_rule(
             }
         }
     }
-    // Exact symmetry about 0.
-    for i in 0..n / 2 {
-        let a = 0.5 * (x[n - 1 - i] - x[i]);
-        x[i] = -a;
-        x[n - 1 - i] = a;
-    }
-    if n % 2 == 1 {
-        x[n / 2] = 0.0;
-    }
+    symmetrize_nodes(&mut x);
     let mut w: Vec<f64> = x
         .iter()
         .map(|&xi| {

@@ -260,10 +260,7 @@ mod tests {
             ("c", Distribution::uniform(-1.0, 3.0).unwrap()),
         ]
         .into_iter()
-        .map(|(n, d)| RandomParameter {
-            name: n.into(),
-            distribution: d,
-        })
+        .map(|(n, d)| RandomParameter::new(n, d))
         .collect()
     }
 

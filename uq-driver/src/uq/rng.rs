@@ -118,22 +118,11 @@ mod tests {
 
     #[test]
     fn streams_are_reproducible_and_distinct() {
-        let a: Vec<u64> = {
-            let mut r = stream(1, 5);
+        let draws = |seed, index| -> Vec<u64> {
+            let mut r = stream(seed, index);
             (0..8).map(|_| r.next_u64()).collect()
         };
-        let b: Vec<u64> = {
-            let mut r = stream(1, 5);
-            (0..8).map(|_| r.next_u64()).collect()
-        };
-        let c: Vec<u64> = {
-            let mut r = stream(1, 6);
-            (0..8).map(|_| r.next_u64()).collect()
-        };
-        let d: Vec<u64> = {
-            let mut r = stream(2, 5);
-            (0..8).map(|_| r.next_u64()).collect()
-        };
+        let (a, b, c, d) = (draws(1, 5), draws(1, 5), draws(1, 6), draws(2, 5));
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(a, d);

@@ -383,10 +383,7 @@ impl Surrogate {
                 i.distribution
                     .validate()
                     .map_err(|e| invalid(format!("input '{}': {e}", i.name)))?;
-                Ok(RandomParameter {
-                    name: i.name.clone(),
-                    distribution: i.distribution.clone(),
-                })
+                Ok(RandomParameter::new(i.name.clone(), i.distribution.clone()))
             })
             .collect::<Result<_, SurrogateError>>()?;
         let pairs = f
@@ -650,14 +647,8 @@ mod tests {
 
     fn inputs(correlated: bool) -> RandomInputs {
         let parameters = vec![
-            RandomParameter {
-                name: "a".into(),
-                distribution: Distribution::normal(2.0, 0.5).unwrap(),
-            },
-            RandomParameter {
-                name: "b".into(),
-                distribution: Distribution::uniform(0.0, 4.0).unwrap(),
-            },
+            RandomParameter::new("a", Distribution::normal(2.0, 0.5).unwrap()),
+            RandomParameter::new("b", Distribution::uniform(0.0, 4.0).unwrap()),
         ];
         let pairs = if correlated {
             vec![CorrelationPair {

@@ -512,7 +512,7 @@ mod tests {
 
     use super::*;
     use crate::uq::method::pce_regression::PceRegression;
-    use crate::uq::method::{Evaluation, Method, MethodSummary, Problem};
+    use crate::uq::method::{Evaluation, Method, MethodSummary, Problem, RunResults};
     use crate::uq::random_inputs::RandomInputs;
     use crate::uq::{Distribution, RandomParameter};
 
@@ -614,14 +614,10 @@ mod tests {
         fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
             self.inner.make_design(inputs, seed)
         }
-        fn make_estimate(
-            &self,
-            design: &Design,
-            rows: &[usize],
-            data: &DMatrix<f64>,
-        ) -> Result<Estimate, MethodError> {
-            self.columns.fetch_add(data.ncols(), Ordering::Relaxed);
-            self.inner.make_estimate(design, rows, data)
+        fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+            self.columns
+                .fetch_add(results.data.ncols(), Ordering::Relaxed);
+            self.inner.make_estimate(results)
         }
         fn chaos_per_column(&self) -> bool {
             true

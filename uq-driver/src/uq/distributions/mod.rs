@@ -400,3 +400,13 @@ pub struct RandomParameter {
     /// Its distribution.
     pub distribution: Distribution,
 }
+
+impl RandomParameter {
+    /// The input `name` with `distribution`.
+    pub fn new(name: impl Into<String>, distribution: Distribution) -> RandomParameter {
+        RandomParameter {
+            name: name.into(),
+            distribution,
+        }
+    }
+}

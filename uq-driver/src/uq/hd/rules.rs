@@ -34,6 +34,7 @@ use std::sync::OnceLock;
 use nalgebra::{DMatrix, DVector};
 
 use crate::uq::pce::askey::Family;
+use crate::uq::quadrature::symmetrize_nodes;
 
 /// Errors of the rule constructors.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -472,18 +473,6 @@ fn bisect(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64) -> f64 {
     0.5 * (a + b)
 }
 
-fn symmetrize_nodes(x: &mut [f64]) {
-    let n = x.len();
-    for i in 0..n / 2 {
-        let a = 0.5 * (x[n - 1 - i] - x[i]);
-        x[i] = -a;
-        x[n - 1 - i] = a;
-    }
-    if n % 2 == 1 {
-        x[n / 2] = 0.0;
-    }
-}
-
 /// Interpolatory weights of the symmetric `nodes` (ascending) for the symmetric germ of
 /// `fam`: odd moments vanish by symmetry, so only the even conditions
 /// `sum_i w_i phi_2k(x_i) = delta_k0` are solved, over the non-negative nodes (half the
@@ -542,4 +531,4 @@ fn clenshaw_curtis(n: usize) -> NodesWeights {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

@@ -311,19 +311,8 @@ pub(crate) fn sparse_grid_size(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::uq::pce::askey::Family;
+    use crate::uq::hd::rules::tests::moment;
     use std::collections::HashSet;
-
-    /// Exact E[prod t_i^{m_i}] for the germ of each rule.
-    fn moment(kind: RuleKind, m: usize) -> f64 {
-        if m % 2 == 1 {
-            return 0.0;
-        }
-        match kind.family() {
-            Family::Hermite => (1..m).step_by(2).map(|k| k as f64).product(),
-            _ => 1.0 / (m as f64 + 1.0),
-        }
-    }
 
     /// All exponent vectors with total degree <= p.
     fn monomials(d: usize, p: usize) -> Vec<Vec<usize>> {
@@ -436,15 +425,6 @@ mod tests {
             (4, [1, 9, 41, 137, 401]),
             (8, [1, 17, 145, 849, 3937]),
         ];
-        for (d, want) in cc {
-            for (l, &w) in want.iter().enumerate() {
-                assert_eq!(
-                    sparse_grid_size(RuleKind::ClenshawCurtis, d, l).unwrap(),
-                    w,
-                    "CC d={d} level {l}"
-                );
-            }
-        }
         // Gauss–Legendre, l + 1 points (shared nodes merged), levels 0..=4
         // (as tabulated in Elastic ml-cpp's sparse-quadrature test):
         // d = 2: 1 5 13 29 53; d = 4: 1 9 41 137 385; d = 8: 1 17 145 849 3905.
@@ -453,13 +433,18 @@ mod tests {
             (4, [1, 9, 41, 137, 385]),
             (8, [1, 17, 145, 849, 3905]),
         ];
-        for (d, want) in gl {
-            for (l, &w) in want.iter().enumerate() {
-                assert_eq!(
-                    sparse_grid_size(RuleKind::GaussLegendre, d, l).unwrap(),
-                    w,
-                    "GL d={d} level {l}"
-                );
+        for (kind, name, table) in [
+            (RuleKind::ClenshawCurtis, "CC", cc),
+            (RuleKind::GaussLegendre, "GL", gl),
+        ] {
+            for (d, want) in table {
+                for (l, &w) in want.iter().enumerate() {
+                    assert_eq!(
+                        sparse_grid_size(kind, d, l).unwrap(),
+                        w,
+                        "{name} d={d} level {l}"
+                    );
+                }
             }
         }
         // Genz–Keister and Gauss–Patterson: against a brute-force union of the tensor grids.

@@ -293,7 +293,7 @@ pub(crate) fn each_target(
     model: &mut dyn BatchModel,
     inputs: &RandomInputs,
     targets: &[Target],
-    mut analyse: impl FnMut(&mut dyn LimitState, &Target, u64) -> Result<LimitResult, ReliabilityError>,
+    mut analyse: impl AnalyseTarget,
 ) -> Result<AdaptiveResult, MethodError> {
     if targets.is_empty() {
         return Err(MethodError::Invalid(InvalidSettings(
@@ -320,6 +320,52 @@ pub(crate) fn each_target(
         runs: next,
     })
 }
+
+/// The analysis of one target that [`each_target`] runs: on the target's limit state, for
+/// the target, with its runs numbered from the given one.
+pub(crate) trait AnalyseTarget:
+    FnMut(&mut dyn LimitState, &Target, u64) -> Result<LimitResult, ReliabilityError>
+{
+}
+
+impl<F> AnalyseTarget for F where
+    F: FnMut(&mut dyn LimitState, &Target, u64) -> Result<LimitResult, ReliabilityError>
+{
+}
+
+/// A reliability method that analyses each target on its own (FORM, SORM, importance
+/// sampling, subset simulation): its [`Adaptive::run`](super::traits::Adaptive::run) is
+/// [`each_target`] over its analysis ([`per_target_items`]).
+pub(crate) trait PerTarget {
+    /// The analysis of a target on `inputs`, deterministic in `seed`; what holds for every
+    /// target (the settings, a given point) is worked out once, here.
+    fn analyser(&self, inputs: &RandomInputs, seed: u64)
+        -> Result<impl AnalyseTarget, MethodError>;
+}
+
+/// The [`Adaptive::only`](super::traits::Adaptive::only) (the method's `quantities`) and
+/// [`Adaptive::run`](super::traits::Adaptive::run) ([`each_target`] over
+/// [`PerTarget::analyser`]) of a [`PerTarget`] method. Used inside `impl Adaptive for …`.
+macro_rules! per_target_items {
+    () => {
+        fn only(&self) -> &[String] {
+            &self.quantities
+        }
+
+        fn run(
+            &self,
+            model: &mut dyn $crate::uq::method::adaptive::BatchModel,
+            inputs: &$crate::uq::random_inputs::RandomInputs,
+            targets: &[$crate::uq::method::adaptive::Target],
+            _names: &[String],
+            seed: u64,
+        ) -> Result<$crate::uq::method::adaptive::AdaptiveResult, $crate::uq::method::MethodError> {
+            let analyse = $crate::uq::method::adaptive::PerTarget::analyser(self, inputs, seed)?;
+            $crate::uq::method::adaptive::each_target(model, inputs, targets, analyse)
+        }
+    };
+}
+pub(crate) use per_target_items;
 
 /// A reliability error as a method error, naming `target` and the physical inputs.
 pub(crate) fn method_error(
@@ -460,13 +506,17 @@ pub(crate) mod tests {
         }
     }
 
+    /// The one target `P(name > limit)`.
+    pub(crate) fn above(name: &str, limit: f64) -> Vec<Target> {
+        targets(&[(name.to_string(), vec![limit], vec![])], &[]).unwrap()
+    }
+
     /// `d` standard normal inputs named `x1..xd`.
     pub(crate) fn standard_inputs(d: usize) -> RandomInputs {
         RandomInputs::independent(
             (1..=d)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: Distribution::normal(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("x{i}"), Distribution::normal(0.0, 1.0).unwrap())
                 })
                 .collect(),
         )
@@ -491,14 +541,8 @@ pub(crate) mod tests {
     #[test]
     fn a_standard_point_maps_physical_values_back_and_refuses_gaps() {
         let inputs = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "k".into(),
-                distribution: Distribution::normal(10.0, 2.0).unwrap(),
-            },
-            RandomParameter {
-                name: "c".into(),
-                distribution: Distribution::lognormal(0.0, 0.5).unwrap(),
-            },
+            RandomParameter::new("k", Distribution::normal(10.0, 2.0).unwrap()),
+            RandomParameter::new("c", Distribution::lognormal(0.0, 0.5).unwrap()),
         ]);
         let values = [("k".to_string(), 14.0), ("c".to_string(), 1.0)]
             .into_iter()

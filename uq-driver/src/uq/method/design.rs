@@ -173,10 +173,10 @@ mod tests {
 
     #[test]
     fn negative_values_of_a_positive_parameter_are_reported_with_their_weight() {
-        let params = RandomInputs::independent(vec![RandomParameter {
-            name: "k".into(),
-            distribution: Distribution::normal(1.0, 1.0).unwrap(),
-        }]);
+        let params = RandomInputs::independent(vec![RandomParameter::new(
+            "k",
+            Distribution::normal(1.0, 1.0).unwrap(),
+        )]);
         // z = -2 maps to k = -1; weight 0.25.
         let d = Design::mapped(
             Germ::Normal,
@@ -209,20 +209,17 @@ mod tests {
         let cube = vec![vec![0.05], vec![0.5], vec![0.95]];
         for d in families {
             assert!(d.mean() > 0.0, "{d:?}");
-            let inputs = RandomInputs::independent(vec![RandomParameter {
-                name: "a".into(),
-                distribution: d.clone(),
-            }]);
+            let inputs = RandomInputs::independent(vec![RandomParameter::new("a", d.clone())]);
             let design = Design::mapped(Germ::Uniform, cube.clone(), None, &inputs);
             assert!(design.values[0][0] <= 0.0, "{d:?}: {:?}", design.values);
             let w = design.sign_warnings(|_| true);
             assert!(w.is_empty(), "{d:?}: {w:?}");
         }
         // A normal input still warns, and its text no longer claims that failed points are run.
-        let normal = RandomInputs::independent(vec![RandomParameter {
-            name: "k".into(),
-            distribution: Distribution::normal(1.0, 1.0).unwrap(),
-        }]);
+        let normal = RandomInputs::independent(vec![RandomParameter::new(
+            "k",
+            Distribution::normal(1.0, 1.0).unwrap(),
+        )]);
         let d = Design::mapped(Germ::Uniform, cube, None, &normal);
         let w = d.sign_warnings(|_| true);
         assert_eq!(w.len(), 1);

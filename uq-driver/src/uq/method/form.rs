@@ -23,7 +23,8 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::adaptive::{
-    check_continuous, each_target, standard_point, AdaptiveResult, BatchModel, LimitResult, Target,
+    check_continuous, per_target_items, standard_point, AnalyseTarget, LimitResult, PerTarget,
+    Target,
 };
 use super::error::{InvalidSettings, MethodError};
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
@@ -283,28 +284,27 @@ impl Adaptive for Form {
         targets as f64 * self.expected_runs_per_target(dim)
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for Form {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
         inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
-        each_target(model, inputs, targets, |g, t, first| {
-            self.analyse(g, t, first, inputs, seed)
-        })
+    ) -> Result<impl AnalyseTarget, MethodError> {
+        Ok(
+            move |g: &mut dyn LimitState, t: &Target, first| {
+                self.analyse(g, t, first, inputs, seed)
+            },
+        )
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::distributions::{Distribution, RandomParameter};
     use crate::uq::special::{norm_isf, norm_sf};
@@ -313,9 +313,11 @@ mod tests {
     fn a_linear_quantity_in_8_inputs_gives_the_exact_probability_within_20_runs_per_input() {
         // q = sum c_i x_i with x_i ~ N(m_i, s_i): q ~ N(sum c m, sum c^2 s^2), exactly.
         let params: Vec<RandomParameter> = (0..8)
-            .map(|i| RandomParameter {
-                name: format!("x{i}"),
-                distribution: Distribution::normal(1.0 + i as f64, 0.5 + 0.1 * i as f64).unwrap(),
+            .map(|i| {
+                RandomParameter::new(
+                    format!("x{i}"),
+                    Distribution::normal(1.0 + i as f64, 0.5 + 0.1 * i as f64).unwrap(),
+                )
             })
             .collect();
         let inputs = RandomInputs::independent(params.clone());
@@ -371,8 +373,7 @@ mod tests {
     #[test]
     fn a_sum_of_squares_warns_of_a_second_design_point() {
         let inputs = standard_inputs(4);
-        let q = vec![("r2".to_string(), vec![16.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("r2", 16.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             // Off-centre by a little, so that the gradient at the median is not zero.
             vec![Ok(x.iter().map(|v| (v - 0.01).powi(2)).sum())]
@@ -397,8 +398,7 @@ mod tests {
     #[test]
     fn a_failed_run_is_a_typed_error_naming_the_target_and_the_inputs() {
         let inputs = standard_inputs(2);
-        let q = vec![("q".to_string(), vec![3.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("q", 3.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             if x[0] > 1.5 {
                 vec![Err("the solver diverged".into())]
@@ -450,10 +450,10 @@ mod tests {
         ] {
             assert!(bad.validate(&problem).is_err(), "{bad:?}");
         }
-        let discrete = RandomInputs::independent(vec![RandomParameter {
-            name: "n".into(),
-            distribution: Distribution::integer_uniform(1, 4).unwrap(),
-        }]);
+        let discrete = RandomInputs::independent(vec![RandomParameter::new(
+            "n",
+            Distribution::integer_uniform(1, 4).unwrap(),
+        )]);
         let e = Form::default()
             .validate(&Problem::of_inputs(&discrete))
             .unwrap_err();

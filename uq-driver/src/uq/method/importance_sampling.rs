@@ -21,14 +21,14 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::adaptive::{
-    each_target, standard_point, AdaptiveResult, BatchModel, FailedRuns, LimitResult, Target,
+    per_target_items, standard_point, AnalyseTarget, FailedRuns, LimitResult, PerTarget, Target,
 };
 use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
 use super::sorm::check_nested_form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability;
+use crate::uq::reliability::{self, LimitState};
 
 /// `kind = "importance_sampling"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -144,24 +144,21 @@ impl Adaptive for ImportanceSampling {
         targets as f64 * (form + self.max_runs as f64)
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for ImportanceSampling {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
         inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
+    ) -> Result<impl AnalyseTarget, MethodError> {
         let settings = self.numerics();
         let centre = match &self.centre {
             Some(c) => Some(standard_point(inputs, c, "`centre`")?),
             None => None,
         };
-        each_target(model, inputs, targets, |g, t, first| {
+        Ok(move |g: &mut dyn LimitState, t: &Target, first| {
             let (mut out, c) = match &centre {
                 Some(c) => (LimitResult::new(t, "importance_sampling", first), c.clone()),
                 None => {
@@ -185,8 +182,7 @@ impl Adaptive for ImportanceSampling {
 
 #[cfg(test)]
 mod tests {
-    use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::special::norm_isf;
 
@@ -195,8 +191,7 @@ mod tests {
         let inputs = standard_inputs(8);
         for p in [1e-3, 1e-6] {
             let b = 8f64.sqrt() * norm_isf(p);
-            let q = vec![("s".to_string(), vec![b], vec![])];
-            let t = targets(&q, &[]).unwrap();
+            let t = above("s", b);
             let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok(x.iter().sum::<f64>())]);
             let r = ImportanceSampling::default()
                 .run(&mut model, &inputs, &t, &["s".into()], 3)
@@ -219,8 +214,7 @@ mod tests {
     fn a_user_centre_skips_form_and_still_gives_an_unbiased_estimate() {
         // P(x1 > 3) = Phi(-3), sampled around (2.8, 0.3), off the design point (3, 0).
         let inputs = standard_inputs(2);
-        let q = vec![("x1".to_string(), vec![3.0], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("x1", 3.0);
         let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok(x[0] + 0.0 * x[1])]);
         let settings = ImportanceSampling {
             centre: Some(

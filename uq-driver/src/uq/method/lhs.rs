@@ -12,7 +12,7 @@ use rand::RngCore;
 use serde::{Deserialize, Serialize};
 
 use super::error::MethodError;
-use super::sample::{UnitCubeSample, SE_REPLICATES};
+use super::sample::{Points, UnitCubeSample, SE_REPLICATES};
 use crate::uq::{rng, sampling};
 
 /// `standard_error` of an unreplicated Latin hypercube.
@@ -50,16 +50,10 @@ impl UnitCubeSample for Lhs {
         self.replicates
     }
 
-    /// A function of `(n, d, seed)` only (of the replicate's seed when replicated).
-    fn block(
-        &self,
-        n: usize,
-        d: usize,
-        seed: u64,
-        replicate: Option<usize>,
-    ) -> Result<Vec<Vec<f64>>, MethodError> {
+    /// A function of `(samples, d, seed)` only (of the replicate's seed when replicated).
+    fn block(&self, d: usize, seed: u64, replicate: Option<usize>) -> Result<Points, MethodError> {
         let seed = replicate.map_or(seed, |r| replicate_seed(seed, r));
-        Ok(sampling::latin_hypercube(n, d, seed))
+        Ok(sampling::latin_hypercube(self.samples, d, seed))
     }
 
     fn standard_error(&self) -> &'static str {

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::MethodError;
-use super::sample::{UnitCubeSample, SE_MONTE_CARLO};
+use super::sample::{Points, UnitCubeSample, SE_MONTE_CARLO};
 use crate::uq::sampling;
 
 /// `kind = "mc"`.
@@ -23,14 +23,8 @@ impl UnitCubeSample for Mc {
     }
 
     /// Point `i` takes its uniforms from the stream `(seed, i)` only.
-    fn block(
-        &self,
-        n: usize,
-        d: usize,
-        seed: u64,
-        _replicate: Option<usize>,
-    ) -> Result<Vec<Vec<f64>>, MethodError> {
-        Ok(sampling::monte_carlo(n, d, seed))
+    fn block(&self, d: usize, seed: u64, _replicate: Option<usize>) -> Result<Points, MethodError> {
+        Ok(sampling::monte_carlo(self.samples, d, seed))
     }
 
     fn standard_error(&self) -> &'static str {

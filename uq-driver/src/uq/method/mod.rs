@@ -52,7 +52,7 @@ pub use error::{InvalidSettings, MethodError};
 pub use estimate::{ChaosError, ChaosErrorKind, Draws, Estimate, Sobol, SobolIntervals};
 pub use traits::{
     details, hyperbolic_terms, AdaptiveMethod, ChaosFit, Evaluation, Intrusive, KindNotes, Method,
-    MethodSummary, Problem, Sampling, Solution,
+    MethodSummary, Problem, RunResults, Sampling, Solution,
 };
 
 // The method modules: declared here, not by the macro below, so that rustfmt reaches them.
@@ -210,14 +210,8 @@ mod tests {
     fn every_sampling_method_estimates_the_analytic_fixture() {
         let (a, s_k, b, t) = (2.0, 0.5, 1.0, 0.2);
         let params = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "K".into(),
-                distribution: crate::uq::Distribution::normal(a, s_k).unwrap(),
-            },
-            RandomParameter {
-                name: "C".into(),
-                distribution: crate::uq::Distribution::normal(b, t).unwrap(),
-            },
+            RandomParameter::new("K", crate::uq::Distribution::normal(a, s_k).unwrap()),
+            RandomParameter::new("C", crate::uq::Distribution::normal(b, t).unwrap()),
         ]);
         let f = |v: &[f64]| v[0] + v[0] * v[1] + v[1] * v[1];
         let mean = a + a * b + b * b + t * t;
@@ -240,9 +234,7 @@ mod tests {
             "kind = \"pce_regression\"\nsamples = 20\norder = 4\nsparse = true\ndesign = \"qmc\"",
         ] {
             let spec: MethodSpec = toml::from_str(text).unwrap();
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text} runs a design");
-            };
+            let m = sampling(&spec);
             let design = m.design(&params, 7).unwrap();
             let values: Vec<f64> = design.values.iter().map(|v| f(v)).collect();
             let data = DMatrix::from_column_slice(values.len(), 1, &values);
@@ -315,13 +307,11 @@ mod tests {
     #[test]
     fn a_weighted_design_refuses_a_missing_point() {
         let spec: MethodSpec = toml::from_str("kind = \"scm\"\nnodes = 2").unwrap();
-        let Evaluation::Sampling(m) = spec.method().evaluation() else {
-            panic!("scm runs a design");
-        };
-        let params = RandomInputs::independent(vec![RandomParameter {
-            name: "K".into(),
-            distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
-        }]);
+        let m = sampling(&spec);
+        let params = RandomInputs::independent(vec![RandomParameter::new(
+            "K",
+            crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+        )]);
         let design = m.design(&params, 0).unwrap();
         let data = DMatrix::from_element(1, 3, 1.0);
         let e = m.estimate(&design, &[1], &data).unwrap_err();
@@ -337,9 +327,11 @@ mod tests {
     fn normal_inputs(dim: usize) -> RandomInputs {
         RandomInputs::independent(
             (0..dim)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(
+                        format!("x{i}"),
+                        crate::uq::Distribution::normal(1.0, 0.1).unwrap(),
+                    )
                 })
                 .collect(),
         )
@@ -347,6 +339,14 @@ mod tests {
 
     fn sampling_of(text: &str) -> MethodSpec {
         toml::from_str(text).unwrap()
+    }
+
+    /// The sampling method `spec` selects (a panic for any other).
+    fn sampling(spec: &MethodSpec) -> &dyn Sampling {
+        let Evaluation::Sampling(m) = spec.method().evaluation() else {
+            panic!("{spec:?}: a sampling method");
+        };
+        m
     }
 
     /// `SobolSampling::estimate` with `data` three rows short of `rows`
@@ -367,9 +367,7 @@ mod tests {
             "kind = \"sparse_grid\"\nlevel = 2",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             let design = m.design(&inputs, 7).unwrap();
             let n = design.len();
             let rows: Vec<usize> = (0..n).collect();
@@ -439,23 +437,15 @@ mod tests {
     #[test]
     fn chaos_methods_refuse_a_discrete_input_in_design_and_estimate() {
         let discrete = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "n".into(),
-                distribution: crate::uq::Distribution::integer_uniform(1, 3).unwrap(),
-            },
-            RandomParameter {
-                name: "x".into(),
-                distribution: crate::uq::Distribution::normal(0.0, 1.0).unwrap(),
-            },
+            RandomParameter::new("n", crate::uq::Distribution::integer_uniform(1, 3).unwrap()),
+            RandomParameter::new("x", crate::uq::Distribution::normal(0.0, 1.0).unwrap()),
         ]);
         for text in [
             "kind = \"scm\"\nnodes = 4",
             "kind = \"pce_regression\"\nsamples = 40\norder = 2",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             match m.design(&discrete, 1) {
                 Err(MethodError::Invalid(e)) => assert!(e.0.contains("integer_uniform"), "{e}"),
                 other => panic!("{text}: {other:?}"),
@@ -476,9 +466,7 @@ mod tests {
         }
         // A sampling method takes the discrete input.
         let lhs = sampling_of("kind = \"lhs\"\nsamples = 30");
-        let Evaluation::Sampling(m) = lhs.method().evaluation() else {
-            panic!("lhs: a sampling method");
-        };
+        let m = sampling(&lhs);
         m.design(&discrete, 1).unwrap();
     }
 
@@ -500,9 +488,7 @@ mod tests {
             "kind = \"nominal\"",
         ] {
             let spec = sampling_of(text);
-            let Evaluation::Sampling(m) = spec.method().evaluation() else {
-                panic!("{text}: a sampling method");
-            };
+            let m = sampling(&spec);
             match m.design(&inputs, 1) {
                 Err(e @ MethodError::InvalidInput { .. }) => {
                     assert!(e.to_string().contains("'u'"), "{e}")

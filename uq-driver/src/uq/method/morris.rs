@@ -11,49 +11,17 @@
 //! probability level (`crate::uq::reliability::morris`). The points are not samples of the
 //! inputs' law: no moments, densities or probabilities come from them.
 
-use serde::{Deserialize, Serialize};
-
 use super::adaptive::{AdaptiveResult, BatchModel, Screening, Target};
 use super::error::{InvalidSettings, MethodError};
 use super::traits::{
     Adaptive, AdaptiveMethod, Evaluation, KindNotes, Method, MethodSummary, Problem,
 };
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, MorrisDesign, Point};
+use crate::uq::reliability::{MorrisDesign, Point};
 use crate::uq::special::norm_ppf;
 
-/// `kind = "morris"`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Morris {
-    /// Trajectories `r` (runs: `r (d + 1)`).
-    pub trajectories: usize,
-    /// Grid levels `p` (even).
-    pub levels: usize,
-    /// Random candidate trajectories the `r` are chosen from (at most `r`: no selection).
-    pub candidates: usize,
-}
-
-impl Default for Morris {
-    fn default() -> Self {
-        let n = reliability::Morris::default();
-        Morris {
-            trajectories: n.trajectories,
-            levels: n.levels,
-            candidates: n.candidates,
-        }
-    }
-}
-
-impl Morris {
-    fn numerics(&self) -> reliability::Morris {
-        reliability::Morris {
-            trajectories: self.trajectories,
-            levels: self.levels,
-            candidates: self.candidates,
-        }
-    }
-}
+/// `kind = "morris"`: the screening's settings are those of the numerics.
+pub use crate::uq::reliability::Morris;
 
 impl Method for Morris {
     fn kind(&self) -> &'static str {
@@ -119,7 +87,7 @@ impl Adaptive for Morris {
         seed: u64,
     ) -> Result<AdaptiveResult, MethodError> {
         let label = "Morris screening";
-        let design = MorrisDesign::new(inputs.len(), &self.numerics(), seed)
+        let design = MorrisDesign::new(inputs.len(), self, seed)
             .map_err(|e| super::adaptive::method_error(e, label, inputs))?;
         let batch: Vec<Point> = design
             .points()
@@ -172,9 +140,8 @@ mod tests {
         // probability level), so mu* = |c_i| and sigma = 0; y2 = x1 x2 interacts.
         let inputs = RandomInputs::independent(
             (1..=3)
-                .map(|i| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: Distribution::uniform(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("x{i}"), Distribution::uniform(0.0, 1.0).unwrap())
                 })
                 .collect(),
         );

@@ -1,12 +1,13 @@
 //! One deterministic run with every random parameter at its mean.
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, RunResults, Sampling,
+};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -64,12 +65,8 @@ impl Sampling for Nominal {
     }
 
     /// The run's values, Std 0.
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         Ok(Estimate::from_quadrature(
             data,
             design.complete_weights(rows)?,

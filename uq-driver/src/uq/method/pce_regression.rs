@@ -13,7 +13,6 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -22,7 +21,7 @@ use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
 use super::traits::{
-    hyperbolic_terms, ChaosFit, Evaluation, Method, MethodSummary, Problem, Sampling,
+    hyperbolic_terms, ChaosFit, Evaluation, Method, MethodSummary, Problem, RunResults, Sampling,
 };
 use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::hd::lars::PathKind;
@@ -302,12 +301,8 @@ impl Sampling for PceRegression {
     }
 
     /// The chaos of every column at the runs that gave a value (`rows`).
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let families = design.families().ok_or_else(|| {
             MethodError::Invalid(InvalidSettings(
                 "regression chaos needs a chaos germ".into(),
@@ -520,19 +515,15 @@ fn regression_error(e: impl std::fmt::Display) -> MethodError {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use super::*;
     use crate::uq::{Distribution, RandomParameter};
 
     fn inputs() -> RandomInputs {
         RandomInputs::independent(vec![
-            RandomParameter {
-                name: "a".into(),
-                distribution: Distribution::normal(1.0, 0.5).unwrap(),
-            },
-            RandomParameter {
-                name: "b".into(),
-                distribution: Distribution::beta(2.0, 3.0, 0.0, 2.0).unwrap(),
-            },
+            RandomParameter::new("a", Distribution::normal(1.0, 0.5).unwrap()),
+            RandomParameter::new("b", Distribution::beta(2.0, 3.0, 0.0, 2.0).unwrap()),
         ])
     }
 

@@ -13,7 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::{InvalidSettings, MethodError};
-use super::sample::{UnitCubeSample, SE_REPLICATES};
+use super::sample::{Points, UnitCubeSample, SE_REPLICATES};
 use super::traits::Problem;
 use crate::uq::hd::sobol_seq::{self, Sobol};
 
@@ -68,19 +68,13 @@ impl UnitCubeSample for Qmc {
         Some(self.replicates)
     }
 
-    fn block(
-        &self,
-        n: usize,
-        d: usize,
-        seed: u64,
-        replicate: Option<usize>,
-    ) -> Result<Vec<Vec<f64>>, MethodError> {
+    fn block(&self, d: usize, seed: u64, replicate: Option<usize>) -> Result<Points, MethodError> {
         let r = replicate.unwrap_or(0) as u64;
         let invalid =
             |e: sobol_seq::SobolError| MethodError::Invalid(InvalidSettings(e.to_string()));
         Sobol::scrambled(d, seed, r)
             .map_err(invalid)?
-            .points(0, n)
+            .points(0, self.samples)
             .map_err(invalid)
     }
 

@@ -9,13 +9,14 @@
 //! replicates, point `i` belongs to replicate `i / samples`; the mean is the mean of the
 //! replicate means and its standard error `sd(replicate means) / sqrt(R)`, an honest one.
 
-use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::Estimate;
-use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, RunResults, Sampling,
+};
 use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 
@@ -24,6 +25,9 @@ pub(crate) const SE_REPLICATES: &str = "replicates: the spread of the replicate 
      sd(replicate means) / sqrt(replicates)";
 /// `standard_error` of plain Monte Carlo.
 pub(crate) const SE_MONTE_CARLO: &str = "Monte Carlo: std / sqrt(samples)";
+
+/// Points of the unit cube, one coordinate per input each.
+pub(crate) type Points = Vec<Vec<f64>>;
 
 /// A method that draws `samples` equally weighted points in the unit cube (per replicate).
 pub(crate) trait UnitCubeSample: std::fmt::Debug + Send + Sync {
@@ -41,15 +45,10 @@ pub(crate) trait UnitCubeSample: std::fmt::Debug + Send + Sync {
         None
     }
 
-    /// The points of replicate `replicate` (`None`: the design is not replicated): `n` points
-    /// of dimension `d` strictly inside (0, 1), a function of `(n, d, seed, replicate)` only.
-    fn block(
-        &self,
-        n: usize,
-        d: usize,
-        seed: u64,
-        replicate: Option<usize>,
-    ) -> Result<Vec<Vec<f64>>, MethodError>;
+    /// The points of replicate `replicate` (`None`: the design is not replicated): `samples`
+    /// points of dimension `d` strictly inside (0, 1), a function of
+    /// `(samples, d, seed, replicate)` only.
+    fn block(&self, d: usize, seed: u64, replicate: Option<usize>) -> Result<Points, MethodError>;
 
     /// Checks of the method's own (beyond `samples` >= 2 and `replicates` >= 2).
     fn check(&self, _problem: &Problem) -> Result<(), InvalidSettings> {
@@ -124,13 +123,13 @@ impl<T: UnitCubeSample> Method for T {
 impl<T: UnitCubeSample> Sampling for T {
     /// Replicate by replicate (point `i` in replicate `i / samples`).
     fn make_design(&self, inputs: &RandomInputs, seed: u64) -> Result<Design, MethodError> {
-        let (n, d) = (self.samples(), inputs.len());
+        let d = inputs.len();
         let points = match self.replicates() {
-            None => self.block(n, d, seed, None)?,
+            None => self.block(d, seed, None)?,
             Some(r) => {
                 let blocks = (0..r)
                     .into_par_iter()
-                    .map(|k| self.block(n, d, seed, Some(k)))
+                    .map(|k| self.block(d, seed, Some(k)))
                     .collect::<Result<Vec<_>, _>>()?;
                 blocks.into_iter().flatten().collect()
             }
@@ -141,12 +140,8 @@ impl<T: UnitCubeSample> Sampling for T {
     }
 
     /// Any subset of the points is a valid (smaller) sample: failed points may be left out.
-    fn make_estimate(
-        &self,
-        _design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { rows, data, .. } = results;
         Ok(match self.replicates() {
             None => Estimate::from_sample(data),
             Some(_) => Estimate::from_replicates(data, rows, self.samples()),
@@ -179,9 +174,8 @@ mod tests {
     fn unit_params(d: usize) -> RandomInputs {
         RandomInputs::independent(
             (0..d)
-                .map(|i| RandomParameter {
-                    name: format!("u{i}"),
-                    distribution: Distribution::uniform(0.0, 1.0).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(format!("u{i}"), Distribution::uniform(0.0, 1.0).unwrap())
                 })
                 .collect(),
         )

@@ -10,14 +10,16 @@
 //! which converges slowly for bounded inputs: F⁻¹(Φ(z)) flattens in the tails). A study whose
 //! inputs all have a Hermite germ gets the same design either way.
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::chaos::{continuous_inputs, order_difference, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate, Sobol};
-use super::traits::{DesignSize, Evaluation, KindNotes, Method, MethodSummary, Problem, Sampling};
+use super::traits::{
+    DesignSize, Evaluation, HashEntry, KindNotes, Method, MethodSummary, Problem, RunResults,
+    Sampling,
+};
 use crate::uq::distributions::{Germ, RandomParameter};
 use crate::uq::pce::{Basis, Family, MultiIndexSet, Pce, PceError};
 use crate::uq::quadrature;
@@ -103,10 +105,7 @@ impl Method for Scm {
     /// SCM follows each input's Askey family since `chaos` became one of its keys: where that
     /// changes the design (an input with a non-Hermite germ) the hash says so, so that a store
     /// of the old Gauss–Hermite design is not resumed; other SCM studies keep their hash.
-    fn hash_entry(
-        &self,
-        parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, parameters: &[RandomParameter]) -> Option<HashEntry> {
         (self.chaos == ChaosBasis::Askey && ChaosBasis::some_own_family(parameters))
             .then(|| ("scm_germ", serde_json::json!("askey")))
     }
@@ -159,12 +158,8 @@ impl Sampling for Scm {
     }
 
     /// Needs every node: a missing weighted node would bias every moment.
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let weights = design.complete_weights(rows)?;
         let dim = design.points.first().map_or(0, Vec::len);
         let set = MultiIndexSet::total_degree(dim, self.order()).map_err(PceError::from)?;
@@ -185,6 +180,8 @@ impl Sampling for Scm {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use std::f64::consts::PI;
 
     use super::*;
@@ -197,10 +194,7 @@ mod tests {
     fn inputs(law: Distribution) -> RandomInputs {
         RandomInputs::independent(
             (0..3)
-                .map(|i| RandomParameter {
-                    name: format!("x{}", i + 1),
-                    distribution: law.clone(),
-                })
+                .map(|i| RandomParameter::new(format!("x{}", i + 1), law.clone()))
                 .collect(),
         )
     }

@@ -45,7 +45,7 @@ use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Estimate, Sobol, SobolIntervals};
 use super::qmc::{check_sobol_points, Qmc, DEFAULT_REPLICATES};
 use super::sample::UnitCubeSample;
-use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{DesignSize, Evaluation, Method, MethodSummary, Problem, RunResults, Sampling};
 use crate::uq::distributions::Germ;
 use crate::uq::hd::sensitivity::{self, SensitivityError};
 use crate::uq::random_inputs::RandomInputs;
@@ -285,7 +285,7 @@ impl SobolSampling {
                 };
                 let blocks = (0..r)
                     .into_par_iter()
-                    .map(|k| qmc.block(per, 2 * d, seed, Some(k)))
+                    .map(|k| qmc.block(2 * d, seed, Some(k)))
                     .collect::<Result<Vec<_>, _>>()?;
                 blocks.into_iter().flatten().collect()
             }
@@ -317,12 +317,8 @@ impl Sampling for SobolSampling {
         Ok(design)
     }
 
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let n = self.samples;
         let d = design.points.first().map_or(0, Vec::len);
         let blocks = PickFreezeRows::new(n, d, rows);
@@ -630,9 +626,11 @@ mod tests {
     fn uniform_params(d: usize, low: f64, high: f64) -> RandomInputs {
         RandomInputs::independent(
             (0..d)
-                .map(|i| RandomParameter {
-                    name: format!("x{}", i + 1),
-                    distribution: Distribution::uniform(low, high).unwrap(),
+                .map(|i| {
+                    RandomParameter::new(
+                        format!("x{}", i + 1),
+                        Distribution::uniform(low, high).unwrap(),
+                    )
                 })
                 .collect(),
         )

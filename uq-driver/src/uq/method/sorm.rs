@@ -12,12 +12,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::adaptive::{each_target, AdaptiveResult, BatchModel, Target};
+use super::adaptive::{per_target_items, AnalyseTarget, PerTarget, Target};
 use super::error::{InvalidSettings, MethodError};
 use super::form::Form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, Scheme};
+use crate::uq::reliability::{self, LimitState, Scheme};
 
 /// `kind = "sorm"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -103,18 +103,15 @@ impl Adaptive for Sorm {
         targets as f64 * (self.form.expected_runs_per_target(dim) + self.hessian_runs(dim) as f64)
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for Sorm {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
         inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
+    ) -> Result<impl AnalyseTarget, MethodError> {
         let settings = reliability::Sorm {
             step: self.hessian_step,
             scheme: if self.hessian_central {
@@ -123,7 +120,7 @@ impl Adaptive for Sorm {
                 Scheme::Forward
             },
         };
-        each_target(model, inputs, targets, |g, t, first| {
+        Ok(move |g: &mut dyn LimitState, t: &Target, first| {
             let mut out = self.form.analyse(g, t, first, inputs, seed)?;
             let mut f = out.form_analysis()?.clone();
             // The Hessian's runs follow every run of the FORM analysis.
@@ -141,8 +138,7 @@ impl Adaptive for Sorm {
 
 #[cfg(test)]
 mod tests {
-    use super::super::adaptive::targets;
-    use super::super::adaptive::tests::{standard_inputs, Analytic};
+    use super::super::adaptive::tests::{above, standard_inputs, Analytic};
     use super::*;
     use crate::uq::special::norm_sf;
 
@@ -162,8 +158,7 @@ mod tests {
         }
         let exact = s * h / 3.0;
         let inputs = standard_inputs(3);
-        let q = vec![("q".to_string(), vec![b], vec![])];
-        let t = targets(&q, &[]).unwrap();
+        let t = above("q", b);
         let mut model = Analytic::new(&inputs, |x: &[f64]| {
             vec![Ok(x[0] + k * (x[1] * x[1] + x[2] * x[2]) / 2.0)]
         });

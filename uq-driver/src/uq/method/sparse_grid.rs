@@ -16,14 +16,13 @@
 //! Mean, Std, Sobol' indices, quantiles and densities all come from the chaos: the sparse
 //! rule's weights can be negative, so its own variance can be too.
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::chaos::{continuous_inputs, ChaosBasis};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{ChaosError, ChaosErrorKind, Estimate};
-use super::traits::{ChaosFit, Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{ChaosFit, Evaluation, Method, MethodSummary, Problem, RunResults, Sampling};
 use crate::uq::distributions::RandomParameter;
 use crate::uq::hd::pseudo_spectral::{level_difference_from, restrict, sparse_pseudo_spectral};
 use crate::uq::hd::rules::RuleKind;
@@ -242,12 +241,8 @@ impl Sampling for SparseGrid {
 
     /// Needs every node (weighted design). The chaos of every column by the sparse
     /// pseudo-spectral projection; the level difference when the rules are nested.
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         design.complete_weights(rows)?;
         let families = design.families().ok_or_else(|| {
             MethodError::Invalid(InvalidSettings("a sparse grid needs a chaos germ".into()))
@@ -316,6 +311,8 @@ impl Sampling for SparseGrid {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use super::*;
     use crate::uq::Distribution;
 
@@ -323,10 +320,7 @@ mod tests {
         RandomInputs::independent(
             ds.into_iter()
                 .enumerate()
-                .map(|(i, d)| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution: d,
-                })
+                .map(|(i, d)| RandomParameter::new(format!("x{i}"), d))
                 .collect(),
         )
     }

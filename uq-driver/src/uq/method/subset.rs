@@ -19,12 +19,12 @@
 use serde::{Deserialize, Serialize};
 
 use super::adaptive::{
-    each_target, generalised_beta, AdaptiveResult, BatchModel, FailedRuns, LimitResult, Target,
+    generalised_beta, per_target_items, AnalyseTarget, FailedRuns, LimitResult, PerTarget, Target,
 };
 use super::error::{InvalidSettings, MethodError};
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, Spread};
+use crate::uq::reliability::{self, LimitState, Spread};
 
 /// `kind = "subset"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -118,20 +118,17 @@ impl Adaptive for Subset {
         targets as f64 * n * (1.0 + 3.0 * (1.0 - self.p0))
     }
 
-    fn only(&self) -> &[String] {
-        &self.quantities
-    }
+    per_target_items!();
+}
 
-    fn run(
+impl PerTarget for Subset {
+    fn analyser(
         &self,
-        model: &mut dyn BatchModel,
-        inputs: &RandomInputs,
-        targets: &[Target],
-        _names: &[String],
+        _inputs: &RandomInputs,
         seed: u64,
-    ) -> Result<AdaptiveResult, MethodError> {
+    ) -> Result<impl AnalyseTarget, MethodError> {
         let settings = self.numerics();
-        each_target(model, inputs, targets, |g, t, first| {
+        Ok(move |g: &mut dyn LimitState, t: &Target, first| {
             let r = reliability::subset_simulation(g, &settings, seed, first)?;
             let mut out = LimitResult::new(t, "subset", first);
             out.probability = r.probability;

@@ -66,14 +66,20 @@ fn check_design<M: Method + ?Sized>(method: &M, inputs: &RandomInputs) -> Result
 /// What every [`Sampling::estimate`] checks before it estimates: the design's inputs and
 /// the settings as [`check_design`] does (the settings may have changed since the design
 /// was built), and that the results fit the design ([`Design::check_results`]).
-fn check_estimate<M: Method + ?Sized>(
-    method: &M,
-    design: &Design,
-    rows: &[usize],
-    data: &DMatrix<f64>,
-) -> Result<(), MethodError> {
-    check_design(method, &design.inputs)?;
-    design.check_results(rows, data)
+fn check_estimate<M: Method + ?Sized>(method: &M, results: RunResults) -> Result<(), MethodError> {
+    check_design(method, &results.design.inputs)?;
+    results.design.check_results(results.rows, results.data)
+}
+
+/// The results of a design's runs, as [`Sampling::make_estimate`] takes them.
+#[derive(Clone, Copy, Debug)]
+pub struct RunResults<'a> {
+    /// The design that was run.
+    pub design: &'a Design,
+    /// The design indices of the points that gave a value (distinct).
+    pub rows: &'a [usize],
+    /// The results: one row per entry of `rows`, one column per time step or quantity.
+    pub data: &'a DMatrix<f64>,
 }
 
 /// The `method` entry of `summary.json`: the kind and the method's settings and diagnostics.
@@ -174,6 +180,9 @@ pub(crate) trait Adaptive: Method {
     ) -> Result<AdaptiveResult, MethodError>;
 }
 
+/// An entry of the study's hash: its key and value.
+pub(crate) type HashEntry = (&'static str, serde_json::Value);
+
 /// A UQ method as the study runner and the report see it.
 pub trait Method: std::fmt::Debug + Send + Sync {
     /// The `kind` in study files and summaries.
@@ -194,10 +203,7 @@ pub trait Method: std::fmt::Debug + Send + Sync {
 
     /// What besides its settings makes the results of this method on `parameters` differ,
     /// as an entry of the study's hash (so that a store of another design is not resumed).
-    fn hash_entry(
-        &self,
-        _parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, _parameters: &[RandomParameter]) -> Option<HashEntry> {
         None
     }
 
@@ -306,8 +312,9 @@ pub trait Sampling: Method {
         rows: &[usize],
         data: &DMatrix<f64>,
     ) -> Result<Estimate, MethodError> {
-        check_estimate(self, design, rows, data)?;
-        self.make_estimate(design, rows, data)
+        let results = RunResults { design, rows, data };
+        check_estimate(self, results)?;
+        self.make_estimate(results)
     }
 
     /// The method's own design, called by [`Sampling::design`] once the inputs and the
@@ -316,12 +323,7 @@ pub trait Sampling: Method {
 
     /// The method's own estimator, called by [`Sampling::estimate`] once the inputs, the
     /// settings and the shape of the results have passed the shared checks.
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError>;
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError>;
 
     /// The rows of `data` (indices into `rows`) that the estimate's mean and Std are taken
     /// from, in the order a running estimate should take them, where they are not all the

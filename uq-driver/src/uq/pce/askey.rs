@@ -15,10 +15,11 @@
 //! coefficients returned by [`Family::recurrence`]; the orthonormal polynomials obey
 //! `sqrt(beta_{n+1}) p_{n+1} = (t - alpha_n) p_n - sqrt(beta_n) p_{n-1}`.
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::uq::distributions::Distribution;
+use crate::uq::quadrature::sorted_eigenvalues;
 
 /// Largest number of nodes of a Gauss rule from [`Family::gauss`].
 pub const MAX_GAUSS_NODES: usize = 200;
@@ -190,16 +191,19 @@ impl Family {
         for k in 0..vals.len() {
             vals[k] = p;
             ders[k] = dp;
-            let (a, b) = self.recurrence(k);
-            let sb = if k == 0 { 0.0 } else { b.sqrt() };
-            let s1 = self.recurrence(k + 1).1.sqrt();
-            let next = ((t - a) * p - sb * pm) / s1;
-            let dnext = (p + (t - a) * dp - sb * dpm) / s1;
-            pm = p;
-            p = next;
-            dpm = dp;
-            dp = dnext;
+            [pm, p, dpm, dp] = self.step_with_derivative(k, t, [pm, p, dpm, dp]);
         }
+    }
+
+    /// One step of the orthonormal recurrence and of its derivative: from
+    /// `[p_{k-1}, p_k, p_{k-1}', p_k']` at `t` to `[p_k, p_{k+1}, p_k', p_{k+1}']`.
+    fn step_with_derivative(&self, k: usize, t: f64, [pm, p, dpm, dp]: [f64; 4]) -> [f64; 4] {
+        let (a, b) = self.recurrence(k);
+        let sb = if k == 0 { 0.0 } else { b.sqrt() };
+        let s1 = self.recurrence(k + 1).1.sqrt();
+        let next = ((t - a) * p - sb * pm) / s1;
+        let dnext = (p + (t - a) * dp - sb * dpm) / s1;
+        [p, next, dp, dnext]
     }
 
     /// The orthonormal polynomial `p_n(t)`.
@@ -233,12 +237,7 @@ impl Family {
                 jac[(k + 1, k)] = s;
             }
         }
-        let mut x: Vec<f64> = SymmetricEigen::new(jac)
-            .eigenvalues
-            .iter()
-            .copied()
-            .collect();
-        x.sort_by(f64::total_cmp);
+        let mut x = sorted_eigenvalues(jac);
         let mut vals = vec![0.0; n + 1];
         for xi in x.iter_mut() {
             // Newton on p_n, derivative from the Christoffel–Darboux-free finite recurrence.
@@ -270,15 +269,7 @@ impl Family {
         let (mut pm, mut p) = (0.0, 1.0);
         let (mut dpm, mut dp) = (0.0, 0.0);
         for k in 0..n {
-            let (a, b) = self.recurrence(k);
-            let sb = if k == 0 { 0.0 } else { b.sqrt() };
-            let s1 = self.recurrence(k + 1).1.sqrt();
-            let next = ((t - a) * p - sb * pm) / s1;
-            let dnext = (p + (t - a) * dp - sb * dpm) / s1;
-            pm = p;
-            p = next;
-            dpm = dp;
-            dp = dnext;
+            [pm, p, dpm, dp] = self.step_with_derivative(k, t, [pm, p, dpm, dp]);
         }
         (p, dp)
     }

@@ -232,13 +232,7 @@ impl Pce {
     /// # Panics
     /// If `t.len() != self.dim()`.
     pub fn eval(&self, t: &[f64]) -> Vec<f64> {
-        assert_eq!(
-            t.len(),
-            self.dim(),
-            "point dimension differs from the basis"
-        );
-        let mut psi = vec![0.0; self.basis.len()];
-        self.basis.eval(t, &mut psi);
+        let psi = self.basis_at(t);
         (0..self.outputs())
             .map(|col| dot_column(&self.coeffs, col, &psi))
             .collect()
@@ -250,6 +244,14 @@ impl Pce {
     /// If `col >= self.outputs()` or `t.len() != self.dim()`.
     pub fn eval_column(&self, col: usize, t: &[f64]) -> f64 {
         assert!(col < self.outputs(), "column {col} out of range");
+        dot_column(&self.coeffs, col, &self.basis_at(t))
+    }
+
+    /// The basis functions at the germ point `t`.
+    ///
+    /// # Panics
+    /// If `t.len() != self.dim()`.
+    fn basis_at(&self, t: &[f64]) -> Vec<f64> {
         assert_eq!(
             t.len(),
             self.dim(),
@@ -257,7 +259,7 @@ impl Pce {
         );
         let mut psi = vec![0.0; self.basis.len()];
         self.basis.eval(t, &mut psi);
-        dot_column(&self.coeffs, col, &psi)
+        psi
     }
 
     /// `n` draws of every output of the surrogate, one row per draw: row `i` is the chaos at

@@ -2,6 +2,8 @@
 
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
+use super::form::FormResult;
+use super::importance::{importance_sampling, ImportanceSampling, ImportanceSamplingResult};
 use super::model::{FnLimitState, LimitState, Outcome, PhysicalLimitState, Side, Threshold};
 use crate::uq::distributions::{Distribution, RandomParameter};
 use crate::uq::random_inputs::RandomInputs;
@@ -41,10 +43,7 @@ impl Linear {
 /// with probability `p`: `ln y ~ N(0, 0.7^2)`, so `limit = exp(0.7 Phi^-1(1 - p))`.
 pub(super) fn lognormal_response(p: f64) -> (RandomInputs, f64) {
     let parameters = (0..8)
-        .map(|i| RandomParameter {
-            name: format!("x{i}"),
-            distribution: Distribution::normal(0.0, 1.0).unwrap(),
-        })
+        .map(|i| RandomParameter::new(format!("x{i}"), Distribution::normal(0.0, 1.0).unwrap()))
         .collect();
     (
         RandomInputs::independent(parameters),
@@ -88,4 +87,22 @@ pub(super) fn chi_square_limit(d: usize, p: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// Importance sampling with the default settings around FORM's design point `f`, seeded
+/// `seed`, its runs numbered from `first_run`.
+pub(super) fn sampling_at_design_point(
+    model: &mut dyn LimitState,
+    f: &FormResult,
+    seed: u64,
+    first_run: u64,
+) -> ImportanceSamplingResult {
+    importance_sampling(
+        model,
+        &ImportanceSampling::default(),
+        &f.u_star,
+        seed,
+        first_run,
+    )
+    .unwrap()
 }

@@ -205,14 +205,7 @@ mod tests {
             let lin = Linear::new(8, p);
             let mut m = lin.model();
             let f = form(&mut m, &Form::default(), 0).unwrap();
-            let r = importance_sampling(
-                &mut m,
-                &ImportanceSampling::default(),
-                &f.u_star,
-                3,
-                f.next_run,
-            )
-            .unwrap();
+            let r = sampling_at_design_point(&mut m, &f, 3, f.next_run);
             let err = (r.probability - p).abs() / p;
             let cov = r.cov.unwrap();
             println!(

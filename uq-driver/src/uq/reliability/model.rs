@@ -374,14 +374,8 @@ mod tests {
     #[test]
     fn physical_adapter_maps_through_the_inputs() {
         let inputs = RandomInputs::independent(vec![
-            RandomParameter {
-                name: "a".into(),
-                distribution: Distribution::normal(10.0, 2.0).unwrap(),
-            },
-            RandomParameter {
-                name: "b".into(),
-                distribution: Distribution::lognormal(0.0, 0.5).unwrap(),
-            },
+            RandomParameter::new("a", Distribution::normal(10.0, 2.0).unwrap()),
+            RandomParameter::new("b", Distribution::lognormal(0.0, 0.5).unwrap()),
         ]);
         let threshold = Threshold {
             limit: 15.0,

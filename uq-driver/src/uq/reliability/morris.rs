@@ -36,7 +36,7 @@ use crate::uq::distributions::Germ;
 use crate::uq::random_inputs::RandomInputs;
 use crate::uq::rng;
 
-/// Morris settings.
+/// Morris settings: `kind = "morris"` of a study file.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Morris {
@@ -44,7 +44,7 @@ pub struct Morris {
     pub trajectories: usize,
     /// Grid levels `p` (even).
     pub levels: usize,
-    /// Candidate trajectories `M` to choose the `r` from (`<= r`: no selection).
+    /// Random candidate trajectories `M` the `r` are chosen from (at most `r`: no selection).
     pub candidates: usize,
 }
 
@@ -328,10 +328,7 @@ mod tests {
             dists
                 .into_iter()
                 .enumerate()
-                .map(|(i, distribution)| RandomParameter {
-                    name: format!("x{i}"),
-                    distribution,
-                })
+                .map(|(i, distribution)| RandomParameter::new(format!("x{i}"), distribution))
                 .collect(),
         )
     }

@@ -9,13 +9,6 @@ use crate::uq::distributions::{Distribution, RandomParameter};
 use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
 use crate::uq::special::{norm_pdf, norm_sf};
 
-fn parameter(name: &str, distribution: Distribution) -> RandomParameter {
-    RandomParameter {
-        name: name.into(),
-        distribution,
-    }
-}
-
 /// A physical model `q(x)` against a threshold.
 fn physical<'a>(
     inputs: &'a RandomInputs,
@@ -31,9 +24,9 @@ fn physical<'a>(
 fn lower_tails_of_a_linear_response() {
     // q = x0 - 2 x1 + 0.5 x2, x ~ N(10, 1), N(3, 0.5), N(-2, 2): q ~ N(3, sqrt 3).
     let inputs = RandomInputs::independent(vec![
-        parameter("a", Distribution::normal(10.0, 1.0).unwrap()),
-        parameter("b", Distribution::normal(3.0, 0.5).unwrap()),
-        parameter("c", Distribution::normal(-2.0, 2.0).unwrap()),
+        RandomParameter::new("a", Distribution::normal(10.0, 1.0).unwrap()),
+        RandomParameter::new("b", Distribution::normal(3.0, 0.5).unwrap()),
+        RandomParameter::new("c", Distribution::normal(-2.0, 2.0).unwrap()),
     ]);
     let q = |x: &[f64]| x[0] - 2.0 * x[1] + 0.5 * x[2];
     let sd = 3f64.sqrt();
@@ -48,14 +41,7 @@ fn lower_tails_of_a_linear_response() {
         let f = form(&mut m, &Form::default(), 0).unwrap();
         assert!((f.probability - exact).abs() < 1e-3 * exact, "FORM {f:?}");
         assert!((q(f.x_star.as_ref().unwrap()) - limit).abs() < 1e-6);
-        let is = importance_sampling(
-            &mut m,
-            &ImportanceSampling::default(),
-            &f.u_star,
-            1,
-            f.next_run,
-        )
-        .unwrap();
+        let is = fixtures::sampling_at_design_point(&mut m, &f, 1, f.next_run);
         assert!((is.probability - exact).abs() < 0.1 * exact, "IS {is:?}");
         let s = subset_simulation(&mut m, &Subset::default(), 1, is.next_run).unwrap();
         assert!(
@@ -103,8 +89,8 @@ fn lognormal_sum_tail(mu: [f64; 2], s: [f64; 2], r: f64, t: f64) -> f64 {
 fn correlated_lognormal_inputs_through_the_nataf_transformation() {
     let (mu, s) = ([0.0, 0.2], [0.25, 0.35]);
     let params = vec![
-        parameter("a", Distribution::lognormal(mu[0], s[0]).unwrap()),
-        parameter("b", Distribution::lognormal(mu[1], s[1]).unwrap()),
+        RandomParameter::new("a", Distribution::lognormal(mu[0], s[0]).unwrap()),
+        RandomParameter::new("b", Distribution::lognormal(mu[1], s[1]).unwrap()),
     ];
     let pair = CorrelationPair {
         between: ["a".into(), "b".into()],
@@ -148,14 +134,7 @@ fn correlated_lognormal_inputs_through_the_nataf_transformation() {
         sorm_err < 0.5 * form_err && sorm_err < 0.03,
         "SORM {so:?} vs {exact:.4e}"
     );
-    let is = importance_sampling(
-        &mut m,
-        &ImportanceSampling::default(),
-        &f.u_star,
-        2,
-        so.next_run,
-    )
-    .unwrap();
+    let is = fixtures::sampling_at_design_point(&mut m, &f, 2, so.next_run);
     let [a, b] = is.interval.unwrap();
     assert!(a <= exact && exact <= b, "IS {is:?} vs {exact:.4e}");
     let ss = subset_simulation(&mut m, &Subset::default(), 2, is.next_run).unwrap();

@@ -10,8 +10,9 @@ const ALL: [RuleKind; 5] = [
     RuleKind::GaussHermite,
 ];
 
-/// Exact moments: N(0,1): (m-1)!! for even m; U(-1,1): 1/(m+1) for even m.
-fn moment(kind: RuleKind, m: usize) -> f64 {
+/// Exact moments `E[t^m]` of the germ of each rule: N(0,1): (m-1)!! for even m; U(-1,1):
+/// 1/(m+1) for even m.
+pub(in crate::uq::hd) fn moment(kind: RuleKind, m: usize) -> f64 {
     if m % 2 == 1 {
         return 0.0;
     }

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use super::design::Design;
 use super::error::{InvalidSettings, MethodError};
 use super::estimate::{Draws, Estimate};
-use super::traits::{Evaluation, Method, MethodSummary, Problem, Sampling};
+use super::traits::{Evaluation, HashEntry, Method, MethodSummary, Problem, RunResults, Sampling};
 use super::MethodSpec;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::random_inputs::{Correlation, CorrelationPair, RandomInputs};
@@ -392,24 +392,19 @@ impl Method for Nested {
             correlation: problem.correlation.cloned(),
         };
         let levels = self.levels(&inputs)?;
-        let outer = Problem {
-            parameters: &levels.outer_inputs.parameters,
-            correlation: levels.outer_inputs.correlation.as_ref(),
-            ..*problem
+        // Each level's method on the study restricted to the level's inputs.
+        let check = |level: &str, spec: &MethodSpec, inputs: &RandomInputs| {
+            let restricted = Problem {
+                parameters: &inputs.parameters,
+                correlation: inputs.correlation.as_ref(),
+                ..*problem
+            };
+            spec.method()
+                .validate(&restricted)
+                .map_err(|e| InvalidSettings(format!("{level}: {e}")))
         };
-        self.outer
-            .method()
-            .validate(&outer)
-            .map_err(|e| InvalidSettings(format!("outer: {e}")))?;
-        let inner = Problem {
-            parameters: &levels.inner_inputs.parameters,
-            correlation: levels.inner_inputs.correlation.as_ref(),
-            ..*problem
-        };
-        self.inner
-            .method()
-            .validate(&inner)
-            .map_err(|e| InvalidSettings(format!("inner: {e}")))
+        check("outer", &self.outer, &levels.outer_inputs)?;
+        check("inner", &self.inner, &levels.inner_inputs)
     }
 
     fn summary(&self, dim: usize) -> MethodSummary {
@@ -460,10 +455,7 @@ impl Method for Nested {
     }
 
     /// The inner method's entry: it draws the designs the runs come from.
-    fn hash_entry(
-        &self,
-        parameters: &[RandomParameter],
-    ) -> Option<(&'static str, serde_json::Value)> {
+    fn hash_entry(&self, parameters: &[RandomParameter]) -> Option<HashEntry> {
         self.inner.method().hash_entry(parameters)
     }
 
@@ -533,12 +525,8 @@ impl Sampling for Nested {
 
     /// The marginal mean (its standard error from the spread of the conditional means over
     /// the outer samples) and the marginal Std (from the corrected variance split).
-    fn make_estimate(
-        &self,
-        design: &Design,
-        rows: &[usize],
-        data: &DMatrix<f64>,
-    ) -> Result<Estimate, MethodError> {
+    fn make_estimate(&self, results: RunResults) -> Result<Estimate, MethodError> {
+        let RunResults { design, rows, data } = results;
         let blocks = self.blocks(design)?;
         let cond = self.conditional(&blocks, rows, data)?;
         marginal(&cond, data.ncols())

@@ -5,19 +5,12 @@ use super::*;
 use crate::uq::distributions::Germ;
 use crate::uq::Distribution;
 
-fn param(name: &str, distribution: Distribution) -> RandomParameter {
-    RandomParameter {
-        name: name.into(),
-        distribution,
-    }
-}
-
 /// x1, x2 ~ N(0, 1) inner; u ~ U(0, 2) outer (second in study order).
 fn inputs() -> RandomInputs {
     RandomInputs::independent(vec![
-        param("x1", Distribution::normal(0.0, 1.0).unwrap()),
-        param("u", Distribution::uniform(0.0, 2.0).unwrap()),
-        param("x2", Distribution::normal(0.0, 1.0).unwrap()),
+        RandomParameter::new("x1", Distribution::normal(0.0, 1.0).unwrap()),
+        RandomParameter::new("u", Distribution::uniform(0.0, 2.0).unwrap()),
+        RandomParameter::new("x2", Distribution::normal(0.0, 1.0).unwrap()),
     ])
 }
 
@@ -336,8 +329,8 @@ fn integer_uniform_covers_its_range_uniformly_in_every_sampling_design() {
     const CHI2_11_999: f64 = 31.26;
     let (low, high) = (-3, 8);
     let inputs = RandomInputs::independent(vec![
-        param("s", Distribution::integer_uniform(low, high).unwrap()),
-        param("x", Distribution::normal(0.0, 1.0).unwrap()),
+        RandomParameter::new("s", Distribution::integer_uniform(low, high).unwrap()),
+        RandomParameter::new("x", Distribution::normal(0.0, 1.0).unwrap()),
     ]);
     for kind in ["mc", "lhs"] {
         let spec: MethodSpec =
