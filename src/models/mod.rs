@@ -257,6 +257,11 @@ impl ModelInfo {
     pub fn variable_by_name(&self, name: &str) -> Option<&'static Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
+
+    /// The error refusing `value` for the variable `vr` (named `?` if unknown) for `reason`.
+    pub fn invalid(&self, vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
+        ModelError::invalid(self.variable(vr).map_or("?", |v| v.name), value, reason)
+    }
 }
 
 /// An error reported by a model; the FMI layer turns it into a status and a log line.
@@ -302,6 +307,17 @@ pub enum ModelError {
     /// Any other failure (file not found, bad resource, …).
     #[error("{0}")]
     Other(String),
+}
+
+impl ModelError {
+    /// `value` refused for the variable `name`, for `reason`.
+    pub fn invalid(name: &'static str, value: impl ToString, reason: impl Into<String>) -> Self {
+        ModelError::InvalidValue {
+            name,
+            value: value.to_string(),
+            reason: reason.into(),
+        }
+    }
 }
 
 /// Result of setting a variable: accepted, or accepted with a warning to log.
@@ -490,11 +506,7 @@ pub fn require_finite(name: &'static str, value: f64) -> Result<(), ModelError> 
     if value.is_finite() {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be finite".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be finite"))
     }
 }
 
@@ -504,11 +516,7 @@ pub fn require_positive(name: &'static str, value: f64) -> Result<(), ModelError
     if value > 0.0 {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be > 0".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be > 0"))
     }
 }
 
@@ -518,11 +526,7 @@ pub fn require_non_negative(name: &'static str, value: f64) -> Result<(), ModelE
     if value >= 0.0 {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be >= 0".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be >= 0"))
     }
 }
 

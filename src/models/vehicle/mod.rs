@@ -264,14 +264,6 @@ impl Vehicle {
             .map_err(|e| ModelError::Other(format!("v_cr_linear: {e}")))
     }
 
-    fn invalid(vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
-        ModelError::InvalidValue {
-            name: INFO.variable(vr).map_or("?", |v| v.name),
-            value: value.to_string(),
-            reason: reason.into(),
-        }
-    }
-
     /// The irregularity of the parameters; random samples are reused while their key holds.
     fn build_irregularity(&mut self, x_lead: f64) -> Result<Irregularity, ModelError> {
         let i = &self.irr;
@@ -280,7 +272,7 @@ impl Vehicle {
             2 | 3 => {
                 let (spectrum, factor) = track::german(i.code).expect("code 2 or 3");
                 if i.lambda_min >= i.lambda_max {
-                    return Err(Self::invalid(
+                    return Err(INFO.invalid(
                         VR_LAMBDA_MIN,
                         i.lambda_min,
                         format!("must be below lambda_max = {} m", i.lambda_max),
@@ -298,9 +290,9 @@ impl Vehicle {
                     _ => {
                         let gen = |k| RandomProfile::generate(k).map(Arc::new);
                         let v =
-                            gen(key).map_err(|e| Self::invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
+                            gen(key).map_err(|e| INFO.invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
                         let l = gen(track::lateral_key(key))
-                            .map_err(|e| Self::invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
+                            .map_err(|e| INFO.invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
                         (v, l)
                     }
                 };
@@ -313,7 +305,7 @@ impl Vehicle {
             }
             10 => {
                 if i.file.is_empty() {
-                    return Err(Self::invalid(
+                    return Err(INFO.invalid(
                         VR_IRREGULARITY_FILE,
                         "",
                         "irregularity = 10 (measured) needs irregularity_file, a file of x, y, z [m]",
@@ -420,7 +412,7 @@ impl Model for Vehicle {
         let (table, spline) = self.load_table()?;
         for (w, &y) in self.y0.iter().enumerate() {
             if y.abs() >= spline.limit() {
-                return Err(Self::invalid(
+                return Err(INFO.invalid(
                     VR_Y0_W1 + w as u32,
                     y,
                     format!(
@@ -538,14 +530,7 @@ impl Model for Vehicle {
     }
 
     fn save(&self, out: &mut StateWriter) {
-        out.u64(STATE_VERSION);
-        TABLE.save_parameters(self, out);
-        out.str(
-            &self
-                .resource_dir
-                .as_ref()
-                .map_or(String::new(), |d| d.display().to_string()),
-        );
+        TABLE.save_head(self, STATE_VERSION, self.resource_dir.as_deref(), out);
         match &self.run {
             None => out.u64(0),
             Some(r) => {
@@ -560,19 +545,11 @@ impl Model for Vehicle {
     }
 
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError> {
-        let version = input.u64()?;
-        if version != STATE_VERSION {
-            return Err(ModelError::CorruptState(format!(
-                "state version {version}, expected {STATE_VERSION}"
-            )));
-        }
         let mut m = Vehicle {
             samples: self.samples.clone(),
             ..Vehicle::default()
         };
-        TABLE.restore_parameters(&mut m, input)?;
-        let dir = input.str()?;
-        m.resource_dir = (!dir.is_empty()).then(|| PathBuf::from(dir));
+        m.resource_dir = TABLE.restore_head(&mut m, STATE_VERSION, input)?;
         match input.u64()? {
             0 => {}
             1 => {

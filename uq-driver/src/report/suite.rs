@@ -539,8 +539,8 @@ fn paper_section(summary: &SuiteSummary) -> Section {
         heading: "Against the paper".into(),
         text: "Published values beside ours.".into(),
         images: vec![],
-        table: Some(Table {
-            header: [
+        table: Some(Table::new(
+            &[
                 "variant",
                 "quantity",
                 "statistic",
@@ -548,12 +548,9 @@ fn paper_section(summary: &SuiteSummary) -> Section {
                 "railuq",
                 "difference",
                 "source",
-            ]
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
+            ],
             rows,
-        }),
+        )),
     }
 }
 
