@@ -344,6 +344,26 @@ macro_rules! variables {
 }
 pub(crate) use variables;
 
+/// Inside an `impl Model`, the [`Model`](crate::models::Model) methods that only read or write
+/// a variable of the table `$table` (a [`Table`]): `get_real -> f64` is a getter and
+/// `set_real(f64)` a setter, each forwarding to the table's method of the same name.
+macro_rules! table_accessors {
+    ($table:ident;) => {};
+    ($table:ident; $get:ident -> $t:ty $(, $($rest:tt)*)?) => {
+        fn $get(&self, vr: u32) -> Result<$t, $crate::models::ModelError> {
+            $table.$get(self, vr)
+        }
+        $crate::models::table::table_accessors!($table; $($($rest)*)?);
+    };
+    ($table:ident; $set:ident($t:ty) $(, $($rest:tt)*)?) => {
+        fn $set(&mut self, vr: u32, value: $t) -> $crate::models::SetResult {
+            $table.$set(self, vr, value)
+        }
+        $crate::models::table::table_accessors!($table; $($($rest)*)?);
+    };
+}
+pub(crate) use table_accessors;
+
 #[cfg(test)]
 mod tests {
     use super::*;

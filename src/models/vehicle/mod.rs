@@ -40,6 +40,7 @@ use super::data_file::{read_data_file, resolve};
 use super::vehicle_track::irregularity::{RandomProfile, SampleKey};
 use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
 use crate::contact::table::{ContactSpline, ContactTable, TableRow};
+use crate::models::table::table_accessors;
 use crate::solver::substeps;
 use equations::{base, dof, Car, State, N_STATES};
 use integrate::{rk4_substep, RateBound, StepError, STABILITY_FACTOR};
@@ -363,6 +364,8 @@ impl Model for Vehicle {
         &INFO
     }
 
+    table_accessors!(TABLE; get_integer -> i32, set_integer(i32), get_string -> String);
+
     fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
         if vr == VR_V_CR_LINEAR {
             return self.v_cr_linear();
@@ -384,18 +387,6 @@ impl Model for Vehicle {
         self.outputs = OnceCell::new();
         self.v_cr = OnceCell::new();
         Ok(warning)
-    }
-
-    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
-        TABLE.get_integer(self, vr)
-    }
-
-    fn set_integer(&mut self, vr: u32, value: i32) -> SetResult {
-        TABLE.set_integer(self, vr, value)
-    }
-
-    fn get_string(&self, vr: u32) -> Result<String, ModelError> {
-        TABLE.get_string(self, vr)
     }
 
     fn set_string(&mut self, vr: u32, value: &str) -> SetResult {

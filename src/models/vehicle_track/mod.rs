@@ -28,7 +28,8 @@ pub use variables::*;
 
 #[cfg(test)]
 use super::Start;
-use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
+use super::{InitContext, Model, ModelError, ModelInfo, StateReader, StateWriter};
+use crate::models::table::table_accessors;
 use coupling::{accelerations, Sim};
 use irregularity::{IrregularityKind, RandomProfile};
 use std::path::PathBuf;
@@ -120,29 +121,7 @@ impl Model for VehicleTrack {
         &INFO
     }
 
-    fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
-        TABLE.get_real(self, vr)
-    }
-
-    fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
-        TABLE.set_real(self, vr, value)
-    }
-
-    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
-        TABLE.get_integer(self, vr)
-    }
-
-    fn set_integer(&mut self, vr: u32, value: i32) -> SetResult {
-        TABLE.set_integer(self, vr, value)
-    }
-
-    fn get_string(&self, vr: u32) -> Result<String, ModelError> {
-        TABLE.get_string(self, vr)
-    }
-
-    fn set_string(&mut self, vr: u32, value: &str) -> SetResult {
-        TABLE.set_string(self, vr, value)
-    }
+    table_accessors!(TABLE; get_real -> f64, set_real(f64), get_integer -> i32, set_integer(i32), get_string -> String, set_string(&str));
 
     fn initialize(&mut self, ctx: &InitContext) -> Result<(), ModelError> {
         self.resource_dir = ctx.resource_dir.clone();
