@@ -530,6 +530,26 @@ pub fn require_non_negative(name: &'static str, value: f64) -> Result<(), ModelE
     }
 }
 
+/// Asserts that the variable table of `info` is sorted by value reference (each used once)
+/// and that no two variables share a name.
+#[cfg(test)]
+pub(crate) fn assert_table_sorted_and_unique(info: &ModelInfo) {
+    let vars = info.variables;
+    for w in vars.windows(2) {
+        assert!(
+            w[0].vr < w[1].vr,
+            "{}: vr not sorted at {} / {}",
+            info.name,
+            w[0].name,
+            w[1].name
+        );
+    }
+    let mut names: Vec<_> = vars.iter().map(|v| v.name).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), vars.len(), "{}: duplicate names", info.name);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -537,19 +557,7 @@ mod tests {
     #[test]
     fn every_registered_table_is_sorted_and_unique() {
         for entry in registry() {
-            let vars = entry.info.variables;
-            for w in vars.windows(2) {
-                assert!(w[0].vr < w[1].vr, "{}: vr not sorted", entry.info.name);
-            }
-            let mut names: Vec<_> = vars.iter().map(|v| v.name).collect();
-            names.sort_unstable();
-            names.dedup();
-            assert_eq!(
-                names.len(),
-                vars.len(),
-                "{}: duplicate names",
-                entry.info.name
-            );
+            assert_table_sorted_and_unique(entry.info);
         }
     }
 
