@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::report::compare::FolderFileError;
 use crate::report::ReportError;
 use crate::spec::Experiment;
 use crate::study::store::format::{self, Slot};
@@ -25,47 +26,6 @@ use crate::study::store::Manifest;
 use crate::text::csv::{push_header, split_line};
 use crate::text::file_name::stem;
 use out_file::OutFile;
-
-/// A file of a study folder that cannot be read, or is not what `uq-driver run` writes.
-#[derive(Debug, thiserror::Error)]
-pub enum FolderFileError {
-    /// A file could not be read.
-    #[error("cannot read {}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A file is not what `uq-driver run` writes (for an export: not a finished study written
-    /// by this version).
-    #[error("{}: {message}", path.display())]
-    Invalid {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
-}
-
-impl FolderFileError {
-    /// `path` could not be read.
-    pub(crate) fn read(path: &Path, source: std::io::Error) -> FolderFileError {
-        FolderFileError::Read {
-            path: path.to_path_buf(),
-            source,
-        }
-    }
-
-    /// `path` is not what `uq-driver run` writes.
-    pub(crate) fn invalid(path: &Path, message: impl Into<String>) -> FolderFileError {
-        FolderFileError::Invalid {
-            path: path.to_path_buf(),
-            message: message.into(),
-        }
-    }
-}
 
 /// Why the runs cannot be exported.
 #[derive(Debug, thiserror::Error)]
