@@ -337,7 +337,7 @@ pub struct InitContext {
 /// Protocol: the host constructs the model with its default parameters, sets variables,
 /// calls [`Model::initialize`] (possibly several times while parameters are still being set),
 /// then [`Model::do_step`] repeatedly.
-pub trait Model: Send + fmt::Debug {
+pub trait Model: Send + fmt::Debug + CloneModel {
     /// The static description of this model.
     fn info(&self) -> &'static ModelInfo;
     /// Reads a Real variable (the caller has checked that `vr` is a Real of this model).
@@ -372,12 +372,23 @@ pub trait Model: Send + fmt::Debug {
     fn initialize(&mut self, ctx: &InitContext) -> Result<(), ModelError>;
     /// Advances the state from `t` (s) by `h` (s) > 0.
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError>;
-    /// A deep copy (for FMU state snapshots).
-    fn clone_box(&self) -> Box<dyn Model>;
     /// Appends the complete model state (parameters and dynamic state) to `out`.
     fn save(&self, out: &mut StateWriter);
     /// Restores what [`Model::save`] wrote.
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError>;
+}
+
+/// A deep copy of a model behind the [`Model`] trait (for FMU state snapshots): every model
+/// that is `Clone` has it.
+pub trait CloneModel {
+    /// A deep copy.
+    fn clone_box(&self) -> Box<dyn Model>;
+}
+
+impl<M: Model + Clone + 'static> CloneModel for M {
+    fn clone_box(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
 }
 
 /// Little-endian writer for [`Model::save`].

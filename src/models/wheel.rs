@@ -145,10 +145,6 @@ impl Model for Wheel {
         }
     }
 
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
-
     fn save(&self, out: &mut StateWriter) {
         TABLE.save_parameters(self, out);
         out.f64s(&self.y);

@@ -216,10 +216,6 @@ impl Model for Bogie {
         }
     }
 
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
-
     fn save(&self, out: &mut StateWriter) {
         TABLE.save_parameters(self, out);
         out.f64s(&[

@@ -1,6 +1,6 @@
 use super::equations::{rhs, Track};
 use super::*;
-use crate::models::Start;
+use crate::models::{CloneModel, Start};
 
 // Tests that integrate many seconds run only in optimised builds (`cargo test --release`,
 // as `make test` does): a debug build is some thirty times slower.

@@ -157,10 +157,6 @@ impl Model for VehicleTrack {
         result
     }
 
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
-
     fn save(&self, out: &mut StateWriter) {
         TABLE.save_head(self, STATE_VERSION, self.resource_dir.as_deref(), out);
         match &self.sim {
