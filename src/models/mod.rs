@@ -257,6 +257,11 @@ impl ModelInfo {
     pub fn variable_by_name(&self, name: &str) -> Option<&'static Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
+
+    /// The error refusing `value` for the variable `vr` (named `?` if unknown) for `reason`.
+    pub fn invalid(&self, vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
+        ModelError::invalid(self.variable(vr).map_or("?", |v| v.name), value, reason)
+    }
 }
 
 /// An error reported by a model; the FMI layer turns it into a status and a log line.
@@ -304,6 +309,17 @@ pub enum ModelError {
     Other(String),
 }
 
+impl ModelError {
+    /// `value` refused for the variable `name`, for `reason`.
+    pub fn invalid(name: &'static str, value: impl ToString, reason: impl Into<String>) -> Self {
+        ModelError::InvalidValue {
+            name,
+            value: value.to_string(),
+            reason: reason.into(),
+        }
+    }
+}
+
 /// Result of setting a variable: accepted, or accepted with a warning to log.
 pub type SetResult = Result<Option<String>, ModelError>;
 
@@ -321,7 +337,7 @@ pub struct InitContext {
 /// Protocol: the host constructs the model with its default parameters, sets variables,
 /// calls [`Model::initialize`] (possibly several times while parameters are still being set),
 /// then [`Model::do_step`] repeatedly.
-pub trait Model: Send + fmt::Debug {
+pub trait Model: Send + fmt::Debug + CloneModel {
     /// The static description of this model.
     fn info(&self) -> &'static ModelInfo;
     /// Reads a Real variable (the caller has checked that `vr` is a Real of this model).
@@ -356,12 +372,23 @@ pub trait Model: Send + fmt::Debug {
     fn initialize(&mut self, ctx: &InitContext) -> Result<(), ModelError>;
     /// Advances the state from `t` (s) by `h` (s) > 0.
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError>;
-    /// A deep copy (for FMU state snapshots).
-    fn clone_box(&self) -> Box<dyn Model>;
     /// Appends the complete model state (parameters and dynamic state) to `out`.
     fn save(&self, out: &mut StateWriter);
     /// Restores what [`Model::save`] wrote.
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError>;
+}
+
+/// A deep copy of a model behind the [`Model`] trait (for FMU state snapshots): every model
+/// that is `Clone` has it.
+pub trait CloneModel {
+    /// A deep copy.
+    fn clone_box(&self) -> Box<dyn Model>;
+}
+
+impl<M: Model + Clone + 'static> CloneModel for M {
+    fn clone_box(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
 }
 
 /// Little-endian writer for [`Model::save`].
@@ -490,11 +517,7 @@ pub fn require_finite(name: &'static str, value: f64) -> Result<(), ModelError> 
     if value.is_finite() {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be finite".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be finite"))
     }
 }
 
@@ -504,11 +527,7 @@ pub fn require_positive(name: &'static str, value: f64) -> Result<(), ModelError
     if value > 0.0 {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be > 0".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be > 0"))
     }
 }
 
@@ -518,12 +537,28 @@ pub fn require_non_negative(name: &'static str, value: f64) -> Result<(), ModelE
     if value >= 0.0 {
         Ok(())
     } else {
-        Err(ModelError::InvalidValue {
-            name,
-            value: value.to_string(),
-            reason: "must be >= 0".into(),
-        })
+        Err(ModelError::invalid(name, value, "must be >= 0"))
     }
+}
+
+/// Asserts that the variable table of `info` is sorted by value reference (each used once)
+/// and that no two variables share a name.
+#[cfg(test)]
+pub(crate) fn assert_table_sorted_and_unique(info: &ModelInfo) {
+    let vars = info.variables;
+    for w in vars.windows(2) {
+        assert!(
+            w[0].vr < w[1].vr,
+            "{}: vr not sorted at {} / {}",
+            info.name,
+            w[0].name,
+            w[1].name
+        );
+    }
+    let mut names: Vec<_> = vars.iter().map(|v| v.name).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), vars.len(), "{}: duplicate names", info.name);
 }
 
 #[cfg(test)]
@@ -533,19 +568,7 @@ mod tests {
     #[test]
     fn every_registered_table_is_sorted_and_unique() {
         for entry in registry() {
-            let vars = entry.info.variables;
-            for w in vars.windows(2) {
-                assert!(w[0].vr < w[1].vr, "{}: vr not sorted", entry.info.name);
-            }
-            let mut names: Vec<_> = vars.iter().map(|v| v.name).collect();
-            names.sort_unstable();
-            names.dedup();
-            assert_eq!(
-                names.len(),
-                vars.len(),
-                "{}: duplicate names",
-                entry.info.name
-            );
+            assert_table_sorted_and_unique(entry.info);
         }
     }
 

@@ -12,6 +12,8 @@
 //! model keeps its parameters in named fields).
 #![forbid(unsafe_code)]
 
+use std::path::{Path, PathBuf};
+
 use super::{Causality, ModelError, SetResult, Start, StateReader, StateWriter, VarType, Variable};
 
 /// How a variable of model `M` is read and (for parameters) written.
@@ -133,6 +135,39 @@ impl<M> Table<M> {
                 Access::String(get, _) => out.str(&get(m)),
             }
         }
+    }
+
+    /// Writes the head of a state that keeps a resource folder: the state format `version`,
+    /// the parameters of `m` ([`Table::save_parameters`]) and the folder (empty: none).
+    pub fn save_head(
+        &self,
+        m: &M,
+        version: u64,
+        resource_dir: Option<&Path>,
+        out: &mut StateWriter,
+    ) {
+        out.u64(version);
+        self.save_parameters(m, out);
+        out.str(&resource_dir.map_or(String::new(), |d| d.display().to_string()));
+    }
+
+    /// Reads what [`Table::save_head`] wrote into `m`, refusing another format `version`;
+    /// returns the resource folder.
+    pub fn restore_head(
+        &self,
+        m: &mut M,
+        version: u64,
+        input: &mut StateReader<'_>,
+    ) -> Result<Option<PathBuf>, ModelError> {
+        let found = input.u64()?;
+        if found != version {
+            return Err(ModelError::CorruptState(format!(
+                "state version {found}, expected {version}"
+            )));
+        }
+        self.restore_parameters(m, input)?;
+        let dir = input.str()?;
+        Ok((!dir.is_empty()).then(|| PathBuf::from(dir)))
     }
 
     /// Reads what [`Table::save_parameters`] wrote; each value passes its check again.
@@ -309,6 +344,26 @@ macro_rules! variables {
 }
 pub(crate) use variables;
 
+/// Inside an `impl Model`, the [`Model`](crate::models::Model) methods that only read or write
+/// a variable of the table `$table` (a [`Table`]): `get_real -> f64` is a getter and
+/// `set_real(f64)` a setter, each forwarding to the table's method of the same name.
+macro_rules! table_accessors {
+    ($table:ident;) => {};
+    ($table:ident; $get:ident -> $t:ty $(, $($rest:tt)*)?) => {
+        fn $get(&self, vr: u32) -> Result<$t, $crate::models::ModelError> {
+            $table.$get(self, vr)
+        }
+        $crate::models::table::table_accessors!($table; $($($rest)*)?);
+    };
+    ($table:ident; $set:ident($t:ty) $(, $($rest:tt)*)?) => {
+        fn $set(&mut self, vr: u32, value: $t) -> $crate::models::SetResult {
+            $table.$set(self, vr, value)
+        }
+        $crate::models::table::table_accessors!($table; $($($rest)*)?);
+    };
+}
+pub(crate) use table_accessors;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -326,11 +381,7 @@ mod tests {
         if v % 2 == 1 {
             Ok(None)
         } else {
-            Err(ModelError::InvalidValue {
-                name,
-                value: v.to_string(),
-                reason: "must be odd".into(),
-            })
+            Err(ModelError::invalid(name, v, "must be odd"))
         }
     }
 

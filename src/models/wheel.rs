@@ -14,7 +14,7 @@
 //! refused.
 #![forbid(unsafe_code)]
 
-use super::table::{finite, non_negative, positive, variables};
+use super::table::{finite, non_negative, positive, table_accessors, variables};
 use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
 use crate::solver::{rk4_step, substeps};
 
@@ -113,13 +113,7 @@ impl Model for Wheel {
         &INFO
     }
 
-    fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
-        TABLE.get_real(self, vr)
-    }
-
-    fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
-        TABLE.set_real(self, vr, value)
-    }
+    table_accessors!(TABLE; get_real -> f64, set_real(f64));
 
     fn initialize(&mut self, _ctx: &InitContext) -> Result<(), ModelError> {
         self.y = [self.q0, self.v0];
@@ -149,10 +143,6 @@ impl Model for Wheel {
                 ),
             })
         }
-    }
-
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
     }
 
     fn save(&self, out: &mut StateWriter) {

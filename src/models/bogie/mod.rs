@@ -35,6 +35,7 @@ pub use stability::{linear_critical_speed, linear_growth_rate, linear_state_matr
 pub use variables::*;
 
 use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
+use crate::models::table::table_accessors;
 use crate::solver::{rk4_step, substeps};
 use stability::clamped_linear_critical_speed;
 
@@ -149,9 +150,7 @@ impl Model for Bogie {
         &INFO
     }
 
-    fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
-        TABLE.get_real(self, vr)
-    }
+    table_accessors!(TABLE; get_real -> f64);
 
     fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
         let warning = TABLE.set_real(self, vr, value)?;
@@ -215,10 +214,6 @@ impl Model for Bogie {
                 ),
             })
         }
-    }
-
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
     }
 
     fn save(&self, out: &mut StateWriter) {

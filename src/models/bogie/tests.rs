@@ -356,13 +356,7 @@ fn save_restore_round_trip() {
 #[test]
 fn variable_table_matches_defaults_and_units() {
     let b = Bogie::default();
-    for w in VARIABLES.windows(2) {
-        assert!(w[0].vr < w[1].vr, "vr not sorted at {}", w[1].name);
-    }
-    let mut names: Vec<_> = VARIABLES.iter().map(|v| v.name).collect();
-    names.sort_unstable();
-    names.dedup();
-    assert_eq!(names.len(), VARIABLES.len());
+    crate::models::assert_table_sorted_and_unique(&INFO);
     for v in &VARIABLES {
         let value = b.get_real(v.vr).unwrap();
         assert!(value.is_finite(), "{}", v.name);

@@ -10,11 +10,11 @@ use crate::models::{ModelError, ModelInfo, SetResult};
 fn above_min_speed(name: &'static str, value: f64) -> SetResult {
     finite(name, value)?;
     if value <= MIN_SPEED {
-        return Err(ModelError::InvalidValue {
+        return Err(ModelError::invalid(
             name,
-            value: value.to_string(),
-            reason: format!("must exceed {MIN_SPEED} m/s (the creepages divide by the speed)"),
-        });
+            value,
+            format!("must exceed {MIN_SPEED} m/s (the creepages divide by the speed)"),
+        ));
     }
     Ok(None)
 }

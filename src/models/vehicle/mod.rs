@@ -40,6 +40,7 @@ use super::data_file::{read_data_file, resolve};
 use super::vehicle_track::irregularity::{RandomProfile, SampleKey};
 use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
 use crate::contact::table::{ContactSpline, ContactTable, TableRow};
+use crate::models::table::table_accessors;
 use crate::solver::substeps;
 use equations::{base, dof, Car, State, N_STATES};
 use integrate::{rk4_substep, RateBound, StepError, STABILITY_FACTOR};
@@ -264,14 +265,6 @@ impl Vehicle {
             .map_err(|e| ModelError::Other(format!("v_cr_linear: {e}")))
     }
 
-    fn invalid(vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
-        ModelError::InvalidValue {
-            name: INFO.variable(vr).map_or("?", |v| v.name),
-            value: value.to_string(),
-            reason: reason.into(),
-        }
-    }
-
     /// The irregularity of the parameters; random samples are reused while their key holds.
     fn build_irregularity(&mut self, x_lead: f64) -> Result<Irregularity, ModelError> {
         let i = &self.irr;
@@ -280,7 +273,7 @@ impl Vehicle {
             2 | 3 => {
                 let (spectrum, factor) = track::german(i.code).expect("code 2 or 3");
                 if i.lambda_min >= i.lambda_max {
-                    return Err(Self::invalid(
+                    return Err(INFO.invalid(
                         VR_LAMBDA_MIN,
                         i.lambda_min,
                         format!("must be below lambda_max = {} m", i.lambda_max),
@@ -298,9 +291,9 @@ impl Vehicle {
                     _ => {
                         let gen = |k| RandomProfile::generate(k).map(Arc::new);
                         let v =
-                            gen(key).map_err(|e| Self::invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
+                            gen(key).map_err(|e| INFO.invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
                         let l = gen(track::lateral_key(key))
-                            .map_err(|e| Self::invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
+                            .map_err(|e| INFO.invalid(VR_LAMBDA_MIN, i.lambda_min, e))?;
                         (v, l)
                     }
                 };
@@ -313,7 +306,7 @@ impl Vehicle {
             }
             10 => {
                 if i.file.is_empty() {
-                    return Err(Self::invalid(
+                    return Err(INFO.invalid(
                         VR_IRREGULARITY_FILE,
                         "",
                         "irregularity = 10 (measured) needs irregularity_file, a file of x, y, z [m]",
@@ -371,6 +364,8 @@ impl Model for Vehicle {
         &INFO
     }
 
+    table_accessors!(TABLE; get_integer -> i32, set_integer(i32), get_string -> String);
+
     fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
         if vr == VR_V_CR_LINEAR {
             return self.v_cr_linear();
@@ -394,18 +389,6 @@ impl Model for Vehicle {
         Ok(warning)
     }
 
-    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
-        TABLE.get_integer(self, vr)
-    }
-
-    fn set_integer(&mut self, vr: u32, value: i32) -> SetResult {
-        TABLE.set_integer(self, vr, value)
-    }
-
-    fn get_string(&self, vr: u32) -> Result<String, ModelError> {
-        TABLE.get_string(self, vr)
-    }
-
     fn set_string(&mut self, vr: u32, value: &str) -> SetResult {
         let warning = TABLE.set_string(self, vr, value)?;
         self.v_cr = OnceCell::new();
@@ -420,7 +403,7 @@ impl Model for Vehicle {
         let (table, spline) = self.load_table()?;
         for (w, &y) in self.y0.iter().enumerate() {
             if y.abs() >= spline.limit() {
-                return Err(Self::invalid(
+                return Err(INFO.invalid(
                     VR_Y0_W1 + w as u32,
                     y,
                     format!(
@@ -533,19 +516,8 @@ impl Model for Vehicle {
         Ok(())
     }
 
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
-
     fn save(&self, out: &mut StateWriter) {
-        out.u64(STATE_VERSION);
-        TABLE.save_parameters(self, out);
-        out.str(
-            &self
-                .resource_dir
-                .as_ref()
-                .map_or(String::new(), |d| d.display().to_string()),
-        );
+        TABLE.save_head(self, STATE_VERSION, self.resource_dir.as_deref(), out);
         match &self.run {
             None => out.u64(0),
             Some(r) => {
@@ -560,19 +532,11 @@ impl Model for Vehicle {
     }
 
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError> {
-        let version = input.u64()?;
-        if version != STATE_VERSION {
-            return Err(ModelError::CorruptState(format!(
-                "state version {version}, expected {STATE_VERSION}"
-            )));
-        }
         let mut m = Vehicle {
             samples: self.samples.clone(),
             ..Vehicle::default()
         };
-        TABLE.restore_parameters(&mut m, input)?;
-        let dir = input.str()?;
-        m.resource_dir = (!dir.is_empty()).then(|| PathBuf::from(dir));
+        m.resource_dir = TABLE.restore_head(&mut m, STATE_VERSION, input)?;
         match input.u64()? {
             0 => {}
             1 => {

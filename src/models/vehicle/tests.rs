@@ -1,6 +1,6 @@
 use super::equations::{rhs, Track};
 use super::*;
-use crate::models::Start;
+use crate::models::{CloneModel, Start};
 
 // Tests that integrate many seconds run only in optimised builds (`cargo test --release`,
 // as `make test` does): a debug build is some thirty times slower.
@@ -66,13 +66,7 @@ fn max4(a: [f64; 4]) -> f64 {
 
 #[test]
 fn variable_table_is_sorted_unique_and_reads_back_its_start_values() {
-    for w in VARIABLES.windows(2) {
-        assert!(w[0].vr < w[1].vr, "{} / {}", w[0].name, w[1].name);
-    }
-    let mut names: Vec<_> = VARIABLES.iter().map(|v| v.name).collect();
-    names.sort_unstable();
-    names.dedup();
-    assert_eq!(names.len(), VARIABLES.len());
+    crate::models::assert_table_sorted_and_unique(&INFO);
     let xml = crate::fmi2::xml::model_description(&INFO).unwrap();
     assert!(xml.contains("name=\"contact_table\"") && xml.contains("name=\"v_cr_linear\""));
     let m = Vehicle::default();

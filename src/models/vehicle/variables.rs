@@ -17,14 +17,14 @@ pub const MAX_SPEED: f64 = 160.0;
 fn speed(name: &'static str, value: f64) -> SetResult {
     finite(name, value)?;
     if value <= MIN_SPEED || value > MAX_SPEED {
-        return Err(ModelError::InvalidValue {
+        return Err(ModelError::invalid(
             name,
-            value: value.to_string(),
-            reason: format!(
+            value,
+            format!(
                 "must exceed {MIN_SPEED} m/s (the creepages divide by the speed) and be at most \
                  {MAX_SPEED} m/s: the speed is in m/s, not km/h"
             ),
-        });
+        ));
     }
     Ok(None)
 }
@@ -32,14 +32,13 @@ fn speed(name: &'static str, value: f64) -> SetResult {
 /// The irregularity codes the vehicle knows.
 fn irregularity_code(name: &'static str, value: i32) -> SetResult {
     if !matches!(value, 0 | 2 | 3 | 10) {
-        return Err(ModelError::InvalidValue {
+        return Err(ModelError::invalid(
             name,
-            value: value.to_string(),
-            reason: "must be 0 (none), 2 (German low interference), 3 (German high \
+            value,
+            "must be 0 (none), 2 (German low interference), 3 (German high \
                      interference) or 10 (measured, irregularity_file): the other spectra of the \
-                     vehicle-track model have no lateral counterpart here"
-                .into(),
-        });
+                     vehicle-track model have no lateral counterpart here",
+        ));
     }
     Ok(None)
 }

@@ -176,12 +176,12 @@ impl VehicleTrack {
         let p = &self.p;
         let hv = p.half_vehicle();
         let track = Track::with_kernel(p.track(), self.kernel)
-            .map_err(|e| Self::invalid(VR_N_SLEEPERS, p.n_sleepers, e))?;
+            .map_err(|e| INFO.invalid(VR_N_SLEEPERS, p.n_sleepers, e))?;
         let law = ContactLaw::from_code(p.contact_law)
-            .ok_or_else(|| Self::invalid(VR_CONTACT_LAW, p.contact_law, "must be 0 or 1"))?;
+            .ok_or_else(|| INFO.invalid(VR_CONTACT_LAW, p.contact_law, "must be 0 or 1"))?;
         let contact = Contact::new(law, hertz_constant(p.r(VR_R)), p.static_load());
         let kind = IrregularityKind::from_code(p.irregularity)
-            .ok_or_else(|| Self::invalid(VR_IRREGULARITY, p.irregularity, "must be 0..10"))?;
+            .ok_or_else(|| INFO.invalid(VR_IRREGULARITY, p.irregularity, "must be 0..10"))?;
         let irregularity = match kind {
             IrregularityKind::None => Irregularity::None,
             IrregularityKind::Spectrum(spectrum) => {
@@ -232,7 +232,7 @@ impl VehicleTrack {
         let span = offsets[0].max(-offsets[3]);
         let max_drift = 0.5 * l - span - MIN_END_MARGIN;
         if max_drift < ls {
-            return Err(Self::invalid(
+            return Err(INFO.invalid(
                 VR_N_SLEEPERS,
                 p.n_sleepers,
                 format!(

@@ -28,7 +28,8 @@ pub use variables::*;
 
 #[cfg(test)]
 use super::Start;
-use super::{InitContext, Model, ModelError, ModelInfo, SetResult, StateReader, StateWriter};
+use super::{InitContext, Model, ModelError, ModelInfo, StateReader, StateWriter};
+use crate::models::table::table_accessors;
 use coupling::{accelerations, Sim};
 use irregularity::{IrregularityKind, RandomProfile};
 use std::path::PathBuf;
@@ -74,14 +75,6 @@ impl VehicleTrack {
         self.kernel = kernel;
     }
 
-    fn invalid(vr: u32, value: impl ToString, reason: impl Into<String>) -> ModelError {
-        ModelError::InvalidValue {
-            name: INFO.variable(vr).map_or("?", |v| v.name),
-            value: value.to_string(),
-            reason: reason.into(),
-        }
-    }
-
     /// Refuses a `dt` at which the explicit integration surely diverges: the highest rail
     /// mode, `ω = (NM π / l)² √(EI / mr)` (bending alone; the supports only raise it), beyond
     /// the undamped stability limit `ω dt = 2` of Zhai's method (damping lowers the limit
@@ -94,7 +87,7 @@ impl VehicleTrack {
         let omega = k * k * (p.r(VR_EI) / p.r(VR_MR)).sqrt();
         let dt = p.r(VR_DT);
         if omega * dt > 2.0 {
-            return Err(Self::invalid(
+            return Err(INFO.invalid(
                 VR_DT,
                 dt,
                 format!(
@@ -128,29 +121,7 @@ impl Model for VehicleTrack {
         &INFO
     }
 
-    fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
-        TABLE.get_real(self, vr)
-    }
-
-    fn set_real(&mut self, vr: u32, value: f64) -> SetResult {
-        TABLE.set_real(self, vr, value)
-    }
-
-    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
-        TABLE.get_integer(self, vr)
-    }
-
-    fn set_integer(&mut self, vr: u32, value: i32) -> SetResult {
-        TABLE.set_integer(self, vr, value)
-    }
-
-    fn get_string(&self, vr: u32) -> Result<String, ModelError> {
-        TABLE.get_string(self, vr)
-    }
-
-    fn set_string(&mut self, vr: u32, value: &str) -> SetResult {
-        TABLE.set_string(self, vr, value)
-    }
+    table_accessors!(TABLE; get_real -> f64, set_real(f64), get_integer -> i32, set_integer(i32), get_string -> String, set_string(&str));
 
     fn initialize(&mut self, ctx: &InitContext) -> Result<(), ModelError> {
         self.resource_dir = ctx.resource_dir.clone();
@@ -162,7 +133,7 @@ impl Model for VehicleTrack {
             Some(IrregularityKind::Spectrum(_))
         ) && lmin >= lmax
         {
-            return Err(Self::invalid(
+            return Err(INFO.invalid(
                 VR_LAMBDA_MIN,
                 lmin,
                 format!("must be below lambda_max = {lmax} m"),
@@ -186,19 +157,8 @@ impl Model for VehicleTrack {
         result
     }
 
-    fn clone_box(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
-
     fn save(&self, out: &mut StateWriter) {
-        out.u64(STATE_VERSION);
-        TABLE.save_parameters(self, out);
-        out.str(
-            &self
-                .resource_dir
-                .as_ref()
-                .map_or(String::new(), |d| d.display().to_string()),
-        );
+        TABLE.save_head(self, STATE_VERSION, self.resource_dir.as_deref(), out);
         match &self.sim {
             None => out.u64(0),
             Some(s) => {
@@ -218,20 +178,12 @@ impl Model for VehicleTrack {
     }
 
     fn restore(&mut self, input: &mut StateReader<'_>) -> Result<(), ModelError> {
-        let version = input.u64()?;
-        if version != STATE_VERSION {
-            return Err(ModelError::CorruptState(format!(
-                "state version {version}, expected {STATE_VERSION}"
-            )));
-        }
         let mut model = VehicleTrack {
             sample_cache: self.sample_cache.clone(),
             kernel: self.kernel,
             ..VehicleTrack::default()
         };
-        TABLE.restore_parameters(&mut model, input)?;
-        let dir = input.str()?;
-        model.resource_dir = (!dir.is_empty()).then(|| PathBuf::from(dir));
+        model.resource_dir = TABLE.restore_head(&mut model, STATE_VERSION, input)?;
         let initialized = input.u64()?;
         if initialized == 1 {
             let head = input.f64s(Some(5))?;

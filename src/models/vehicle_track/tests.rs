@@ -31,13 +31,7 @@ fn run(m: &mut VehicleTrack, stop: f64, h: f64) -> Vec<[f64; 6]> {
 
 #[test]
 fn variable_table_is_sorted_unique_and_exports() {
-    for w in VARIABLES.windows(2) {
-        assert!(w[0].vr < w[1].vr, "{} / {}", w[0].name, w[1].name);
-    }
-    let mut names: Vec<_> = VARIABLES.iter().map(|v| v.name).collect();
-    names.sort_unstable();
-    names.dedup();
-    assert_eq!(names.len(), VARIABLES.len());
+    crate::models::assert_table_sorted_and_unique(&INFO);
     let xml = crate::fmi2::xml::model_description(&INFO).unwrap();
     assert!(xml.contains("name=\"Kpz\"") && xml.contains("tunable"));
     // Every variable answers get_* with its type, and parameters return their start.

@@ -17,11 +17,7 @@ pub const DEFAULT_SPEED: f64 = 300.0 / 3.6;
 pub const REAL_SLOTS: usize = 40;
 
 fn invalid(name: &'static str, value: i32, reason: &str) -> SetResult {
-    Err(ModelError::InvalidValue {
-        name,
-        value: value.to_string(),
-        reason: reason.into(),
-    })
+    Err(ModelError::invalid(name, value, reason))
 }
 
 /// Largest computing window (sleepers): 2^16 − 1 sleepers are about 39 km of track at 0.6 m,
@@ -80,16 +76,16 @@ pub const MAX_SPEED: f64 = 160.0;
 fn speed_in_range(name: &'static str, value: f64) -> SetResult {
     non_negative(name, value)?;
     if value > MAX_SPEED {
-        return Err(ModelError::InvalidValue {
+        return Err(ModelError::invalid(
             name,
-            value: value.to_string(),
-            reason: format!(
+            value,
+            format!(
                 "must be at most {MAX_SPEED} m/s ({} km/h, above the 574.8 km/h rail speed \
                  record): the speed is in m/s, not km/h ({value} km/h = {:.2} m/s)",
                 MAX_SPEED * 3.6,
                 value / 3.6
             ),
-        });
+        ));
     }
     Ok(None)
 }

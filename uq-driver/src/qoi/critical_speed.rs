@@ -209,6 +209,13 @@ fn interpolate(times: &[f64], values: &[f64], t: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// The signal `f(t)` at the times `t` before `end` (s), 0 from then on.
+    fn until(t: &[f64], end: f64, f: impl Fn(f64) -> f64) -> Vec<f64> {
+        t.iter()
+            .map(|&t| if t < end { f(t) } else { 0.0 })
+            .collect()
+    }
+
     /// Uniform grid 0, dt, …, stop and the paper's ramp V = 100 − t/10.
     fn grid(stop: f64, dt: f64) -> (Vec<f64>, Vec<f64>) {
         let n = (stop / dt).round() as usize;
@@ -325,16 +332,7 @@ mod tests {
             CriticalSpeed::NeverStops
         );
         // Dies out, but less than one window before the end: not confirmed.
-        let s: Vec<f64> = t
-            .iter()
-            .map(|&t| {
-                if t < 29.5 {
-                    9e-3 * (27.0 * t).sin()
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let s = until(&t, 29.5, |t| 9e-3 * (27.0 * t).sin());
         assert_eq!(
             critical_speed(&t, &s, &v, 1.0, 1e-4).unwrap(),
             CriticalSpeed::NeverStops
@@ -357,16 +355,7 @@ mod tests {
     fn window_longer_than_the_record() {
         // Hunting that dies out at 3 s in a 10 s record: a 20 s window can never be quiet.
         let (t, v) = grid(10.0, 0.01);
-        let s: Vec<f64> = t
-            .iter()
-            .map(|&t| {
-                if t < 3.0 {
-                    5e-3 * (27.0 * t).cos()
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let s = until(&t, 3.0, |t| 5e-3 * (27.0 * t).cos());
         assert_eq!(
             critical_speed(&t, &s, &v, 20.0, 1e-4).unwrap(),
             CriticalSpeed::NeverStops

@@ -83,58 +83,34 @@ pub fn evaluate<'a>(
             };
             Ok((w, Code::Ok))
         }
-        QoiSpec::MaxAbs {
-            signal: s,
-            from,
-            to,
-            ..
-        } => {
-            let m = in_window(times, signal(s), *from, *to)
-                .map(f64::abs)
-                .fold(f64::NAN, f64::max);
-            if m.is_nan() {
-                return Err(empty_window(s, *from, *to));
-            }
-            Ok((m, Code::Ok))
-        }
-        QoiSpec::Min {
-            signal: s,
-            from,
-            to,
-            ..
-        }
-        | QoiSpec::Max {
-            signal: s,
-            from,
-            to,
-            ..
-        } => {
-            let values = in_window(times, signal(s), *from, *to);
-            // NaN-skipping folds, as max_abs: a window of NaN only has no value.
+        QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+            let values = in_window(times, signal(&w.signal), w.from, w.to);
+            // NaN-skipping folds: a window of NaN only has no value (NaN here).
             let m = match q {
-                QoiSpec::Min { .. } => values.fold(f64::NAN, f64::min),
-                _ => values.fold(f64::NAN, f64::max),
+                QoiSpec::MaxAbs(_) => values.map(f64::abs).fold(f64::NAN, f64::max),
+                QoiSpec::Min(_) => values.fold(f64::NAN, f64::min),
+                QoiSpec::Max(_) => values.fold(f64::NAN, f64::max),
+                _ => {
+                    let (lo, hi) = values
+                        .filter(|v| v.is_finite())
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                            (lo.min(v), hi.max(v))
+                        });
+                    if lo > hi {
+                        f64::NAN
+                    } else {
+                        hi - lo
+                    }
+                }
             };
             if m.is_nan() {
-                return Err(empty_window(s, *from, *to));
+                return Err(QoiError::EmptyInterval {
+                    signal: w.signal.clone(),
+                    from: w.from,
+                    to: w.to.unwrap_or(f64::INFINITY),
+                });
             }
             Ok((m, Code::Ok))
-        }
-        QoiSpec::Range {
-            signal: s,
-            from,
-            to,
-            ..
-        } => {
-            let (lo, hi) = in_window(times, signal(s), *from, *to)
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v), hi.max(v))
-                });
-            if lo > hi {
-                return Err(empty_window(s, *from, *to));
-            }
-            Ok((hi - lo, Code::Ok))
         }
         QoiSpec::Final { signal: s, .. } => signal(s)
             .last()
@@ -157,13 +133,4 @@ fn in_window<'a>(
         .zip(values)
         .filter(move |(t, _)| **t >= from && **t <= to)
         .map(|(_, v)| *v)
-}
-
-/// No sample of `signal` in [from, to].
-fn empty_window(signal: &str, from: f64, to: Option<f64>) -> QoiError {
-    QoiError::EmptyInterval {
-        signal: signal.to_owned(),
-        from,
-        to: to.unwrap_or(f64::INFINITY),
-    }
 }

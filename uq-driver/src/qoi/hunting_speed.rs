@@ -390,6 +390,18 @@ pub(crate) fn continue_down<S: Stages>(
 mod tests {
     use super::*;
 
+    /// The bracket (hunts, decays) and the runs of a search that found one.
+    fn found(r: HuntingSpeed) -> (f64, f64, usize) {
+        match r {
+            HuntingSpeed::Found {
+                hunts,
+                decays,
+                runs,
+            } => (hunts, decays, runs),
+            r => panic!("{r:?}"),
+        }
+    }
+
     fn spec() -> HuntingSpeedSpec {
         toml::from_str(
             "name = \"v\"\nspeed_parameter = \"V0\"\nset = { ramp = 0.0 }\nlow = 40.0\n\
@@ -407,14 +419,7 @@ mod tests {
                 Ok::<_, ()>(v >= v_star)
             })
             .unwrap();
-            let HuntingSpeed::Found {
-                hunts,
-                decays,
-                runs,
-            } = r
-            else {
-                panic!("{r:?}")
-            };
+            let (hunts, decays, runs) = found(r);
             assert!(
                 decays < v_star && v_star <= hunts,
                 "{decays} {v_star} {hunts}"
@@ -454,9 +459,7 @@ mod tests {
     #[test]
     fn tiny_tolerance_stops_at_floating_point_resolution() {
         let r = bisect(1.0, 2.0, 1e-300, |v| Ok::<_, ()>(v >= 1.5)).unwrap();
-        let HuntingSpeed::Found { hunts, decays, .. } = r else {
-            panic!()
-        };
+        let (hunts, decays, _) = found(r);
         assert_eq!(hunts, 1.5);
         assert_eq!(decays, 1.5f64.next_down());
     }
@@ -577,14 +580,7 @@ mod tests {
         for fold in [52.13, 55.0, 60.01, 79.99] {
             let mut m = Hysteresis::new(fold, 85.0);
             let r = continue_down(40.0, 120.0, 2.0, 0.05, &mut m).unwrap();
-            let HuntingSpeed::Found {
-                hunts,
-                decays,
-                runs,
-            } = r
-            else {
-                panic!("{r:?}")
-            };
+            let (hunts, decays, runs) = found(r);
             assert!(decays < fold && fold <= hunts, "{decays} {fold} {hunts}");
             assert!(hunts - decays <= 0.05, "{decays} {hunts}");
             assert_eq!(runs, m.speeds.len());
@@ -596,11 +592,7 @@ mod tests {
             assert_eq!(&m.speeds[..3], &[120.0, 118.0, 116.0]);
             // Bisection from the disturbance finds the basin instead.
             let mut b = Hysteresis::new(fold, 85.0);
-            let HuntingSpeed::Found { hunts, .. } =
-                bisect(40.0, 120.0, 0.05, |v| b.first(v)).unwrap()
-            else {
-                panic!()
-            };
+            let (hunts, _, _) = found(bisect(40.0, 120.0, 0.05, |v| b.first(v)).unwrap());
             assert!((hunts - 85.0).abs() <= 0.05, "{hunts}");
         }
     }

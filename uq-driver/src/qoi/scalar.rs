@@ -71,111 +71,15 @@ pub enum QoiSpec {
         limits_below: Vec<f64>,
     },
     /// Largest |signal| over [from, to] (s).
-    MaxAbs {
-        /// Name in reports.
-        name: String,
-        /// Signal.
-        signal: String,
-        /// Start of the interval (s).
-        #[serde(default)]
-        from: f64,
-        /// End of the interval (s; default the stop time).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        to: Option<f64>,
-        /// The value the quantity takes in a run the FMU ends before the stop time
-        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// (every quantity of the study must then set it, and the study may store no
-        /// series). Left out of the serialized settings when unset, so the study hash of
-        /// existing studies is unchanged.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        if_ended: Option<f64>,
-        /// Exceedance limits.
-        #[serde(default)]
-        limits: Vec<f64>,
-        /// Limits below: P(q < limit) is reported.
-        #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        limits_below: Vec<f64>,
-    },
+    MaxAbs(WindowQoi),
     /// Smallest value of the signal (signed) over [from, to] (s): e.g. the least wheel–rail
     /// force, 0 when the wheel leaves the rail.
-    Min {
-        /// Name in reports.
-        name: String,
-        /// Signal.
-        signal: String,
-        /// Start of the interval (s).
-        #[serde(default)]
-        from: f64,
-        /// End of the interval (s; default the stop time).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        to: Option<f64>,
-        /// The value the quantity takes in a run the FMU ends before the stop time
-        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// (every quantity of the study must then set it, and the study may store no
-        /// series). Left out of the serialized settings when unset, so the study hash of
-        /// existing studies is unchanged.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        if_ended: Option<f64>,
-        /// Exceedance limits.
-        #[serde(default)]
-        limits: Vec<f64>,
-        /// Limits below: P(q < limit) is reported.
-        #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        limits_below: Vec<f64>,
-    },
+    Min(WindowQoi),
     /// Largest value of the signal (signed) over [from, to] (s).
-    Max {
-        /// Name in reports.
-        name: String,
-        /// Signal.
-        signal: String,
-        /// Start of the interval (s).
-        #[serde(default)]
-        from: f64,
-        /// End of the interval (s; default the stop time).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        to: Option<f64>,
-        /// The value the quantity takes in a run the FMU ends before the stop time
-        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// (every quantity of the study must then set it, and the study may store no
-        /// series). Left out of the serialized settings when unset, so the study hash of
-        /// existing studies is unchanged.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        if_ended: Option<f64>,
-        /// Exceedance limits.
-        #[serde(default)]
-        limits: Vec<f64>,
-        /// Limits below: P(q < limit) is reported.
-        #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        limits_below: Vec<f64>,
-    },
+    Max(WindowQoi),
     /// Peak-to-peak value, max − min of the signal over [from, to] (s): e.g. the ripple of a
     /// wheel–rail force as the wheel passes the sleepers.
-    Range {
-        /// Name in reports.
-        name: String,
-        /// Signal.
-        signal: String,
-        /// Start of the interval (s).
-        #[serde(default)]
-        from: f64,
-        /// End of the interval (s; default the stop time).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        to: Option<f64>,
-        /// The value the quantity takes in a run the FMU ends before the stop time
-        /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
-        /// (every quantity of the study must then set it, and the study may store no
-        /// series). Left out of the serialized settings when unset, so the study hash of
-        /// existing studies is unchanged.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        if_ended: Option<f64>,
-        /// Exceedance limits.
-        #[serde(default)]
-        limits: Vec<f64>,
-        /// Limits below: P(q < limit) is reported.
-        #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        limits_below: Vec<f64>,
-    },
+    Range(WindowQoi),
     /// Value of a signal at the stop time.
     Final {
         /// Name in reports.
@@ -193,6 +97,36 @@ pub enum QoiSpec {
     /// [`crate::qoi::hunting_speed`]): two quantities, `name` (lowest speed that keeps hunting)
     /// and `name_decay` (highest speed at which the disturbance dies out).
     HuntingSpeed(HuntingSpeedSpec),
+}
+
+/// Settings of a quantity over a window [from, to] (s) of one signal: the kinds `max_abs`,
+/// `min`, `max` and `range`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindowQoi {
+    /// Name in reports.
+    pub name: String,
+    /// Signal.
+    pub signal: String,
+    /// Start of the interval (s).
+    #[serde(default)]
+    pub from: f64,
+    /// End of the interval (s; default the stop time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<f64>,
+    /// The value the quantity takes in a run the FMU ends before the stop time
+    /// (fmi2Terminated: e.g. the Vehicle's derailment) instead of the point failing
+    /// (every quantity of the study must then set it, and the study may store no
+    /// series). Left out of the serialized settings when unset, so the study hash of
+    /// existing studies is unchanged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub if_ended: Option<f64>,
+    /// Exceedance limits.
+    #[serde(default)]
+    pub limits: Vec<f64>,
+    /// Limits below: P(q < limit) is reported.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub limits_below: Vec<f64>,
 }
 
 fn is_default<T: Default + PartialEq>(x: &T) -> bool {
@@ -297,11 +231,8 @@ impl QoiSpec {
         match self {
             QoiSpec::CriticalSpeed { name, .. }
             | QoiSpec::Sperling { name, .. }
-            | QoiSpec::MaxAbs { name, .. }
-            | QoiSpec::Min { name, .. }
-            | QoiSpec::Max { name, .. }
-            | QoiSpec::Range { name, .. }
             | QoiSpec::Final { name, .. } => name,
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => &w.name,
             QoiSpec::HuntingSpeed(h) => &h.name,
         }
     }
@@ -320,12 +251,10 @@ impl QoiSpec {
     pub fn signals(&self) -> Vec<&str> {
         match self {
             QoiSpec::CriticalSpeed { signal, speed, .. } => vec![signal, speed],
-            QoiSpec::Sperling { signal, .. }
-            | QoiSpec::MaxAbs { signal, .. }
-            | QoiSpec::Min { signal, .. }
-            | QoiSpec::Max { signal, .. }
-            | QoiSpec::Range { signal, .. }
-            | QoiSpec::Final { signal, .. } => vec![signal],
+            QoiSpec::Sperling { signal, .. } | QoiSpec::Final { signal, .. } => vec![signal],
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                vec![&w.signal]
+            }
             QoiSpec::HuntingSpeed(_) => Vec::new(),
         }
     }
@@ -335,11 +264,8 @@ impl QoiSpec {
         match self {
             QoiSpec::CriticalSpeed { limits, .. }
             | QoiSpec::Sperling { limits, .. }
-            | QoiSpec::MaxAbs { limits, .. }
-            | QoiSpec::Min { limits, .. }
-            | QoiSpec::Max { limits, .. }
-            | QoiSpec::Range { limits, .. }
             | QoiSpec::Final { limits, .. } => limits,
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => &w.limits,
             QoiSpec::HuntingSpeed(h) => &h.limits,
         }
     }
@@ -349,11 +275,10 @@ impl QoiSpec {
         match self {
             QoiSpec::CriticalSpeed { limits_below, .. }
             | QoiSpec::Sperling { limits_below, .. }
-            | QoiSpec::MaxAbs { limits_below, .. }
-            | QoiSpec::Min { limits_below, .. }
-            | QoiSpec::Max { limits_below, .. }
-            | QoiSpec::Range { limits_below, .. }
             | QoiSpec::Final { limits_below, .. } => limits_below,
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                &w.limits_below
+            }
             QoiSpec::HuntingSpeed(h) => &h.limits_below,
         }
     }
@@ -361,11 +286,13 @@ impl QoiSpec {
     /// The value it takes in a run the FMU ends before the stop time (`if_ended`; only the
     /// window kinds `max_abs`, `min`, `max`, `range` have the setting).
     pub(crate) fn if_ended(&self) -> Option<f64> {
+        self.window().and_then(|w| w.if_ended)
+    }
+
+    /// The settings of a window kind (`max_abs`, `min`, `max`, `range`).
+    pub(crate) fn window(&self) -> Option<&WindowQoi> {
         match self {
-            QoiSpec::MaxAbs { if_ended, .. }
-            | QoiSpec::Min { if_ended, .. }
-            | QoiSpec::Max { if_ended, .. }
-            | QoiSpec::Range { if_ended, .. } => *if_ended,
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => Some(w),
             _ => None,
         }
     }
@@ -375,11 +302,10 @@ impl QoiSpec {
         match self {
             QoiSpec::CriticalSpeed { speed, .. } => Some(speed),
             QoiSpec::Sperling { .. } => None,
-            QoiSpec::MaxAbs { signal, .. }
-            | QoiSpec::Min { signal, .. }
-            | QoiSpec::Max { signal, .. }
-            | QoiSpec::Range { signal, .. }
-            | QoiSpec::Final { signal, .. } => Some(signal),
+            QoiSpec::Final { signal, .. } => Some(signal),
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                Some(&w.signal)
+            }
             QoiSpec::HuntingSpeed(h) => Some(&h.speed_parameter),
         }
     }
@@ -450,40 +376,18 @@ impl QoiSpec {
                     words.signal(signal)
                 )
             }
-            QoiSpec::MaxAbs {
-                signal, from, to, ..
-            } => {
-                let signal = words.signal(signal);
-                match to {
-                    Some(to) => format!("largest |{signal}| over {from}–{to} s"),
-                    None => format!("largest |{signal}| from {from} s to the end"),
-                }
-            }
-            QoiSpec::Min {
-                signal, from, to, ..
-            }
-            | QoiSpec::Max {
-                signal, from, to, ..
-            } => {
-                let which = match self {
-                    QoiSpec::Min { .. } => "smallest",
-                    _ => "largest",
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                let signal = words.signal(&w.signal);
+                let what = match self {
+                    QoiSpec::MaxAbs(_) => format!("largest |{signal}|"),
+                    QoiSpec::Min(_) => format!("smallest value of {signal} (signed)"),
+                    QoiSpec::Max(_) => format!("largest value of {signal} (signed)"),
+                    _ => format!("peak-to-peak (max − min) of {signal}"),
                 };
-                let signal = words.signal(signal);
-                match to {
-                    Some(to) => format!("{which} value of {signal} (signed) over {from}–{to} s"),
-                    None => format!("{which} value of {signal} (signed) from {from} s to the end"),
-                }
-            }
-            QoiSpec::Range {
-                signal, from, to, ..
-            } => {
-                let signal = words.signal(signal);
-                match to {
-                    Some(to) => format!("peak-to-peak (max − min) of {signal} over {from}–{to} s"),
-                    None => {
-                        format!("peak-to-peak (max − min) of {signal} from {from} s to the end")
-                    }
+                let from = w.from;
+                match w.to {
+                    Some(to) => format!("{what} over {from}–{to} s"),
+                    None => format!("{what} from {from} s to the end"),
                 }
             }
             QoiSpec::Final { signal, .. } => format!("{} at the stop time", words.signal(signal)),
@@ -555,21 +459,10 @@ impl QoiSpec {
                     None
                 }
             }
-            QoiSpec::MaxAbs {
-                from, to, if_ended, ..
-            }
-            | QoiSpec::Min {
-                from, to, if_ended, ..
-            }
-            | QoiSpec::Max {
-                from, to, if_ended, ..
-            }
-            | QoiSpec::Range {
-                from, to, if_ended, ..
-            } => {
-                if to.is_some_and(|t| t <= *from) {
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                if w.to.is_some_and(|t| t <= w.from) {
                     Some("`to` must be after `from`")
-                } else if if_ended.is_some_and(|v| !v.is_finite()) {
+                } else if w.if_ended.is_some_and(|v| !v.is_finite()) {
                     Some("if_ended must be finite")
                 } else {
                     None
@@ -614,10 +507,8 @@ impl QoiSpec {
                     0.5 / step
                 ))
             }
-            QoiSpec::MaxAbs { from, to, .. }
-            | QoiSpec::Min { from, to, .. }
-            | QoiSpec::Max { from, to, .. }
-            | QoiSpec::Range { from, to, .. } => {
+            QoiSpec::MaxAbs(w) | QoiSpec::Min(w) | QoiSpec::Max(w) | QoiSpec::Range(w) => {
+                let WindowQoi { from, to, .. } = w;
                 let tol = 1e-9 * step;
                 let to_t = to.unwrap_or(stop).min(stop);
                 // The first communication point at or after `from`.
@@ -774,42 +665,31 @@ mod tests {
         assert!(q.validate(11.0).is_ok());
     }
 
+    /// A window quantity of signal `x` from `from` to `to` (s), no limits.
+    fn window(name: &str, from: f64, to: Option<f64>) -> WindowQoi {
+        WindowQoi {
+            name: name.into(),
+            signal: "x".into(),
+            from,
+            to,
+            if_ended: None,
+            limits: vec![],
+            limits_below: vec![],
+        }
+    }
+
     #[test]
     fn max_abs_and_final() {
         let t = [0.0, 1.0, 2.0, 3.0];
         let x = [1.0, -4.0, 2.0, 0.5];
-        let q = QoiSpec::MaxAbs {
-            name: "m".into(),
-            signal: "x".into(),
-            from: 1.5,
-            to: None,
-            if_ended: None,
-            limits: vec![],
-            limits_below: vec![],
-        };
+        let q = QoiSpec::MaxAbs(window("m", 1.5, None));
         assert_eq!(evaluate(&q, &t, |_| &x[..]).unwrap(), (2.0, Code::Ok));
-        let q = QoiSpec::Range {
-            name: "r".into(),
-            signal: "x".into(),
-            from: 0.5,
-            to: Some(2.5),
-            if_ended: None,
-            limits: vec![],
-            limits_below: vec![],
-        };
+        let q = QoiSpec::Range(window("r", 0.5, Some(2.5)));
         // Values at t = 1 and 2 only: the range is their difference, by hand.
         let (r, code) = evaluate(&q, &t, |_| &x[..]).unwrap();
         assert_eq!(code, Code::Ok);
         assert_eq!(r, (x[2] - x[1]).abs());
-        let q = QoiSpec::Range {
-            name: "r".into(),
-            signal: "x".into(),
-            from: 10.0,
-            to: None,
-            if_ended: None,
-            limits: vec![],
-            limits_below: vec![],
-        };
+        let q = QoiSpec::Range(window("r", 10.0, None));
         assert!(evaluate(&q, &t, |_| &x[..]).is_err());
         let q = QoiSpec::Final {
             name: "f".into(),

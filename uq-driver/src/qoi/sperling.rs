@@ -389,14 +389,15 @@ mod tests {
         }
     }
 
+    /// The sum of two signals, sample by sample.
+    fn added(a: &[f64], b: &[f64]) -> Vec<f64> {
+        a.iter().zip(b).map(|(x, y)| x + y).collect()
+    }
+
     #[test]
     fn two_lines_combine_as_the_tenth_power_sum() {
         let dt = 0.005;
-        let a: Vec<f64> = sine(1.0, 0.1, dt, 5.0, 0.0)
-            .iter()
-            .zip(sine(8.0, 0.3, dt, 5.0, 0.5))
-            .map(|(x, y)| x + y)
-            .collect();
+        let a = added(&sine(1.0, 0.1, dt, 5.0, 0.0), &sine(8.0, 0.3, dt, 5.0, 0.5));
         let r = sperling_index(&a, dt, &Default::default()).unwrap();
         let (w1, w2) = (by_hand(0.1, 1.0, 0.325), by_hand(0.3, 8.0, 400.0 / 64.0));
         let expected = (w1.powi(10) + w2.powi(10)).powf(0.1);
@@ -407,11 +408,10 @@ mod tests {
     fn lines_outside_the_band_do_not_count() {
         let dt = 0.005;
         // 0.4 Hz is below f_min, 45 Hz above f_max: nothing is left.
-        let a: Vec<f64> = sine(0.4, 1.0, dt, 5.0, 0.0)
-            .iter()
-            .zip(sine(45.0, 1.0, dt, 5.0, 0.0))
-            .map(|(x, y)| x + y)
-            .collect();
+        let a = added(
+            &sine(0.4, 1.0, dt, 5.0, 0.0),
+            &sine(45.0, 1.0, dt, 5.0, 0.0),
+        );
         let r = sperling_index(&a, dt, &Default::default()).unwrap();
         assert!(r.w < 1e-3, "{}", r.w);
     }

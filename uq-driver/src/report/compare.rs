@@ -17,9 +17,9 @@ use super::{
 use crate::results::numbers::count;
 use crate::results::sig;
 
-/// Why a folder cannot be compared.
+/// A file of a study folder that cannot be read, or is not what `uq-driver run` writes.
 #[derive(Debug, thiserror::Error)]
-pub enum CompareError {
+pub enum FolderFileError {
     /// A file could not be read.
     #[error("cannot read {}", path.display())]
     Read {
@@ -29,7 +29,8 @@ pub enum CompareError {
         #[source]
         source: std::io::Error,
     },
-    /// A file is not what `uq-driver run` writes.
+    /// A file is not what `uq-driver run` writes (for an export: not a finished study written
+    /// by this version).
     #[error("{}: {message}", path.display())]
     Invalid {
         /// The file.
@@ -37,6 +38,32 @@ pub enum CompareError {
         /// What is wrong.
         message: String,
     },
+}
+
+impl FolderFileError {
+    /// `path` could not be read.
+    pub(crate) fn read(path: &Path, source: std::io::Error) -> FolderFileError {
+        FolderFileError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// `path` is not what `uq-driver run` writes.
+    pub(crate) fn invalid(path: &Path, message: impl Into<String>) -> FolderFileError {
+        FolderFileError::Invalid {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Why a folder cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A file cannot be read, or is not what `uq-driver run` writes.
+    #[error(transparent)]
+    File(#[from] FolderFileError),
     /// Writing the page failed.
     #[error(transparent)]
     Report(#[from] ReportError),
@@ -65,11 +92,8 @@ impl Folder {
     }
 }
 
-fn read(path: &Path) -> Result<String, CompareError> {
-    std::fs::read_to_string(path).map_err(|source| CompareError::Read {
-        path: path.to_path_buf(),
-        source,
-    })
+fn read(path: &Path) -> Result<String, FolderFileError> {
+    std::fs::read_to_string(path).map_err(|source| FolderFileError::read(path, source))
 }
 
 /// The study folders in `dirs`; a suite's folder stands for its variants' folders.
@@ -77,11 +101,8 @@ fn folders(dirs: &[PathBuf]) -> Result<Vec<Folder>, CompareError> {
     let mut out = Vec::new();
     for dir in dirs {
         let path = dir.join("summary.json");
-        let summary: Value =
-            serde_json::from_str(&read(&path)?).map_err(|e| CompareError::Invalid {
-                path: path.clone(),
-                message: format!("not JSON: {e}"),
-            })?;
+        let summary: Value = serde_json::from_str(&read(&path)?)
+            .map_err(|e| FolderFileError::invalid(&path, format!("not JSON: {e}")))?;
         if let Some(variants) = summary["variants"]
             .as_array()
             .filter(|_| summary["suite"].is_string())
@@ -99,10 +120,11 @@ fn folders(dirs: &[PathBuf]) -> Result<Vec<Folder>, CompareError> {
                 label: String::new(),
             });
         } else {
-            return Err(CompareError::Invalid {
-                path,
-                message: "not the summary of a study or suite written by uq-driver".into(),
-            });
+            return Err(FolderFileError::invalid(
+                &path,
+                "not the summary of a study or suite written by uq-driver",
+            )
+            .into());
         }
     }
     Ok(out)
@@ -127,9 +149,11 @@ impl Csv {
         let mut columns = vec![Vec::new(); header.len()];
         for (i, line) in lines.enumerate() {
             for (j, cell) in line.split(',').enumerate().take(header.len()) {
-                let v: f64 = cell.trim().parse().map_err(|_| CompareError::Invalid {
-                    path: path.to_path_buf(),
-                    message: format!("line {}: '{cell}' is not a number", i + 2),
+                let v: f64 = cell.trim().parse().map_err(|_| {
+                    FolderFileError::invalid(
+                        path,
+                        format!("line {}: '{cell}' is not a number", i + 2),
+                    )
                 })?;
                 columns[j].push(v);
             }
@@ -593,13 +617,10 @@ fn quantity_section(studies: &[Folder], q: &str, out: &Path) -> Result<Section, 
             )
         },
         images,
-        table: Some(Table {
-            header: ["study", "mean", "Std", "valid runs", "exceedance"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect(),
+        table: Some(Table::new(
+            &["study", "mean", "Std", "valid runs", "exceedance"],
             rows,
-        }),
+        )),
     })
 }
 

@@ -16,24 +16,15 @@ pub use crate::text::csv::{push_field, push_header, push_shortest, shortest};
 /// as many names as columns, otherwise [`ReportError::LengthMismatch`] is returned and no
 /// file is written. Header names containing a comma, quote or line break are quoted.
 pub fn write_columns(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<(), ReportError> {
-    if header.len() != columns.len() {
-        return Err(ReportError::LengthMismatch {
-            path: path.to_path_buf(),
-            what: "header".to_string(),
-            len: header.len(),
-            expected: columns.len(),
-        });
-    }
+    same_length(path, || "header".into(), header.len(), columns.len())?;
     let rows = columns.first().map_or(0, |c| c.len());
     for (j, column) in columns.iter().enumerate() {
-        if column.len() != rows {
-            return Err(ReportError::LengthMismatch {
-                path: path.to_path_buf(),
-                what: format!("column {j} ({:?})", header[j]),
-                len: column.len(),
-                expected: rows,
-            });
-        }
+        same_length(
+            path,
+            || format!("column {j} ({:?})", header[j]),
+            column.len(),
+            rows,
+        )?;
     }
 
     let mut out = String::with_capacity(16 * (rows + 1) * columns.len().max(1));
@@ -50,6 +41,24 @@ pub fn write_columns(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result
     write_bytes(path, out.as_bytes())
 }
 
+/// Refuses `len` values of `what` where `expected` are needed (nothing is written to `path`).
+fn same_length(
+    path: &Path,
+    what: impl FnOnce() -> String,
+    len: usize,
+    expected: usize,
+) -> Result<(), ReportError> {
+    if len == expected {
+        return Ok(());
+    }
+    Err(ReportError::LengthMismatch {
+        path: path.to_path_buf(),
+        what: what(),
+        len,
+        expected,
+    })
+}
+
 /// Writes densities on a grid over time in long format: header `time,x,density`, then one row
 /// per (time, grid point), time-major.
 ///
@@ -63,23 +72,19 @@ pub fn write_grid(
     grid: &[f64],
     density: &[Vec<f64>],
 ) -> Result<(), ReportError> {
-    if density.len() != times.len() {
-        return Err(ReportError::LengthMismatch {
-            path: path.to_path_buf(),
-            what: "density (number of times)".to_string(),
-            len: density.len(),
-            expected: times.len(),
-        });
-    }
+    same_length(
+        path,
+        || "density (number of times)".into(),
+        density.len(),
+        times.len(),
+    )?;
     for (k, row) in density.iter().enumerate() {
-        if row.len() != grid.len() {
-            return Err(ReportError::LengthMismatch {
-                path: path.to_path_buf(),
-                what: format!("density at time index {k}"),
-                len: row.len(),
-                expected: grid.len(),
-            });
-        }
+        same_length(
+            path,
+            || format!("density at time index {k}"),
+            row.len(),
+            grid.len(),
+        )?;
     }
 
     let mut out = String::with_capacity(32 * (times.len() * grid.len() + 1));

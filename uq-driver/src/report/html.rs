@@ -42,6 +42,16 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
+impl Table {
+    /// A table with the column headings `header` and the `rows`.
+    pub(crate) fn new(header: &[&str], rows: Vec<Vec<String>>) -> Table {
+        Table {
+            header: header.iter().map(|s| s.to_string()).collect(),
+            rows,
+        }
+    }
+}
+
 impl ReportPage {
     /// Renders the page as HTML; all text is escaped.
     pub fn to_html(&self) -> String {

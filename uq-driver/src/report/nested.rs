@@ -155,10 +155,7 @@ fn quantity_section(q: &ScalarStats, n: &NestedScalar, images: Vec<String>) -> S
             n.intervals
         ),
         images,
-        table: Some(Table {
-            header: vec!["statistic".into(), "value [95 % interval]".into()],
-            rows,
-        }),
+        table: Some(Table::new(&["statistic", "value [95 % interval]"], rows)),
     }
 }
 
@@ -480,8 +477,8 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
                them (see the suite's description for what those were computed on)."
             .into(),
         images: vec!["variance_split.csv".into()],
-        table: Some(Table {
-            header: [
+        table: Some(Table::new(
+            &[
                 "variant",
                 "quantity",
                 "mean",
@@ -495,11 +492,9 @@ pub fn suite_section(summary: &SuiteSummary) -> Option<Section> {
                 "P(q > limit)",
                 "P(q > limit | outer): median [min, max]",
                 "P (paper)",
-            ]
-            .map(String::from)
-            .to_vec(),
+            ],
             rows,
-        }),
+        )),
     })
 }
 

@@ -419,22 +419,16 @@ fn compare_scalar(
         .iter()
         .find_map(|d| d.summary.units.get(q))
         .map(String::as_str);
-    let mut mean_plot = LinePlot::new(
-        format!("mean of {q} against model runs"),
-        "model runs",
-        label(&format!("mean {q}"), unit),
-    );
-    mean_plot.log_x = true;
-    convergence(mean_plot, &kinds, &runs, &means)
-        .write(&dir.join(format!("{}_mean_vs_runs.svg", stem(q))))?;
-    let mut std_plot = LinePlot::new(
-        format!("Std of {q} against model runs"),
-        "model runs",
-        label(&format!("Std {q}"), unit),
-    );
-    std_plot.log_x = true;
-    convergence(std_plot, &kinds, &runs, &stds)
-        .write(&dir.join(format!("{}_std_vs_runs.svg", stem(q))))?;
+    for (what, values, file) in [("mean", &means, "mean"), ("Std", &stds, "std")] {
+        let mut plot = LinePlot::new(
+            format!("{what} of {q} against model runs"),
+            "model runs",
+            label(&format!("{what} {q}"), unit),
+        );
+        plot.log_x = true;
+        convergence(plot, &kinds, &runs, values)
+            .write(&dir.join(format!("{}_{file}_vs_runs.svg", stem(q))))?;
+    }
     let idx: Vec<f64> = having.iter().map(|(i, _)| *i as f64).collect();
     write_columns(
         &dir.join(format!("{}_compare.csv", stem(q))),
@@ -539,8 +533,8 @@ fn paper_section(summary: &SuiteSummary) -> Section {
         heading: "Against the paper".into(),
         text: "Published values beside ours.".into(),
         images: vec![],
-        table: Some(Table {
-            header: [
+        table: Some(Table::new(
+            &[
                 "variant",
                 "quantity",
                 "statistic",
@@ -548,12 +542,9 @@ fn paper_section(summary: &SuiteSummary) -> Section {
                 "railuq",
                 "difference",
                 "source",
-            ]
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
+            ],
             rows,
-        }),
+        )),
     }
 }
 

@@ -253,20 +253,8 @@ pub struct SobolSummary {
 impl SobolSummary {
     /// Column `col` of `sobol`, labelled by `names` (the parameters, in study order).
     pub fn of(sobol: &Sobol, col: usize, names: &[&str]) -> SobolSummary {
-        let label = |v: &[f64]| -> BTreeMap<String, f64> {
-            names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(v.iter().copied())
-                .collect()
-        };
-        let label_ci = |v: &[(f64, f64)]| -> BTreeMap<String, [f64; 2]> {
-            names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(v.iter().map(|&(lo, hi)| [lo, hi]))
-                .collect()
-        };
+        let label = |v: &[f64]| by_name(names, v.iter().copied());
+        let label_ci = |v: &[(f64, f64)]| by_name(names, v.iter().map(|&(lo, hi)| [lo, hi]));
         let ci = sobol.intervals.as_ref();
         // Given data: first-order indices only.
         let total = !sobol.given_data;
@@ -283,6 +271,11 @@ impl SobolSummary {
             estimator: sobol.given_data.then_some("given_data"),
         }
     }
+}
+
+/// `values` keyed by `names` (the parameters, in study order), as `summary.json` lists them.
+pub(crate) fn by_name<T>(names: &[&str], values: impl Iterator<Item = T>) -> BTreeMap<String, T> {
+    names.iter().map(|n| n.to_string()).zip(values).collect()
 }
 
 /// `1234567` as `1 234 567`.

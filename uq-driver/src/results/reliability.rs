@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::results::by_name;
 use crate::uq::method::adaptive::{generalised_beta, LimitResult, Screening};
 use crate::uq::reliability::Side;
 
@@ -61,6 +62,11 @@ pub struct LimitProbability {
     pub(crate) tail_extrapolated: bool,
 }
 
+/// The JSON of a method's details, if it ran (and they serialize).
+fn json<T: Serialize>(details: &Option<T>) -> Option<serde_json::Value> {
+    details.as_ref().and_then(|d| serde_json::to_value(d).ok())
+}
+
 /// `above` or `below`.
 pub(crate) fn direction(side: Side) -> &'static str {
     match side {
@@ -72,43 +78,18 @@ pub(crate) fn direction(side: Side) -> &'static str {
 impl LimitProbability {
     /// The entry of an adaptive method's result, the parameters named by `names`.
     pub(crate) fn of(r: &LimitResult, names: &[&str]) -> LimitProbability {
-        let by_name = |v: &[f64]| -> BTreeMap<String, f64> {
-            names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(v.iter().copied())
-                .collect()
-        };
+        let label = |v: &[f64]| by_name(names, v.iter().copied());
         let mut details = serde_json::Map::new();
         let mut put = |key: &str, v: Option<serde_json::Value>| {
             if let Some(v) = v {
                 details.insert(key.to_owned(), v);
             }
         };
-        put(
-            "form",
-            r.form.as_ref().and_then(|f| serde_json::to_value(f).ok()),
-        );
-        put(
-            "sorm",
-            r.sorm.as_ref().and_then(|f| serde_json::to_value(f).ok()),
-        );
-        put(
-            "importance_sampling",
-            r.importance_sampling
-                .as_ref()
-                .and_then(|f| serde_json::to_value(f).ok()),
-        );
-        put(
-            "subset",
-            r.subset.as_ref().and_then(|f| serde_json::to_value(f).ok()),
-        );
-        put(
-            "multistart",
-            r.multistart
-                .as_ref()
-                .and_then(|f| serde_json::to_value(f).ok()),
-        );
+        put("form", json(&r.form));
+        put("sorm", json(&r.sorm));
+        put("importance_sampling", json(&r.importance_sampling));
+        put("subset", json(&r.subset));
+        put("multistart", json(&r.multistart));
         let ci_kind = r.ci_95.map(|_| match r.method {
             "subset" => "log-normal on the CoV of fully correlated levels (conservative)".into(),
             _ => "log-normal with the estimated CoV".into(),
@@ -120,8 +101,8 @@ impl LimitProbability {
             ci_95: r.ci_95,
             cov: r.cov,
             beta: r.beta,
-            design_point: r.design_point.as_ref().map(|(_, x)| by_name(x)),
-            importance: r.importance.as_deref().map(by_name),
+            design_point: r.design_point.as_ref().map(|(_, x)| label(x)),
+            importance: r.importance.as_deref().map(label),
             runs: r.runs as usize,
             method: r.method.to_owned(),
             upper_95: r.upper_95,
@@ -201,23 +182,13 @@ impl MorrisScreening {
     /// The entry of a screening, the parameters named by `names`.
     pub(crate) fn of(s: &Screening, names: &[&str]) -> MorrisScreening {
         let m = &s.morris;
-        let by_name = |v: &[f64]| -> BTreeMap<String, f64> {
-            names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(v.iter().copied())
-                .collect()
-        };
+        let label = |v: &[f64]| by_name(names, v.iter().copied());
         MorrisScreening {
-            mu_star: by_name(&m.mu_star),
-            sigma: by_name(&m.sigma),
-            mu: by_name(&m.mu),
+            mu_star: label(&m.mu_star),
+            sigma: label(&m.sigma),
+            mu: label(&m.mu),
             ranking: m.ranking.iter().map(|&i| names[i].to_owned()).collect(),
-            effects: names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(m.effects.iter().copied())
-                .collect(),
+            effects: by_name(names, m.effects.iter().copied()),
             warnings: m.warnings.clone(),
         }
     }

@@ -33,11 +33,9 @@ use crate::fmu::Fmu;
 use crate::qoi::evaluate::Code;
 use crate::qoi::QoiSpec;
 use crate::report::{self, units, StudyReport};
-use crate::results::{
-    FmuInfo, LimitProbability, MorrisScreening, PointStatus, PointTable, ScalarStats,
-};
+use crate::results::{LimitProbability, MorrisScreening, PointStatus, PointTable, ScalarStats};
 use crate::spec::Study;
-use crate::study::facts::{calculated_strings, summary, RunFacts};
+use crate::study::facts::{fmu_info, summary, RunFacts};
 use crate::study::outcome::{StudyResult, StudyRunError};
 use crate::study::plan::{fingerprint, ranges};
 use crate::study::progress;
@@ -212,14 +210,12 @@ fn finish(
     warnings.splice(0..0, notes);
     let fmu_sha256 = fingerprint::sha256_file(fmu.path()).unwrap_or_default();
     let facts = RunFacts {
-        fmu: Some(FmuInfo {
-            path: fmu.path().display().to_string(),
-            model_name: md.model_name.clone(),
-            guid: md.guid.clone(),
-            generation_tool: md.generation_tool.clone(),
-            sha256: fmu_sha256,
-            calculated_strings: calculated_strings(fmu, &study.experiment, opts.isolate.is_some()),
-        }),
+        fmu: Some(fmu_info(
+            fmu,
+            fmu_sha256,
+            &study.experiment,
+            opts.isolate.is_some(),
+        )),
         model_runs: runs,
         runs_new: runs.saturating_sub(resumed),
         runs_resumed: resumed,

@@ -43,6 +43,26 @@ pub(crate) fn calculated_strings(
     }
 }
 
+/// What `summary.json` says of the FMU a study ran (`fmu`): its file, its modelDescription's
+/// identity, its SHA-256 (`sha256`) and its String calculated parameters
+/// ([`calculated_strings`]).
+pub(crate) fn fmu_info(
+    fmu: &Fmu,
+    sha256: String,
+    experiment: &Experiment,
+    isolated: bool,
+) -> FmuInfo {
+    let md = fmu.description();
+    FmuInfo {
+        path: fmu.path().display().to_string(),
+        model_name: md.model_name.clone(),
+        guid: md.guid.clone(),
+        generation_tool: md.generation_tool.clone(),
+        sha256,
+        calculated_strings: calculated_strings(fmu, experiment, isolated),
+    }
+}
+
 /// Facts of a run for the summary.
 pub(crate) struct RunFacts {
     pub(crate) fmu: Option<FmuInfo>,

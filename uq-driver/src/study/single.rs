@@ -8,10 +8,10 @@ use std::time::Instant;
 use crate::fmu::Fmu;
 use crate::report::units;
 use crate::report::{self, ReportError, StudyReport};
-use crate::results::{FmuInfo, OutputSplit, PointStatus, PointTable};
+use crate::results::{OutputSplit, PointStatus, PointTable};
 use crate::spec::Study;
 use crate::study::analysis::{self, Analysed, AnalysisError};
-use crate::study::facts::{calculated_strings, summary, RunFacts};
+use crate::study::facts::{fmu_info, summary, RunFacts};
 use crate::study::outcome::{StudyResult, StudyRunError};
 use crate::study::plan::ranges;
 use crate::study::plan::size;
@@ -106,14 +106,12 @@ pub(crate) fn finish(
     units::describe_signals(&mut quantities, &study.qoi, md);
     let analysis_time = started.elapsed().as_secs_f64();
     let facts = RunFacts {
-        fmu: Some(FmuInfo {
-            path: fmu.path().display().to_string(),
-            model_name: md.model_name.clone(),
-            guid: md.guid.clone(),
-            generation_tool: md.generation_tool.clone(),
-            sha256: outcome.fmu_sha256.clone(),
-            calculated_strings: calculated_strings(fmu, &study.experiment, opts.isolate.is_some()),
-        }),
+        fmu: Some(fmu_info(
+            fmu,
+            outcome.fmu_sha256.clone(),
+            &study.experiment,
+            opts.isolate.is_some(),
+        )),
         model_runs: design.len(),
         runs_new: outcome.n_new,
         runs_resumed: outcome.n_resumed,

@@ -100,11 +100,25 @@ impl Shape {
 }
 
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Shape {
-    Shape::RoundRect {
-        min: (x0, y0),
-        max: (x1, y1),
-        r: 0.0,
-    }
+    round_rect((x0, y0), (x1, y1), 0.0)
+}
+
+/// An axis-aligned rectangle from `min` to `max` with corners rounded to radius `r`.
+fn round_rect(min: Pt, max: Pt, r: f64) -> Shape {
+    Shape::RoundRect { min, max, r }
+}
+
+/// A segment from `a` to `b` of width `w` with round ends.
+fn capsule(a: Pt, b: Pt, w: f64) -> Shape {
+    Shape::Capsule { a, b, w }
+}
+
+/// The ballast bed under a side-view track.
+fn ballast() -> (Shape, Rgb) {
+    (
+        Shape::Polygon(vec![(0.03, 0.95), (0.97, 0.95), (0.9, 0.86), (0.1, 0.86)]),
+        BALLAST,
+    )
 }
 
 /// A `w` x `h` rectangle centred on `c`, turned by `angle` [rad] about `pivot`.
@@ -117,8 +131,8 @@ fn turned_rect(c: Pt, w: f64, h: f64, pivot: Pt, angle: f64) -> Shape {
     Shape::Polygon(corners.to_vec())
 }
 
-/// A coil spring from `a` to `b` drawn as a zigzag of `coils` turns, `width` wide.
-fn spring(a: Pt, b: Pt, coils: usize, width: f64, line: f64) -> Vec<Shape> {
+/// A coil spring from `a` to `b` drawn in orange as a zigzag of `coils` turns, `width` wide.
+fn spring(a: Pt, b: Pt, coils: usize, width: f64, line: f64) -> Vec<(Shape, Rgb)> {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
     let len = dx.hypot(dy);
     let (ux, uy) = (dx / len, dy / len);
@@ -133,11 +147,7 @@ fn spring(a: Pt, b: Pt, coils: usize, width: f64, line: f64) -> Vec<Shape> {
     }
     pts.extend([at(len - lead, 0.0), b]);
     pts.windows(2)
-        .map(|p| Shape::Capsule {
-            a: p[0],
-            b: p[1],
-            w: line,
-        })
+        .map(|p| (capsule(p[0], p[1], line), ORANGE))
         .collect()
 }
 
@@ -147,14 +157,7 @@ fn damper(top: Pt, bottom: Pt, width: f64, line: f64) -> Vec<(Shape, Rgb)> {
     let mid = (top.1 + bottom.1) / 2.0;
     let half = width / 2.0;
     vec![
-        (
-            Shape::Capsule {
-                a: top,
-                b: (x, mid + 0.02),
-                w: line,
-            },
-            DARK,
-        ),
+        (capsule(top, (x, mid + 0.02), line), DARK),
         (
             rect(x - half * 0.75, mid + 0.01, x + half * 0.75, mid + 0.03),
             DARK,
@@ -200,37 +203,12 @@ fn wheel_scene() -> Vec<(Shape, Rgb)> {
     let mut s = vec![(rect(0.12, 0.07, 0.88, 0.12), DARK)];
     for i in 0..8 {
         let x = 0.14 + 0.1 * i as f64;
-        s.push((
-            Shape::Capsule {
-                a: (x, 0.07),
-                b: (x + 0.04, 0.035),
-                w: 0.014,
-            },
-            DARK,
-        ));
+        s.push((capsule((x, 0.07), (x + 0.04, 0.035), 0.014), DARK));
     }
-    s.extend(
-        spring((0.34, 0.12), (0.34, 0.35), 4, 0.1, 0.022)
-            .into_iter()
-            .map(|sh| (sh, ORANGE)),
-    );
+    s.extend(spring((0.34, 0.12), (0.34, 0.35), 4, 0.1, 0.022));
     s.extend(damper((0.66, 0.12), (0.66, 0.35), 0.1, 0.018));
-    s.push((
-        Shape::Capsule {
-            a: (0.5, 0.35),
-            b: (0.5, 0.58),
-            w: 0.035,
-        },
-        DARK,
-    ));
-    s.push((
-        Shape::RoundRect {
-            min: (0.26, 0.335),
-            max: (0.74, 0.375),
-            r: 0.012,
-        },
-        DEEP_BLUE,
-    ));
+    s.push((capsule((0.5, 0.35), (0.5, 0.58), 0.035), DARK));
+    s.push((round_rect((0.26, 0.335), (0.74, 0.375), 0.012), DEEP_BLUE));
     s.extend(track(0.06, 0.94, 0.8, 4));
     s.extend(wheel((0.5, 0.595), 0.19));
     s
@@ -267,52 +245,29 @@ fn bogie_scene() -> Vec<(Shape, Rgb)> {
 /// The vehicle on the track (side view): car body on two bogies, four wheels, rail on
 /// sleepers and ballast.
 fn vehicle_track_scene() -> Vec<(Shape, Rgb)> {
-    let mut s = vec![(
-        Shape::Polygon(vec![(0.03, 0.95), (0.97, 0.95), (0.9, 0.86), (0.1, 0.86)]),
-        BALLAST,
-    )];
+    let mut s = vec![ballast()];
     s.extend(track(0.04, 0.96, 0.77, 7));
     for bogie_x in [0.25, 0.75] {
         for dx in [-0.1, 0.1] {
             s.extend(wheel((bogie_x + dx, 0.705), 0.06));
-            s.extend(
-                spring((bogie_x + dx, 0.6), (bogie_x + dx, 0.67), 2, 0.05, 0.012)
-                    .into_iter()
-                    .map(|sh| (sh, ORANGE)),
-            );
+            s.extend(spring(
+                (bogie_x + dx, 0.6),
+                (bogie_x + dx, 0.67),
+                2,
+                0.05,
+                0.012,
+            ));
         }
         s.push((
-            Shape::RoundRect {
-                min: (bogie_x - 0.17, 0.565),
-                max: (bogie_x + 0.17, 0.605),
-                r: 0.01,
-            },
+            round_rect((bogie_x - 0.17, 0.565), (bogie_x + 0.17, 0.605), 0.01),
             DEEP_BLUE,
         ));
-        s.extend(
-            spring((bogie_x, 0.47), (bogie_x, 0.565), 3, 0.07, 0.016)
-                .into_iter()
-                .map(|sh| (sh, ORANGE)),
-        );
+        s.extend(spring((bogie_x, 0.47), (bogie_x, 0.565), 3, 0.07, 0.016));
     }
-    s.push((
-        Shape::RoundRect {
-            min: (0.05, 0.15),
-            max: (0.95, 0.48),
-            r: 0.05,
-        },
-        BLUE,
-    ));
+    s.push((round_rect((0.05, 0.15), (0.95, 0.48), 0.05), BLUE));
     for i in 0..5 {
         let x = 0.12 + 0.16 * i as f64;
-        s.push((
-            Shape::RoundRect {
-                min: (x, 0.22),
-                max: (x + 0.1, 0.32),
-                r: 0.015,
-            },
-            GLASS,
-        ));
+        s.push((round_rect((x, 0.22), (x + 0.1, 0.32), 0.015), GLASS));
     }
     s.push((rect(0.05, 0.4, 0.95, 0.42), DEEP_BLUE));
     s
@@ -321,24 +276,14 @@ fn vehicle_track_scene() -> Vec<(Shape, Rgb)> {
 /// The full car seen from the front: car body rolled a little on the secondary springs, a bogie
 /// frame on the primary springs, a wheelset with coned wheels on two rails.
 fn vehicle_scene() -> Vec<(Shape, Rgb)> {
-    let mut s = vec![(
-        Shape::Polygon(vec![(0.03, 0.95), (0.97, 0.95), (0.9, 0.86), (0.1, 0.86)]),
-        BALLAST,
-    )];
+    let mut s = vec![ballast()];
     s.push((rect(0.08, 0.83, 0.92, 0.87), WOOD));
     for x in [0.2, 0.8] {
         s.push((rect(x - 0.035, 0.8, x + 0.035, 0.83), STEEL));
         s.push((rect(x - 0.02, 0.78, x + 0.02, 0.8), LIGHT_STEEL));
     }
     // Wheelset: axle and two coned wheels with their flanges inside the rails.
-    s.push((
-        Shape::Capsule {
-            a: (0.12, 0.7),
-            b: (0.88, 0.7),
-            w: 0.03,
-        },
-        DARK,
-    ));
+    s.push((capsule((0.12, 0.7), (0.88, 0.7), 0.03), DARK));
     for (x, side) in [(0.2, 1.0), (0.8, -1.0)] {
         // The tread is coned: the rolling radius grows towards the flange (inside).
         let (outer, inner) = (0.77, 0.78);
@@ -364,27 +309,12 @@ fn vehicle_scene() -> Vec<(Shape, Rgb)> {
     // Primary springs from the axle boxes to the bogie frame.
     for x in [0.1, 0.9] {
         s.push((rect(x - 0.035, 0.67, x + 0.035, 0.73), STEEL));
-        s.extend(
-            spring((x, 0.67), (x, 0.6), 2, 0.05, 0.012)
-                .into_iter()
-                .map(|sh| (sh, ORANGE)),
-        );
+        s.extend(spring((x, 0.67), (x, 0.6), 2, 0.05, 0.012));
     }
-    s.push((
-        Shape::RoundRect {
-            min: (0.05, 0.55),
-            max: (0.95, 0.6),
-            r: 0.012,
-        },
-        DEEP_BLUE,
-    ));
+    s.push((round_rect((0.05, 0.55), (0.95, 0.6), 0.012), DEEP_BLUE));
     // Secondary springs and the car body, rolled about the floor's centre.
     for x in [0.3, 0.7] {
-        s.extend(
-            spring((x, 0.55), (x, 0.46), 3, 0.07, 0.016)
-                .into_iter()
-                .map(|sh| (sh, ORANGE)),
-        );
+        s.extend(spring((x, 0.55), (x, 0.46), 3, 0.07, 0.016));
     }
     let pivot = (0.5, 0.45);
     let roll = -0.03;
@@ -465,14 +395,7 @@ pub fn model_png(name: &str) -> Vec<u8> {
         _ => wheel_scene(),
     };
     let mut canvas = Canvas::new();
-    canvas.fill(
-        &Shape::RoundRect {
-            min: (0.0, 0.0),
-            max: (1.0, 1.0),
-            r: 0.12,
-        },
-        BACKGROUND,
-    );
+    canvas.fill(&round_rect((0.0, 0.0), (1.0, 1.0), 0.12), BACKGROUND);
     for (shape, color) in &scene {
         canvas.fill(shape, *color);
     }

@@ -1,14 +1,17 @@
 //! Optional FMI 2.0 Co-Simulation capabilities: directional and input/output derivatives,
 //! status queries and FMU states (get, set, free, serialize).
 
-use std::ffi::{c_char, c_int};
+use std::ffi::c_int;
 use std::ptr;
 
 use super::{same_len, FmuState, Instance, InstanceState, StatusKind};
 use crate::fmu::binary::c_string;
-use crate::fmu::binary::{RawStatus, StatePtr};
+use crate::fmu::binary::{Component, Functions, RawStatus, StatePtr};
 use crate::fmu::error::{FmuError, Status};
 use crate::fmu::logger::LogSink;
+
+/// A `fmi2Get…Status` function: the kind of status and where to write it.
+type StatusFn<T> = unsafe extern "C" fn(Component, c_int, *mut T) -> RawStatus;
 
 impl Instance {
     // ------------------------------------------------------------------------------------------
@@ -125,53 +128,62 @@ impl Instance {
     // ------------------------------------------------------------------------------------------
     // Status queries.
 
+    /// Calls the status query `function` (`pick` takes it from the API) for `kind`, the FMU
+    /// writing over `value`.
+    fn status<T>(
+        &mut self,
+        function: &'static str,
+        pick: fn(&Functions) -> StatusFn<T>,
+        kind: StatusKind,
+        mut value: T,
+    ) -> Result<T, FmuError> {
+        self.call(function, |api, c| {
+            // SAFETY: `value` is writable.
+            unsafe { pick(api)(c, kind as c_int, &mut value) }
+        })?;
+        Ok(value)
+    }
+
     /// `fmi2GetStatus`.
     pub fn get_status(&mut self, kind: StatusKind) -> Result<Status, FmuError> {
-        let mut value: RawStatus = 0;
-        self.call("fmi2GetStatus", |api, c| {
-            // SAFETY: `value` is writable.
-            unsafe { (api.get_status)(c, kind as c_int, &mut value) }
-        })?;
+        let value = self.status("fmi2GetStatus", |api| api.get_status, kind, 0)?;
         Ok(Status::from_raw(value))
     }
 
     /// `fmi2GetRealStatus` (e.g. [`StatusKind::LastSuccessfulTime`], in s).
     pub fn get_real_status(&mut self, kind: StatusKind) -> Result<f64, FmuError> {
-        let mut value = 0.0;
-        self.call("fmi2GetRealStatus", |api, c| {
-            // SAFETY: `value` is writable.
-            unsafe { (api.get_real_status)(c, kind as c_int, &mut value) }
-        })?;
-        Ok(value)
+        self.status("fmi2GetRealStatus", |api| api.get_real_status, kind, 0.0)
     }
 
     /// `fmi2GetIntegerStatus`.
     pub fn get_integer_status(&mut self, kind: StatusKind) -> Result<i32, FmuError> {
-        let mut value: c_int = 0;
-        self.call("fmi2GetIntegerStatus", |api, c| {
-            // SAFETY: `value` is writable.
-            unsafe { (api.get_integer_status)(c, kind as c_int, &mut value) }
-        })?;
-        Ok(value)
+        self.status(
+            "fmi2GetIntegerStatus",
+            |api| api.get_integer_status,
+            kind,
+            0,
+        )
     }
 
     /// `fmi2GetBooleanStatus` (e.g. [`StatusKind::Terminated`]).
     pub fn get_boolean_status(&mut self, kind: StatusKind) -> Result<bool, FmuError> {
-        let mut value: c_int = 0;
-        self.call("fmi2GetBooleanStatus", |api, c| {
-            // SAFETY: `value` is writable.
-            unsafe { (api.get_boolean_status)(c, kind as c_int, &mut value) }
-        })?;
+        let value = self.status(
+            "fmi2GetBooleanStatus",
+            |api| api.get_boolean_status,
+            kind,
+            0,
+        )?;
         Ok(value != 0)
     }
 
     /// `fmi2GetStringStatus` (e.g. [`StatusKind::PendingStatus`]).
     pub fn get_string_status(&mut self, kind: StatusKind) -> Result<String, FmuError> {
-        let mut value: *const c_char = ptr::null();
-        self.call("fmi2GetStringStatus", |api, c| {
-            // SAFETY: `value` is writable.
-            unsafe { (api.get_string_status)(c, kind as c_int, &mut value) }
-        })?;
+        let value = self.status(
+            "fmi2GetStringStatus",
+            |api| api.get_string_status,
+            kind,
+            ptr::null(),
+        )?;
         // SAFETY: the FMU returned null or a NUL-terminated string valid until its next call.
         unsafe { c_string(value) }
             .ok_or_else(|| self.protocol("fmi2GetStringStatus", "returned a null string"))

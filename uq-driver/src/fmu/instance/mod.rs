@@ -232,6 +232,19 @@ impl Instance {
     // ------------------------------------------------------------------------------------------
     // Call plumbing.
 
+    /// [`Instance::call`] of the FMI function `function` (`pick` takes it from the API) whose
+    /// only argument is the component.
+    fn call_plain(
+        &mut self,
+        function: &'static str,
+        pick: fn(&Functions) -> unsafe extern "C" fn(Component) -> RawStatus,
+    ) -> Result<Status, FmuError> {
+        self.call(function, |api, c| {
+            // SAFETY: `c` is a live component.
+            unsafe { pick(api)(c) }
+        })
+    }
+
     /// Calls `f` with the function table and the component, then checks the status.
     fn call(
         &mut self,
@@ -328,9 +341,8 @@ impl Instance {
 
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization_mode(&mut self) -> Result<(), FmuError> {
-        self.call("fmi2EnterInitializationMode", |api, c| {
-            // SAFETY: `c` is a live component.
-            unsafe { (api.enter_initialization_mode)(c) }
+        self.call_plain("fmi2EnterInitializationMode", |api| {
+            api.enter_initialization_mode
         })?;
         self.state = InstanceState::InitializationMode;
         Ok(())
@@ -338,9 +350,8 @@ impl Instance {
 
     /// `fmi2ExitInitializationMode`: afterwards the instance steps.
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmuError> {
-        self.call("fmi2ExitInitializationMode", |api, c| {
-            // SAFETY: `c` is a live component.
-            unsafe { (api.exit_initialization_mode)(c) }
+        self.call_plain("fmi2ExitInitializationMode", |api| {
+            api.exit_initialization_mode
         })?;
         self.state = InstanceState::Stepping;
         Ok(())
@@ -358,29 +369,20 @@ impl Instance {
 
     /// `fmi2CancelStep` (only meaningful for asynchronous FMUs).
     pub fn cancel_step(&mut self) -> Result<(), FmuError> {
-        self.call("fmi2CancelStep", |api, c| {
-            // SAFETY: `c` is a live component.
-            unsafe { (api.cancel_step)(c) }
-        })?;
+        self.call_plain("fmi2CancelStep", |api| api.cancel_step)?;
         Ok(())
     }
 
     /// `fmi2Terminate`.
     pub fn terminate(&mut self) -> Result<(), FmuError> {
-        self.call("fmi2Terminate", |api, c| {
-            // SAFETY: `c` is a live component.
-            unsafe { (api.terminate)(c) }
-        })?;
+        self.call_plain("fmi2Terminate", |api| api.terminate)?;
         self.state = InstanceState::Terminated;
         Ok(())
     }
 
     /// `fmi2Reset`: back to the state after instantiation, with the start values.
     pub fn reset(&mut self) -> Result<(), FmuError> {
-        self.call("fmi2Reset", |api, c| {
-            // SAFETY: `c` is a live component.
-            unsafe { (api.reset)(c) }
-        })?;
+        self.call_plain("fmi2Reset", |api| api.reset)?;
         self.state = InstanceState::Instantiated;
         Ok(())
     }

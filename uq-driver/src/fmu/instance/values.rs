@@ -5,73 +5,111 @@ use std::ffi::{c_char, c_int};
 use std::ptr;
 
 use super::{c_string_arg, same_len, Instance, InstanceState};
-use crate::fmu::binary::c_string;
+use crate::fmu::binary::{c_string, Component, Functions, RawStatus, Vr};
 use crate::fmu::description::ScalarVariable;
 use crate::fmu::error::FmuError;
 
+/// A `fmi2Set…` function: value references and as many values.
+type SetFn<T> = unsafe extern "C" fn(Component, *const Vr, usize, *const T) -> RawStatus;
+/// A `fmi2Get…` function: value references and room for as many values.
+type GetFn<T> = unsafe extern "C" fn(Component, *const Vr, usize, *mut T) -> RawStatus;
+
 impl Instance {
+    /// Calls the setter `function` (`pick` takes it from the API; `what` names the method in
+    /// errors) with `vrs` and as many `values`.
+    fn set_values<T>(
+        &mut self,
+        what: &'static str,
+        function: &'static str,
+        pick: fn(&Functions) -> SetFn<T>,
+        vrs: &[u32],
+        values: &[T],
+    ) -> Result<(), FmuError> {
+        same_len(what, vrs.len(), values.len())?;
+        self.call(function, |api, c| {
+            // SAFETY: both arrays have `vrs.len()` elements.
+            unsafe { pick(api)(c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+        })?;
+        Ok(())
+    }
+
+    /// Calls the getter `function` (`pick` takes it from the API; `what` names the method in
+    /// errors) with `vrs`, writing as many `values`.
+    fn get_values<T>(
+        &mut self,
+        what: &'static str,
+        function: &'static str,
+        pick: fn(&Functions) -> GetFn<T>,
+        vrs: &[u32],
+        values: &mut [T],
+    ) -> Result<(), FmuError> {
+        same_len(what, vrs.len(), values.len())?;
+        self.call(function, |api, c| {
+            // SAFETY: both arrays have `vrs.len()` elements; the output is writable.
+            unsafe { pick(api)(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) }
+        })?;
+        Ok(())
+    }
+
     // ------------------------------------------------------------------------------------------
     // Values.
 
     /// `fmi2SetReal`.
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), FmuError> {
-        same_len("set_real", vrs.len(), values.len())?;
-        self.call("fmi2SetReal", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements.
-            unsafe { (api.set_real)(c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
-        })?;
-        Ok(())
+        self.set_values("set_real", "fmi2SetReal", |api| api.set_real, vrs, values)
     }
 
     /// `fmi2GetReal`.
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<(), FmuError> {
-        same_len("get_real", vrs.len(), values.len())?;
-        self.call("fmi2GetReal", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements; the output is writable.
-            unsafe { (api.get_real)(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) }
-        })?;
-        Ok(())
+        self.get_values("get_real", "fmi2GetReal", |api| api.get_real, vrs, values)
     }
 
     /// `fmi2SetInteger` (also for Enumeration variables).
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<(), FmuError> {
-        same_len("set_integer", vrs.len(), values.len())?;
-        self.call("fmi2SetInteger", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements (i32 is a C int).
-            unsafe { (api.set_integer)(c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
-        })?;
-        Ok(())
+        self.set_values(
+            "set_integer",
+            "fmi2SetInteger",
+            |api| api.set_integer,
+            vrs,
+            values,
+        )
     }
 
     /// `fmi2GetInteger` (also for Enumeration variables).
     pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<(), FmuError> {
-        same_len("get_integer", vrs.len(), values.len())?;
-        self.call("fmi2GetInteger", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements; the output is writable.
-            unsafe { (api.get_integer)(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) }
-        })?;
-        Ok(())
+        self.get_values(
+            "get_integer",
+            "fmi2GetInteger",
+            |api| api.get_integer,
+            vrs,
+            values,
+        )
     }
 
     /// `fmi2SetBoolean`.
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> Result<(), FmuError> {
         same_len("set_boolean", vrs.len(), values.len())?;
         let raw: Vec<c_int> = values.iter().map(|&b| c_int::from(b)).collect();
-        self.call("fmi2SetBoolean", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements.
-            unsafe { (api.set_boolean)(c, vrs.as_ptr(), vrs.len(), raw.as_ptr()) }
-        })?;
-        Ok(())
+        self.set_values(
+            "set_boolean",
+            "fmi2SetBoolean",
+            |api| api.set_boolean,
+            vrs,
+            &raw,
+        )
     }
 
     /// `fmi2GetBoolean`.
     pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [bool]) -> Result<(), FmuError> {
         same_len("get_boolean", vrs.len(), values.len())?;
         let mut raw: Vec<c_int> = vec![0; vrs.len()];
-        self.call("fmi2GetBoolean", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements; the output is writable.
-            unsafe { (api.get_boolean)(c, vrs.as_ptr(), vrs.len(), raw.as_mut_ptr()) }
-        })?;
+        self.get_values(
+            "get_boolean",
+            "fmi2GetBoolean",
+            |api| api.get_boolean,
+            vrs,
+            &mut raw,
+        )?;
         for (v, r) in values.iter_mut().zip(raw) {
             *v = r != 0;
         }
@@ -97,10 +135,13 @@ impl Instance {
     pub fn get_string(&mut self, vrs: &[u32], values: &mut [String]) -> Result<(), FmuError> {
         same_len("get_string", vrs.len(), values.len())?;
         let mut raw: Vec<*const c_char> = vec![ptr::null(); vrs.len()];
-        self.call("fmi2GetString", |api, c| {
-            // SAFETY: both arrays have `vrs.len()` elements; the output is writable.
-            unsafe { (api.get_string)(c, vrs.as_ptr(), vrs.len(), raw.as_mut_ptr()) }
-        })?;
+        self.get_values(
+            "get_string",
+            "fmi2GetString",
+            |api| api.get_string,
+            vrs,
+            &mut raw,
+        )?;
         for (v, &p) in values.iter_mut().zip(&raw) {
             // SAFETY: the FMU returned null or NUL-terminated strings valid until its next call.
             match unsafe { c_string(p) } {

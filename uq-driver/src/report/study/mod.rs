@@ -532,21 +532,29 @@ fn quantity_section(
     if !q.deterministic {
         images.push(format!("{}_pdf.csv", stem(name)));
     }
-    images.push(format!("{}_samples.csv", stem(name)));
     let rows = if nominal {
         nominal_rows(q)
     } else {
         statistics_rows(q, names)
     };
-    Ok(Section {
+    Ok(quantity_table(name, text, images, rows))
+}
+
+/// The section of quantity `name`: `text`, the `images` and then the quantity's samples CSV,
+/// and a table of (statistic, value) `rows`.
+fn quantity_table(
+    name: &str,
+    text: String,
+    mut images: Vec<String>,
+    rows: Vec<Vec<String>>,
+) -> Section {
+    images.push(format!("{}_samples.csv", stem(name)));
+    Section {
         heading: format!("Quantity {name}"),
         text,
         images,
-        table: Some(Table {
-            header: vec!["statistic".into(), "value".into()],
-            rows,
-        }),
-    })
+        table: Some(Table::new(&["statistic", "value"], rows)),
+    }
 }
 
 /// `W = 2.31 is below the limit 2.5 (nominal run; no probability)`, or `exceeds`.

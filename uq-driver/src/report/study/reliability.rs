@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::super::svg::{BarChart, BarGroup};
 use super::super::units::with_unit;
-use super::super::{palette, Band, LinePlot, ReportError, Section, Series, Table};
+use super::super::{palette, Band, LinePlot, ReportError, Section, Series};
 use crate::report::file_name::stem;
 use crate::results::numbers::count;
 use crate::results::{sig, LimitProbability, MorrisScreening, ScalarStats, Summary};
@@ -84,16 +84,7 @@ pub(super) fn section(
             ),
         ]);
     }
-    images.push(format!("{}_samples.csv", stem(name)));
-    Ok(Section {
-        heading: format!("Quantity {name}"),
-        text,
-        images,
-        table: Some(Table {
-            header: vec!["statistic".into(), "value".into()],
-            rows,
-        }),
-    })
+    Ok(super::quantity_table(name, text, images, rows))
 }
 
 /// `P(q > 6) = 2.15e-3 (95 % interval 1.95e-3–2.36e-3, CoV 4.9 %), β = 2.85, by

@@ -54,9 +54,6 @@ pub fn system_section(sys: &SystemSpec) -> Section {
             written(sys.step)
         ),
         images: vec![],
-        table: Some(Table {
-            header: vec!["part".into(), "value".into()],
-            rows,
-        }),
+        table: Some(Table::new(&["part", "value"], rows)),
     }
 }

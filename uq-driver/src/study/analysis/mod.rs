@@ -322,19 +322,17 @@ fn density_range(
     let (lower, upper) = OutputStats::band(&estimate.mean, &estimate.std, 3.0);
     let lowest = quantiles.iter().min_by(|a, b| a.0.total_cmp(&b.0));
     let highest = quantiles.iter().max_by(|a, b| a.0.total_cmp(&b.0));
-    let finite = |v: &f64| v.is_finite();
-    let lo = lower
-        .iter()
-        .chain(lowest.map(|q| &q.1).into_iter().flatten())
-        .copied()
-        .filter(finite)
-        .fold(f64::INFINITY, f64::min);
-    let hi = upper
-        .iter()
-        .chain(highest.map(|q| &q.1).into_iter().flatten())
-        .copied()
-        .filter(finite)
-        .fold(f64::NEG_INFINITY, f64::max);
+    // The finite values of a band and of a quantile's series, folded by `pick` from `start`.
+    let extreme =
+        |band: &[f64], q: Option<&(f64, Vec<f64>)>, start: f64, pick: fn(f64, f64) -> f64| {
+            band.iter()
+                .chain(q.map(|q| &q.1).into_iter().flatten())
+                .copied()
+                .filter(|v| v.is_finite())
+                .fold(start, pick)
+        };
+    let lo = extreme(&lower, lowest, f64::INFINITY, f64::min);
+    let hi = extreme(&upper, highest, f64::NEG_INFINITY, f64::max);
     if lo < hi {
         return (lo, hi);
     }
@@ -348,22 +346,11 @@ fn density_range(
 
 /// Statistics of the scalar quantity `name` (one of those `q` defines) from its estimate and
 /// its valid run values; quantiles and the density from `density` where given (e.g. the
-/// pooled draws of a nested study), else from the draws the estimate names.
+/// pooled draws of a nested study), else from the draws the estimate names; the exceedance
+/// counted over `independent` where given: the run values that are independent draws of the
+/// input law (e.g. the runs of `A` and `B` of a pick-freeze design, whose other blocks reuse
+/// their columns), named by `of_what`.
 pub(crate) fn scalar_stats(
-    name: &str,
-    q: &QoiSpec,
-    estimate: &Estimate,
-    runs: QuantityRuns,
-    settings: &Settings,
-    density: Option<Vec<f64>>,
-) -> Result<ScalarStats, AnalysisError> {
-    scalar_stats_counted(name, q, estimate, runs, settings, density, None)
-}
-
-/// [`scalar_stats`] with the exceedance counted over `independent` where given: the run
-/// values that are independent draws of the input law (e.g. the runs of `A` and `B` of a
-/// pick-freeze design, whose other blocks reuse their columns), named by `of_what`.
-fn scalar_stats_counted(
     name: &str,
     q: &QoiSpec,
     estimate: &Estimate,
@@ -535,12 +522,7 @@ pub fn analyse_runs(
     let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();
-    let runs = Runs::of(records);
-    if runs.rows.len() < method.min_runs() {
-        return Err(AnalysisError::TooFewRuns {
-            ok: runs.rows.len(),
-        });
-    }
+    let runs = Runs::at_least(records, method.min_runs())?;
     // A sample of the inputs' law: sensitivity from the runs themselves.
     let given = method.samples_the_law();
     // Over time only up to a length: a row of indices per time costs memory (see
@@ -602,8 +584,7 @@ pub fn analyse_runs(
         });
         // A pick-freeze design's exceedance is counted over its independent runs only.
         let independent = moment_values.as_deref().map(|v| (v, INDEPENDENT_RUNS));
-        let mut stats =
-            scalar_stats_counted(&name, q, &estimate, qr, &settings, None, independent)?;
+        let mut stats = scalar_stats(&name, q, &estimate, qr, &settings, None, independent)?;
         if let Some(values) = moment_values {
             stats.convergence = convergence(&estimate, 0, &values).filter(|_| !stats.deterministic);
         }

@@ -62,12 +62,7 @@ pub fn analyse(
     let settings = Settings::of(study, &surrogates);
     let times = study.times();
     let nt = times.len();
-    let runs = Runs::of(records);
-    if runs.rows.len() < method.min_runs() {
-        return Err(AnalysisError::TooFewRuns {
-            ok: runs.rows.len(),
-        });
-    }
+    let runs = Runs::at_least(records, method.min_runs())?;
     let blocks = method
         .blocks(design)
         .map_err(|source| AnalysisError::Output {
@@ -324,7 +319,7 @@ fn quantity(
     };
     let table = conditional_table(study, blocks, &cond, &limits, &exceedance);
     let n = present.len() as f64;
-    let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled))?;
+    let mut stats = scalar_stats(name, q, &estimate, qr, settings, Some(pooled), None)?;
     stats.draws = draws_of(&cond);
     stats.convergence = outer_convergence(&c, &runs_of(&cond)).filter(|_| !stats.deterministic);
     stats.exceedance = exceedance

@@ -39,6 +39,17 @@ impl<'a> Runs<'a> {
         Runs { rows, values }
     }
 
+    /// [`Runs::of`], refused when fewer than `min` points have a valid run.
+    pub(crate) fn at_least(stored: &'a StoredRuns, min: usize) -> Result<Runs<'a>, AnalysisError> {
+        let runs = Runs::of(stored);
+        if runs.rows.len() < min {
+            return Err(AnalysisError::TooFewRuns {
+                ok: runs.rows.len(),
+            });
+        }
+        Ok(runs)
+    }
+
     /// Output `o` (of `nt` times each) as runs × times.
     pub(crate) fn output(&self, o: usize, nt: usize) -> Result<DMatrix<f64>, AnalysisError> {
         self.block(o, nt, 0, nt)

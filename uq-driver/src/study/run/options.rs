@@ -124,95 +124,52 @@ impl RunControl {
     }
 }
 
+/// Builder methods of [`RunOptions`]: `with_x: x = (T);` sets the field `x` to the argument,
+/// `with_x: x = Some(T);` to `Some` of it.
+macro_rules! setters {
+    ($($(#[$doc:meta])* $name:ident: $field:ident = $($some:ident)?($t:ty);)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(mut self, v: $t) -> Self {
+                self.$field = $($some)?(v);
+                self
+            }
+        )*
+    };
+}
+
 impl RunOptions {
-    /// Worker threads of the model runs (at least 1; the default is all cores).
-    pub fn with_threads(mut self, v: usize) -> Self {
-        self.threads = Some(v);
-        self
-    }
-
-    /// Shows a progress bar (on a terminal).
-    pub fn with_progress(mut self, v: bool) -> Self {
-        self.progress = v;
-        self
-    }
-
-    /// Prints progress lines (for a log file).
-    pub fn with_progress_lines(mut self, v: bool) -> Self {
-        self.progress_lines = v;
-        self
-    }
-
-    /// Unweighted designs: continues past failed points.
-    pub fn with_allow_failures(mut self, v: bool) -> Self {
-        self.allow_failures = v;
-        self
-    }
-
-    /// Discards earlier results in the output folder.
-    pub fn with_fresh(mut self, v: bool) -> Self {
-        self.fresh = v;
-        self
-    }
-
-    /// Stops after this many newly finished points (the study resumes later).
-    pub fn with_max_new_points(mut self, v: usize) -> Self {
-        self.max_new_points = Some(v);
-        self
-    }
-
-    /// Runs only these points of the design (a shard).
-    pub fn with_points(mut self, v: Vec<usize>) -> Self {
-        self.points = Some(v);
-        self
-    }
-
-    /// Writes the CSV files and `summary.json` only.
-    pub fn with_no_report(mut self, v: bool) -> Self {
-        self.no_report = v;
-        self
-    }
-
-    /// Runs the points that failed in an earlier run again.
-    pub fn with_retry_failed(mut self, v: bool) -> Self {
-        self.retry_failed = v;
-        self
-    }
-
-    /// Runs each point in a worker process started from this executable (see the field).
-    pub fn with_isolate(mut self, v: PathBuf) -> Self {
-        self.isolate = Some(v);
-        self
-    }
-
-    /// The time limit of one run (see the field).
-    pub fn with_timeout_per_run(mut self, v: Duration) -> Self {
-        self.timeout_per_run = Some(v);
-        self
-    }
-
-    /// Starts a large study without asking.
-    pub fn with_yes(mut self, v: bool) -> Self {
-        self.yes = v;
-        self
-    }
-
-    /// Runs every point on a fresh FMU instance.
-    pub fn with_fresh_instances(mut self, v: bool) -> Self {
-        self.fresh_instances = v;
-        self
-    }
-
-    /// Instantiates the FMU with `loggingOn = true`.
-    pub fn with_fmu_logging(mut self, v: bool) -> Self {
-        self.fmu_logging = v;
-        self
-    }
-
-    /// Shares `v` with the run: stop it or read its progress from another thread.
-    pub fn with_control(mut self, v: Arc<RunControl>) -> Self {
-        self.control = Some(v);
-        self
+    setters! {
+        /// Worker threads of the model runs (at least 1; the default is all cores).
+        with_threads: threads = Some(usize);
+        /// Shows a progress bar (on a terminal).
+        with_progress: progress = (bool);
+        /// Prints progress lines (for a log file).
+        with_progress_lines: progress_lines = (bool);
+        /// Unweighted designs: continues past failed points.
+        with_allow_failures: allow_failures = (bool);
+        /// Discards earlier results in the output folder.
+        with_fresh: fresh = (bool);
+        /// Stops after this many newly finished points (the study resumes later).
+        with_max_new_points: max_new_points = Some(usize);
+        /// Runs only these points of the design (a shard).
+        with_points: points = Some(Vec<usize>);
+        /// Writes the CSV files and `summary.json` only.
+        with_no_report: no_report = (bool);
+        /// Runs the points that failed in an earlier run again.
+        with_retry_failed: retry_failed = (bool);
+        /// Runs each point in a worker process started from this executable (see the field).
+        with_isolate: isolate = Some(PathBuf);
+        /// The time limit of one run (see the field).
+        with_timeout_per_run: timeout_per_run = Some(Duration);
+        /// Starts a large study without asking.
+        with_yes: yes = (bool);
+        /// Runs every point on a fresh FMU instance.
+        with_fresh_instances: fresh_instances = (bool);
+        /// Instantiates the FMU with `loggingOn = true`.
+        with_fmu_logging: fmu_logging = (bool);
+        /// Shares `v` with the run: stop it or read its progress from another thread.
+        with_control: control = Some(Arc<RunControl>);
     }
 
     /// Checks that the options fit together: `threads` at least 1, and `timeout_per_run`

@@ -49,21 +49,10 @@ fn check_times(times: &[f64]) -> Result<(), PointError> {
 
 /// Starts `slot`'s instance (fresh, or reset: [`Slot::start`]), sets the parameters (the fixed ones, the random
 /// `values`, then the Real `extra` values) and the inputs, initializes and records the signals
-/// at `times`, ending early where the FMU ends the simulation.
+/// at `times`, ending early where the FMU ends the simulation. `stop_defined`: whether the
+/// FMU is told the stop time (the last of `times`); false lets the run go on after `times`,
+/// as a continuation does.
 pub(super) fn simulate_point(
-    fmu: &Fmu,
-    slot: &mut Slot,
-    iface: &Interface,
-    values: &[f64],
-    times: &[f64],
-    extra: &[(u32, f64)],
-) -> Result<Trace, PointError> {
-    simulate_point_to(fmu, slot, iface, values, times, extra, true)
-}
-
-/// [`simulate_point`], telling the FMU the stop time (the last of `times`) or not
-/// (`stop_defined` false: the run may go on after `times`, as a continuation does).
-pub(super) fn simulate_point_to(
     fmu: &Fmu,
     slot: &mut Slot,
     iface: &Interface,
@@ -174,7 +163,7 @@ pub fn run_point(
     times: &[f64],
 ) -> Result<Vec<f64>, PointError> {
     let nt = times.len();
-    let trace = simulate_point(fmu, slot, iface, values, times, &[]).inspect_err(|_| {
+    let trace = simulate_point(fmu, slot, iface, values, times, &[], true).inspect_err(|_| {
         // A failed instance may be in Error state: start the next point on a fresh one.
         slot.discard();
     })?;
@@ -314,7 +303,7 @@ pub fn simulate_with(
         logging_on,
     };
     let mut slot = Slot::new(policy, logging_on);
-    let trace = simulate_point(fmu, &mut slot, &iface, &[], times, &[])?;
+    let trace = simulate_point(fmu, &mut slot, &iface, &[], times, &[], true)?;
     let calculated_strings = match slot.current().map(|inst| inst.get_calculated_strings()) {
         Some(Ok(values)) => values,
         Some(Err(e)) => {

@@ -5,7 +5,7 @@
 
 use super::error::PointError;
 use super::instances::Slot;
-use super::point::{ended_by_fmu, simulate_point, simulate_point_to, Trace};
+use super::point::{ended_by_fmu, simulate_point, Trace};
 use crate::fmu::{Fmu, FmuState, Instance};
 use crate::qoi::evaluate::Code;
 use crate::qoi::hunting_speed::{
@@ -84,6 +84,7 @@ impl SpeedRuns {
             values,
             &self.times,
             &[(self.speed, speed)],
+            true,
         )
         .inspect_err(|_| slot.discard())?;
         self.judge(h, slot, &self.times, trace)
@@ -185,7 +186,7 @@ impl Stages for Continuation<'_> {
     fn first(&mut self, speed: f64) -> Result<bool, Self::Error> {
         self.speed = speed;
         let runs = self.runs;
-        let trace = simulate_point_to(
+        let trace = simulate_point(
             self.fmu,
             self.slot,
             &runs.run,

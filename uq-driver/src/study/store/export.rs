@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::report::compare::FolderFileError;
 use crate::report::ReportError;
 use crate::spec::Experiment;
 use crate::study::store::format::{self, Slot};
@@ -29,23 +30,10 @@ use out_file::OutFile;
 /// Why the runs cannot be exported.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
-    /// A file could not be read.
-    #[error("cannot read {}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The folder is not a finished study written by this version of `uq-driver run`.
-    #[error("{}: {message}", path.display())]
-    Invalid {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
+    /// A file of the folder cannot be read, or the folder is not a finished study written by
+    /// this version of `uq-driver run`.
+    #[error(transparent)]
+    File(#[from] FolderFileError),
     /// Writing failed.
     #[error(transparent)]
     Report(#[from] ReportError),
@@ -84,18 +72,12 @@ pub struct Exported {
     pub npz: PathBuf,
 }
 
-fn read(path: &Path) -> Result<Vec<u8>, ExportError> {
-    std::fs::read(path).map_err(|source| ExportError::Read {
-        path: path.to_path_buf(),
-        source,
-    })
+fn read(path: &Path) -> Result<Vec<u8>, FolderFileError> {
+    std::fs::read(path).map_err(|source| FolderFileError::read(path, source))
 }
 
 fn invalid(path: &Path, message: impl Into<String>) -> ExportError {
-    ExportError::Invalid {
-        path: path.to_path_buf(),
-        message: message.into(),
-    }
+    FolderFileError::invalid(path, message).into()
 }
 
 /// Writes `runs.csv` and `runs.npz` of the study in `dir` into `out`.
@@ -153,16 +135,10 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
         path: dir.to_path_buf(),
         source,
     })?;
-    let file = std::fs::File::open(&rp).map_err(|source| ExportError::Read {
-        path: rp.clone(),
-        source,
-    })?;
+    let file = std::fs::File::open(&rp).map_err(|source| FolderFileError::read(&rp, source))?;
     let len = file
         .metadata()
-        .map_err(|source| ExportError::Read {
-            path: rp.clone(),
-            source,
-        })?
+        .map_err(|source| FolderFileError::read(&rp, source))?
         .len();
     let map = if len == 0 {
         None
@@ -170,10 +146,8 @@ pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
         // This process holds the folder's lock, under which alone `run` appends to, repairs
         // or truncates the file.
         Some(
-            crate::sys::map_read_only(&file).map_err(|source| ExportError::Read {
-                path: rp.clone(),
-                source,
-            })?,
+            crate::sys::map_read_only(&file)
+                .map_err(|source| FolderFileError::read(&rp, source))?,
         )
     };
     let bytes: &[u8] = map.as_deref().unwrap_or_default();
