@@ -29,10 +29,9 @@ fn once_study(dir: &Path, fmu: &Path) -> PathBuf {
 
 #[test]
 fn an_fmu_instantiable_once_per_process_runs_on_every_thread_with_a_library_copy_each() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = once_study(dir.path(), &fmu);
     let mut files = Vec::new();
     for threads in ["1", "4"] {
@@ -131,10 +130,9 @@ fn run_once(
 
 #[test]
 fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // x declares [-10, 10]; N(0, 6) puts about 10 % of the draws outside.
     let (out, o) = run_once(
         dir.path(),
@@ -172,10 +170,9 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
 
 #[test]
 fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let (out, o) = run_once(
         dir.path(),
         &fmu,
@@ -210,10 +207,9 @@ fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run(
 
 #[test]
 fn huge_and_escaped_fmu_log_messages_are_cut_before_reaching_points_csv_and_the_store() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // Every step logs 1 MB (a colour escape first); points with x > 1 fail with such a message.
     let (out, o) = run_once(
         dir.path(),

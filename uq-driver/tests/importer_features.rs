@@ -211,17 +211,10 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
     let dir = tempfile::tempdir().unwrap();
     // stop_at uniform on [0.5, 2]: runs with stop_at < 1 end early (failed, allowed), the others
     // reach the stop time 1 s (stop_at = 1 exactly would end at the stop time: a whole run).
-    let study = write_toml(
+    let study = early_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 16\n\
-             [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
-             [fixed]\nu = 1\n[outputs]\nvariables = [\"u_integral\"]\n\
-             [analysis]\nallow_failures = true\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        "[outputs]\nvariables = [\"u_integral\"]\n[analysis]\nallow_failures = true\n",
     );
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
@@ -247,17 +240,30 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
 /// A study of the Features FMU over `stop_at` uniform on [0.5, 2] (runs with stop_at < 1 end
 /// before the stop time 1 s) at u = 1, with `rest` appended (its quantities, outputs).
 fn early_study(dir: &Path, fmu: &Path, rest: &str) -> PathBuf {
-    write_toml(
-        dir,
-        "s",
-        &format!(
-            "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 16\n\
-             [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
-             [fixed]\nu = 1\n{rest}",
-            utf8(fmu)
-        ),
-    )
+    let experiment = "stop = 1.0\nstep = 0.1";
+    let rest = format!("[fixed]\nu = 1\n{rest}");
+    mc_study(dir, fmu, ["early", experiment], 16, ("stop_at", 0.5, 2.0), &rest)
+}
+
+/// `s.toml` in `dir`: the Monte Carlo study `name` of the Features FMU `fmu` with the
+/// `[experiment]` keys `experiment`, `samples` runs over the one random parameter `parameter`
+/// uniform on [low, high], and `rest` appended.
+fn mc_study(
+    dir: &Path,
+    fmu: &Path,
+    [name, experiment]: [&str; 2],
+    samples: u32,
+    (parameter, low, high): (&str, f64, f64),
+    rest: &str,
+) -> PathBuf {
+    let text = format!(
+        "name = \"{name}\"\nfmu = {:?}\n[experiment]\n{experiment}\n\
+         [method]\nkind = \"mc\"\nsamples = {samples}\n\
+         [[parameters]]\nname = \"{parameter}\"\ndistribution = \"uniform\"\nlow = {low}\n\
+         high = {high}\n{rest}",
+        utf8(fmu)
+    );
+    write_toml(dir, "s", &text)
 }
 
 #[test]
@@ -396,17 +402,15 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
     let dir = tempfile::tempdir().unwrap();
     // misbehave_at, an ordinary Real, is the random parameter; int_param, bool_param,
     // enum_param and string_param come from [fixed] in all their TOML forms.
-    let study = write_toml(
+    let study = mc_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"typed\"\nfmu = {:?}\n[experiment]\nstop = 0.2\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 3\n\
-             [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
-             [fixed]\nint_param = -4\nbool_param = true\nenum_param = 1\nstring_param = \"abcdef\"\nu = 2\n\
-             [outputs]\nvariables = [\"int_out\", \"bool_out\", \"enum_out\", \"string_len\", \"u_gain\"]\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        ["typed", "stop = 0.2\nstep = 0.1"],
+        3,
+        ("gain", 1.0, 2.0),
+        "[fixed]\nint_param = -4\nbool_param = true\nenum_param = 1\nstring_param = \"abcdef\"\n\
+         u = 2\n[outputs]\nvariables = [\"int_out\", \"bool_out\", \"enum_out\", \"string_len\", \
+         \"u_gain\"]\n",
     );
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
@@ -438,17 +442,13 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
     let Some(fmu) = features() else { return };
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,1\n").unwrap();
-    let study = write_toml(
+    let study = mc_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"inputs\"\nfmu = {:?}\n[experiment]\nstop = 1\nstep = 0.25\n\
-             [method]\nkind = \"mc\"\nsamples = 2\n\
-             [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
-             [inputs]\nfile = \"signal.csv\"\n\
-             [outputs]\nvariables = [\"u_echo\"]\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        ["inputs", "stop = 1\nstep = 0.25"],
+        2,
+        ("gain", 1.0, 2.0),
+        "[inputs]\nfile = \"signal.csv\"\n[outputs]\nvariables = [\"u_echo\"]\n",
     );
     let out = dir.path().join("out");
     let run = |extra: &[&str]| run_study(&study, &out, extra);

@@ -584,10 +584,9 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
 #[test]
 fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
     // `simulate` exited 0 with no CSV and no message.
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("f4.csv");
     let o = run_limited(
         &[
@@ -611,10 +610,9 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
 #[test]
 fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
     // The FMU's printf output was interleaved with the CSV rows on stdout.
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let o = run_limited(
         &[
             "simulate",

@@ -193,10 +193,9 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
     // runs to analyse, left only store/: the per-point messages could not be read. Now
     // points.csv is written with every point's status (the Features FMU fails its step at
     // t = misbehave_at with mode 1, an fmi2Error).
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     for (name, extra, failures) in [
         ("stopped", "", "stopped at the first failure"),
         (

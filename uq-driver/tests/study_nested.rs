@@ -75,6 +75,14 @@ fn study(dir: &Path, fmu: &Path, name: &str, outer: &str, inner: &str) -> PathBu
     study_with(dir, fmu, name, outer, inner, 3, "[3.0]")
 }
 
+/// The built `Functions`, a new temporary folder and there the study `name` of [`study`]
+/// (`[outer, inner]` its methods), or `None` when the test FMUs cannot be built.
+fn nested_study(name: &str, [outer, inner]: [&str; 2]) -> Option<(tempfile::TempDir, PathBuf)> {
+    let (fmu, dir) = test_fmus::test_fmu_and_dir("Functions")?;
+    let s = study(dir.path(), &fmu, name, outer, inner);
+    Some((dir, s))
+}
+
 /// x1 and x2 ~ N(0, 1).
 pub(crate) const X1_X2: &str = "[[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
                      [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n";
@@ -232,17 +240,15 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
 /// corrected split meets the closed form all the same.
 #[test]
 fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((dir, s)) = nested_study(
+        "two-level-mc",
+        [
+            "{ kind = \"lhs\", samples = 3000 }",
+            "{ kind = \"mc\", samples = 6 }",
+        ],
+    ) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        &fmu,
-        "two-level-mc",
-        "{ kind = \"lhs\", samples = 3000 }",
-        "{ kind = \"mc\", samples = 6 }",
-    );
     let out = run_beside(&s, &[]);
     let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
     let n = h.len() as f64;
@@ -264,17 +270,15 @@ fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() 
 /// into three shards and merged: every (outer, inner) point is one record of the store.
 #[test]
 fn a_nested_study_is_the_same_resumed_and_sharded() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((dir, s)) = nested_study(
+        "two-level-shards",
+        [
+            "{ kind = \"qmc\", samples = 4, replicates = 2 }",
+            "{ kind = \"lhs\", samples = 5 }",
+        ],
+    ) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        &fmu,
-        "two-level-shards",
-        "{ kind = \"qmc\", samples = 4, replicates = 2 }",
-        "{ kind = \"lhs\", samples = 5 }",
-    );
     let s = utf8(&s);
     let whole = dir.path().join("whole");
     run_ok(&["run", s, "--out", utf8(&whole), "-t", "2"]);
@@ -316,10 +320,9 @@ fn conditional_sobol_indices_of_an_outer_sample_without_inner_variance_are_nan_n
     // Before: the S_<p> columns of <q>_conditional.csv wrote 0 where the inner variance is
     // zero (the indices are 0/0 there). Here y = x1 + x2² + h(seed) with x1, x2 fixed and the
     // inner input x3, which function 4 ignores: every outer sample has no inner variance.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let text = nested_text(
         "flat-inner",
         &fmu,
@@ -353,10 +356,9 @@ fn a_sparse_inner_chaos_writes_a_rectangular_conditional_table_on_the_union_of_i
     // had rows of 31 to 44 fields under the first sample's 41 labels, no `loo` column, and
     // the inner chaos's error warnings were dropped. Ishigami (function 1) with its `a` and
     // `b` outer: the terms LARS keeps depend on them.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let pi = PI;
     let inner_params = uniform(&["x1", "x2", "x3"], -pi, pi);
     let head = |name: &str, method: &str, params: &str, fixed: &str| {
@@ -560,10 +562,9 @@ fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extr
     // the count line printed the pooled-draw P beside the interval of the mean of the
     // conditional P. y = x1 + x2² + h ≥ −4.3 or so in every run: −30 is below all of them,
     // 40 above all.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let s = study_with(
         dir.path(),
         &fmu,

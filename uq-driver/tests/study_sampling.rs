@@ -296,10 +296,9 @@ function = {function}
 
 #[test]
 fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, 8192);
     let out = dir.path().join("ishigami");
     run_study_ok(&study, &out, &[]);
@@ -337,10 +336,9 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
 
 #[test]
 fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 3, 8, 0.0, 1.0, 4096);
     let out = dir.path().join("g");
     run_study_ok(&study, &out, &[]);
@@ -415,10 +413,9 @@ fn clopper_pearson_by_bisection(k: usize, n: usize) -> (f64, f64) {
 /// 0.977). It is counted over the 2N runs of A and B alone.
 #[test]
 fn sobol_sampling_counts_its_exceedance_over_the_independent_a_and_b_runs() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let n = 64;
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, n);
     // The limit belongs to the [[qoi]] table: right after its signal.

@@ -26,10 +26,9 @@ fn linear_study(dir: &Path, fmu: &Path) -> std::path::PathBuf {
 /// `run` had no `--seed` / `--set`: a changed seed or sample size meant editing the file.
 #[test]
 fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = linear_study(dir.path(), &fmu);
     let out = dir.path().join("out");
     let args = [
@@ -83,10 +82,9 @@ fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
 /// 256-run study, and the terminal never printed the inner/outer variance split.
 #[test]
 fn nested_study_prints_its_variance_split_and_converges_over_its_own_runs() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // 16 outer samples × 16 inner collocation points (4 × 4 Gauss–Hermite): 256 runs.
     let text = format!(
         "{head}[method]\nkind = \"nested\"\nouter = {{ kind = \"mc\", samples = 16 }}\n\
@@ -127,10 +125,9 @@ fn nested_study_prints_its_variance_split_and_converges_over_its_own_runs() {
 /// The density of a non-negative quantity spilled below 0.
 #[test]
 fn the_density_of_a_non_negative_quantity_has_no_mass_below_zero() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // Function 6: y = x1² + … + x8², here x1² + x2² (a chi-square with 2 degrees of freedom,
     // density e^(-y/2)/2, 1/2 at 0).
     let text = format!(
