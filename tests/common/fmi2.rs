@@ -47,7 +47,8 @@ pub struct CallbackFunctions {
 }
 
 pub type GetStrFn = unsafe extern "C" fn() -> CStrPtr;
-pub type SetDebugLoggingFn = unsafe extern "C" fn(Component, c_int, usize, *const CStrPtr) -> Status;
+pub type SetDebugLoggingFn =
+    unsafe extern "C" fn(Component, c_int, usize, *const CStrPtr) -> Status;
 pub type InstantiateFn = unsafe extern "C" fn(
     CStrPtr,
     c_int,
@@ -70,7 +71,8 @@ pub type StateSlotFn = unsafe extern "C" fn(Component, *mut FmuState) -> Status;
 pub type SetStateFn = unsafe extern "C" fn(Component, FmuState) -> Status;
 pub type StateSizeFn = unsafe extern "C" fn(Component, FmuState, *mut usize) -> Status;
 pub type SerializeFn = unsafe extern "C" fn(Component, FmuState, *mut c_char, usize) -> Status;
-pub type DeserializeFn = unsafe extern "C" fn(Component, *const c_char, usize, *mut FmuState) -> Status;
+pub type DeserializeFn =
+    unsafe extern "C" fn(Component, *const c_char, usize, *mut FmuState) -> Status;
 pub type DirectionalDerivativeFn = unsafe extern "C" fn(
     Component,
     *const Vr,

@@ -16,7 +16,8 @@ use std::process::{Command, Output};
 
 use crate::support::refusal::assert_refused;
 use crate::support::{
-    driver, run_args, stderr, study_head, test_fmus, uniform, utf8, write_toml, DRIVER,
+    assert_contains, driver, run_args, stderr, study_head, test_fmus, uniform, utf8, write_toml,
+    DRIVER,
 };
 
 /// Random parameters the Functions FMU has (the g-function uses the first eight).
@@ -191,7 +192,7 @@ fn a_sparse_grid_whose_surrogate_basis_does_not_fit_is_refused_before_any_run() 
         Some("300000000"),
     );
     let err = stderr(&o);
-    assert!(err.contains("stopped after 1 of 9841 points"), "{err}");
+    assert_contains(&err, "stopped after 1 of 9841 points");
 }
 
 /// Points of the isotropic Gauss–Patterson grid of `level` in `d` dimensions: nested rules

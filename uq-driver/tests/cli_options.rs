@@ -2,7 +2,7 @@
 //! `merge` / `slurm` taking `--no-report` as `run` does.
 
 use crate::support::wheel;
-use crate::support::{assert_same_files, read, run_ok, run_study, stderr, utf8};
+use crate::support::{assert_contains, assert_same_files, read, run_ok, run_study, stderr, utf8};
 
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
@@ -46,10 +46,7 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
     let o = run_study(&twice, &dir.path().join("o2"), &[]);
     let err = stderr(&o);
     assert!(!o.status.success());
-    assert!(
-        err.contains("quantiles 0.5 and 0.5 both give the column 'q50'"),
-        "{err}"
-    );
+    assert_contains(&err, "quantiles 0.5 and 0.5 both give the column 'q50'");
     assert!(!dir.path().join("o2/q.csv").exists());
 }
 
@@ -75,7 +72,7 @@ fn merge_and_slurm_take_no_report_as_run_does() {
     }
     let bare = dir.path().join("bare");
     let said = run_ok(&["merge", utf8(&plan), "--out", utf8(&bare), "--no-report"]);
-    assert!(said.contains("no report"), "{said}");
+    assert_contains(&said, "no report");
     let full = dir.path().join("full");
     run_ok(&["merge", utf8(&plan), "--out", utf8(&full)]);
     assert!(full.join("index.html").exists());
@@ -148,9 +145,9 @@ fn threads_0_is_refused_in_the_command_s_terms() {
     let o = crate::support::run(&["run", "x.toml", "--out", "o", "--threads", "0"]);
     let err = crate::support::stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("0 threads cannot run anything: give at least 1, or leave --threads out"),
-        "{err}"
+    assert_contains(
+        &err,
+        "0 threads cannot run anything: give at least 1, or leave --threads out",
     );
     assert!(!err.contains("NonZero") && !err.contains("usize"), "{err}");
 }

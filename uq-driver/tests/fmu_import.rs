@@ -16,7 +16,7 @@ use uq_driver::fmu::{
 };
 use zip::write::SimpleFileOptions;
 
-use crate::support::{run, run_study, stderr, test_fmus, utf8};
+use crate::support::{assert_contains, run, run_study, stderr, test_fmus, utf8};
 
 const MANIFEST_DIR: &str = env!("CARGO_MANIFEST_DIR");
 const GUID: &str = "{6a1c2d9e-3b7f-4e0a-9d51-uq-driver-test}";
@@ -297,15 +297,13 @@ fn fmu_log_messages_arrive_in_errors() {
         other => panic!("unexpected error {other}"),
     }
     let text = err.to_string();
-    assert!(
-        text.contains("Dahlquist.fmu: fmi2SetReal returned Error for instance 'quiet'"),
-        "{text}"
+    assert_contains(
+        &text,
+        "Dahlquist.fmu: fmi2SetReal returned Error for instance 'quiet'",
     );
-    assert!(
-        text.contains(
-            "[Error] logStatusError: fmi2SetReal: unknown or read-only value reference 99"
-        ),
-        "{text}"
+    assert_contains(
+        &text,
+        "[Error] logStatusError: fmi2SetReal: unknown or read-only value reference 99",
     );
     assert_eq!(inst.state(), InstanceState::Error);
     inst.reset().unwrap();
@@ -500,14 +498,8 @@ fn binary_missing_a_function_is_refused_by_name() {
         "{err}"
     );
     let text = err.to_string();
-    assert!(
-        text.contains("NoStep.fmu/binaries/linux64/dahlquist.so"),
-        "{text}"
-    );
-    assert!(
-        text.contains("does not export the required function fmi2DoStep"),
-        "{text}"
-    );
+    assert_contains(&text, "NoStep.fmu/binaries/linux64/dahlquist.so");
+    assert_contains(&text, "does not export the required function fmi2DoStep");
 }
 
 #[test]
@@ -624,8 +616,8 @@ fn missing_binary_names_the_expected_file() {
     let err = Fmu::open(&path).unwrap_err();
     assert!(matches!(err, FmuError::MissingBinary { .. }), "{err}");
     let text = err.to_string();
-    assert!(text.contains("binaries/linux64/dahlquist.so"), "{text}");
-    assert!(text.contains("binaries/ has: win64"), "{text}");
+    assert_contains(&text, "binaries/linux64/dahlquist.so");
+    assert_contains(&text, "binaries/ has: win64");
 }
 
 #[test]
@@ -720,11 +712,8 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     let o = simulate("1.05");
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("canHandleVariableCommunicationStepSize"),
-        "{err}"
-    );
-    assert!(err.contains("give a stop time of 1 or 1.1 s"), "{err}");
+    assert_contains(&err, "canHandleVariableCommunicationStepSize");
+    assert_contains(&err, "give a stop time of 1 or 1.1 s");
     assert!(simulate("1.0").status.success());
     let study = dir.path().join("s.toml");
     fs::write(
@@ -741,10 +730,7 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     let o = run_study(&study, &dir.path().join("out"), &[]);
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("canHandleVariableCommunicationStepSize"),
-        "{err}"
-    );
+    assert_contains(&err, "canHandleVariableCommunicationStepSize");
 }
 
 /// An FMU whose `<ModelStructure/>` is empty although it has outputs was read as having no
@@ -793,7 +779,7 @@ fn simulate_output_time_writes_the_time_column_once() {
     // x = exp(-t) exactly at the communication points (the C FMU's exact update).
     let x: f64 = lines[2].split(',').nth(1).unwrap().parse().unwrap();
     assert!((x - (-0.1f64).exp()).abs() < 1e-12, "{x}");
-    assert!(err.contains("--output time adds no second one"), "{err}");
+    assert_contains(&err, "--output time adds no second one");
     // Only the time: the FMU's independent variable, one column.
     let o = run(&[&args[..], &["--output", "time"]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
@@ -817,8 +803,5 @@ fn simulate_without_a_default_step_takes_the_step_fmpy_takes() {
     let rows: Vec<&str> = out.lines().skip(1).collect();
     assert_eq!(rows.len(), 501, "0 to 1 s by 0.002 s");
     assert_eq!(rows[1].split(',').next(), Some("0.002"));
-    assert!(
-        err.contains("communication step 0.002 s (500 steps"),
-        "{err}"
-    );
+    assert_contains(&err, "communication step 0.002 s (500 steps");
 }

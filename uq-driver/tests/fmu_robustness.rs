@@ -8,7 +8,8 @@ use std::process::Output;
 use uq_driver::fmu::Fmu;
 
 use crate::support::{
-    csv_records, read, run, run_args, stderr, stdout, study_head, test_fmus, utf8, write_toml,
+    assert_contains, csv_records, read, run, run_args, stderr, stdout, study_head, test_fmus, utf8,
+    write_toml,
 };
 
 /// A Monte Carlo study of the Once FMU: x ~ U(0, 2), y recorded on [0, 1] by 0.1.
@@ -165,7 +166,7 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
     // Printed before the runs, and not a second time with the final warnings.
     assert_eq!(stderr.matches(&want).count(), 1, "{stderr}");
     let summary = read(&out.join("summary.json"));
-    assert!(summary.contains(&want), "{summary}");
+    assert_contains(&summary, &want);
 }
 
 #[test]
@@ -185,24 +186,19 @@ fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run(
     );
     let stderr = stderr(&o);
     assert!(!o.status.success(), "{stderr}");
-    assert!(
-        stderr.contains(
-            "random parameter 'x' takes values in [20, 30], wholly outside the range [-10, 10]"
-        ),
-        "{stderr}"
+    assert_contains(
+        &stderr,
+        "random parameter 'x' takes values in [20, 30], wholly outside the range [-10, 10]",
     );
     assert!(!out.join("store").exists());
     // simulate --set outside the range: a warning, and the run.
     let o = run(&["simulate", utf8(&fmu), "--set", "x=12"]);
     let stderr = crate::support::stderr(&o);
     assert!(o.status.success(), "{stderr}");
-    assert!(
-        stderr.contains("x = 12 is outside the range [-10, 10]"),
-        "{stderr}"
-    );
+    assert_contains(&stderr, "x = 12 is outside the range [-10, 10]");
     let o = run(&["inspect", utf8(&fmu)]);
     let stdout = stdout(&o);
-    assert!(stdout.contains("range [-10, 10] slope"), "{stdout}");
+    assert_contains(&stdout, "range [-10, 10] slope");
 }
 
 #[test]
@@ -257,7 +253,7 @@ fn inspect_prints_a_huge_start_value_in_exponent_form() {
         .lines()
         .find(|l| l.trim_start().starts_with("fail_above"))
         .expect("fail_above listed");
-    assert!(line.contains(" 1e300 "), "{line}");
+    assert_contains(&line, " 1e300 ");
     assert!(line.len() < 200, "{line}");
 }
 

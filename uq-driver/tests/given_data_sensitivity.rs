@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use crate::study_chaos::{borehole_parameters, run_functions};
 use crate::support::csv::Csv;
-use crate::support::{benchmarks, read, summary, test_fmus, uniform};
+use crate::support::{assert_contains, benchmarks, read, summary, test_fmus, uniform};
 
 /// An unreplicated Latin hypercube of 2 000 runs.
 const LHS_2000: &str = "kind = \"lhs\"\nsamples = 2000";
@@ -265,8 +265,5 @@ fn correlated_inputs_give_the_first_order_indices_of_the_physical_inputs() {
         assert!((rho - spearman_exact).abs() < 0.03, "Spearman {p} = {rho}");
     }
     let warnings = sum["warnings"].to_string();
-    assert!(
-        warnings.contains("those of the physical parameters"),
-        "{warnings}"
-    );
+    assert_contains(&warnings, "those of the physical parameters");
 }

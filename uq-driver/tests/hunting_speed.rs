@@ -15,7 +15,9 @@ use uq_driver::spec::FixedValue;
 use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
-use crate::support::{built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8};
+use crate::support::{
+    assert_contains, built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8,
+};
 
 /// Settings of the fast configuration.
 const DURATION: f64 = 60.0;
@@ -204,7 +206,7 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
             err.contains("quantity 'v_hunt'") && err.contains(needle),
             "{err}"
         );
-        assert!(err.contains("widen the bracket"), "{err}");
+        assert_contains(&err, "widen the bracket");
     }
     // A weighted design with a point outside: the same message, and a hint.
     std::fs::write(
@@ -215,9 +217,9 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
     let o = run_study(&study, &dir.path().join("scm"), &[]);
     assert!(!o.status.success());
     let err = stderr(&o);
-    assert!(
-        err.contains("widen the bracket (or use a method that can leave points out"),
-        "{err}"
+    assert_contains(
+        &err,
+        "widen the bracket (or use a method that can leave points out",
     );
 }
 
@@ -370,9 +372,9 @@ fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
         .unwrap();
     let text = uq_driver::results::numbers::to_spread(mean(1, 0), std_b);
     assert!(cells[4].contains(&text), "{text} not in {row_b}");
-    assert!(
-        html.contains("<th>mean end [m]</th><th>Std end [m]</th><th>mean peak [m]</th>"),
-        "{html}"
+    assert_contains(
+        &html,
+        "<th>mean end [m]</th><th>Std end [m]</th><th>mean peak [m]</th>",
     );
     assert_eq!(&cells[6..], ["></td>", "></td>"], "{row_b}");
 }

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    built_fmu, edit, read, read_json, run, run_study, run_study_ok, stderr, succeeded, test_fmus,
-    utf8, write_toml,
+    assert_contains, built_fmu, edit, read, read_json, run, run_study, run_study_ok, stderr,
+    succeeded, test_fmus, utf8, write_toml,
 };
 
 fn features() -> Option<PathBuf> {
@@ -198,10 +198,7 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
         assert!(t.windows(2).all(|w| w[1] > w[0]), "no duplicate row");
         let integral = *csv.col("u_integral").last().unwrap();
         assert!((integral - 2.0 * last).abs() < 1e-12, "{integral}");
-        assert!(
-            err.contains(&format!("ended the simulation at t = {last} s")),
-            "{err}"
-        );
+        assert_contains(&err, &format!("ended the simulation at t = {last} s"));
     }
 }
 
@@ -224,17 +221,14 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
         let stop_at: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
         if stop_at < 1.0 - 1e-9 {
             failed += 1;
-            assert!(line.contains("ended the simulation at t ="), "{line}");
+            assert_contains(&line, "ended the simulation at t =");
         } else {
             assert!(line.ends_with(",ok"), "{line}");
         }
     }
     assert!(failed > 0 && failed < 16, "{points}");
     let summary = read(&out.join("summary.json"));
-    assert!(
-        summary.contains(&format!("\"failed_runs\": {failed}")),
-        "{summary}"
-    );
+    assert_contains(&summary, &format!("\"failed_runs\": {failed}"));
 }
 
 /// A study of the Features FMU over `stop_at` uniform on [0.5, 2] (runs with stop_at < 1 end
@@ -242,7 +236,14 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
 fn early_study(dir: &Path, fmu: &Path, rest: &str) -> PathBuf {
     let experiment = "stop = 1.0\nstep = 0.1";
     let rest = format!("[fixed]\nu = 1\n{rest}");
-    mc_study(dir, fmu, ["early", experiment], 16, ("stop_at", 0.5, 2.0), &rest)
+    mc_study(
+        dir,
+        fmu,
+        ["early", experiment],
+        16,
+        ("stop_at", 0.5, 2.0),
+        &rest,
+    )
 }
 
 /// `s.toml` in `dir`: the Monte Carlo study `name` of the Features FMU `fmu` with the
@@ -303,10 +304,7 @@ fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit
     let text = summary["quantities"]["peak"]["definition"]["text"]
         .as_str()
         .unwrap();
-    assert!(
-        text.contains("100 in a run the FMU ends before the stop time"),
-        "{text}"
-    );
+    assert_contains(&text, "100 in a run the FMU ends before the stop time");
 }
 
 #[test]

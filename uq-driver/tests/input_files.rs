@@ -8,7 +8,7 @@ use std::process::Output;
 use std::time::Duration;
 
 use crate::support::wheel::{wheel_fmu, write_study};
-use crate::support::{built_fmu, driver, run, run_study, stderr, utf8};
+use crate::support::{assert_contains, built_fmu, driver, run, run_study, stderr, utf8};
 
 /// Runs `uq-driver args`, failing the test if it has not ended within 60 s (a FIFO opened
 /// for reading blocks for ever).
@@ -75,9 +75,9 @@ fn a_random_or_fixed_parameter_that_is_also_an_input_column_is_refused() {
     let o = run_study(&fixed, &dir.path().join("f"), &["--no-report"]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("'K' is given a value in [fixed] and also a column of the input file"),
-        "{err}"
+    assert_contains(
+        &err,
+        "'K' is given a value in [fixed] and also a column of the input file",
     );
     // simulate --set K=... --input k.csv.
     let k_csv = dir.path().join("k.csv");
@@ -94,10 +94,7 @@ fn a_random_or_fixed_parameter_that_is_also_an_input_column_is_refused() {
     ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("'K' is given a value (--set) and also a column"),
-        "{err}"
-    );
+    assert_contains(&err, "'K' is given a value (--set) and also a column");
     // The file alone drives K: accepted.
     let o = run(&[
         "simulate",
@@ -150,7 +147,7 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
     let o = run_within(&["run", utf8(&study), "--out", utf8(&out), "--no-report"]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("is a FIFO (named pipe)"), "{err}");
+    assert_contains(&err, "is a FIFO (named pipe)");
     // VehicleTrack's measured profile.
     let vt = built_fmu("VehicleTrack");
     for (file, kind) in [
@@ -162,10 +159,7 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
         let o = run_within(&[&args[..], &[&set, "--set", "irregularity=10"]].concat());
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(
-            err.contains(&format!("profile_file '{file}': {kind}")),
-            "{err}"
-        );
+        assert_contains(&err, &format!("profile_file '{file}': {kind}"));
     }
 }
 
@@ -194,7 +188,7 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
     ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("line 2: expected two numbers"), "{err}");
+    assert_contains(&err, "line 2: expected two numbers");
     assert!(!err.contains("SECRET") && !err.contains("daemon"), "{err}");
     // An input file with a header of the wheel's variables, then a secret in a cell.
     let input = dir.path().join("in.csv");
@@ -209,7 +203,7 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
     ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("line 3, column 2"), "{err}");
+    assert_contains(&err, "line 3, column 2");
     assert!(!err.contains("SECRET"), "{err}");
     // A header that names no variable: the column's number, not its text.
     std::fs::write(&input, "time,SECRET-2\n0,1\n").unwrap();
@@ -223,9 +217,6 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
     ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("column 2 names no variable of the FMU"),
-        "{err}"
-    );
+    assert_contains(&err, "column 2 names no variable of the FMU");
     assert!(!err.contains("SECRET"), "{err}");
 }

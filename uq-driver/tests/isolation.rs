@@ -14,7 +14,8 @@ use uq_driver::uq::method::Design;
 use uq_driver::uq::Germ;
 
 use crate::support::{
-    built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head, test_fmus, utf8,
+    assert_contains, built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head,
+    test_fmus, utf8,
 };
 
 /// Eight Monte Carlo points with misbehave_at ~ U(0.3, 1.8) and stop = 1: the points with
@@ -157,8 +158,8 @@ fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnabl
         let o = c.run(&["-t", threads]);
         assert!(!o.status.success(), "an in-process Fatal stops the study");
         let err = stderr(&o);
-        assert!(err.contains("After fmi2Fatal"), "{err}");
-        assert!(err.contains("--isolate"), "{err}");
+        assert_contains(&err, "After fmi2Fatal");
+        assert_contains(&err, "--isolate");
         assert!(!err.contains("an earlier call returned Fatal"), "{err}");
         let o = c.run(&["--isolate", "-t", threads]);
         assert!(o.status.success(), "{}", stderr(&o));
@@ -210,9 +211,9 @@ fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
         let o = c.run(&["-t", threads, "--fresh"]);
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(err.contains("ended by a call to exit()"), "{err}");
-        assert!(err.contains("running point "), "{err}");
-        assert!(err.contains("--isolate"), "{err}");
+        assert_contains(&err, "ended by a call to exit()");
+        assert_contains(&err, "running point ");
+        assert_contains(&err, "--isolate");
         assert_eq!(c.leftover_temp_folders(), 0);
     }
     // The finished points are in the store: --isolate resumes and completes the study.
@@ -342,7 +343,7 @@ fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
     let o = c.run(&["--isolate", "--timeout-per-run", "0.5"]);
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("no longer running"), "{err}");
+    assert_contains(&err, "no longer running");
     assert!(!lock.exists(), "released at the end");
 }
 
@@ -354,7 +355,7 @@ fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
     let o = c.run(&[]);
     let err = stderr(&o);
     assert!(!o.status.success());
-    assert!(err.contains("exists and is not a folder"), "{err}");
+    assert_contains(&err, "exists and is not a folder");
     assert!(!err.contains("File exists"), "{err}");
 }
 
@@ -455,7 +456,7 @@ fn integral_design_values_set_an_integer_random_parameter() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("not a whole number"), "{err}");
+    assert_contains(&err, "not a whole number");
 }
 
 #[test]
@@ -470,7 +471,7 @@ fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read
     let err = uq_driver::fmu::Fmu::open(dir.path())
         .unwrap_err()
         .to_string();
-    assert!(err.contains("more than the limit"), "{err}");
+    assert_contains(&err, "more than the limit");
 }
 
 /// Runs uq-driver with `args` (and `TMPDIR` = `tmp`), killing it after `limit`: a regression
@@ -569,10 +570,10 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
                 .expect("ends");
             let err = stderr(&o);
             assert_eq!(o.status.signal(), Some(sig), "{err}");
-            assert!(err.contains(&format!("killed by {name}")), "{err}");
-            assert!(err.contains("running point "), "{err}");
-            assert!(err.contains("misbehave_at = "), "{err}");
-            assert!(err.contains("--isolate"), "{err}");
+            assert_contains(&err, &format!("killed by {name}"));
+            assert_contains(&err, "running point ");
+            assert_contains(&err, "misbehave_at = ");
+            assert_contains(&err, "--isolate");
         }
         // The finished points are kept: --isolate resumes and completes the study.
         let o = c.run(&["--isolate"]);
@@ -603,8 +604,8 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
     .expect("ends");
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("called exit()"), "{err}");
-    assert!(err.contains("Features.fmu"), "{err}");
+    assert_contains(&err, "called exit()");
+    assert_contains(&err, "Features.fmu");
 }
 
 #[test]

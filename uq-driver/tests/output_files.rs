@@ -8,7 +8,9 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use crate::support::wheel::{self, write_study};
-use crate::support::{read, run, run_study, stderr, stdout, study_head, test_fmus, utf8};
+use crate::support::{
+    assert_contains, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8,
+};
 
 fn text(o: &Output) -> String {
     format!("{}{}", stdout(o), stderr(o))
@@ -33,7 +35,7 @@ fn a_symlink_planted_as_the_lock_file_is_refused_and_its_target_kept() {
     let o = run_study(&study, &out, &[]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
-    assert!(t.contains("symbolic link"), "{t}");
+    assert_contains(&t, "symbolic link");
     assert!(!t.contains("VICTIM"), "the target's content is echoed: {t}");
     assert_eq!(read(&victim), "root:x:0:0:VICTIM:/root:/bin/sh\n");
     assert!(!out.join("store").exists(), "refused before any run");
@@ -184,7 +186,7 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
     assert!(!out.join("index.html").exists());
     assert!(!t.contains("index.html: "), "{t}");
     assert!(!t.contains("report: "), "{t}");
-    assert!(t.contains("--no-report"), "{t}");
+    assert_contains(&t, "--no-report");
 }
 
 #[test]
@@ -224,7 +226,7 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
         let o = run_study(&study, &out, &["-t", "1"]);
         let all = text(&o);
         assert!(!o.status.success(), "{all}");
-        assert!(all.contains(failures), "{all}");
+        assert_contains(&all, failures);
         let points = std::fs::read_to_string(out.join("points.csv")).unwrap_or_default();
         assert!(
             points.starts_with("index,misbehave_at,status"),

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use crate::support::csv::Csv;
 use crate::support::wheel;
-use crate::support::{read, run_study_ok};
+use crate::support::{assert_contains, read, run_study_ok};
 
 /// The values of `<quantity>_samples.csv` (`run,<quantity>`), by run.
 fn samples(path: &Path) -> Vec<f64> {
@@ -101,5 +101,5 @@ from = 1.5
         );
     }
     let summary = read(&out.join("summary.json"));
-    assert!(summary.contains("smallest value of q"), "{summary}");
+    assert_contains(&summary, "smallest value of q");
 }

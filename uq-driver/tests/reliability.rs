@@ -11,7 +11,8 @@ use serde_json::Value;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    run, run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
+    assert_contains, run, run_killed, run_study, run_study_ok, stderr, study_head, summary,
+    test_fmus, write_toml,
 };
 
 /// `P(Z > z)` of a standard normal, by the Lentz continued fraction of Mills' ratio for
@@ -301,8 +302,8 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     let o = run_study(&p, &out, &[]);
     assert!(!o.status.success());
     let err = stderr(&o);
-    assert!(err.contains("P(q > 3)"), "{err}");
-    assert!(err.contains("failed at x = "), "{err}");
+    assert_contains(&err, "P(q > 3)");
+    assert_contains(&err, "failed at x = ");
     let x: f64 = err
         .split("failed at x = ")
         .nth(1)
@@ -315,7 +316,7 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     assert!(x > 2.0, "the point named is x = {x}");
     // Run again: the failed run is answered from the store, the same error.
     let again = stderr(&run_study(&p, &out, &[]));
-    assert!(again.contains("failed at x = "), "{again}");
+    assert_contains(&again, "failed at x = ");
 }
 
 /// Kills `study` once its store holds about 300 runs of 10 001 values, resumes it, and
@@ -460,12 +461,12 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
                 "{beyond} runs beyond: {e}"
             );
             let w = e["warnings"][0].as_str().unwrap();
-            assert!(w.contains("importance_sampling"), "{w}");
+            assert_contains(&w, "importance_sampling");
         } else {
             assert!(e["ci_95"].is_array(), "{beyond} runs beyond: {e}");
         }
     }
-    assert!(text.contains("no interval"), "{text}");
+    assert_contains(&text, "no interval");
 }
 
 #[test]
@@ -581,8 +582,8 @@ fn a_reliability_study_is_refused_by_plan_shards_and_told_to_run_on_one_machine(
         ]);
         let err = stderr(&o);
         assert!(!o.status.success(), "{kind}: planned in shards");
-        assert!(err.contains("cannot be split into shards"), "{err}");
-        assert!(err.contains("uq-driver run"), "{err}");
+        assert_contains(&err, "cannot be split into shards");
+        assert_contains(&err, "uq-driver run");
         assert!(
             !out.join("plan.json").exists(),
             "{kind}: a plan was written"

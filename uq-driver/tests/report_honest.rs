@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use crate::support::csv::Csv;
 use crate::support::wheel::wheel_fmu;
 use crate::support::{
-    final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok, stderr, study_head,
-    summary, utf8, write_toml,
+    assert_contains, final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok, stderr,
+    study_head, summary, utf8, write_toml,
 };
 
 /// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
@@ -93,11 +93,11 @@ fn a_single_run_has_no_density_and_says_so() {
     );
     let out = dir.path().join("out");
     let stdout = run_study_ok(&s, &out, &[]);
-    assert!(stdout.contains("q_end = "), "{stdout}");
-    assert!(stdout.contains("(nominal run;"), "{stdout}");
-    assert!(
-        stdout.contains("is below the limit 1 m (nominal run; no probability)"),
-        "{stdout}"
+    assert_contains(&stdout, "q_end = ");
+    assert_contains(&stdout, "(nominal run;");
+    assert_contains(
+        &stdout,
+        "is below the limit 1 m (nominal run; no probability)",
     );
     for f in [
         "q_pdf.svg",
@@ -113,14 +113,14 @@ fn a_single_run_has_no_density_and_says_so() {
     // A nominal run is a value against each limit, not a probability
     // ("0 of 1 runs exceeded 1 (95 % upper bound of P: 0.950)"), and its inputs were held at
     // their means, not sampled.
-    assert!(
-        html.contains("from the one nominal run (every parameter at its mean)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "from the one nominal run (every parameter at its mean)",
     );
     assert!(html.contains("no density"));
-    assert!(
-        html.contains("is below the limit 1 m (nominal run; no probability)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "is below the limit 1 m (nominal run; no probability)",
     );
     for wrong in [
         "upper bound of P",
@@ -131,12 +131,9 @@ fn a_single_run_has_no_density_and_says_so() {
     ] {
         assert!(!html.contains(wrong), "{wrong} on a nominal page:\n{html}");
     }
-    assert!(html.contains("<th>value used</th>"), "{html}");
-    assert!(
-        html.contains("normal, mean 100, std 10 (cov 0.1) (not sampled)"),
-        "{html}"
-    );
-    assert!(html.contains("1 model run ("), "{html}");
+    assert_contains(&html, "<th>value used</th>");
+    assert_contains(&html, "normal, mean 100, std 10 (cov 0.1) (not sampled)");
+    assert_contains(&html, "1 model run (");
     assert!(!html.contains("1 model runs"), "{html}");
     assert!(!html.contains("Some("), "Rust debug text in the page");
     assert!(!html.contains("Normal {"), "Rust debug text in the page");
@@ -166,20 +163,17 @@ fn zero_spread_and_no_exceedance_read_as_such() {
     );
     assert!(!out.join("q_end_pdf.svg").exists());
     let html = read(&out.join("index.html"));
-    assert!(
-        html.contains("every one of the 20 runs gives the same value"),
-        "{html}"
-    );
+    assert_contains(&html, "every one of the 20 runs gives the same value");
     assert!(html.contains("q has the same value in every run at every time"));
     // No run exceeds the limit: a count with its upper bound, not "0 ± 0".
-    assert!(
-        html.contains("0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)",
     );
     // The terminal says the same, the limit with its unit.
-    assert!(
-        printed.contains("P(q_end > 1 m): 0 of 20 runs exceeded 1 m (95 % upper bound"),
-        "{printed}"
+    assert_contains(
+        &printed,
+        "P(q_end > 1 m): 0 of 20 runs exceeded 1 m (95 % upper bound",
     );
     assert!(!html.contains("± 0"), "{html}");
     let s = summary(&out);
@@ -251,7 +245,7 @@ fn units_reach_axes_summary_and_sidecar() {
     assert!(v[0] <= v[2] + 1e-12 && v[1] <= v[3] + 1e-12, "{v:?}");
     // Inputs as written.
     let html = read(&out.join("index.html"));
-    assert!(html.contains("normal, mean 20, std 2 (cov 0.1)"), "{html}");
+    assert_contains(&html, "normal, mean 20, std 2 (cov 0.1)");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
@@ -324,7 +318,7 @@ fn no_report_export_and_compare() {
     let o = run(&["export", utf8(&a), "--runs"]);
     assert!(!o.status.success());
     let err = stderr(&o);
-    assert!(err.contains("is in use by another uq-driver run"), "{err}");
+    assert_contains(&err, "is in use by another uq-driver run");
     drop(held);
 
     let b = dir.path().join("b");
@@ -332,7 +326,7 @@ fn no_report_export_and_compare() {
     let page = dir.path().join("page");
     run_ok(&["compare", utf8(&a), utf8(&b), "--out", utf8(&page)]);
     let html = read(&page.join("index.html"));
-    assert!(html.contains("href=\"../b/index.html\""), "{html}");
+    assert_contains(&html, "href=\"../b/index.html\"");
     assert!(html.contains("Quantity q_end"));
     plots_are_well_formed(&page);
 }
@@ -345,10 +339,7 @@ fn names_are_forgiven_or_suggested() {
     let out = run(&["run", "wheel-sgn", "--out", "/nonexistent/x"]);
     let err = stderr(&out);
     assert!(!out.status.success());
-    assert!(
-        err.contains("did you mean the built-in study wheel-sgm?"),
-        "{err}"
-    );
+    assert_contains(&err, "did you mean the built-in study wheel-sgm?");
     // A misspelt key and a misspelt variable.
     let dir = tempfile::tempdir().unwrap();
     let s = study(
@@ -359,7 +350,7 @@ fn names_are_forgiven_or_suggested() {
     );
     let out = run(&["run", utf8(&s), "--out", "/nonexistent/x"]);
     let err = stderr(&out);
-    assert!(err.contains("hint: did you mean `nodes`?"), "{err}");
+    assert_contains(&err, "hint: did you mean `nodes`?");
     let s = study(
         dir.path(),
         "var",
@@ -368,7 +359,7 @@ fn names_are_forgiven_or_suggested() {
     );
     let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("v"))]);
     let err = stderr(&out);
-    assert!(err.contains("'Kk': did you mean 'K'?"), "{err}");
+    assert_contains(&err, "'Kk': did you mean 'K'?");
     // cov = 15 is most likely 15 %.
     let s = study(
         dir.path(),
@@ -378,7 +369,7 @@ fn names_are_forgiven_or_suggested() {
     );
     let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("c"))]);
     let err = stderr(&out);
-    assert!(err.contains("did you mean cov = 0.15?"), "{err}");
+    assert_contains(&err, "did you mean cov = 0.15?");
 }
 
 #[test]
@@ -394,12 +385,9 @@ fn a_missing_fmu_lists_every_place_searched() {
     .unwrap();
     let out = run(&["run", utf8(&p), "--out", utf8(&dir.path().join("o"))]);
     let err = stderr(&out);
-    assert!(
-        err.contains("FMU Nowhere.fmu not found; looked in:"),
-        "{err}"
-    );
+    assert_contains(&err, "FMU Nowhere.fmu not found; looked in:");
     assert!(err.contains(&dir.path().join("Nowhere.fmu").display().to_string()));
-    assert!(err.contains("share/railuq/fmu/Nowhere.fmu"), "{err}");
+    assert_contains(&err, "share/railuq/fmu/Nowhere.fmu");
     assert!(err.contains(&fmu_dir().join("Nowhere.fmu").display().to_string()));
 }
 
@@ -434,7 +422,7 @@ fn a_one_letter_signal_is_described_after_its_name() {
         s["quantities"]["a_range"]["definition"]["settings"]["signal_description"],
         "Acceleration q''"
     );
-    assert!(stdout.contains(expected), "{stdout}");
+    assert_contains(&stdout, expected);
     let html = read(&out.join("index.html"));
     assert!(
         html.contains(&expected.replace('\'', "&#39;")),
@@ -464,14 +452,11 @@ fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_diff
     let out = dir.path().join("out");
     run_study_ok(&p, &out, &[]);
     let page = read(&out.join("lhs/index.html"));
-    assert!(
-        page.contains("railuq study lhs, a variant of the suite"),
-        "{page}"
-    );
-    assert!(page.contains("href=\"../index.html\""), "{page}");
+    assert_contains(&page, "railuq study lhs, a variant of the suite");
+    assert_contains(&page, "href=\"../index.html\"");
     let suite = read(&out.join("index.html"));
     assert!(!suite.contains("0.000e0"), "{suite}");
-    assert!(suite.contains("(reference)"), "{suite}");
+    assert_contains(&suite, "(reference)");
 }
 
 #[test]
@@ -480,10 +465,7 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
     // FMU declares" (there is no FMU), and its description promised a system "given below"
     // that the page did not show.
     let (_dir, out, stdout) = run_builtin("wheel-sgm");
-    assert!(
-        stdout.contains("the Galerkin system solved once"),
-        "{stdout}"
-    );
+    assert_contains(&stdout, "the Galerkin system solved once");
     let html = read(&out.join("index.html"));
     for wrong in [
         "1 model runs",
@@ -492,23 +474,17 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
     ] {
         assert!(!html.contains(wrong), "{wrong}:\n{html}");
     }
-    assert!(html.contains("No model runs"), "{html}");
-    assert!(html.contains("declares no unit"), "{html}");
-    assert!(
-        html.contains("<td>M (constant part)</td><td>[[10]]</td>"),
-        "{html}"
-    );
-    assert!(html.contains("K += K · [[1]]"), "{html}");
+    assert_contains(&html, "No model runs");
+    assert_contains(&html, "declares no unit");
+    assert_contains(&html, "<td>M (constant part)</td><td>[[10]]</td>");
+    assert_contains(&html, "K += K · [[1]]");
     // `export --runs` of this folder failed with "cannot read
     // .../store/manifest.json: No such file or directory"; an SGM study ran no model.
     assert!(!out.join("points.csv").exists() && !out.join("store").exists());
     let o = run(&["export", utf8(&out), "--runs"]);
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("an SGM study has no model runs to export"),
-        "{err}"
-    );
+    assert_contains(&err, "an SGM study has no model runs to export");
     assert!(!err.contains("No such file"), "{err}");
     assert!(!out.join("runs").exists());
 }
@@ -627,10 +603,10 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
     let runs = csv_column(&out.join("q_peak_convergence.csv"), "runs");
     assert_eq!(*runs.last().unwrap(), 512.0, "A and B of 256 base rows");
     let band = read(&out.join("q_peak_convergence.svg"));
-    assert!(band.contains("iid standard errors"), "{band}");
+    assert_contains(&band, "iid standard errors");
     // Scalar densities are per unit of the quantity .
     let pdf = read(&out.join("q_peak_pdf.svg"));
-    assert!(pdf.contains("probability density [1/m]"), "{pdf}");
+    assert_contains(&pdf, "probability density [1/m]");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 

@@ -11,6 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use uq_driver::internals::store::{self, Manifest, Record, Store};
 
+use crate::support::assert_contains;
+
 fn manifest(n_points: usize, n_values: usize) -> Manifest {
     Manifest {
         study_hash: "study".into(),
@@ -93,18 +95,12 @@ fn flipped_byte_in_record_1_of_1000_keeps_the_other_999() {
             let header_intact = byte - ranges[1].start >= 25;
             assert_eq!(r.rerun == vec![1], header_intact, "{where_}: {r}");
             let text = r.summary().unwrap();
-            assert!(text.contains("skipped 1 damaged stretch"), "{text}");
-            assert!(text.contains("kept 999 valid records"), "{text}");
+            assert_contains(&text, "skipped 1 damaged stretch");
+            assert_contains(&text, "kept 999 valid records");
             if header_intact {
-                assert!(
-                    text.contains("point 1 lost its record and will be run again"),
-                    "{text}"
-                );
+                assert_contains(&text, "point 1 lost its record and will be run again");
             } else {
-                assert!(
-                    text.contains("among the 1 points without a result"),
-                    "{text}"
-                );
+                assert_contains(&text, "among the 1 points without a result");
             }
             assert!(r.backup.is_some(), "damage before the end is rewritten");
             drop(s);

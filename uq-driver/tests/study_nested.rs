@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_same_files, final_quantity, read_json, run, run_beside, run_ok, run_study_ok,
-    study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, assert_same_files, final_quantity, read_json, run, run_beside, run_ok,
+    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_toml,
 };
 
 /// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
@@ -595,10 +595,7 @@ fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extr
         stdout.contains("below every model run") && stdout.contains("extrapolation alone"),
         "{stdout}"
     );
-    assert!(
-        stdout.contains("95 % lower bound of P, one-sided"),
-        "{stdout}"
-    );
+    assert_contains(&stdout, "95 % lower bound of P, one-sided");
     // One probability per limit: the count's P is the two-level table's, and with the same
     // number of draws from every outer sample the count itself gives it.
     for (c, e) in q["exceedance_counts"]

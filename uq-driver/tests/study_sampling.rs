@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::wheel::{self, read_csv, reference, reference_sobol};
 use crate::support::{
-    assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_ok, run_study_ok,
-    study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_ok,
+    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_toml,
 };
 
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
@@ -327,7 +327,7 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
     let method = &summary(&out)["method"];
     assert_eq!(method["replicates"], 8);
     let kind = method["intervals"].as_str().unwrap();
-    assert!(kind.contains("R = 8 independently scrambled"), "{kind}");
+    assert_contains(&kind, "R = 8 independently scrambled");
     // Over time, y is constant after initialization: the same indices at every time.
     let csv = read_csv(&out.join("y_sobol.csv"));
     assert_eq!(csv.at(0.1, "S_x1"), q["first"]["x1"].as_f64().unwrap());

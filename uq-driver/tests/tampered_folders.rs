@@ -7,7 +7,7 @@ use std::fs;
 use std::path::Path;
 
 use crate::support::wheel::{self, read_csv};
-use crate::support::{run, run_ok, run_study, stderr, utf8};
+use crate::support::{assert_contains, run, run_ok, run_study, stderr, utf8};
 use uq_driver::internals::store::{decode, encode, Record};
 
 /// A small MC study of the wheel with seed `seed`.
@@ -51,7 +51,7 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
         err.contains("shard 0") && err.contains("does not belong to this plan"),
         "{err}"
     );
-    assert!(err.contains("records of another study or FMU"), "{err}");
+    assert_contains(&err, "records of another study or FMU");
     // run-shard does not resume it either.
     let o = run(&["run-shard", utf8(&a), "--shard", "0"]);
     assert!(!o.status.success());

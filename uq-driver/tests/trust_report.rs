@@ -6,8 +6,8 @@ use std::path::Path;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    final_quantity, read, run_study, run_study_ok, stderr, study_head, summary, test_fmus,
-    write_toml,
+    assert_contains, final_quantity, read, run_study, run_study_ok, stderr, study_head, summary,
+    test_fmus, write_toml,
 };
 
 /// `Functions` with function 5 (y = x1 + … + x8), x1 and x2 normal: a Monte Carlo study.
@@ -60,12 +60,9 @@ fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
     // Keys are checked as the study file's own are.
     let e = run_study(&study, &dir.path().join("e1"), &["--set", "method.zzz=1"]);
     let text = stderr(&e);
-    assert!(text.contains("unknown field `zzz`"), "{text}");
+    assert_contains(&text, "unknown field `zzz`");
     // Named by the setting, not by a line of the rewritten text.
-    assert!(
-        text.contains("linear.toml (with --set method.zzz=1): unknown"),
-        "{text}"
-    );
+    assert_contains(&text, "linear.toml (with --set method.zzz=1): unknown");
     let e = run_study(
         &study,
         &dir.path().join("e2"),

@@ -15,8 +15,8 @@ use std::process::Output;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    final_quantity, run, run_args, run_beside, run_study, stderr, stdout, study_head, summary,
-    test_fmus, write_toml,
+    assert_contains, final_quantity, run, run_args, run_beside, run_study, stderr, stdout,
+    study_head, summary, test_fmus, write_toml,
 };
 
 /// A study on the test FMU `model` (1 s or 0.1 s long), with `body` (fixed values, parameters,
@@ -220,10 +220,7 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     let n_failed = failed.len();
     assert!(n_failed > 2 && n_failed < 64, "{n_failed} failed");
     let stdout = stdout(&o);
-    assert!(
-        stdout.contains(&format!("{n_failed} points failed")),
-        "{stdout}"
-    );
+    assert_contains(&stdout, &format!("{n_failed} points failed"));
     // One thread: the points run in design order up to the first failure, then the study
     // stops; the message says so instead of "1 of 64 points failed".
     let f = failed[0];
