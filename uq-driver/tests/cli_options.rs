@@ -2,7 +2,9 @@
 //! `merge` / `slurm` taking `--no-report` as `run` does.
 
 use crate::support::wheel;
-use crate::support::{assert_contains, assert_same_files, read, run_ok, run_study, stderr, utf8};
+use crate::support::{
+    assert_contains, assert_same_files, failed, read, run_ok, run_study, stderr, utf8,
+};
 
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
@@ -44,8 +46,7 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
         "[analysis]\nquantiles = [0.5, 0.99, 0.5]",
     );
     let o = run_study(&twice, &dir.path().join("o2"), &[]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert_contains(&err, "quantiles 0.5 and 0.5 both give the column 'q50'");
     assert!(!dir.path().join("o2/q.csv").exists());
 }

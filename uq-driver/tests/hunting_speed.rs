@@ -16,7 +16,8 @@ use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8,
+    assert_contains, built_fmu, failed, read, run_ok, run_study, run_study_ok, stderr, summary,
+    utf8,
 };
 
 /// Settings of the fast configuration.
@@ -200,8 +201,7 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
     ] {
         std::fs::write(&study, study_text("kind = \"nominal\"", low, high)).unwrap();
         let o = run_study(&study, &dir.path().join(format!("out{low}")), &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(
             err.contains("quantity 'v_hunt'") && err.contains(needle),
             "{err}"
@@ -215,8 +215,7 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
     )
     .unwrap();
     let o = run_study(&study, &dir.path().join("scm"), &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert_contains(
         &err,
         "widen the bracket (or use a method that can leave points out",
@@ -241,8 +240,7 @@ fn a_nested_study_whose_bracket_misses_the_transition_names_the_bracket() {
     assert!(text.contains("level = \"outer\""));
     std::fs::write(&study, text).unwrap();
     let o = run_study(&study, &dir.path().join("nested"), &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert!(
         err.contains("quantity 'v_hunt'")
             && err.contains("the top of the bracket (high = 69)")
@@ -288,8 +286,7 @@ fn settings_that_do_not_fit_the_fmu_are_refused_before_any_run() {
         std::fs::write(&study, text).unwrap();
         let out = dir.path().join("out");
         let o = run_study(&study, &out, &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(err.contains(needle), "{err} should mention {needle}");
         assert!(
             !out.join("store").exists()

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, built_fmu, edit, read, read_json, run, run_study, run_study_ok, stderr,
-    succeeded, test_fmus, utf8, write_toml,
+    assert_contains, built_fmu, edit, failed, read, read_json, run, run_study, run_study_ok,
+    stderr, succeeded, test_fmus, utf8, write_toml,
 };
 
 fn features() -> Option<PathBuf> {
@@ -102,8 +102,7 @@ fn wrong_values_for_typed_variables_are_refused_clearly() {
         ("nothere=1", "no variable named 'nothere'"),
     ] {
         let o = run(&["simulate", f, "--set", set]);
-        let err = stderr(&o);
-        assert!(!o.status.success());
+        let err = failed(&o);
         assert!(err.contains(needle), "{set}: {err}");
     }
     let o = run(&["simulate", f, "--output", "string_out"]);
@@ -363,11 +362,9 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
     assert_eq!(t[11], 1.05);
     assert!((csv.col("u_integral")[11] - 1.05).abs() < 1e-12);
     let o = run(&["simulate", utf8(&fmu), "--step", "0"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("--step 0: the communication step must be positive"),
-        "{}",
-        stderr(&o)
+    assert_contains(
+        &failed(&o),
+        "--step 0: the communication step must be positive",
     );
 }
 
@@ -426,8 +423,7 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
     edit(&study, "name = \"gain\"", "name = \"int_param\"");
     edit(&study, "int_param = -4\n", "");
     let o = run_study(&study, &out, &["--fresh"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert!(
         err.contains("random parameter 'int_param' is an Integer variable")
             && err.contains("not a whole number"),
@@ -457,8 +453,7 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
     // Other signals change the records: the folder is not resumed with them.
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,2\n").unwrap();
     let o = run(&[]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("different study"), "{}", stderr(&o));
+    assert_contains(&failed(&o), "different study");
     // A column that is not an input is refused with the file's name.
     std::fs::write(dir.path().join("signal.csv"), "time,u_echo\n0,0\n1,2\n").unwrap();
     let o = run(&["--fresh"]);
@@ -520,6 +515,5 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
         "--step",
         "0.001",
     ]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("/nonexistent/track.csv"));
+    assert_contains(&failed(&o), "/nonexistent/track.csv");
 }

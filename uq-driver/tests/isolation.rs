@@ -14,8 +14,8 @@ use uq_driver::uq::method::Design;
 use uq_driver::uq::Germ;
 
 use crate::support::{
-    assert_contains, built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head,
-    test_fmus, utf8,
+    assert_contains, built_fmu, csv_records, driver, edit, failed, read, run_args, stderr,
+    study_head, test_fmus, utf8,
 };
 
 /// Eight Monte Carlo points with misbehave_at ~ U(0.3, 1.8) and stop = 1: the points with
@@ -256,8 +256,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
     // Failures not allowed: the study stops and names --retry-failed.
     edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("--retry-failed"), "{}", stderr(&o));
+    assert_contains(&failed(&o), "--retry-failed");
     // The FMU is "fixed" (misbehave = 0 is a different study, so the fix is simulated by the
     // same study with failures allowed): a plain re-run keeps the failures and says so ...
     edit(&c.study, "allow_failures = false", "allow_failures = true");
@@ -330,8 +329,7 @@ fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let o = c.run(&["--isolate"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert!(
         err.contains("is in use by another uq-driver run")
             && err.contains(&format!("pid {}", first.id())),
@@ -353,8 +351,7 @@ fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
     let Some(c) = case(0) else { return };
     std::fs::write(&c.out, "x").unwrap();
     let o = c.run(&[]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert_contains(&err, "exists and is not a folder");
     assert!(!err.contains("File exists"), "{err}");
 }
@@ -365,8 +362,7 @@ fn error_causes_are_printed_once() {
     let Some(c) = case(1) else { return };
     edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert_eq!(err.matches("fails on purpose").count(), 1, "{err}");
     let o = crate::support::run(&["inspect", "/nonexistent/M.fmu"]);
     let err = stderr(&o);

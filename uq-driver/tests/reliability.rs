@@ -11,7 +11,7 @@ use serde_json::Value;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, run, run_killed, run_study, run_study_ok, stderr, study_head, summary,
+    assert_contains, failed, run, run_killed, run_study, run_study_ok, stderr, study_head, summary,
     test_fmus, write_toml,
 };
 
@@ -300,8 +300,7 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     let p = write_toml(dir.path(), "failed", &text);
     let out = dir.path().join("failed");
     let o = run_study(&p, &out, &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert_contains(&err, "P(q > 3)");
     assert_contains(&err, "failed at x = ");
     let x: f64 = err

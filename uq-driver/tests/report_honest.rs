@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use crate::support::csv::Csv;
 use crate::support::wheel::wheel_fmu;
 use crate::support::{
-    assert_contains, final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok, stderr,
-    study_head, summary, utf8, write_toml,
+    assert_contains, failed, final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok,
+    stderr, study_head, summary, utf8, write_toml,
 };
 
 /// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
@@ -316,8 +316,7 @@ fn no_report_export_and_compare() {
     // While a run holds the folder, export refuses instead of reading a store being written.
     let held = uq_driver::internals::store::FolderLock::acquire(&a).unwrap();
     let o = run(&["export", utf8(&a), "--runs"]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert_contains(&err, "is in use by another uq-driver run");
     drop(held);
 

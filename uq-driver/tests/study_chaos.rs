@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, benchmarks, final_quantity, run, run_beside, run_ok, run_study, stderr,
-    study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, benchmarks, failed, final_quantity, run, run_beside, run_ok, run_study,
+    stderr, study_head, summary, test_fmus, uniform, utf8, write_toml,
 };
 
 /// A study on the Functions FMU: `function`, the random parameters and the method (TOML),
@@ -436,8 +436,7 @@ fn chaos_methods_refuse_integer_inputs_and_sampling_runs_them() {
     ] {
         let s = study(dir.path(), "int", 4, params, method);
         let o = run_study(&s, &dir.path().join("o"), &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(
             err.contains("integer_uniform") && err.contains("'x1'"),
             "{err}"
@@ -490,8 +489,7 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
     rows.pop();
     std::fs::write(dir.path().join("pts.csv"), rows.join("\n")).unwrap();
     let o = run_study(&s, &out, &[]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("different study"));
+    assert_contains(&failed(&o), "different study");
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::fs;
 use std::path::Path;
 
 use crate::support::wheel::{self, read_csv};
-use crate::support::{assert_contains, run, run_ok, run_study, stderr, utf8};
+use crate::support::{assert_contains, failed, run, run_ok, run_study, stderr, utf8};
 use uq_driver::internals::store::{decode, encode, Record};
 
 /// A small MC study of the wheel with seed `seed`.
@@ -54,12 +54,7 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
     assert_contains(&err, "records of another study or FMU");
     // run-shard does not resume it either.
     let o = run(&["run-shard", utf8(&a), "--shard", "0"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("records of another study"),
-        "{}",
-        stderr(&o)
-    );
+    assert_contains(&failed(&o), "records of another study");
 
     // The same in a study folder: the run is not resumed from another study's records.
     let (x, y) = (dir.path().join("x"), dir.path().join("y"));
@@ -68,12 +63,7 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
     run_ok(&["run", utf8(&sb), "--out", utf8(&y), "--no-report"]);
     fs::copy(records(&y), records(&x)).unwrap();
     let o = run_study(&sa, &x, &["--no-report"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("copied from another folder"),
-        "{}",
-        stderr(&o)
-    );
+    assert_contains(&failed(&o), "copied from another folder");
 }
 
 /// plan.json's study edited after planning (seed 42 → 43) was merged without a word: the

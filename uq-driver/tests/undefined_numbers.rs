@@ -15,7 +15,7 @@ use std::process::Output;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, final_quantity, run, run_args, run_beside, run_study, stderr, stdout,
+    assert_contains, failed, final_quantity, run, run_args, run_beside, run_study, stderr, stdout,
     study_head, summary, test_fmus, write_toml,
 };
 
@@ -225,8 +225,7 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     // stops; the message says so instead of "1 of 64 points failed".
     let f = failed[0];
     let o = args("1", &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     let want = format!(
         "stopped at the first failure of 64 points (runs not started: {}; how many of those \
          would fail is not known); first: point {f} with",
@@ -286,8 +285,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
     );
     let out = dir.path().join("f9.out");
     let o = run_study(&s, &out, &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert!(
         err.contains("'function' is an Integer declared with min = 1, max = 8")
             && err.contains("the value 9 given for it is outside that range"),

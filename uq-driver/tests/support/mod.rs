@@ -64,6 +64,14 @@ pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Asserts that the run `o` failed, showing its output if not; returns its standard error.
+#[track_caller]
+pub fn failed(o: &Output) -> String {
+    let err = stderr(o);
+    assert!(!o.status.success(), "succeeded:\n{}\n{err}", stdout(o));
+    err
+}
+
 /// Asserts that `o` (of `uq-driver what`) succeeded, showing its output if not; returns its
 /// standard output.
 pub fn succeeded(o: &Output, what: &dyn std::fmt::Debug) -> String {
