@@ -17,7 +17,7 @@ use uq_driver::study::simulate;
 use crate::support::csv::Csv;
 use crate::support::{
     assert_contains, built_fmu, failed, read, run_ok, run_study, run_study_ok, stderr, summary,
-    utf8,
+    utf8, write_file,
 };
 
 /// Settings of the fast configuration.
@@ -84,8 +84,11 @@ fn hunts_directly(fmu: &Fmu, params: &[(&str, f64)], speed: f64) -> bool {
 #[test]
 fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(&study, study_text("kind = \"nominal\"", LOW, HIGH)).unwrap();
+    let study = write_file(
+        dir.path(),
+        "s.toml",
+        study_text("kind = \"nominal\"", LOW, HIGH),
+    );
     let out = dir.path().join("out");
     let stdout = run_study_ok(&study, &out, &[]);
     let (_, hunt) = samples(&out, "v_hunt");
@@ -130,12 +133,11 @@ fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
 #[test]
 fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_and_sharded() {
     let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(
-        &study,
+    let study = write_file(
+        dir.path(),
+        "s.toml",
         study_text("kind = \"scm\"\nnodes = 2\norder = 1", LOW, HIGH),
-    )
-    .unwrap();
+    );
     let base = dir.path().join("in-process");
     run_study_ok(&study, &base, &["-t", "2"]);
     let (text, hunt) = samples(&base, "v_hunt");

@@ -8,7 +8,9 @@ use std::process::Output;
 use std::time::Duration;
 
 use crate::support::wheel::{wheel_fmu, write_study};
-use crate::support::{assert_contains, built_fmu, driver, run, run_study, stderr, utf8};
+use crate::support::{
+    assert_contains, built_fmu, driver, run, run_study, stderr, utf8, write_file,
+};
 
 /// Runs `uq-driver args`, failing the test if it has not ended within 60 s (a FIFO opened
 /// for reading blocks for ever).
@@ -168,12 +170,11 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
 #[test]
 fn errors_about_input_and_profile_files_never_quote_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let secret = dir.path().join("shadow");
-    std::fs::write(
-        &secret,
+    let secret = write_file(
+        dir.path(),
+        "shadow",
         "root:$6$SECRETHASH:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\n",
-    )
-    .unwrap();
+    );
     let vt = built_fmu("VehicleTrack");
     let set = format!("profile_file={}", utf8(&secret));
     let o = run(&[
@@ -191,8 +192,7 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
     assert_contains(&err, "line 2: expected two numbers");
     assert!(!err.contains("SECRET") && !err.contains("daemon"), "{err}");
     // An input file with a header of the wheel's variables, then a secret in a cell.
-    let input = dir.path().join("in.csv");
-    std::fs::write(&input, "time,K\n0,100\n1,SECRET-1\n").unwrap();
+    let input = write_file(dir.path(), "in.csv", "time,K\n0,100\n1,SECRET-1\n");
     let o = run(&[
         "simulate",
         utf8(&wheel_fmu()),

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use crate::support::refusal::assert_refused;
 use crate::support::wheel::{self, wheel_fmu};
-use crate::support::{driver, run, run_ok, run_study, stderr, utf8};
+use crate::support::{driver, run, run_ok, run_study, stderr, utf8, write_file};
 
 fn study(dir: &Path, name: &str, experiment: &str, method: &str) -> PathBuf {
     wheel::write_study(dir, name, name, 42, experiment, method, "")
@@ -234,8 +234,7 @@ fn a_long_study_needs_yes() {
     .replace("kind = \"nominal\"", "kind = \"lhs\"\nsamples = 99000")
     .replace("stop = 6.0", "stop = 60.0")
     .replace("variables = [\"Zc_acc\", \"P1\"]", "variables = []");
-    let p = dir.path().join("long.toml");
-    std::fs::write(&p, text).unwrap();
+    let p = write_file(dir.path(), "long.toml", text);
     let out = dir.path().join("out");
     let o = run_study(&p, &out, &["--threads", "1"]);
     assert_refused(

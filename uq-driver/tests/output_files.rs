@@ -9,7 +9,7 @@ use std::process::{Command, Output};
 
 use crate::support::wheel::{self, write_study};
 use crate::support::{
-    assert_contains, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8,
+    assert_contains, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8, write_file,
 };
 
 fn text(o: &Output) -> String {
@@ -27,8 +27,7 @@ fn is_link(p: &Path) -> bool {
 fn a_symlink_planted_as_the_lock_file_is_refused_and_its_target_kept() {
     let dir = tempfile::tempdir().unwrap();
     let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
-    let victim = dir.path().join("passwd");
-    std::fs::write(&victim, "root:x:0:0:VICTIM:/root:/bin/sh\n").unwrap();
+    let victim = write_file(dir.path(), "passwd", "root:x:0:0:VICTIM:/root:/bin/sh\n");
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
     symlink(&victim, out.join("uq-driver.lock")).unwrap();

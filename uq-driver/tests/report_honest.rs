@@ -10,7 +10,7 @@ use crate::support::csv::Csv;
 use crate::support::wheel::wheel_fmu;
 use crate::support::{
     assert_contains, failed, final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok,
-    stderr, study_head, summary, utf8, write_toml,
+    stderr, study_head, summary, utf8, write_file, write_toml,
 };
 
 /// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
@@ -374,14 +374,13 @@ fn names_are_forgiven_or_suggested() {
 #[test]
 fn a_missing_fmu_lists_every_place_searched() {
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("s.toml");
-    std::fs::write(
-        &p,
+    let p = write_file(
+        dir.path(),
+        "s.toml",
         "name = \"s\"\nfmu = \"Nowhere.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.1\n\
          [method]\nkind = \"scm\"\nnodes = 2\n[[parameters]]\nname = \"K\"\nmean = 1.0\nstd = 0.1\n\
          [outputs]\nvariables = [\"q\"]\n",
-    )
-    .unwrap();
+    );
     let out = run(&["run", utf8(&p), "--out", utf8(&dir.path().join("o"))]);
     let err = stderr(&out);
     assert_contains(&err, "FMU Nowhere.fmu not found; looked in:");

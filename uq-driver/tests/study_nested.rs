@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use crate::support::csv::Csv;
 use crate::support::{
     assert_contains, assert_same_files, final_quantity, read_json, run, run_beside, run_ok,
-    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_toml,
+    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_file, write_toml,
 };
 
 /// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
@@ -379,8 +379,11 @@ function = 1
     let outer_params = "[[parameters]]\nname = \"a\"\ndistribution = \"uniform\"\nlow = 2.0\n\
                         high = 9.0\nlevel = \"outer\"\n[[parameters]]\nname = \"b\"\n\
                         distribution = \"uniform\"\nlow = 0.0\nhigh = 0.3\nlevel = \"outer\"\n";
-    let s = dir.path().join("nested.toml");
-    std::fs::write(&s, head("ishigami-nested", method, outer_params, "")).unwrap();
+    let s = write_file(
+        dir.path(),
+        "nested.toml",
+        head("ishigami-nested", method, outer_params, ""),
+    );
     let out = dir.path().join("out");
     run_study_ok(&s, &out, &[]);
     let table = Csv::read(&out.join("y_end_conditional.csv")).rectangular();
@@ -460,8 +463,11 @@ function = 1
     std::fs::write(dir.path().join("own.csv"), own).unwrap();
     let alone = "kind = \"pce_regression\"\npoints = \"own.csv\"\norder = 6\nsparse = true";
     let fixed = format!("a = {}\nb = {}\n", r[col("a")], r[col("b")]);
-    let s1 = dir.path().join("alone.toml");
-    std::fs::write(&s1, head("ishigami-alone", alone, "", &fixed)).unwrap();
+    let s1 = write_file(
+        dir.path(),
+        "alone.toml",
+        head("ishigami-alone", alone, "", &fixed),
+    );
     let out1 = dir.path().join("alone");
     run_study_ok(&s1, &out1, &[]);
     let sur = read_json(&out1.join("surrogate.json"));

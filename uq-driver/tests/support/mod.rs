@@ -178,8 +178,13 @@ pub fn uniform(names: &[&str], low: f64, high: f64) -> String {
 
 /// Writes `text` to `dir/<name>.toml`; returns its path.
 pub fn write_toml(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
+    write_file(dir, &format!("{name}.toml"), text)
+}
+
+/// Writes `bytes` to the file `dir/name`; returns its path.
+pub fn write_file(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     p
 }
 
