@@ -39,6 +39,37 @@ limits = [10.0]
     write_toml(dir, name, &text)
 }
 
+/// K ~ N(100, 10²), the wheel's stiffness.
+const K: &str = "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0";
+
+/// K ~ N(100, 10²) and C ~ N(20, (0.1 × 20)²), the wheel's stiffness and damping.
+const K_AND_C: &str = "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+                       [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1";
+
+/// A new temporary folder, where [`study`] `name` runs into `out` with the arguments `extra`;
+/// returns the folder, `out` and the standard output.
+fn run_wheel(
+    name: &str,
+    method: &str,
+    parameters: &str,
+    extra: &[&str],
+) -> (tempfile::TempDir, PathBuf, String) {
+    run_in_new_dir(|dir| study(dir, name, method, parameters), extra)
+}
+
+/// A new temporary folder, where the study file that `write` writes into it runs into `out`
+/// with the arguments `extra`; returns the folder, `out` and the standard output.
+fn run_in_new_dir(
+    write: impl FnOnce(&Path) -> PathBuf,
+    extra: &[&str],
+) -> (tempfile::TempDir, PathBuf, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let s = write(dir.path());
+    let out = dir.path().join("out");
+    let stdout = run_study_ok(&s, &out, extra);
+    (dir, out, stdout)
+}
+
 /// Every `.svg` of `dir` parses as XML (quick-xml, to the end) with an `<svg>` root, every
 /// `.png` decodes.
 fn plots_are_well_formed(dir: &Path) -> usize {
@@ -84,15 +115,7 @@ fn plots_are_well_formed(dir: &Path) -> usize {
 
 #[test]
 fn a_single_run_has_no_density_and_says_so() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "one-run",
-        "kind = \"nominal\"",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = dir.path().join("out");
-    let stdout = run_study_ok(&s, &out, &[]);
+    let (dir, out, stdout) = run_wheel("one-run", "kind = \"nominal\"", K, &[]);
     assert_contains(&stdout, "q_end = ");
     assert_contains(&stdout, "(nominal run;");
     assert_contains(
@@ -146,17 +169,14 @@ fn a_single_run_has_no_density_and_says_so() {
 
 #[test]
 fn zero_spread_and_no_exceedance_read_as_such() {
-    let dir = tempfile::tempdir().unwrap();
     // The largest RK4 step h around 1.5 ms always gives 7 substeps per 0.01 s step: every run
     // computes the same q, bit for bit.
-    let s = study(
-        dir.path(),
+    let (dir, out, printed) = run_wheel(
         "zero-spread",
         "kind = \"lhs\"\nsamples = 20",
         "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
+        &[],
     );
-    let out = dir.path().join("out");
-    let printed = run_study_ok(&s, &out, &[]);
     assert!(
         !out.join("q_pdf.svg").exists(),
         "heat map of a deterministic output"
@@ -189,16 +209,7 @@ fn zero_spread_and_no_exceedance_read_as_such() {
 
 #[test]
 fn units_reach_axes_summary_and_sidecar() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "units",
-        "kind = \"scm\"\nnodes = 3",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (dir, out, _) = run_wheel("units", "kind = \"scm\"\nnodes = 3", K_AND_C, &[]);
     let s = summary(&out);
     assert_eq!(s["outputs"]["q"]["unit"], "m");
     assert_eq!(s["quantities"]["q_peak"]["unit"], "m");
@@ -252,12 +263,7 @@ fn units_reach_axes_summary_and_sidecar() {
 #[test]
 fn no_report_export_and_compare() {
     let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "lhs",
-        "kind = \"lhs\"\nsamples = 30",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
+    let s = study(dir.path(), "lhs", "kind = \"lhs\"\nsamples = 30", K);
     let a = dir.path().join("a");
     run_study_ok(&s, &a, &["--no-report"]);
     assert!(a.join("q.csv").exists() && a.join("summary.json").exists());
@@ -339,36 +345,24 @@ fn names_are_forgiven_or_suggested() {
     let err = stderr(&out);
     assert!(!out.status.success());
     assert_contains(&err, "did you mean the built-in study wheel-sgm?");
-    // A misspelt key and a misspelt variable.
+    // A misspelt key and a misspelt variable; cov = 15 is most likely 15 %.
     let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "typo",
-        "kind = \"scm\"\nnodse = 3",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = run(&["run", utf8(&s), "--out", "/nonexistent/x"]);
-    let err = stderr(&out);
-    assert_contains(&err, "hint: did you mean `nodes`?");
-    let s = study(
-        dir.path(),
-        "var",
-        "kind = \"scm\"\nnodes = 2",
-        "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("v"))]);
-    let err = stderr(&out);
-    assert_contains(&err, "'Kk': did you mean 'K'?");
-    // cov = 15 is most likely 15 %.
-    let s = study(
-        dir.path(),
-        "cov",
-        "kind = \"scm\"\nnodes = 2",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15",
-    );
-    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("c"))]);
-    let err = stderr(&out);
-    assert_contains(&err, "did you mean cov = 0.15?");
+    let kk = "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0";
+    let cov = "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15";
+    for (name, method, parameters, hint) in [
+        ("typo", "nodse = 3", K, "hint: did you mean `nodes`?"),
+        ("var", "nodes = 2", kk, "'Kk': did you mean 'K'?"),
+        ("cov", "nodes = 2", cov, "did you mean cov = 0.15?"),
+    ] {
+        let s = study(
+            dir.path(),
+            name,
+            &format!("kind = \"scm\"\n{method}"),
+            parameters,
+        );
+        let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join(name))]);
+        assert_contains(&stderr(&out), hint);
+    }
 }
 
 #[test]
@@ -394,22 +388,16 @@ fn a_one_letter_signal_is_described_after_its_name() {
     // With `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
     // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
     // description went after the first "a" of the sentence, inside "peak".
-    let dir = tempfile::tempdir().unwrap();
-    let p = write_toml(
-        dir.path(),
-        "a",
-        &format!(
-            "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
-             [method]\nkind = \"lhs\"\nsamples = 10\n\
-             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-             [outputs]\nvariables = [\"a\"]\n\
-             [[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
-             to = 2.0\nlimits = [1.0]\n",
-            wheel_fmu().display()
-        ),
+    let text = format!(
+        "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
+         [method]\nkind = \"lhs\"\nsamples = 10\n\
+         [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [outputs]\nvariables = [\"a\"]\n\
+         [[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
+         to = 2.0\nlimits = [1.0]\n",
+        wheel_fmu().display()
     );
-    let out = dir.path().join("out");
-    let stdout = run_study_ok(&p, &out, &[]);
+    let (_dir, out, stdout) = run_in_new_dir(|dir| write_toml(dir, "a", &text), &[]);
     let expected = "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s";
     let s = summary(&out);
     assert_eq!(
@@ -433,22 +421,16 @@ fn a_one_letter_signal_is_described_after_its_name() {
 fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
     // A variant's page was headed "railuq study scm" with no word of
     // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
-    let dir = tempfile::tempdir().unwrap();
-    let p = write_toml(
-        dir.path(),
-        "s",
-        &format!(
-            "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
-             [method]\nkind = \"scm\"\nnodes = 2\n\
-             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-             [outputs]\nvariables = [\"q\"]\n\
-             [[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
-             [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
-            wheel_fmu().display()
-        ),
+    let text = format!(
+        "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
+         [method]\nkind = \"scm\"\nnodes = 2\n\
+         [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+         [outputs]\nvariables = [\"q\"]\n\
+         [[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
+         [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
+        wheel_fmu().display()
     );
-    let out = dir.path().join("out");
-    run_study_ok(&p, &out, &[]);
+    let (_dir, out, _) = run_in_new_dir(|dir| write_toml(dir, "s", &text), &[]);
     let page = read(&out.join("lhs/index.html"));
     assert_contains(&page, "railuq study lhs, a variant of the suite");
     assert_contains(&page, "href=\"../index.html\"");
@@ -551,8 +533,7 @@ fn sobol_sampling_study(dir: &Path) -> PathBuf {
         dir,
         "sobol",
         "kind = \"sobol_sampling\"\nsamples = 256\nbase = \"qmc\"\nreplicates = 8",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
+        K_AND_C,
     );
     let out = dir.join("out");
     run_study_ok(&s, &out, &[]);
@@ -613,16 +594,7 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
 /// chaos order has whole-number ticks and a dot at every order.
 #[test]
 fn std_over_time_and_chaos_convergence_read_as_such() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "stdplot",
-        "kind = \"scm\"\nnodes = 4",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (dir, out, _) = run_wheel("stdplot", "kind = \"scm\"\nnodes = 4", K_AND_C, &[]);
     let html = read(&out.join("index.html"));
     assert!(html.contains("q_std.svg"), "Std plot not on the page");
     let std = read(&out.join("q_std.svg"));
@@ -745,15 +717,7 @@ fn units_csv_names_every_column_written_and_no_other() {
 fn nominal_studies_write_no_header_only_density_files() {
     // A nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
     // and no rows, although the README says none is written for a deterministic result.
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "nom",
-        "kind = \"nominal\"",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (dir, out, _) = run_wheel("nom", "kind = \"nominal\"", K, &[]);
     for f in ["q_pdf.csv", "q_end_pdf.csv", "q_peak_pdf.csv"] {
         assert!(!out.join(f).exists(), "{f} written for a nominal study");
     }
