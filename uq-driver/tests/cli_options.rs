@@ -2,9 +2,7 @@
 //! `merge` / `slurm` taking `--no-report` as `run` does.
 
 use crate::support::wheel;
-use crate::support::{
-    assert_contains, assert_same_files, failed, read, run_ok, run_study, stderr, utf8,
-};
+use crate::support::{assert_contains, assert_same_files, failed, read, run_ok, run_study, utf8};
 
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";

@@ -16,8 +16,8 @@ use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, built_fmu, failed, read, run_ok, run_study, run_study_ok, stderr, summary,
-    utf8, write_file,
+    assert_contains, built_fmu, failed, read, run_ok, run_study, run_study_ok, summary, utf8,
+    write_file,
 };
 
 /// Settings of the fast configuration.

@@ -57,6 +57,16 @@ fn run_wheel(
     run_in_new_dir(|dir| study(dir, name, method, parameters), extra)
 }
 
+/// The text of the wheel study `name` over [0, `stop`] s in steps of 0.01 s by `method`, K
+/// (as [`K`]) its random parameter, the one output `output` and `rest` appended.
+fn k_study([name, stop, method, output]: [&str; 4], rest: &str) -> String {
+    format!(
+        "name = \"{name}\"\nfmu = \"{}\"\n[experiment]\nstop = {stop}\nstep = 0.01\n\
+         [method]\n{method}\n{K}\n[outputs]\nvariables = [\"{output}\"]\n{rest}",
+        wheel_fmu().display()
+    )
+}
+
 /// A new temporary folder, where the study file that `write` writes into it runs into `out`
 /// with the arguments `extra`; returns the folder, `out` and the standard output.
 fn run_in_new_dir(
@@ -115,7 +125,7 @@ fn plots_are_well_formed(dir: &Path) -> usize {
 
 #[test]
 fn a_single_run_has_no_density_and_says_so() {
-    let (dir, out, stdout) = run_wheel("one-run", "kind = \"nominal\"", K, &[]);
+    let (_dir, out, stdout) = run_wheel("one-run", "kind = \"nominal\"", K, &[]);
     assert_contains(&stdout, "q_end = ");
     assert_contains(&stdout, "(nominal run;");
     assert_contains(
@@ -171,7 +181,7 @@ fn a_single_run_has_no_density_and_says_so() {
 fn zero_spread_and_no_exceedance_read_as_such() {
     // The largest RK4 step h around 1.5 ms always gives 7 substeps per 0.01 s step: every run
     // computes the same q, bit for bit.
-    let (dir, out, printed) = run_wheel(
+    let (_dir, out, printed) = run_wheel(
         "zero-spread",
         "kind = \"lhs\"\nsamples = 20",
         "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
@@ -209,7 +219,7 @@ fn zero_spread_and_no_exceedance_read_as_such() {
 
 #[test]
 fn units_reach_axes_summary_and_sidecar() {
-    let (dir, out, _) = run_wheel("units", "kind = \"scm\"\nnodes = 3", K_AND_C, &[]);
+    let (_dir, out, _) = run_wheel("units", "kind = \"scm\"\nnodes = 3", K_AND_C, &[]);
     let s = summary(&out);
     assert_eq!(s["outputs"]["q"]["unit"], "m");
     assert_eq!(s["quantities"]["q_peak"]["unit"], "m");
@@ -388,14 +398,10 @@ fn a_one_letter_signal_is_described_after_its_name() {
     // With `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
     // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
     // description went after the first "a" of the sentence, inside "peak".
-    let text = format!(
-        "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
-         [method]\nkind = \"lhs\"\nsamples = 10\n\
-         [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [outputs]\nvariables = [\"a\"]\n\
-         [[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
+    let text = k_study(
+        ["a", "2.0", "kind = \"lhs\"\nsamples = 10", "a"],
+        "[[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
          to = 2.0\nlimits = [1.0]\n",
-        wheel_fmu().display()
     );
     let (_dir, out, stdout) = run_in_new_dir(|dir| write_toml(dir, "a", &text), &[]);
     let expected = "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s";
@@ -421,14 +427,10 @@ fn a_one_letter_signal_is_described_after_its_name() {
 fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
     // A variant's page was headed "railuq study scm" with no word of
     // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
-    let text = format!(
-        "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
-         [method]\nkind = \"scm\"\nnodes = 2\n\
-         [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [outputs]\nvariables = [\"q\"]\n\
-         [[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
+    let text = k_study(
+        ["two", "1.0", "kind = \"scm\"\nnodes = 2", "q"],
+        "[[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
          [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
-        wheel_fmu().display()
     );
     let (_dir, out, _) = run_in_new_dir(|dir| write_toml(dir, "s", &text), &[]);
     let page = read(&out.join("lhs/index.html"));
@@ -594,7 +596,7 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
 /// chaos order has whole-number ticks and a dot at every order.
 #[test]
 fn std_over_time_and_chaos_convergence_read_as_such() {
-    let (dir, out, _) = run_wheel("stdplot", "kind = \"scm\"\nnodes = 4", K_AND_C, &[]);
+    let (_dir, out, _) = run_wheel("stdplot", "kind = \"scm\"\nnodes = 4", K_AND_C, &[]);
     let html = read(&out.join("index.html"));
     assert!(html.contains("q_std.svg"), "Std plot not on the page");
     let std = read(&out.join("q_std.svg"));
@@ -717,7 +719,7 @@ fn units_csv_names_every_column_written_and_no_other() {
 fn nominal_studies_write_no_header_only_density_files() {
     // A nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
     // and no rows, although the README says none is written for a deterministic result.
-    let (dir, out, _) = run_wheel("nom", "kind = \"nominal\"", K, &[]);
+    let (_dir, out, _) = run_wheel("nom", "kind = \"nominal\"", K, &[]);
     for f in ["q_pdf.csv", "q_end_pdf.csv", "q_peak_pdf.csv"] {
         assert!(!out.join(f).exists(), "{f} written for a nominal study");
     }

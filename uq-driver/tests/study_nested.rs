@@ -240,7 +240,7 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
 /// corrected split meets the closed form all the same.
 #[test]
 fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() {
-    let Some((dir, s)) = nested_study(
+    let Some((_dir, s)) = nested_study(
         "two-level-mc",
         [
             "{ kind = \"lhs\", samples = 3000 }",

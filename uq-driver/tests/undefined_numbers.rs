@@ -212,18 +212,18 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     let o = args("2", &["--allow-failures"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let (_, rows) = csv(&out.join("points.csv"));
-    let failed: Vec<usize> = rows
+    let failed_points: Vec<usize> = rows
         .iter()
         .filter(|r| r[3].contains("failed"))
         .map(|r| r[0].parse().unwrap())
         .collect();
-    let n_failed = failed.len();
+    let n_failed = failed_points.len();
     assert!(n_failed > 2 && n_failed < 64, "{n_failed} failed");
     let stdout = stdout(&o);
     assert_contains(&stdout, &format!("{n_failed} points failed"));
     // One thread: the points run in design order up to the first failure, then the study
     // stops; the message says so instead of "1 of 64 points failed".
-    let f = failed[0];
+    let f = failed_points[0];
     let o = args("1", &[]);
     let err = failed(&o);
     let want = format!(
