@@ -8,8 +8,8 @@ use std::process::Output;
 use uq_driver::fmu::Fmu;
 
 use crate::support::{
-    assert_contains, csv_records, read, run, run_args, stderr, stdout, study_head, test_fmus, utf8,
-    write_toml,
+    assert_contains, csv_records, failed, read, run, run_args, stderr, stdout, study_head,
+    test_fmus, utf8, write_toml,
 };
 
 /// A Monte Carlo study of the Once FMU: x ~ U(0, 2), y recorded on [0, 1] by 0.1.
@@ -273,8 +273,7 @@ fn simulate_set_of_an_integer_outside_its_range_is_refused_as_a_fixed_one_is() {
         "--stop",
         "0.1",
     ]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
+    let err = failed(&o);
     assert!(
         err.contains("'misbehave' is an Integer declared with min = 0, max = 12")
             && err.contains("the value 13 given for it is outside that range"),

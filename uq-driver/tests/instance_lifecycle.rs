@@ -11,8 +11,8 @@ use std::process::Output;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, csv_records, read, run, run_args, run_ok, stderr, study_head, test_fmus, utf8,
-    write_toml,
+    assert_contains, csv_records, failed, read, run, run_args, run_ok, stderr, study_head,
+    test_fmus, utf8, write_toml,
 };
 
 /// Eight Monte Carlo points with gain ~ U(1, 2), u = 0.7, stop 1 s, step 0.1 s; `fixed`
@@ -367,8 +367,7 @@ fn a_fatal_reset_in_the_self_check_keeps_the_fresh_run_and_stops_the_study() {
         return;
     };
     let o = c.try_run("t1", &["-t", "1"]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
+    let err = failed(&o);
     assert!(
         err.contains("reset self-check") && err.contains("After fmi2Fatal"),
         "{err}"
