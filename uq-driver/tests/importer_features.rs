@@ -21,9 +21,12 @@ fn read_csv(text: &str) -> Csv {
     Csv::parse(text).numeric()
 }
 
-fn simulate(fmu: &Path, args: &[&str]) -> (String, String) {
+/// `uq-driver simulate FMU` with the arguments `line` (split at white space) and then `extra`,
+/// which must succeed; returns its standard output and standard error.
+fn simulate(fmu: &Path, line: &str, extra: &[&str]) -> (String, String) {
     let mut all = vec!["simulate", utf8(fmu)];
-    all.extend_from_slice(args);
+    all.extend(line.split_whitespace());
+    all.extend_from_slice(extra);
     let o = run(&all);
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
@@ -35,18 +38,8 @@ fn integer_boolean_enumeration_and_string_parameters_reach_the_fmu() {
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "int_param=-17",
-            "--set",
-            "bool_param=true",
-            "--set",
-            "enum_param=3",
-            "--set",
-            "string_param=grüße, 世界",
-            "--step",
-            "0.5",
-        ],
+        "--set int_param=-17 --set bool_param=true --set enum_param=3 --step 0.5",
+        &["--set", "string_param=grüße, 世界"],
     );
     let csv = read_csv(&out);
     assert_eq!(csv.col("int_out"), [-17.0; 3]);
@@ -61,7 +54,7 @@ fn integer_boolean_enumeration_and_string_parameters_reach_the_fmu() {
 fn simulate_without_outputs_records_every_number_and_names_the_string_it_skips() {
     // An FMU with only non-Real outputs wrote a CSV with only `time`, silently.
     let Some(fmu) = features() else { return };
-    let (out, err) = simulate(&fmu, &["--step", "0.5"]);
+    let (out, err) = simulate(&fmu, "--step 0.5", &[]);
     let csv = read_csv(&out);
     for name in [
         "u_echo",
@@ -122,20 +115,8 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
     .unwrap();
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--input",
-            utf8(&input),
-            "--step",
-            "0.1",
-            "--output",
-            "u_echo",
-            "--output",
-            "u_integral",
-            "--output",
-            "k_echo",
-            "--output",
-            "flag_echo",
-        ],
+        "--step 0.1 --output u_echo --output u_integral --output k_echo --output flag_echo",
+        &["--input", utf8(&input)],
     );
     let csv = read_csv(&out);
     let t = csv.col("time");
@@ -177,18 +158,8 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
     for (stop_at, last, rows) in [("0.55", 0.55, 7), ("0.5", 0.5, 6)] {
         let (out, err) = simulate(
             &fmu,
-            &[
-                "--set",
-                &format!("stop_at={stop_at}"),
-                "--set",
-                "u=2",
-                "--stop",
-                "2",
-                "--step",
-                "0.1",
-                "--output",
-                "u_integral",
-            ],
+            "--set u=2 --stop 2 --step 0.1 --output u_integral",
+            &["--set", &format!("stop_at={stop_at}")],
         );
         let csv = read_csv(&out);
         let t = csv.col("time");
@@ -344,16 +315,8 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "u=1",
-            "--stop",
-            "1.05",
-            "--step",
-            "0.1",
-            "--output",
-            "u_integral",
-        ],
+        "--set u=1 --stop 1.05 --step 0.1 --output u_integral",
+        &[],
     );
     let csv = read_csv(&out);
     let t = csv.col("time");
@@ -372,21 +335,12 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
 fn csv_numbers_are_short_and_read_back_exactly() {
     // 2.2e-308 was written as a 326-character decimal.
     let Some(fmu) = features() else { return };
-    let (out, _) = simulate(
-        &fmu,
-        &["--set", "u=2.2e-308", "--step", "0.5", "--output", "u_echo"],
-    );
+    let (out, _) = simulate(&fmu, "--set u=2.2e-308 --step 0.5 --output u_echo", &[]);
     assert_eq!(out, "time,u_echo\n0,2.2e-308\n0.5,2.2e-308\n1,2.2e-308\n");
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "u=1.7976931348623157e308",
-            "--step",
-            "1",
-            "--output",
-            "u_echo",
-        ],
+        "--set u=1.7976931348623157e308 --step 1 --output u_echo",
+        &[],
     );
     assert!(out.ends_with("1,1.7976931348623157e308\n"), "{out}");
 }
@@ -483,20 +437,8 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
     std::fs::write(&profile, text).unwrap();
     let (out, _) = simulate(
         &vt,
-        &[
-            "--set",
-            "irregularity=10",
-            "--set",
-            &format!("profile_file={}", profile.display()),
-            "--set",
-            "ramp_length=0",
-            "--stop",
-            "0.1",
-            "--step",
-            "0.001",
-            "--output",
-            "Z0_1",
-        ],
+        "--set irregularity=10 --set ramp_length=0 --stop 0.1 --step 0.001 --output Z0_1",
+        &["--set", &format!("profile_file={}", profile.display())],
     );
     let csv = read_csv(&out);
     let z = csv.col("Z0_1");
