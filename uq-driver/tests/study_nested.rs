@@ -104,7 +104,7 @@ fn study_with(
 /// The text of a two-level study `name` of `Functions` (function 4) with the study seed
 /// `seed`: the method `nested` of `outer` and `inner`; `seed` the outer parameter, the inner
 /// `parameters` and the `[fixed]` values `fixed` besides the function; `y` and its final value
-/// `y_end` with the limits `limits` (a TOML array).
+/// `y_end` with the limits `limits` (a TOML array; none when empty).
 pub(crate) fn nested_text(
     name: &str,
     fmu: &Path,
@@ -126,10 +126,14 @@ high = {SEEDS}
 level = "outer"
 {parameters}[fixed]
 function = 4
-{fixed}{outputs}limits = {limits}
-"#,
+{fixed}{outputs}{limits}"#,
         head = study_head(name, fmu, seed, "stop = 0.2\nstep = 0.1"),
-        outputs = final_quantity("y", "y_end")
+        outputs = final_quantity("y", "y_end"),
+        limits = if limits.is_empty() {
+            String::new()
+        } else {
+            format!("limits = {limits}\n")
+        }
     )
 }
 
