@@ -9,7 +9,8 @@ use std::process::{Command, Output};
 
 use crate::support::wheel::{self, write_study};
 use crate::support::{
-    assert_contains, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8, write_file,
+    assert_contains, qoi, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8,
+    write_file,
 };
 
 fn text(o: &Output) -> String {
@@ -78,21 +79,9 @@ fn symlinks_planted_as_summary_json_and_points_csv_are_replaced_not_written_thro
 #[test]
 fn quantity_names_with_slashes_or_the_folders_own_names_stay_inside_and_apart() {
     let dir = tempfile::tempdir().unwrap();
-    let qoi = r#"
-[[qoi]]
-kind = "final"
-name = "../../escape_y"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "points"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "/tmp/uq-driver-abs-test"
-signal = "q"
-"#;
-    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let names = ["../../escape_y", "points", "/tmp/uq-driver-abs-test"];
+    let qoi = names.map(|n| qoi("final", n, "q")).concat();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, &qoi);
     let out = dir.path().join("a").join("b").join("out");
     std::fs::create_dir_all(&out).unwrap();
     let o = run_study(&study, &out, &[]);
@@ -155,17 +144,8 @@ fn every_figure_links_to_its_section_of_the_guide_page_written_beside_the_report
 #[test]
 fn two_names_that_would_share_a_file_are_refused_before_any_run() {
     let dir = tempfile::tempdir().unwrap();
-    let qoi = r#"
-[[qoi]]
-kind = "final"
-name = "y"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "y_pdf"
-signal = "q"
-"#;
-    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let qoi = ["y", "y_pdf"].map(|n| qoi("final", n, "q")).concat();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, &qoi);
     let out = dir.path().join("out");
     let o = run_study(&study, &out, &[]);
     let t = text(&o);

@@ -159,9 +159,14 @@ pub fn study_head(name: &str, fmu: &Path, seed: u64, experiment: &str) -> String
 /// `[outputs]` with the one variable `signal`, and a quantity `name`: its final value.
 pub fn final_quantity(signal: &str, name: &str) -> String {
     format!(
-        "[outputs]\nvariables = [\"{signal}\"]\n\
-         [[qoi]]\nkind = \"final\"\nname = \"{name}\"\nsignal = \"{signal}\"\n"
+        "[outputs]\nvariables = [\"{signal}\"]\n{}",
+        qoi("final", name, signal)
     )
+}
+
+/// A `[[qoi]]` table: the quantity `name` of the kind `kind` of the output `signal`.
+pub fn qoi(kind: &str, name: &str, signal: &str) -> String {
+    format!("[[qoi]]\nkind = \"{kind}\"\nname = \"{name}\"\nsignal = \"{signal}\"\n")
 }
 
 /// Random parameters `names`, each uniform on [`low`, `high`] (`[[parameters]]` tables).
