@@ -34,10 +34,9 @@ fn ishigami(dir: &Path, name: &str, method: &str) -> PathBuf {
 
 #[test]
 fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let names = ISHIGAMI_INPUTS;
     let out = ishigami(dir.path(), "ishigami", LHS_2000);
     // Closed form (a = 7, b = 0.1): V1 = (1 + b pi^4 / 5)^2 / 2, V2 = a^2 / 8, V3 = 0.
@@ -92,10 +91,9 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
 
 #[test]
 fn the_page_of_an_lhs_study_has_the_scatter_plots_and_the_given_data_bars() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let names = ISHIGAMI_INPUTS;
     let out = ishigami(dir.path(), "scatter", "kind = \"lhs\"\nsamples = 200");
     let page = read(&out.join("index.html"));

@@ -43,10 +43,9 @@ pub(crate) fn run_functions(
 
 #[test]
 fn ishigami_sobol_indices_within_0_01_by_sparse_regression_with_200_runs() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let pi = std::f64::consts::PI;
     let out = run_functions(
         dir.path(),
@@ -92,10 +91,9 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     // Before: SCM mapped uniform inputs through the normal to Gauss–Hermite nodes: on 12
     // nodes per input the Ishigami mean came out 4.09 (true 3.5), and its only accuracy
     // indicator (order_difference, 0.0024) said it had converged.
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let pi = std::f64::consts::PI;
     let (mean, var) = benchmarks::ishigami_moments();
     let (first, total) = benchmarks::ishigami_indices();

@@ -65,10 +65,9 @@ fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 
 #[test]
 fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     for (name, method) in [
         ("sg", "kind = \"sparse_grid\"\nlevel = 3"),
         ("scm", "kind = \"scm\"\nnodes = 4"),
@@ -133,10 +132,9 @@ fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
 /// standard error of the mean, the number where it has one.
 #[test]
 fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let variants =
         "[[variants]]\nname = \"sg\"\nmethod = { kind = \"sparse_grid\", level = 2 }\n\n\
                     [[variants]]\nname = \"mc\"\nmethod = { kind = \"mc\", samples = 100 }\n";
@@ -163,10 +161,9 @@ fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
 
 #[test]
 fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // x1, x2 ~ U(−1, 2): a third of the points have x1 <= 0, as the user chose.
     let s = study(
         dir.path(),
@@ -184,10 +181,9 @@ fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
 
 #[test]
 fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // misbehave = 6: NaN outputs from misbehave_at on: the points with misbehave_at within
     // the 1 s run fail, about 40 % of them.
     let body = "[fixed]\nmisbehave = 6\n[[parameters]]\nname = \"gain\"\n\
@@ -269,10 +265,9 @@ fn number_after(text: &str, after: &str) -> usize {
 
 #[test]
 fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // The Functions FMU declares function with min = 1, max = 8.
     let body = function4(X1_X2, false).replace("function = 4", "function = 9");
     let s = study(
@@ -307,10 +302,9 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
 
 #[test]
 fn sobol_indices_of_an_output_without_variance_are_nan_not_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // y = 1.79 in every run whatever x3, x4: Var = 0, so S = V_i / Var is 0/0.
     for (name, method) in [
         ("sg", "kind = \"sparse_grid\"\nlevel = 4"),
