@@ -110,7 +110,6 @@ fn write_zip(path: &Path, entries: &[Entry<'_>]) {
     fs::write(path, w.finish().unwrap().into_inner()).unwrap();
 }
 
-/// Packs `xml` and optionally a binary as `binaries/linux64/dahlquist.so` into `dir/name`.
 /// The error of opening the FMU `name` (without a binary) whose model description is the C
 /// FMU's with `from` replaced by `to`.
 fn open_edited(name: &str, from: &str, to: &str) -> FmuError {
@@ -130,6 +129,7 @@ fn open_with_entry(dir: &Path, name: &str, entry: Entry<'_>) -> FmuError {
     Fmu::open(&path).unwrap_err()
 }
 
+/// Packs `xml` and optionally a binary as `binaries/linux64/dahlquist.so` into `dir/name`.
 fn write_fmu(dir: &Path, name: &str, xml: &str, binary: Option<&Path>) -> PathBuf {
     let path = dir.join(name);
     let bytes = binary.map(|b| fs::read(b).unwrap());

@@ -34,6 +34,14 @@ fn bogie_fmu() -> PathBuf {
     built_fmu("Bogie")
 }
 
+/// A new temporary folder with the study `s.toml` of [`study_text`] by `method` between
+/// [`LOW`] and [`HIGH`].
+fn study_in_new_dir(method: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_file(dir.path(), "s.toml", study_text(method, LOW, HIGH));
+    (dir, study)
+}
+
 /// A study of the bogie's hunting speed: `method` (TOML inline table), the bracket.
 fn study_text(method: &str, low: f64, high: f64) -> String {
     format!(
@@ -83,12 +91,7 @@ fn hunts_directly(fmu: &Fmu, params: &[(&str, f64)], speed: f64) -> bool {
 
 #[test]
 fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
-    let dir = tempfile::tempdir().unwrap();
-    let study = write_file(
-        dir.path(),
-        "s.toml",
-        study_text("kind = \"nominal\"", LOW, HIGH),
-    );
+    let (dir, study) = study_in_new_dir("kind = \"nominal\"");
     let out = dir.path().join("out");
     let stdout = run_study_ok(&study, &out, &[]);
     let (_, hunt) = samples(&out, "v_hunt");
@@ -132,12 +135,7 @@ fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
 
 #[test]
 fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_and_sharded() {
-    let dir = tempfile::tempdir().unwrap();
-    let study = write_file(
-        dir.path(),
-        "s.toml",
-        study_text("kind = \"scm\"\nnodes = 2\norder = 1", LOW, HIGH),
-    );
+    let (dir, study) = study_in_new_dir("kind = \"scm\"\nnodes = 2\norder = 1");
     let base = dir.path().join("in-process");
     run_study_ok(&study, &base, &["-t", "2"]);
     let (text, hunt) = samples(&base, "v_hunt");

@@ -34,6 +34,25 @@ fn records_path(dir: &Path) -> std::path::PathBuf {
     dir.join("store").join("records.bin")
 }
 
+/// A store of [`manifest`]`(n_points, n_values)` written by [`write_store`] into a new
+/// temporary folder: the manifest, the folder, the records' byte ranges and the bytes of the
+/// records file.
+fn written_store(
+    n_points: usize,
+    n_values: usize,
+) -> (
+    Manifest,
+    tempfile::TempDir,
+    Vec<std::ops::Range<usize>>,
+    Vec<u8>,
+) {
+    let m = manifest(n_points, n_values);
+    let dir = tempfile::tempdir().unwrap();
+    let ranges = write_store(dir.path(), &m);
+    let clean = fs::read(records_path(dir.path())).unwrap();
+    (m, dir, ranges, clean)
+}
+
 /// A store of `n` finished points written through the public API; returns each record's byte
 /// range in `records.bin`.
 fn write_store(dir: &Path, m: &Manifest) -> Vec<std::ops::Range<usize>> {
@@ -66,10 +85,7 @@ fn expected(i: usize, n_values: usize) -> Record {
 #[test]
 fn flipped_byte_in_record_1_of_1000_keeps_the_other_999() {
     // Before: the resume kept record 0 and silently dropped the 999 after the damage.
-    let m = manifest(1000, 3);
-    let dir = tempfile::tempdir().unwrap();
-    let ranges = write_store(dir.path(), &m);
-    let clean = fs::read(records_path(dir.path())).unwrap();
+    let (m, dir, ranges, clean) = written_store(1000, 3);
     for byte in ranges[1].clone() {
         for bit in [0u8, 7] {
             let mut bytes = clean.clone();
@@ -273,10 +289,7 @@ fn old_format_store_is_converted_and_kept_as_records_v1() {
 
 #[test]
 fn torn_tail_is_cut_and_its_point_reported() {
-    let m = manifest(5, 2);
-    let dir = tempfile::tempdir().unwrap();
-    let ranges = write_store(dir.path(), &m);
-    let clean = fs::read(records_path(dir.path())).unwrap();
+    let (m, dir, ranges, clean) = written_store(5, 2);
     let last = ranges[4].clone();
     for cut in last.start + 1..last.end {
         fs::write(records_path(dir.path()), &clean[..cut]).unwrap();
