@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use crate::support::wheel;
-use crate::support::{assert_contains, assert_same_files, failed, read, run_ok, run_study, utf8};
+use crate::support::{
+    assert_contains, assert_same_files, failed, plan_and_run_shards, read, run_ok, run_study, utf8,
+};
 
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
@@ -61,10 +63,7 @@ fn merge_and_slurm_take_no_report_as_run_does() {
     let dir = tempfile::tempdir().unwrap();
     let study = mc_study(dir.path(), "nr", 3, "kind = \"mc\"\nsamples = 12", "");
     let plan = dir.path().join("plan");
-    run_ok(&["plan", utf8(&study), "--shards", "2", "--out", utf8(&plan)]);
-    for k in ["0", "1"] {
-        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
-    }
+    plan_and_run_shards(&study, &plan, 2);
     let bare = dir.path().join("bare");
     let said = run_ok(&["merge", utf8(&plan), "--out", utf8(&bare), "--no-report"]);
     assert_contains(&said, "no report");

@@ -16,7 +16,7 @@ use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_contains, built_fmu, failed, read, run_ok, run_study, run_study_ok, summary, utf8,
+    assert_contains, built_fmu, failed, read, run_sharded, run_study, run_study_ok, summary, utf8,
     write_file,
 };
 
@@ -173,13 +173,7 @@ fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_an
     assert!(stdout.contains("(3 resumed)"));
     assert_eq!(samples(&resumed, "v_hunt").0, text);
     // Two shards, merged.
-    let plan = dir.path().join("plan");
-    let (s, p) = (utf8(&study), utf8(&plan));
-    run_ok(&["plan", s, "--shards", "2", "--out", p]);
-    run_ok(&["run-shard", p, "--shard", "0"]);
-    run_ok(&["run-shard", p, "--shard", "1"]);
-    let merged = dir.path().join("merged");
-    run_ok(&["merge", p, "--out", utf8(&merged)]);
+    let merged = run_sharded(&study, dir.path(), 2, "merged");
     assert_eq!(samples(&merged, "v_hunt").0, text);
 }
 

@@ -739,16 +739,13 @@ fn summary_json_gives_each_inputs_own_mean_and_std() {
     // The README promised a truncated normal's own mean and Std in summary.json;
     // only the page had them. K: N(100, 10²) truncated to [95, ∞): α = −0.5, λ = φ(α)/(1 − Φ(α)),
     // mean = 100 + 10 λ, variance = 10² (1 + α λ − λ²), with Φ(−0.5) from the normal table.
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
+    let (_dir, out, _) = run_wheel(
         "moments",
         "kind = \"lhs\"\nsamples = 8",
         "[[parameters]]\nname = \"K\"\ndistribution = \"truncated_normal\"\nmean = 100.0\nstd = 10.0\nlow = 95.0\nhigh = inf\n\
          [[parameters]]\nname = \"C\"\ndistribution = \"lognormal\"\nmean = 20.0\nstd = 2.0",
+        &["--no-report"],
     );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &["--no-report"]);
     let summary = summary(&out);
     let p = &summary["parameters"];
     let alpha: f64 = -0.5;

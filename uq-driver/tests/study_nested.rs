@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 use crate::support::csv::Csv;
 use crate::support::{
     assert_contains, assert_same_files, final_quantity, read_json, run, run_beside, run_ok,
-    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_file, write_toml,
+    run_sharded, run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_file,
+    write_toml,
 };
 
 /// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
@@ -303,14 +304,7 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
     let o = run_ok(&["run", s, "--out", r, "-t", "1"]);
     assert!(o.contains("(17 resumed)"), "{o}");
 
-    let plan = dir.path().join("plan");
-    let p = utf8(&plan);
-    run_ok(&["plan", s, "--shards", "3", "--out", p]);
-    for k in ["0", "1", "2"] {
-        run_ok(&["run-shard", p, "--shard", k]);
-    }
-    let merged = dir.path().join("merged");
-    run_ok(&["merge", p, "--out", utf8(&merged)]);
+    let merged = run_sharded(Path::new(s), dir.path(), 3, "merged");
 
     for other in [&resumed, &merged] {
         assert_same_files(&whole, other, &files);

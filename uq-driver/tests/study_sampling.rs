@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::wheel::{self, read_csv, reference, reference_sobol};
 use crate::support::{
-    assert_contains, assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_ok,
-    run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_sharded,
+    run_study_ok, study_head, summary, test_fmus, uniform, write_toml,
 };
 
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
@@ -157,13 +157,7 @@ fn a_sharded_qmc_study_gives_the_files_of_the_whole_study() {
     );
     let whole = dir.path().join("whole");
     run_study_ok(&study, &whole, &[]);
-    let plan = dir.path().join("plan");
-    let result = dir.path().join("result");
-    run_ok(&["plan", utf8(&study), "--shards", "3", "--out", utf8(&plan)]);
-    for k in ["0", "1", "2"] {
-        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
-    }
-    run_ok(&["merge", utf8(&plan), "--out", utf8(&result)]);
+    let result = run_sharded(&study, dir.path(), 3, "result");
     assert_same_files(&whole, &result, &["q.csv", "q_pdf.csv", "points.csv"]);
 }
 

@@ -117,6 +117,25 @@ pub fn run_builtin(name: &str) -> (tempfile::TempDir, PathBuf, String) {
     (dir, out, stdout)
 }
 
+/// `uq-driver plan STUDY --shards N --out PLAN`, then `run-shard` of each of the `shards`.
+pub fn plan_and_run_shards(study: &Path, plan: &Path, shards: usize) {
+    let n = shards.to_string();
+    run_ok(&["plan", utf8(study), "--shards", &n, "--out", utf8(plan)]);
+    for k in 0..shards {
+        run_ok(&["run-shard", utf8(plan), "--shard", &k.to_string()]);
+    }
+}
+
+/// `study` planned in `shards` shards into `dir/plan`, each run, and merged into
+/// `dir/<merged>`; returns that folder.
+pub fn run_sharded(study: &Path, dir: &Path, shards: usize, merged: &str) -> PathBuf {
+    let plan = dir.join("plan");
+    plan_and_run_shards(study, &plan, shards);
+    let out = dir.join(merged);
+    run_ok(&["merge", utf8(&plan), "--out", utf8(&out)]);
+    out
+}
+
 /// Starts `uq-driver run STUDY --out OUT` with `extra` arguments and kills it once its store
 /// holds more than `bytes` of records; it must not finish before, and must get there within a
 /// minute.
