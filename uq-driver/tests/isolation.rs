@@ -56,6 +56,14 @@ impl Case {
             .expect("runs")
     }
 
+    /// [`Case::run`], which must succeed.
+    #[track_caller]
+    fn run_ok(&self, extra: &[&str]) -> Output {
+        let o = self.run(extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        o
+    }
+
     /// A private temporary folder, to see what the driver leaves behind.
     fn tmp(&self) -> PathBuf {
         let t = self.dir.path().join("tmp");
@@ -103,8 +111,7 @@ impl Case {
 #[test]
 fn isolate_a_segfaulting_fmu_fails_its_points_with_the_signal_and_its_last_log_lines() {
     let Some(c) = case(2) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("killed by signal 11 (SIGSEGV");
     c.check_failed_with("misbehave = 2: segfaulting on purpose");
     assert_eq!(c.leftover_temp_folders(), 0);
@@ -113,16 +120,14 @@ fn isolate_a_segfaulting_fmu_fails_its_points_with_the_signal_and_its_last_log_l
 #[test]
 fn isolate_an_aborting_fmu_fails_its_points_with_sigabrt() {
     let Some(c) = case(3) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("signal 6 (SIGABRT");
 }
 
 #[test]
 fn isolate_an_fmu_calling_exit_fails_its_points_with_the_exit_status() {
     let Some(c) = case(4) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("exited with status 0");
 }
 
@@ -130,8 +135,7 @@ fn isolate_an_fmu_calling_exit_fails_its_points_with_the_exit_status() {
 fn isolate_a_hanging_fmu_is_killed_after_the_timeout_and_the_study_goes_on() {
     let Some(c) = case(5) else { return };
     let t0 = Instant::now();
-    let o = c.run(&["--isolate", "--timeout-per-run", "0.5", "-t", "2"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate", "--timeout-per-run", "0.5", "-t", "2"]);
     c.check_failed_with("longer than --timeout-per-run 0.5 s");
     c.check_failed_with("misbehave = 5: blocking forever");
     assert!(t0.elapsed() < Duration::from_secs(30));
@@ -142,8 +146,7 @@ fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
     // In one process an fmi2Fatal leaves the FMU unusable for every later point; a worker that
     // saw it is retired, so the points after it run on a fresh copy.
     let Some(c) = case(7) else { return };
-    let o = c.run(&["--isolate", "-t", "1"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate", "-t", "1"]);
     c.check_failed_with("returned Fatal");
 }
 
@@ -162,8 +165,7 @@ fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnabl
         assert_contains(&err, "After fmi2Fatal");
         assert_contains(&err, "--isolate");
         assert!(!err.contains("an earlier call returned Fatal"), "{err}");
-        let o = c.run(&["--isolate", "-t", threads]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate", "-t", threads]);
         // Every point at or below 1 failed by its own Fatal, every other one is ok.
         c.check_failed_with("returned Fatal");
     }
@@ -173,13 +175,11 @@ fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnabl
 fn isolate_errors_nan_and_warnings_behave_as_in_process() {
     for (mode, needle) in [(1, "returned Error"), (6, "non-finite value")] {
         let Some(c) = case(mode) else { return };
-        let o = c.run(&["--isolate"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate"]);
         c.check_failed_with(needle);
         // In-process gives the same statuses and the same numbers.
         let isolated = c.u_integral();
-        let o = c.run(&["--fresh"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--fresh"]);
         c.check_failed_with(needle);
         let in_process = c.u_integral();
         assert_eq!(isolated, in_process);
@@ -217,8 +217,7 @@ fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
         assert_eq!(c.leftover_temp_folders(), 0);
     }
     // The finished points are in the store: --isolate resumes and completes the study.
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("exited with status 0");
 }
 
@@ -260,8 +259,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
     // The FMU is "fixed" (misbehave = 0 is a different study, so the fix is simulated by the
     // same study with failures allowed): a plain re-run keeps the failures and says so ...
     edit(&c.study, "allow_failures = false", "allow_failures = true");
-    let o = c.run(&[]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = c.run_ok(&[]);
     assert!(
         stderr(&o).contains("not run again (--retry-failed"),
         "{}",
@@ -271,8 +269,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
     assert!(failed_before >= 2);
     // ... and --retry-failed runs them again (they fail again here: same FMU), with no point
     // counted twice in the store.
-    let o = c.run(&["--retry-failed"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = c.run_ok(&["--retry-failed"]);
     assert!(
         String::from_utf8_lossy(&o.stdout).contains(&format!("({} resumed)", 8 - failed_before)),
         "{}",
@@ -519,8 +516,7 @@ fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers(
     // The same numbers as in-process with a well-behaved FMU (mode 9 changes no value).
     let isolated = c.u_integral();
     edit(&c.study, "misbehave = 9", "misbehave = 0");
-    let o = c.run(&["--fresh", "-t", "1"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--fresh", "-t", "1"]);
     let in_process = c.u_integral();
     assert_eq!(isolated, in_process);
 }
@@ -572,8 +568,7 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
             assert_contains(&err, "--isolate");
         }
         // The finished points are kept: --isolate resumes and completes the study.
-        let o = c.run(&["--isolate"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate"]);
         c.check_failed_with(name);
     }
 }
