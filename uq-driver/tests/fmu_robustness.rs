@@ -104,47 +104,44 @@ fn private_copies_of_a_library_keep_globals_apart() {
 }
 
 /// Runs a study of the Once FMU with `method`, `parameter` (a `[[parameters]]` body for x)
-/// and `fixed` (the `[fixed]` body) into `dir/out` with `--no-report` and `extra` arguments;
-/// returns that folder and the run.
+/// and `fixed` (the `[fixed]` body) into `out` of a new temporary folder with `--no-report`
+/// and `extra` arguments; returns that folder, the FMU, `out` and the run, or `None` when the
+/// test FMUs cannot be built.
 fn run_once(
-    dir: &Path,
-    fmu: &Path,
     [method, parameter, fixed]: [&str; 3],
     extra: &[&str],
-) -> (PathBuf, Output) {
+) -> Option<(tempfile::TempDir, PathBuf, PathBuf, Output)> {
+    let (fmu, dir) = test_fmus::test_fmu_and_dir("Once")?;
     let study = write_toml(
-        dir,
+        dir.path(),
         "s",
         &format!(
             "{}\
              [method]\n{method}\n[[parameters]]\nname = \"x\"\n{parameter}\n\
              [fixed]\n{fixed}\n[outputs]\nvariables = [\"y\"]\n",
-            study_head("s", fmu, 7, "stop = 0.3\nstep = 0.1")
+            study_head("s", &fmu, 7, "stop = 0.3\nstep = 0.1")
         ),
     );
-    let out = dir.join("out");
+    let out = dir.path().join("out");
     let mut args = run_args(&study, &out, &["--no-report"]);
     args.extend_from_slice(extra);
     let o = run(&args);
-    (out, o)
+    Some((dir, fmu, out, o))
 }
 
 #[test]
 fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
-    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
-        return;
-    };
     // x declares [-10, 10]; N(0, 6) puts about 10 % of the draws outside.
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, _, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 200",
             "distribution = \"normal\"\nmean = 0\nstd = 6",
             "step_delay = 0",
         ],
         &[],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
     let points = read(&out.join("points.csv"));
@@ -171,19 +168,16 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
 
 #[test]
 fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run() {
-    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
-        return;
-    };
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, fmu, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 4",
             "distribution = \"uniform\"\nlow = 20\nhigh = 30",
             "step_delay = 0",
         ],
         &[],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(!o.status.success(), "{stderr}");
     assert_contains(
@@ -203,20 +197,17 @@ fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run(
 
 #[test]
 fn huge_and_escaped_fmu_log_messages_are_cut_before_reaching_points_csv_and_the_store() {
-    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
-        return;
-    };
     // Every step logs 1 MB (a colour escape first); points with x > 1 fail with such a message.
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, _, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 12",
             "distribution = \"uniform\"\nlow = 0\nhigh = 2",
             "log_bytes = 1000000\nfail_above = 1",
         ],
         &["--allow-failures"],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
     let points = read(&out.join("points.csv"));
