@@ -32,7 +32,7 @@
 //! throughput) and the fraction of it reached; and the largest relative difference of the
 //! fast kernel from the plain one over 6 s runs.
 
-use std::ffi::{c_char, c_int, c_uint, c_void, CString};
+use std::ffi::CString;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::ptr::null;

@@ -244,7 +244,7 @@ fn inspect_prints_a_huge_start_value_in_exponent_form() {
         .lines()
         .find(|l| l.trim_start().starts_with("fail_above"))
         .expect("fail_above listed");
-    assert_contains(&line, " 1e300 ");
+    assert_contains(line, " 1e300 ");
     assert!(line.len() < 200, "{line}");
 }
 

@@ -191,7 +191,7 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
         let stop_at: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
         if stop_at < 1.0 - 1e-9 {
             failed += 1;
-            assert_contains(&line, "ended the simulation at t =");
+            assert_contains(line, "ended the simulation at t =");
         } else {
             assert!(line.ends_with(",ok"), "{line}");
         }
@@ -274,7 +274,7 @@ fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit
     let text = summary["quantities"]["peak"]["definition"]["text"]
         .as_str()
         .unwrap();
-    assert_contains(&text, "100 in a run the FMU ends before the stop time");
+    assert_contains(text, "100 in a run the FMU ends before the stop time");
 }
 
 #[test]

@@ -313,8 +313,8 @@ fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
         "{statuses:?}"
     );
     for s in statuses.iter().filter(|s| *s != "ok") {
-        assert_contains(&s, "the FMU logged nothing");
-        assert_contains(&s, "--fmu-logging");
+        assert_contains(s, "the FMU logged nothing");
+        assert_contains(s, "--fmu-logging");
         assert!(!s.contains(said), "{s}");
     }
     for (name, extra) in [

@@ -449,7 +449,7 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
                 "{beyond} runs beyond: {e}"
             );
             let w = e["warnings"][0].as_str().unwrap();
-            assert_contains(&w, "importance_sampling");
+            assert_contains(w, "importance_sampling");
         } else {
             assert!(e["ci_95"].is_array(), "{beyond} runs beyond: {e}");
         }

@@ -286,7 +286,7 @@ fn sobol_sampling_qmc_base_intervals_are_student_t_on_the_replicate_spread() {
         let summary = m.summary(d);
         let kind = summary.details["intervals"].as_str().unwrap();
         assert!(kind.starts_with("replicates"), "{kind}");
-        assert_contains(&kind, &format!("R = {r} "));
+        assert_contains(kind, &format!("R = {r} "));
         assert_eq!(summary.details["replicates"], r);
     }
 }

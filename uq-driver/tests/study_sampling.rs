@@ -321,7 +321,7 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
     let method = &summary(&out)["method"];
     assert_eq!(method["replicates"], 8);
     let kind = method["intervals"].as_str().unwrap();
-    assert_contains(&kind, "R = 8 independently scrambled");
+    assert_contains(kind, "R = 8 independently scrambled");
     // Over time, y is constant after initialization: the same indices at every time.
     let csv = read_csv(&out.join("y_sobol.csv"));
     assert_eq!(csv.at(0.1, "S_x1"), q["first"]["x1"].as_f64().unwrap());

@@ -125,7 +125,7 @@ fn derailment_study(dir: &Path, edits: &[(&str, &str)]) -> std::path::PathBuf {
         assert!(text.contains(from), "{from}");
         text = text.replace(from, to);
     }
-    let study = write_file(&dir, "derail.toml", text);
+    let study = write_file(dir, "derail.toml", text);
     let out = dir.join("out");
     run_ok(&["run", utf8(&study), "--out", utf8(&out), "--yes"]);
     out
