@@ -34,6 +34,15 @@ pub(crate) fn hashed_normal(seed: i64) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
 }
 
+/// The population of tracks: h of every seed of the range, its mean and its variance.
+pub(crate) fn population() -> (Vec<f64>, f64, f64) {
+    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let n = h.len() as f64;
+    let mean = h.iter().sum::<f64>() / n;
+    let var = h.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+    (h, mean, var)
+}
+
 /// The complementary error function (Numerical Recipes' `erfcc`, fractional error below
 /// 1.2e-7 everywhere).
 fn erfc(x: f64) -> f64 {
@@ -152,11 +161,8 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     let Some(fmu) = test_fmus::test_fmu("Functions") else {
         return;
     };
-    // The population of tracks: h over every seed of the range.
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let (h, h_mean, var_outer) = population();
     let n = h.len() as f64;
-    let h_mean = h.iter().sum::<f64>() / n;
-    let var_outer = h.iter().map(|x| (x - h_mean).powi(2)).sum::<f64>() / n;
     let var_inner = 3.0;
     let (f_inner, f_outer) = (
         var_inner / (var_inner + var_outer),
@@ -255,10 +261,7 @@ fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() 
         return;
     };
     let out = run_beside(&s, &[]);
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
-    let n = h.len() as f64;
-    let m = h.iter().sum::<f64>() / n;
-    let var_outer = h.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
+    let (_, _, var_outer) = population();
     let f_outer = var_outer / (3.0 + var_outer);
     let split = &summary(&out)["quantities"]["y_end"]["variance_split"];
     let outer = split["outer"].as_f64().unwrap();
@@ -513,13 +516,13 @@ fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
     let Some(fmu) = test_fmus::test_fmu("Functions") else {
         return;
     };
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let (h, h_mean, _) = population();
     let n = h.len() as f64;
     let p_true: Vec<f64> = [1.0, 3.0]
         .iter()
         .map(|c| h.iter().map(|x| inner_exceedance(c - x)).sum::<f64>() / n)
         .collect();
-    let mean_true = 1.0 + h.iter().sum::<f64>() / n;
+    let mean_true = 1.0 + h_mean;
     let dir = tempfile::tempdir().unwrap();
     let (mut covered, mut mean_covered, mut t_kind) = ([0; 2], 0, 0);
     let seeds = 40;
