@@ -27,18 +27,22 @@ fn first_order(out: &Path, p: &str) -> (f64, [f64; 2]) {
 /// The Ishigami function's inputs, uniform on [-π, π].
 const ISHIGAMI_INPUTS: [&str; 3] = ["x1", "x2", "x3"];
 
-/// Runs the Ishigami function (function 1 of the test FMU) by `method` into `dir/name`.
-fn ishigami(dir: &Path, name: &str, method: &str) -> PathBuf {
-    run_functions(dir, name, 1, &uniform(&ISHIGAMI_INPUTS, -PI, PI), method)
+/// Runs the Ishigami function (function 1 of the test FMU) by `method` into `name` of a new
+/// temporary folder; returns the folder and `name`, or `None` when the test FMUs cannot be
+/// built.
+fn ishigami(name: &str, method: &str) -> Option<(tempfile::TempDir, PathBuf)> {
+    let dir = test_fmus::dir_if_built()?;
+    let inputs = uniform(&ISHIGAMI_INPUTS, -PI, PI);
+    let out = run_functions(dir.path(), name, 1, &inputs, method);
+    Some((dir, out))
 }
 
 #[test]
 fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
-    let Some(dir) = test_fmus::dir_if_built() else {
+    let Some((_dir, out)) = ishigami("ishigami", LHS_2000) else {
         return;
     };
     let names = ISHIGAMI_INPUTS;
-    let out = ishigami(dir.path(), "ishigami", LHS_2000);
     // Closed form (a = 7, b = 0.1): V1 = (1 + b pi^4 / 5)^2 / 2, V2 = a^2 / 8, V3 = 0.
     let (a, b) = (7.0f64, 0.1f64);
     let var = a * a / 8.0 + b * PI.powi(4) / 5.0 + b * b * PI.powi(8) / 18.0 + 0.5;
@@ -91,11 +95,10 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
 
 #[test]
 fn the_page_of_an_lhs_study_has_the_scatter_plots_and_the_given_data_bars() {
-    let Some(dir) = test_fmus::dir_if_built() else {
+    let Some((_dir, out)) = ishigami("scatter", "kind = \"lhs\"\nsamples = 200") else {
         return;
     };
     let names = ISHIGAMI_INPUTS;
-    let out = ishigami(dir.path(), "scatter", "kind = \"lhs\"\nsamples = 200");
     let page = read(&out.join("index.html"));
     assert!(
         page.contains("Y_scatter.svg"),
