@@ -7,9 +7,9 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-use crate::study_chaos::{borehole_parameters, run_functions};
+use crate::study_chaos::{borehole_parameters, run_functions, run_ishigami};
 use crate::support::csv::Csv;
-use crate::support::{assert_contains, benchmarks, read, summary, test_fmus, uniform};
+use crate::support::{assert_contains, benchmarks, read, summary, test_fmus};
 
 /// An unreplicated Latin hypercube of 2 000 runs.
 const LHS_2000: &str = "kind = \"lhs\"\nsamples = 2000";
@@ -32,8 +32,7 @@ const ISHIGAMI_INPUTS: [&str; 3] = ["x1", "x2", "x3"];
 /// built.
 fn ishigami(name: &str, method: &str) -> Option<(tempfile::TempDir, PathBuf)> {
     let dir = test_fmus::dir_if_built()?;
-    let inputs = uniform(&ISHIGAMI_INPUTS, -PI, PI);
-    let out = run_functions(dir.path(), name, 1, &inputs, method);
+    let out = run_ishigami(dir.path(), name, method);
     Some((dir, out))
 }
 

@@ -41,17 +41,20 @@ pub(crate) fn run_functions(
     run_beside(&study(dir, name, function, parameters, method), &[])
 }
 
+/// [`run_functions`] of the Ishigami function (function 1), x1, x2 and x3 uniform on [-π, π].
+pub(crate) fn run_ishigami(dir: &Path, name: &str, method: &str) -> PathBuf {
+    let pi = std::f64::consts::PI;
+    run_functions(dir, name, 1, &uniform(&["x1", "x2", "x3"], -pi, pi), method)
+}
+
 #[test]
 fn ishigami_sobol_indices_within_0_01_by_sparse_regression_with_200_runs() {
     let Some(dir) = test_fmus::dir_if_built() else {
         return;
     };
-    let pi = std::f64::consts::PI;
-    let out = run_functions(
+    let out = run_ishigami(
         dir.path(),
         "ishigami",
-        1,
-        &uniform(&["x1", "x2", "x3"], -pi, pi),
         "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 200\norder = 14\nsparse = true",
     );
     let (first, total) = benchmarks::ishigami_indices();
@@ -94,15 +97,11 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     let Some(dir) = test_fmus::dir_if_built() else {
         return;
     };
-    let pi = std::f64::consts::PI;
     let (mean, var) = benchmarks::ishigami_moments();
     let (first, total) = benchmarks::ishigami_indices();
-    let params = uniform(&["x1", "x2", "x3"], -pi, pi);
-    let askey = run_functions(
+    let askey = run_ishigami(
         dir.path(),
         "scm-askey",
-        1,
-        &params,
         "kind = \"scm\"\nnodes = 12\norder = 11",
     );
     let q = &summary(&askey)["quantities"]["Y"];
@@ -126,11 +125,9 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     let warnings = summary(&askey)["warnings"].to_string();
     assert!(!warnings.contains("the chaos holds"), "{warnings}");
 
-    let hermite = run_functions(
+    let hermite = run_ishigami(
         dir.path(),
         "scm-hermite",
-        1,
-        &params,
         "kind = \"scm\"\nnodes = 12\norder = 8\nchaos = \"hermite\"",
     );
     let sum = summary(&hermite);
@@ -648,17 +645,13 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     // per input (the quadrature's Std is off by more than 5 % of the closed form's) against
     // 12 nodes (converged).
     let dir = tempfile::tempdir().unwrap();
-    let pi = std::f64::consts::PI;
     let (_, var) = benchmarks::ishigami_moments();
-    let params = uniform(&["x1", "x2", "x3"], -pi, pi);
     // Y2: Ishigami's largest value is 1 + 7 + 0.1 π⁴ ≈ 17.7, so 20 is beyond every run; 0 is
     // within them.
     let limits = "\n[[qoi]]\nkind = \"final\"\nname = \"Y2\"\nsignal = \"y\"\nlimits = [20.0, 0.0]";
-    let coarse = run_functions(
+    let coarse = run_ishigami(
         dir.path(),
         "scm4",
-        1,
-        &params,
         &format!("kind = \"scm\"\nnodes = 4{limits}"),
     );
     let s = summary(&coarse);
@@ -681,13 +674,7 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
         "the page says where P comes from"
     );
 
-    let fine = run_functions(
-        dir.path(),
-        "scm12",
-        1,
-        &params,
-        "kind = \"scm\"\nnodes = 12",
-    );
+    let fine = run_ishigami(dir.path(), "scm12", "kind = \"scm\"\nnodes = 12");
     let s = summary(&fine);
     let std = s["quantities"]["Y"]["std"].as_f64().unwrap();
     assert!((std / var.sqrt() - 1.0).abs() < 1e-5, "std {std}");
