@@ -130,12 +130,7 @@ def ot_fit(x, y):
 
 
 def bench(h, work, driver, test_fmu_dir, repeats):
-    root = Path(__file__).resolve().parents[1]
-    work = Path(work) / "hd20"
-    work.mkdir(parents=True, exist_ok=True)
-    h.run_cmd([sys.executable, str(root / "uq-driver/tests/fmus/build.py"), str(test_fmu_dir),
-               "--only", "Functions"])
-    fmu = Path(test_fmu_dir).resolve() / "Functions.fmu"
+    work, fmu = h.functions_fmu(work, "hd20", test_fmu_dir)
     import openturns
     sec = h.Section(
         "20-input chaos: uq-driver's pce_regression against OpenTURNS' LARS on the same 200 "

@@ -473,12 +473,7 @@ def summary_section(h, summaries, sections):
 
 def bench(h, work, driver, fmu_dir, test_fmu_dir):
     """All the sections: the summary first, then one per benchmark."""
-    root = Path(__file__).resolve().parents[1]
-    work = Path(work) / "hd"
-    work.mkdir(parents=True, exist_ok=True)
-    h.run_cmd([sys.executable, str(root / "uq-driver/tests/fmus/build.py"), str(test_fmu_dir),
-               "--only", "Functions"])
-    fmu = Path(test_fmu_dir).resolve() / "Functions.fmu"
+    work, fmu = h.functions_fmu(work, "hd", test_fmu_dir)
     sections, summaries = [], []
     for case in CASES:
         sec, s = bench_case(h, driver, work, fmu, case)

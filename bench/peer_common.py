@@ -140,7 +140,18 @@ def pdf_evolution(draws):
     return TIMES[picked], grid, np.array(dens)
 
 
-def write_outputs(out_dir, mean, std, std_chaos, quantiles, pdf, s1, st):
+def quadrature_moments(weights, y):
+    """Mean and Std over time of the runs `y` (runs × times) with the quadrature `weights`."""
+    w = np.asarray(weights)
+    mean = w @ y
+    return mean, np.sqrt(np.maximum(w @ (y - mean) ** 2, 0.0))
+
+
+def write_outputs(out_dir, mean, std, std_chaos, draws, s1, st):
+    """The CSV files of uq-driver, the quantiles and PDFs over time from `draws` (draws × times)
+    of the chaos."""
+    quantiles = np.quantile(draws, QUANTILES, axis=0)
+    pdf = pdf_evolution(draws)
     os.makedirs(out_dir, exist_ok=True)
     cols = [TIMES, mean, std, mean - 3 * std, mean + 3 * std] + list(quantiles) + [std_chaos]
     head = "time,mean,std,lower_3sigma,upper_3sigma,q1,q50,q99,std_pce"

@@ -31,9 +31,7 @@ passed in as `h`.
 """
 import json
 import math
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from scipy import stats
@@ -574,12 +572,7 @@ def ot_version():
 
 def bench(h, work, driver, test_fmu_dir):
     """The sections: the summary first, then one per case, then the coverage."""
-    root = Path(__file__).resolve().parents[1]
-    work = Path(work) / "reliability"
-    work.mkdir(parents=True, exist_ok=True)
-    h.run_cmd([sys.executable, str(root / "uq-driver/tests/fmus/build.py"), str(test_fmu_dir),
-               "--only", "Functions"])
-    fmu = Path(test_fmu_dir).resolve() / "Functions.fmu"
+    work, fmu = h.functions_fmu(work, "reliability", test_fmu_dir)
     t_ref = time.perf_counter()
     refs, corr_text = {}, []
     for case in CASES:

@@ -117,6 +117,16 @@ class LoadWatch:
         return max(0.0, other / wall) if wall > 0 else 0.0
 
 
+def functions_fmu(work, name, test_fmu_dir):
+    """The folder `work/name` (created) and the path of the Functions test FMU, built into
+    `test_fmu_dir` by uq-driver/tests/fmus/build.py."""
+    work = Path(work) / name
+    work.mkdir(parents=True, exist_ok=True)
+    run_cmd([sys.executable, str(ROOT / "uq-driver/tests/fmus/build.py"), str(test_fmu_dir),
+             "--only", "Functions"])
+    return work, Path(test_fmu_dir).resolve() / "Functions.fmu"
+
+
 def run_cmd(cmd, show_stderr=False):
     """Runs a command; returns (wall s, CPU s of the child, stdout). A failure is fatal."""
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -398,40 +408,12 @@ def fmpy_simulate_loop(points):
 
 
 def fmpy_slave_loop(points):
-    """The fast fmpy loop: extract once, one FMU2Slave instance, fmi2Reset between points."""
-    import numpy as np
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-    path = str(fmu("Wheel"))
-    t0 = time.perf_counter()
-    md = read_model_description(path)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    unzip = extract(path)
-    out = np.empty((len(points), NT))
-    try:
-        s = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
-        s.instantiate()
-        kc, q = [vr["K"], vr["C"]], [vr["q"]]
-        for i, (k, c) in enumerate(points):
-            if i:
-                s.reset()
-            s.setReal(kc, [k, c])
-            s.setupExperiment(startTime=0.0)
-            s.enterInitializationMode()
-            s.exitInitializationMode()
-            row = out[i]
-            row[0] = s.getReal(q)[0]
-            t = 0.0
-            for j in range(1, NT):
-                s.doStep(currentCommunicationPoint=t, communicationStepSize=STEP)
-                t += STEP
-                row[j] = s.getReal(q)[0]
-        s.terminate()
-        s.freeInstance()
-    finally:
-        shutil.rmtree(unzip, ignore_errors=True)
-    return time.perf_counter() - t0, out
+    """The fast fmpy loop (bench/peer_common.py): extract once, one FMU2Slave instance,
+    fmi2Reset between points. Returns (wall time, runs × times array of q)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import peer_common
+    out, wall = peer_common.run_wheel(str(fmu("Wheel")), points)
+    return wall, out
 
 
 def bench_wheel_1000(work, repeats, quick, checks):
@@ -749,14 +731,9 @@ def bench_realtime(work, repeats, step_cost):
     rtf = {}
     for label, model, sim, extra in cases:
         out = work / f"{model}.csv"
-        cmd = [str(DRIVER), "simulate", str(fmu(model)), *extra, "--out", str(out)]
-        sec.cmd(f"target/release/uq-driver simulate {rel(fmu(model))} "
-                f"{' '.join(extra)} --out {rel(out)}   # x{repeats}".replace("  ", " "))
-        walls, util = [], []
-        for _ in range(repeats):
-            wall, cpu, _ = run_cmd(cmd)
-            walls.append(wall)
-            util.append(cpu / wall)
+        shown = (f"target/release/uq-driver simulate {rel(fmu(model))} "
+                 f"{' '.join(extra)} --out {rel(out)}   # x{repeats}".replace("  ", " "))
+        walls, util = simulate_timed(sec, model, extra, out, repeats, shown)
         with open(out) as f:
             n_rows = sum(1 for _ in f) - 1
         if model == "VehicleTrack" and n_rows != 2001:
@@ -793,14 +770,9 @@ def bench_vehicle_realtime(work, repeats):
     sim = 20.0
     out = work / "Vehicle.csv"
     extra = ["--set", "v=40", "--set", "ramp=0", "--stop", f"{sim:g}", "--step", "0.01"]
-    cmd = [str(DRIVER), "simulate", str(fmu("Vehicle")), *extra, "--out", str(out)]
-    sec.cmd(f"target/release/uq-driver simulate {rel(fmu('Vehicle'))} {' '.join(extra)} "
-            f"--out {rel(out)}   # x{repeats}")
-    walls, util = [], []
-    for _ in range(repeats):
-        wall, cpu, _ = run_cmd(cmd)
-        walls.append(wall)
-        util.append(cpu / wall)
+    shown = (f"target/release/uq-driver simulate {rel(fmu('Vehicle'))} {' '.join(extra)} "
+             f"--out {rel(out)}   # x{repeats}")
+    walls, util = simulate_timed(sec, "Vehicle", extra, out, repeats, shown)
     with open(out) as f:
         header = f.readline().strip().split(",")
         rows = [line.strip().split(",") for line in f if line.strip()]
@@ -995,6 +967,20 @@ def bench_hd_goals(work):
     import hd_goals
     return hd_goals.bench(sys.modules[__name__], work, DRIVER, FMU_DIR,
                           ROOT / "target" / "test-fmu")
+
+
+def simulate_timed(sec, model, extra, out, repeats, shown):
+    """`uq-driver simulate` of the built FMU `model` with the arguments `extra` into `out`,
+    `repeats` times, shown in `sec` as `shown`; returns the wall times (s) and CPU / wall of
+    each run."""
+    cmd = [str(DRIVER), "simulate", str(fmu(model)), *extra, "--out", str(out)]
+    sec.cmd(shown)
+    walls, util = [], []
+    for _ in range(repeats):
+        wall, cpu, _ = run_cmd(cmd)
+        walls.append(wall)
+        util.append(cpu / wall)
+    return walls, util
 
 
 def bench_hd20(work, repeats):

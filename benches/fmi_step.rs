@@ -32,7 +32,7 @@
 //! throughput) and the fraction of it reached; and the largest relative difference of the
 //! fast kernel from the plain one over 6 s runs.
 
-use std::ffi::{c_char, c_int, c_uint, c_void, CString};
+use std::ffi::CString;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::ptr::null;
@@ -42,30 +42,10 @@ use libloading::Library;
 
 // ---------------------------------------------------------------- C ABI (fmi2FunctionTypes.h)
 
-type Component = *mut c_void;
-type Vr = c_uint;
-type Status = c_int;
-type CStrPtr = *const c_char;
-
-const OK: Status = 0;
-const CO_SIMULATION: c_int = 1;
-const FMI2_TRUE: c_int = 1;
-const FMI2_FALSE: c_int = 0;
-
-type InstantiateFn = unsafe extern "C" fn(
-    CStrPtr,
-    c_int,
-    CStrPtr,
-    CStrPtr,
-    *const c_void,
-    c_int,
-    c_int,
-) -> Component;
-type FreeInstanceFn = unsafe extern "C" fn(Component);
-type SetupExperimentFn = unsafe extern "C" fn(Component, c_int, f64, f64, c_int, f64) -> Status;
-type ComponentFn = unsafe extern "C" fn(Component) -> Status;
-type GetRealFn = unsafe extern "C" fn(Component, *const Vr, usize, *mut f64) -> Status;
-type DoStepFn = unsafe extern "C" fn(Component, f64, f64, c_int) -> Status;
+#[path = "../tests/common/fmi2.rs"]
+#[allow(dead_code)] // the constants and types this benchmark does not use
+mod fmi2;
+use fmi2::*;
 
 /// The functions this benchmark calls, as C function pointers.
 struct Api {
@@ -101,16 +81,6 @@ fn fail(msg: &str) -> ! {
     std::process::exit(1)
 }
 
-fn library_path() -> PathBuf {
-    if let Some(p) = std::env::var_os("RAILUQ_SO") {
-        return PathBuf::from(p);
-    }
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
-    target.join("release").join("librailuq.so")
-}
-
 impl Api {
     fn load(path: &Path) -> Api {
         if !path.is_file() {
@@ -126,9 +96,8 @@ impl Api {
             Ok(l) => l.into(),
             Err(e) => fail(&format!("dlopen {}: {e}", path.display())),
         };
-        // SAFETY: each field's type is the fmi2FunctionTypes.h type of its symbol (the
-        // callbacks argument of fmi2Instantiate is passed as NULL only, hence `*const c_void`);
-        // the pointers are used only while `_lib`, stored in the same struct, stays loaded.
+        // SAFETY: each field's type is the fmi2FunctionTypes.h type of its symbol; the pointers
+        // are used only while `_lib`, stored in the same struct, stays loaded.
         unsafe {
             Api {
                 instantiate: sym(&lib, path, "fmi2Instantiate"),
@@ -387,7 +356,7 @@ fn main() {
         }
     }
 
-    let path = library_path();
+    let path = fmi2::library_path("release");
     let api = Api::load(&path);
     println!(
         "fmi_step: {} (budget {:.1} s per model)",

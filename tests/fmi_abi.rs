@@ -31,7 +31,7 @@
     any(target_arch = "x86_64", target_arch = "aarch64")
 ))]
 
-use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::ptr::{null, null_mut};
 use std::sync::{Barrier, Mutex, OnceLock, PoisonError};
@@ -41,125 +41,10 @@ use libloading::Library;
 
 // ---------------------------------------------------------------- C ABI (fmi2FunctionTypes.h)
 
-type Component = *mut c_void;
-type ComponentEnvironment = *mut c_void;
-type FmuState = *mut c_void;
-type Vr = c_uint;
-type Status = c_int;
-type CStrPtr = *const c_char;
-
-const OK: Status = 0;
-const WARNING: Status = 1;
-const DISCARD: Status = 2;
-const ERROR: Status = 3;
-#[cfg_attr(not(feature = "test-panic"), allow(dead_code))] // used by the panic test only
-const FATAL: Status = 4;
-
-const MODEL_EXCHANGE: c_int = 0;
-const CO_SIMULATION: c_int = 1;
-
-const DO_STEP_STATUS: c_int = 0;
-const LAST_SUCCESSFUL_TIME: c_int = 2;
-const TERMINATED: c_int = 3;
-
-/// The logger as we receive it (see the module documentation on varargs).
-type LoggerFn =
-    unsafe extern "C" fn(ComponentEnvironment, CStrPtr, Status, CStrPtr, CStrPtr, CStrPtr);
-type AllocateMemoryFn = unsafe extern "C" fn(usize, usize) -> *mut c_void;
-type FreeMemoryFn = unsafe extern "C" fn(*mut c_void);
-type StepFinishedFn = unsafe extern "C" fn(ComponentEnvironment, Status);
-
-/// `fmi2CallbackFunctions`; `Option<fn>` has the layout of a nullable C function pointer.
-#[repr(C)]
-struct CallbackFunctions {
-    logger: Option<LoggerFn>,
-    allocate_memory: Option<AllocateMemoryFn>,
-    free_memory: Option<FreeMemoryFn>,
-    step_finished: Option<StepFinishedFn>,
-    component_environment: ComponentEnvironment,
-}
-
-type GetStrFn = unsafe extern "C" fn() -> CStrPtr;
-type SetDebugLoggingFn = unsafe extern "C" fn(Component, c_int, usize, *const CStrPtr) -> Status;
-type InstantiateFn = unsafe extern "C" fn(
-    CStrPtr,
-    c_int,
-    CStrPtr,
-    CStrPtr,
-    *const CallbackFunctions,
-    c_int,
-    c_int,
-) -> Component;
-type FreeInstanceFn = unsafe extern "C" fn(Component);
-type SetupExperimentFn = unsafe extern "C" fn(Component, c_int, f64, f64, c_int, f64) -> Status;
-type ComponentFn = unsafe extern "C" fn(Component) -> Status;
-type GetRealFn = unsafe extern "C" fn(Component, *const Vr, usize, *mut f64) -> Status;
-type GetIntFn = unsafe extern "C" fn(Component, *const Vr, usize, *mut c_int) -> Status;
-type GetStringFn = unsafe extern "C" fn(Component, *const Vr, usize, *mut CStrPtr) -> Status;
-type SetRealFn = unsafe extern "C" fn(Component, *const Vr, usize, *const f64) -> Status;
-type SetIntFn = unsafe extern "C" fn(Component, *const Vr, usize, *const c_int) -> Status;
-type SetStringFn = unsafe extern "C" fn(Component, *const Vr, usize, *const CStrPtr) -> Status;
-type StateSlotFn = unsafe extern "C" fn(Component, *mut FmuState) -> Status;
-type SetStateFn = unsafe extern "C" fn(Component, FmuState) -> Status;
-type StateSizeFn = unsafe extern "C" fn(Component, FmuState, *mut usize) -> Status;
-type SerializeFn = unsafe extern "C" fn(Component, FmuState, *mut c_char, usize) -> Status;
-type DeserializeFn = unsafe extern "C" fn(Component, *const c_char, usize, *mut FmuState) -> Status;
-type DirectionalDerivativeFn = unsafe extern "C" fn(
-    Component,
-    *const Vr,
-    usize,
-    *const Vr,
-    usize,
-    *const f64,
-    *mut f64,
-) -> Status;
-type SetInputDerivativesFn =
-    unsafe extern "C" fn(Component, *const Vr, usize, *const c_int, *const f64) -> Status;
-type GetOutputDerivativesFn =
-    unsafe extern "C" fn(Component, *const Vr, usize, *const c_int, *mut f64) -> Status;
-type DoStepFn = unsafe extern "C" fn(Component, f64, f64, c_int) -> Status;
-type GetIntStatusFn = unsafe extern "C" fn(Component, c_int, *mut c_int) -> Status;
-type GetRealStatusFn = unsafe extern "C" fn(Component, c_int, *mut f64) -> Status;
-type GetStringStatusFn = unsafe extern "C" fn(Component, c_int, *mut CStrPtr) -> Status;
-
-/// The 25 common and 9 Co-Simulation functions of FMI 2.0, as listed in the standard.
-const FMI2_CS_SYMBOLS: [&str; 34] = [
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    // Co-Simulation only.
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
+#[allow(dead_code)] // the constants and types this test does not use
+#[path = "common/fmi2.rs"]
+mod fmi2;
+use fmi2::*;
 
 // ---------------------------------------------------------------- the Wheel model
 
@@ -355,19 +240,9 @@ unsafe fn sym<T: Copy>(lib: &Library, path: &Path, name: &str) -> T {
     }
 }
 
-fn library_path() -> PathBuf {
-    if let Some(p) = std::env::var_os("RAILUQ_SO") {
-        return PathBuf::from(p);
-    }
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
-    target.join("debug").join("librailuq.so")
-}
-
 impl Fmu {
     fn load() -> Fmu {
-        let path = library_path();
+        let path = fmi2::library_path("debug");
         assert!(
             path.is_file(),
             "{} does not exist: build it first with \

@@ -73,17 +73,22 @@ def probed_keys(tmp) -> dict:
     return ctx
 
 
+def marked(path, marker):
+    """Each `<!-- MARKER: WHAT -->` of the Markdown file `path`: (WHAT, the lines after it)."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    for i, line in enumerate(lines):
+        m = re.match(rf"<!-- {marker}: (.+?) -->", line)
+        if m:
+            yield m.group(1), lines[i + 1:]
+
+
 def documented_keys() -> dict:
     """`<!-- keys: A B -->` followed by a table whose first column holds `key`: each context
     A, B documents those keys (a marker without a table documents none)."""
-    lines = STUDY_FILE_MD.read_text(encoding="utf-8").splitlines()
     doc = {}
-    for i, line in enumerate(lines):
-        m = re.match(r"<!-- keys: (.+?) -->", line)
-        if not m:
-            continue
+    for contexts, after in marked(STUDY_FILE_MD, "keys"):
         found = set()
-        for row in lines[i + 1:]:
+        for row in after:
             if row.startswith("|"):
                 cell = row.split("|")[1].strip()
                 km = re.fullmatch(r"`([A-Za-z0-9_]+)`", cell)
@@ -91,24 +96,33 @@ def documented_keys() -> dict:
                     found.add(km.group(1))
             elif found or (row.strip() and not row.startswith("|")):
                 break
-        for c in m.group(1).split():
+        for c in contexts.split():
             assert c not in doc, f"context {c} is marked twice"
             doc[c] = found
     return doc
 
 
-def test_the_reference_documents_every_study_file_key_and_no_unknown_one(tmp_path):
-    probed = probed_keys(tmp_path)
-    doc = documented_keys()
+def mismatches(actual: dict, doc: dict, label: str, page: str, unknown: str) -> list:
+    """What the documented sets `doc` miss or add against the `actual` ones (by context, in the
+    order of `actual`), each context named by `label` (a format string), their tables being in
+    `page` and an entry documented but not there called `unknown`."""
     problems = []
-    for c, ks in sorted(probed.items()):
+    for c, have in actual.items():
+        name = label.format(c)
         if c not in doc:
-            problems.append(f"{c}: no table in study-file.md (keys {sorted(ks)})")
+            problems.append(f"{name}: no table in {page} {sorted(have)})")
             continue
-        if ks - doc[c]:
-            problems.append(f"{c}: undocumented {sorted(ks - doc[c])}")
-        if doc[c] - ks:
-            problems.append(f"{c}: documented but unknown to uq-driver {sorted(doc[c] - ks)}")
+        if have - doc[c]:
+            problems.append(f"{name}: undocumented {sorted(have - doc[c])}")
+        if doc[c] - have:
+            problems.append(f"{name}: documented but {unknown} {sorted(doc[c] - have)}")
+    return problems
+
+
+def test_the_reference_documents_every_study_file_key_and_no_unknown_one(tmp_path):
+    probed = dict(sorted(probed_keys(tmp_path).items()))
+    doc = documented_keys()
+    problems = mismatches(probed, doc, "{}", "study-file.md (keys", "unknown to uq-driver")
     # Contexts the probes cannot list (the keys every parameter takes whatever its family) are
     # checked by acceptance below; any other documented context must exist.
     for c in sorted(set(doc) - set(probed) - {"parameters"}):
@@ -170,19 +184,15 @@ def options_of(*path) -> set:
 
 
 def documented_options() -> dict:
-    lines = COMMANDS_MD.read_text(encoding="utf-8").splitlines()
     doc = {}
-    for i, line in enumerate(lines):
-        m = re.match(r"<!-- options: (.+?) -->", line)
-        if not m:
-            continue
+    for command, after in marked(COMMANDS_MD, "options"):
         found = set()
-        for row in lines[i + 1:]:
+        for row in after:
             if not row.startswith("|"):
                 break
             found |= set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", row.split("|")[1]))
-        assert m.group(1) not in doc, f"{m.group(1)} is marked twice"
-        doc[m.group(1)] = found
+        assert command not in doc, f"{command} is marked twice"
+        doc[command] = found
     return doc
 
 
@@ -200,16 +210,8 @@ def all_commands() -> list:
 def test_the_reference_documents_every_command_and_option_and_no_unknown_one():
     doc = documented_options()
     commands = all_commands()
-    problems = []
-    for c in commands:
-        opts = options_of(*c.split())
-        if c not in doc:
-            problems.append(f"uq-driver {c}: no table in commands.md (options {sorted(opts)})")
-            continue
-        if opts - doc[c]:
-            problems.append(f"uq-driver {c}: undocumented {sorted(opts - doc[c])}")
-        if doc[c] - opts:
-            problems.append(f"uq-driver {c}: documented but unknown {sorted(doc[c] - opts)}")
+    options = {c: options_of(*c.split()) for c in commands}
+    problems = mismatches(options, doc, "uq-driver {}", "commands.md (options", "unknown")
     for c in sorted(set(doc) - set(commands)):
         problems.append(f"uq-driver {c}: documented, but there is no such command")
     assert not problems, "\n".join(problems)

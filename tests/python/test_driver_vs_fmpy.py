@@ -22,6 +22,22 @@ def driver_simulate(fmu, values, stop, step, tmp_path, outputs=()):
     return np.genfromtxt(out, delimiter=",", names=True)
 
 
+def both_simulate(fmu, values, stop, step, tmp_path, outputs):
+    """The same run by uq-driver and by fmpy: (ours, fmpy's)."""
+    ours = driver_simulate(fmu, values, stop, step, tmp_path, outputs)
+    ref = simulate_fmu(fmu, start_values=values, output_interval=step, stop_time=stop,
+                       output=list(outputs))
+    return ours, ref
+
+
+def assert_close(ours, ref, outputs, floor):
+    """Each of `outputs` within 1e-12 of fmpy's, relative to its largest value (at least
+    `floor`)."""
+    for name in outputs:
+        scale = max(floor, np.max(np.abs(ref[name])))
+        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * scale, name
+
+
 @pytest.mark.parametrize(
     "values",
     [{"K": 100.0, "C": 20.0}, {"K": 83.1, "C": 23.7}, {"K": 121.4, "C": 15.2}],
@@ -39,25 +55,17 @@ def test_bogie_trajectory_matches_fmpy(tmp_path):
     bogie = fmu_path("Bogie")
     values = {"K_sy": 1.9e5, "C_sy": 2.7e4, "K_phi": 2.6e6}
     outputs = ("Y", "phi", "V", "F_T")
-    ours = driver_simulate(bogie, values, 60.0, 0.01, tmp_path, outputs)
-    ref = simulate_fmu(bogie, start_values=values, output_interval=0.01, stop_time=60.0,
-                       output=list(outputs))
-    for name in outputs:
-        scale = max(1.0, np.max(np.abs(ref[name])))
-        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * scale, name
+    ours, ref = both_simulate(bogie, values, 60.0, 0.01, tmp_path, outputs)
+    assert_close(ours, ref, outputs, 1.0)
 
 
 def test_vehicle_track_trajectory_matches_fmpy(tmp_path):
     vt = fmu_path("VehicleTrack")
     values = {"Kpz": 1.6e6, "Csz": 1.3e5, "dip_depth": 3e-4, "irregularity": 3}
     outputs = ("Zc_acc", "P1", "Zw1", "Zr1")
-    ours = driver_simulate(vt, values, 0.5, 0.001, tmp_path, outputs)
-    ref = simulate_fmu(vt, start_values=values, output_interval=0.001, stop_time=0.5,
-                       output=list(outputs))
+    ours, ref = both_simulate(vt, values, 0.5, 0.001, tmp_path, outputs)
     assert len(ours) == len(ref) == 501
-    for name in outputs:
-        scale = max(1e-12, np.max(np.abs(ref[name])))
-        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * scale, name
+    assert_close(ours, ref, outputs, 1e-12)
     # The dip makes an impact: the leading wheel's force rises well above the static load.
     assert np.max(ref["P1"]) > 1.2 * 69.0e3
 
@@ -70,9 +78,7 @@ def test_bogie_run_past_the_speed_limit_ends_early_and_both_keep_the_rows(tmp_pa
     bogie = fmu_path("Bogie")
     values = {"V0": 10.0, "ramp": 1.0}
     outputs = ("Y", "V")
-    ours = driver_simulate(bogie, values, 12.0, 0.1, tmp_path, outputs)
-    ref = simulate_fmu(bogie, start_values=values, output_interval=0.1, stop_time=12.0,
-                       output=list(outputs))
+    ours, ref = both_simulate(bogie, values, 12.0, 0.1, tmp_path, outputs)
     assert abs(ref["time"][-1] - 8.9) < 1e-9, ref["time"][-1]
     # fmpy records the last successful time once more after the discarded step.
     if ref["time"][-1] == ref["time"][-2]:
@@ -88,13 +94,9 @@ def test_vehicle_trajectory_matches_fmpy(tmp_path):
     car = fmu_path("Vehicle")
     values = {"v": 60.0, "k4": 1.9e5, "D6": 1.5e5, "irregularity": 3, "seed": 7}
     outputs = ("y_w1", "Y_1L", "Q_1L", "YQ_1L", "SumY_1", "ay_floor_1", "speed")
-    ours = driver_simulate(car, values, 2.0, 0.01, tmp_path, outputs)
-    ref = simulate_fmu(car, start_values=values, output_interval=0.01, stop_time=2.0,
-                       output=list(outputs))
+    ours, ref = both_simulate(car, values, 2.0, 0.01, tmp_path, outputs)
     assert len(ours) == len(ref) == 201
-    for name in outputs:
-        scale = max(1e-12, np.max(np.abs(ref[name])))
-        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * scale, name
+    assert_close(ours, ref, outputs, 1e-12)
     assert np.all(ref["speed"] == 60.0)
     # The irregular track excites the car: the wheel loads vary by more than 1 %.
     assert np.ptp(ref["Q_1L"][50:]) > 0.01 * np.mean(ref["Q_1L"])
@@ -128,12 +130,9 @@ def test_vehicle_derailment_ends_the_run_and_both_keep_the_rows(tmp_path):
     car = fmu_path("Vehicle")
     values = {"v": 45.0, "R": 300.0, "y0_w3": 0.0}
     outputs = ("y_w1", "Y_1L")
-    ours = driver_simulate(car, values, 10.0, 0.01, tmp_path, outputs)
-    ref = simulate_fmu(car, start_values=values, output_interval=0.01, stop_time=10.0,
-                       output=list(outputs))
+    ours, ref = both_simulate(car, values, 10.0, 0.01, tmp_path, outputs)
     if ref["time"][-1] == ref["time"][-2]:
         ref = ref[:-1]
     assert ref["time"][-1] < 9.0, "derailed well before the stop time"
     assert len(ours) == len(ref)
-    for name in outputs:
-        assert np.max(np.abs(ours[name] - ref[name])) <= 1e-12 * np.max(np.abs(ref[name])), name
+    assert_close(ours, ref, outputs, 0.0)

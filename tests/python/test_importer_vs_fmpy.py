@@ -2,31 +2,19 @@
 every type, input signals, an FMU that ends the simulation, a stop time off the grid, and
 VehicleTrack's measured track profile. Where fmpy and uq-driver take the same steps the
 trajectories must be equal bit for bit (the CSV numbers read back exactly)."""
-import importlib.util
 import math
-import os
-import pathlib
 import subprocess
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from conftest import DRIVER, ROOT, fmu_path
-
-BUILD_SCRIPT = ROOT / "uq-driver" / "tests" / "fmus" / "build.py"
-OUT_DIR = pathlib.Path(os.environ.get("RAILUQ_TEST_FMU_DIR", ROOT / "target" / "test-fmu"))
+from conftest import DRIVER, build_test_fmus, fmu_path
 
 
 @pytest.fixture(scope="module")
 def features():
-    spec = importlib.util.spec_from_file_location("build_test_fmus", BUILD_SCRIPT)
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
-    try:
-        return str(build.build(OUT_DIR)["Features"][0])
-    except build.BuildError as e:
-        pytest.fail(f"the C test FMUs cannot be built: {e}")
+    return str(build_test_fmus()["Features"][0])
 
 
 def driver(fmu, tmp_path, *args):

@@ -144,14 +144,21 @@ def test_killed_shard_resumes(tmp_path):
     assert_same_outputs(d / "result", local_run(study, tmp_path / "local"))
 
 
+def merge_refused(d, pattern):
+    """`uq-driver merge D` fails, with `pattern` (a regex) in its error and no result written;
+    returns the finished process."""
+    p = driver("merge", d, check=False)
+    assert p.returncode != 0
+    assert re.search(pattern, p.stderr), p.stderr
+    assert not (d / "result" / "summary.json").exists()
+    return p
+
+
 def test_merge_names_a_missing_shard(tmp_path):
     d = plan(write_study(tmp_path, "wheel-shards", samples=40), tmp_path / "plan")
     run_shards(d, (0, 1, 3))
-    p = driver("merge", d, check=False)
-    assert p.returncode != 0
-    assert re.search(r"\bshard 2\b", p.stderr), p.stderr
+    p = merge_refused(d, r"\bshard 2\b")
     assert not re.search(r"\bshard [013]\b", p.stderr), f"names a complete shard: {p.stderr}"
-    assert not (d / "result" / "summary.json").exists()
 
 
 def test_merge_names_a_shard_of_another_plan(tmp_path):
@@ -161,10 +168,7 @@ def test_merge_names_a_shard_of_another_plan(tmp_path):
     run_shards(d, (0, 1, 3))
     run_shards(other, (2,))
     shutil.copytree(other / "shards" / "2", d / "shards" / "2")
-    p = driver("merge", d, check=False)
-    assert p.returncode != 0
-    assert re.search(r"\bshard 2\b", p.stderr), p.stderr
-    assert not (d / "result" / "summary.json").exists()
+    merge_refused(d, r"\bshard 2\b")
 
 
 def test_merge_names_a_duplicated_point(tmp_path):
@@ -180,10 +184,7 @@ def test_merge_names_a_duplicated_point(tmp_path):
     (index,) = struct.unpack("<Q", first[4:12])
     with open(d / "shards" / "1" / "store" / "records.bin", "ab") as f:
         f.write(first)
-    p = driver("merge", d, check=False)
-    assert p.returncode != 0
-    assert re.search(rf"\bpoint {index}\b", p.stderr), p.stderr
-    assert not (d / "result" / "summary.json").exists()
+    merge_refused(d, rf"\bpoint {index}\b")
 
 
 def test_run_shard_outside_the_plan_is_refused(tmp_path):

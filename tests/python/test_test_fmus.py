@@ -6,10 +6,8 @@ closed forms, Gauss quadrature written here, the documented hash re-implemented 
 fmpy's own handling of inputs and early stops. A failing build is a failure, not a skip.
 """
 import ctypes
-import importlib.util
 import math
 import os
-import pathlib
 import shutil
 import signal
 import subprocess
@@ -25,9 +23,8 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2LastSuccessfulTime, fmi2Terminated
 from fmpy.validation import validate_fmu
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-BUILD_SCRIPT = ROOT / "uq-driver" / "tests" / "fmus" / "build.py"
-OUT_DIR = pathlib.Path(os.environ.get("RAILUQ_TEST_FMU_DIR", ROOT / "target" / "test-fmu"))
+from conftest import build_test_fmus
+
 NAMES = ["Functions", "Features"]
 
 FMI2_CS_FUNCTIONS = """
@@ -47,13 +44,7 @@ fmi2GetBooleanStatus fmi2GetStringStatus
 
 @pytest.fixture(scope="session")
 def built():
-    spec = importlib.util.spec_from_file_location("build_test_fmus", BUILD_SCRIPT)
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
-    try:
-        return build.build(OUT_DIR)
-    except build.BuildError as e:
-        pytest.fail(f"the C test FMUs cannot be built: {e}")
+    return build_test_fmus()
 
 
 @pytest.fixture(scope="session")

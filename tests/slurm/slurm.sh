@@ -32,23 +32,9 @@ have_all() {
   done
 }
 
-# apt-get, waiting (5 min at most) while another apt-get or dpkg holds its locks.
-apt_get() {
-  local i out
-  for i in $(seq 1 60); do
-    if out=$(apt-get -o DPkg::Lock::Timeout=300 "$@" 2>&1); then
-      return 0
-    fi
-    if ! grep -qiE 'could not get lock|unable to lock' <<<"$out"; then
-      echo "$out" | tail -20 >&2
-      return 1
-    fi
-    have_all && return 0  # someone else's install just finished
-    sleep 5
-  done
-  echo "$out" | tail -20 >&2
-  return 1
-}
+# apt_get (the waiting apt-get) and its hook apt_installed.
+. "$(dirname "${BASH_SOURCE[0]}")/../apt_get.sh"
+apt_installed() { have_all; }
 
 install_packages() {
   have_all && return 0

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::support::wheel::{self, read_csv};
-use crate::support::{driver, run_args, run_killed, stderr, summary};
+use crate::support::{assert_contains, driver, run_args, run_killed, stderr, summary};
 
 /// `uq-driver args` with the environment `env`.
 fn run(args: &[&str], env: &[(&str, &str)]) -> Output {
@@ -196,7 +196,7 @@ fn series_larger_than_the_memory_limit_are_run_and_analysed_in_blocks() {
     );
     assert!(!unblocked.status.success());
     let err = stderr(&unblocked);
-    assert!(err.contains("refused"), "{err}");
+    assert_contains(&err, "refused");
 }
 
 /// Under an address-space limit (`ulimit -v`) a study whose estimate fitted ran all its runs,

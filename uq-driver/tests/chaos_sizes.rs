@@ -16,7 +16,8 @@ use std::process::{Command, Output};
 
 use crate::support::refusal::assert_refused;
 use crate::support::{
-    driver, run_args, stderr, study_head, test_fmus, uniform, utf8, write_toml, DRIVER,
+    assert_contains, driver, run_args, stderr, study_head, test_fmus, uniform, utf8, write_toml,
+    DRIVER,
 };
 
 /// Random parameters the Functions FMU has (the g-function uses the first eight).
@@ -102,10 +103,9 @@ fn estimate_bytes(err: &str) -> f64 {
 /// it is refused before any run; it used to be estimated at 5 MiB and started.
 #[test]
 fn a_lars_study_whose_design_matrix_does_not_fit_is_refused_before_any_run() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let p = study(
         dir.path(),
         "lars",
@@ -152,10 +152,9 @@ fn binomial(n: usize, k: usize) -> f64 {
 /// 300 MB limit it is refused before any run; it used to be estimated at 22 MiB.
 #[test]
 fn a_sparse_grid_whose_surrogate_basis_does_not_fit_is_refused_before_any_run() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let p = study(
         dir.path(),
         "sg",
@@ -191,7 +190,7 @@ fn a_sparse_grid_whose_surrogate_basis_does_not_fit_is_refused_before_any_run() 
         Some("300000000"),
     );
     let err = stderr(&o);
-    assert!(err.contains("stopped after 1 of 9841 points"), "{err}");
+    assert_contains(&err, "stopped after 1 of 9841 points");
 }
 
 /// Points of the isotropic Gauss–Patterson grid of `level` in `d` dimensions: nested rules
@@ -211,10 +210,9 @@ fn patterson_points(d: usize, level: usize) -> f64 {
 /// as `run` does and as they do for a sampling study of as many runs.
 #[test]
 fn plan_of_a_large_sparse_grid_needs_yes() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let runs = patterson_points(18, 4);
     assert_eq!(runs, 105_601.0);
     let p = study(
@@ -260,10 +258,9 @@ fn plan_of_a_large_sparse_grid_needs_yes() {
 /// address space; making the points (the old refusal came after them) took 5 s and 820 MB.
 #[test]
 fn a_sparse_grid_over_the_point_cap_is_refused_before_its_points_are_made() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let points = patterson_points(20, 5);
     assert_eq!(points, 1_515_009.0);
     let p = study(

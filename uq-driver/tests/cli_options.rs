@@ -1,23 +1,31 @@
 //! Command-line consistency pinned: exact quantile column names through a whole study, and
 //! `merge` / `slurm` taking `--no-report` as `run` does.
 
+use std::path::{Path, PathBuf};
+
 use crate::support::wheel;
-use crate::support::{assert_same_files, read, run_ok, run_study, stderr, utf8};
+use crate::support::{
+    assert_contains, assert_same_files, failed, plan_and_run_shards, read, run_ok, run_study, utf8,
+};
 
 /// A short grid: the files, not the numbers, are under test.
 const EXPERIMENT: &str = "start = 0.0\nstop = 0.5\nstep = 0.05";
+
+/// `name.toml` in `dir`: the wheel study `name` with the seed `seed` over [`EXPERIMENT`] by
+/// `method`, with `rest` appended.
+fn mc_study(dir: &Path, name: &str, seed: u64, method: &str, rest: &str) -> PathBuf {
+    wheel::write_study(dir, name, name, seed, EXPERIMENT, method, rest)
+}
 
 /// `quantiles = [0.0015, 0.002, 0.9951]` gave the columns `q0.2,q0.2,q99.5`; the
 /// names are the percentages written out (0.15, 0.2, 99.51), in the CSV and the band plot.
 #[test]
 fn quantile_columns_of_a_study_name_each_level_exactly() {
     let dir = tempfile::tempdir().unwrap();
-    let study = wheel::write_study(
+    let study = mc_study(
         dir.path(),
         "qq",
-        "qq",
         1,
-        EXPERIMENT,
         "kind = \"mc\"\nsamples = 16",
         "[analysis]\nquantiles = [0.0015, 0.002, 0.9951]",
     );
@@ -34,22 +42,16 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
         assert!(band.contains(name), "{name} not in the band plot");
     }
     // A level given twice is refused before anything runs.
-    let twice = wheel::write_study(
+    let twice = mc_study(
         dir.path(),
         "q2",
-        "q2",
         1,
-        EXPERIMENT,
         "kind = \"mc\"\nsamples = 16",
         "[analysis]\nquantiles = [0.5, 0.99, 0.5]",
     );
     let o = run_study(&twice, &dir.path().join("o2"), &[]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
-    assert!(
-        err.contains("quantiles 0.5 and 0.5 both give the column 'q50'"),
-        "{err}"
-    );
+    let err = failed(&o);
+    assert_contains(&err, "quantiles 0.5 and 0.5 both give the column 'q50'");
     assert!(!dir.path().join("o2/q.csv").exists());
 }
 
@@ -59,23 +61,12 @@ fn quantile_columns_of_a_study_name_each_level_exactly() {
 #[test]
 fn merge_and_slurm_take_no_report_as_run_does() {
     let dir = tempfile::tempdir().unwrap();
-    let study = wheel::write_study(
-        dir.path(),
-        "nr",
-        "nr",
-        3,
-        EXPERIMENT,
-        "kind = \"mc\"\nsamples = 12",
-        "",
-    );
+    let study = mc_study(dir.path(), "nr", 3, "kind = \"mc\"\nsamples = 12", "");
     let plan = dir.path().join("plan");
-    run_ok(&["plan", utf8(&study), "--shards", "2", "--out", utf8(&plan)]);
-    for k in ["0", "1"] {
-        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
-    }
+    plan_and_run_shards(&study, &plan, 2);
     let bare = dir.path().join("bare");
     let said = run_ok(&["merge", utf8(&plan), "--out", utf8(&bare), "--no-report"]);
-    assert!(said.contains("no report"), "{said}");
+    assert_contains(&said, "no report");
     let full = dir.path().join("full");
     run_ok(&["merge", utf8(&plan), "--out", utf8(&full)]);
     assert!(full.join("index.html").exists());
@@ -93,34 +84,28 @@ fn merge_and_slurm_take_no_report_as_run_does() {
     assert_eq!(svgs, 0, "plots written with --no-report");
     assert_same_files(&bare, &full, &["q.csv", "points.csv"]);
     // slurm --dry-run writes the scripts; the merge job carries the option.
-    let sl = dir.path().join("sl");
-    run_ok(&[
-        "slurm",
-        utf8(&study),
-        "--shards",
-        "2",
-        "--out",
-        utf8(&sl),
-        "--dry-run",
-        "--no-report",
-    ]);
-    let merge = read(&sl.join("slurm/merge.sbatch"));
+    // The merge job's script of `slurm --dry-run` into `name` with the arguments `extra`.
+    let merge_job = |name: &str, extra: &[&str]| {
+        let sl = dir.path().join(name);
+        let dry = [
+            "slurm",
+            utf8(&study),
+            "--shards",
+            "2",
+            "--out",
+            utf8(&sl),
+            "--dry-run",
+        ];
+        run_ok(&[&dry[..], extra].concat());
+        read(&sl.join("slurm/merge.sbatch"))
+    };
+    let merge = merge_job("sl", &["--no-report"]);
     let last = merge.lines().last().unwrap();
     assert!(
         last.starts_with("exec ") && last.ends_with(" --no-report"),
         "{last}"
     );
-    let sl2 = dir.path().join("sl2");
-    run_ok(&[
-        "slurm",
-        utf8(&study),
-        "--shards",
-        "2",
-        "--out",
-        utf8(&sl2),
-        "--dry-run",
-    ]);
-    let merge = read(&sl2.join("slurm/merge.sbatch"));
+    let merge = merge_job("sl2", &[]);
     assert!(!merge.contains("--no-report"), "{merge}");
 }
 
@@ -148,9 +133,9 @@ fn threads_0_is_refused_in_the_command_s_terms() {
     let o = crate::support::run(&["run", "x.toml", "--out", "o", "--threads", "0"]);
     let err = crate::support::stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("0 threads cannot run anything: give at least 1, or leave --threads out"),
-        "{err}"
+    assert_contains(
+        &err,
+        "0 threads cannot run anything: give at least 1, or leave --threads out",
     );
     assert!(!err.contains("NonZero") && !err.contains("usize"), "{err}");
 }

@@ -7,6 +7,8 @@ use std::fmt::Write as _;
 use uq_driver::fmu::description::ParseLimits;
 use uq_driver::fmu::{Causality, DescriptionError, ModelDescription, VariableKind};
 
+use crate::support::assert_contains;
+
 /// A valid description with `n` Real variables `v0..v{n-1}` (every tenth a tunable parameter
 /// with a start value, the others outputs), one per line, listed as outputs.
 fn many_variables(n: usize) -> String {
@@ -85,7 +87,7 @@ fn deep_nesting_bomb_is_refused_naming_the_limit() {
         }
     );
     let text = err.to_string();
-    assert!(text.contains("nested more than 256 deep"), "{text}");
+    assert_contains(&text, "nested more than 256 deep");
     // Exactly at the limit is fine; one more level is not.
     let nest = |levels: usize| {
         let inner = levels - 2; // below the root and <x>
@@ -146,10 +148,7 @@ fn huge_invalid_attribute_is_quoted_briefly_in_the_error() {
     let err = ModelDescription::parse(xml.as_bytes()).unwrap_err();
     let text = err.to_string();
     assert!(text.len() < 1000, "{} bytes", text.len());
-    assert!(
-        text.contains(&format!("({} bytes in all)", big.len())),
-        "{text}"
-    );
+    assert_contains(&text, &format!("({} bytes in all)", big.len()));
 }
 
 #[test]
@@ -203,11 +202,8 @@ fn utf16_description_says_fmi_requires_utf8() {
         let err = ModelDescription::parse(&utf16(&xml, big_endian, bom)).unwrap_err();
         assert!(matches!(err, DescriptionError::NotUtf8 { .. }), "{err:?}");
         let text = err.to_string();
-        assert!(text.contains(what), "{text}");
-        assert!(
-            text.contains("FMI 2.0 requires modelDescription.xml in UTF-8"),
-            "{text}"
-        );
+        assert_contains(&text, what);
+        assert_contains(&text, "FMI 2.0 requires modelDescription.xml in UTF-8");
     }
     let mut utf32 = vec![0xFF, 0xFE, 0, 0];
     utf32.extend(xml.chars().flat_map(|c| (c as u32).to_le_bytes()));
@@ -226,7 +222,7 @@ fn latin1_description_is_refused_with_the_position_of_the_first_bad_byte() {
     let latin1: Vec<u8> = xml.chars().map(|c| c as u32 as u8).collect();
     let err = ModelDescription::parse(&latin1).unwrap_err();
     let text = err.to_string();
-    assert!(text.contains("byte 0xE9 at line 5"), "{text}");
+    assert_contains(&text, "byte 0xE9 at line 5");
     // Valid UTF-8 bytes, but declared as Latin-1: ambiguous, refused.
     let err = ModelDescription::parse(xml.as_bytes()).unwrap_err();
     assert!(text_has(&err, "declares encoding=\"ISO-8859-1\""), "{err}");

@@ -16,7 +16,7 @@ use uq_driver::fmu::{
 };
 use zip::write::SimpleFileOptions;
 
-use crate::support::{run, run_study, stderr, test_fmus, utf8};
+use crate::support::{assert_contains, failed, run, run_study, stderr, test_fmus, utf8};
 
 const MANIFEST_DIR: &str = env!("CARGO_MANIFEST_DIR");
 const GUID: &str = "{6a1c2d9e-3b7f-4e0a-9d51-uq-driver-test}";
@@ -108,6 +108,25 @@ fn write_zip(path: &Path, entries: &[Entry<'_>]) {
         }
     }
     fs::write(path, w.finish().unwrap().into_inner()).unwrap();
+}
+
+/// The error of opening the FMU `name` (without a binary) whose model description is the C
+/// FMU's with `from` replaced by `to`.
+fn open_edited(name: &str, from: &str, to: &str) -> FmuError {
+    let dir = tempfile::tempdir().unwrap();
+    let xml = model_description().replace(from, to);
+    Fmu::open(&write_fmu(dir.path(), name, &xml, None)).unwrap_err()
+}
+
+/// The error of opening `dir/name`, an archive of the C FMU's model description and `entry`.
+fn open_with_entry(dir: &Path, name: &str, entry: Entry<'_>) -> FmuError {
+    let path = dir.join(name);
+    let xml = model_description();
+    write_zip(
+        &path,
+        &[Entry::File("modelDescription.xml", xml.as_bytes()), entry],
+    );
+    Fmu::open(&path).unwrap_err()
 }
 
 /// Packs `xml` and optionally a binary as `binaries/linux64/dahlquist.so` into `dir/name`.
@@ -297,15 +316,13 @@ fn fmu_log_messages_arrive_in_errors() {
         other => panic!("unexpected error {other}"),
     }
     let text = err.to_string();
-    assert!(
-        text.contains("Dahlquist.fmu: fmi2SetReal returned Error for instance 'quiet'"),
-        "{text}"
+    assert_contains(
+        &text,
+        "Dahlquist.fmu: fmi2SetReal returned Error for instance 'quiet'",
     );
-    assert!(
-        text.contains(
-            "[Error] logStatusError: fmi2SetReal: unknown or read-only value reference 99"
-        ),
-        "{text}"
+    assert_contains(
+        &text,
+        "[Error] logStatusError: fmi2SetReal: unknown or read-only value reference 99",
     );
     assert_eq!(inst.state(), InstanceState::Error);
     inst.reset().unwrap();
@@ -338,15 +355,8 @@ fn fmu_log_messages_arrive_in_errors() {
     inst.enter_initialization_mode().unwrap();
     inst.exit_initialization_mode().unwrap();
     let err = inst.do_step(0.0, -0.1, true).unwrap_err();
-    assert!(
-        err.to_string().contains("fmi2DoStep returned Error"),
-        "{err}"
-    );
-    assert!(
-        err.to_string()
-            .contains("step size must be positive, got -0.1"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "fmi2DoStep returned Error");
+    assert_contains(&err.to_string(), "step size must be positive, got -0.1");
     drop(inst);
 
     // With logging on, the FMU's informational messages are kept too.
@@ -406,10 +416,7 @@ fn fmu_state_round_trips_and_serializes() {
     ));
     // ... or return the FMU's error.
     let err = inst.cancel_step().unwrap_err();
-    assert!(
-        err.to_string().contains("fmi2CancelStep is not supported"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "fmi2CancelStep is not supported");
 }
 
 #[test]
@@ -500,14 +507,8 @@ fn binary_missing_a_function_is_refused_by_name() {
         "{err}"
     );
     let text = err.to_string();
-    assert!(
-        text.contains("NoStep.fmu/binaries/linux64/dahlquist.so"),
-        "{text}"
-    );
-    assert!(
-        text.contains("does not export the required function fmi2DoStep"),
-        "{text}"
-    );
+    assert_contains(&text, "NoStep.fmu/binaries/linux64/dahlquist.so");
+    assert_contains(&text, "does not export the required function fmi2DoStep");
 }
 
 #[test]
@@ -521,10 +522,7 @@ fn wrong_guid_makes_instantiation_fail_with_the_fmu_message() {
     let fmu = Fmu::open(&path).unwrap();
     let err = fmu.instantiate("g", false).unwrap_err();
     assert!(matches!(err, FmuError::InstantiateFailed { .. }), "{err}");
-    assert!(
-        err.to_string().contains("wrong GUID {another-guid}"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "wrong GUID {another-guid}");
     assert_eq!(live_instances(&fmu), 0);
 }
 
@@ -555,48 +553,32 @@ fn zip_without_model_description_is_reported() {
         matches!(err, FmuError::MissingModelDescription { .. }),
         "{err}"
     );
-    assert!(err.to_string().contains("no modelDescription.xml"), "{err}");
+    assert_contains(&err.to_string(), "no modelDescription.xml");
 }
 
 #[test]
 fn malformed_xml_is_reported_with_its_position() {
-    let dir = tempfile::tempdir().unwrap();
-    let xml = model_description().replace("</ModelVariables>", "</ModelVariablez>");
-    let path = write_fmu(dir.path(), "bad.fmu", &xml, None);
-    let err = Fmu::open(&path).unwrap_err();
+    let err = open_edited("bad.fmu", "</ModelVariables>", "</ModelVariablez>");
     assert!(
         matches!(err, FmuError::MalformedXml { line, .. } if line > 40),
         "{err}"
     );
-    assert!(
-        err.to_string()
-            .contains("malformed modelDescription.xml at line"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "malformed modelDescription.xml at line");
 }
 
 #[test]
 fn fmi_1_0_is_refused_naming_the_version() {
-    let dir = tempfile::tempdir().unwrap();
-    let xml = model_description().replace("fmiVersion=\"2.0\"", "fmiVersion=\"1.0\"");
-    let path = write_fmu(dir.path(), "v1.fmu", &xml, None);
-    let err = Fmu::open(&path).unwrap_err();
+    let err = open_edited("v1.fmu", "fmiVersion=\"2.0\"", "fmiVersion=\"1.0\"");
     assert!(
         matches!(&err, FmuError::UnsupportedFmiVersion { found, .. } if found == "1.0"),
         "{err}"
     );
-    assert!(
-        err.to_string().contains("unsupported FMI version \"1.0\""),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "unsupported FMI version \"1.0\"");
 }
 
 #[test]
 fn model_exchange_only_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let xml = model_description().replace("<CoSimulation", "<ModelExchange");
-    let path = write_fmu(dir.path(), "me.fmu", &xml, None);
-    let err = Fmu::open(&path).unwrap_err();
+    let err = open_edited("me.fmu", "<CoSimulation", "<ModelExchange");
     assert!(
         matches!(
             err,
@@ -607,25 +589,21 @@ fn model_exchange_only_is_refused() {
         ),
         "{err}"
     );
-    assert!(err.to_string().contains("Model Exchange FMU only"), "{err}");
+    assert_contains(&err.to_string(), "Model Exchange FMU only");
 }
 
 #[test]
 fn missing_binary_names_the_expected_file() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("nobin.fmu");
-    write_zip(
-        &path,
-        &[
-            Entry::File("modelDescription.xml", model_description().as_bytes()),
-            Entry::File("binaries/win64/dahlquist.dll", b"MZ"),
-        ],
+    let err = open_with_entry(
+        dir.path(),
+        "nobin.fmu",
+        Entry::File("binaries/win64/dahlquist.dll", b"MZ"),
     );
-    let err = Fmu::open(&path).unwrap_err();
     assert!(matches!(err, FmuError::MissingBinary { .. }), "{err}");
     let text = err.to_string();
-    assert!(text.contains("binaries/linux64/dahlquist.so"), "{text}");
-    assert!(text.contains("binaries/ has: win64"), "{text}");
+    assert_contains(&text, "binaries/linux64/dahlquist.so");
+    assert_contains(&text, "binaries/ has: win64");
 }
 
 #[test]
@@ -636,67 +614,45 @@ fn binary_that_is_not_a_library_is_a_load_error() {
     let path = write_fmu(dir.path(), "junk.fmu", &model_description(), Some(&junk));
     let err = Fmu::open(&path).unwrap_err();
     assert!(matches!(err, FmuError::Load { .. }), "{err}");
-    assert!(
-        err.to_string().contains("cannot load the FMU binary"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "cannot load the FMU binary");
 }
 
 #[test]
 fn zip_slip_entry_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let probe = std::env::temp_dir().join("uq-driver-zip-slip-probe.txt");
-    let path = dir.path().join("slip.fmu");
-    write_zip(
-        &path,
-        &[
-            Entry::File("modelDescription.xml", model_description().as_bytes()),
-            Entry::File("../uq-driver-zip-slip-probe.txt", b"escaped"),
-        ],
+    let err = open_with_entry(
+        dir.path(),
+        "slip.fmu",
+        Entry::File("../uq-driver-zip-slip-probe.txt", b"escaped"),
     );
-    let err = Fmu::open(&path).unwrap_err();
     assert!(
         matches!(&err, FmuError::UnsafeEntry { entry, .. } if entry == "../uq-driver-zip-slip-probe.txt"),
         "{err}"
     );
-    assert!(
-        err.to_string().contains("escapes the extraction folder"),
-        "{err}"
-    );
+    assert_contains(&err.to_string(), "escapes the extraction folder");
     assert!(!probe.exists());
 }
 
 #[test]
 fn absolute_path_entry_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("abs.fmu");
     let target = dir.path().join("absolute-target.txt");
     let name = target.to_string_lossy().into_owned();
-    write_zip(
-        &path,
-        &[
-            Entry::File("modelDescription.xml", model_description().as_bytes()),
-            Entry::File(&name, b"absolute"),
-        ],
-    );
-    let err = Fmu::open(&path).unwrap_err();
+    let err = open_with_entry(dir.path(), "abs.fmu", Entry::File(&name, b"absolute"));
     assert!(matches!(err, FmuError::UnsafeEntry { .. }), "{err}");
-    assert!(err.to_string().contains("absolute path"), "{err}");
+    assert_contains(&err.to_string(), "absolute path");
     assert!(!target.exists());
 }
 
 #[test]
 fn symlink_entry_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("link.fmu");
-    write_zip(
-        &path,
-        &[
-            Entry::File("modelDescription.xml", model_description().as_bytes()),
-            Entry::Symlink("resources/passwd", "/etc/passwd"),
-        ],
+    let err = open_with_entry(
+        dir.path(),
+        "link.fmu",
+        Entry::Symlink("resources/passwd", "/etc/passwd"),
     );
-    let err = Fmu::open(&path).unwrap_err();
     assert!(
         matches!(&err, FmuError::UnsafeEntry { entry, reason, .. } if entry == "resources/passwd" && reason == "symbolic link"),
         "{err}"
@@ -718,13 +674,9 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     let fmu = write_fmu(dir.path(), "Fixed.fmu", &xml, Some(&bins.full));
     let simulate = |stop: &str| run(&["simulate", utf8(&fmu), "--stop", stop, "--step", "0.1"]);
     let o = simulate("1.05");
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("canHandleVariableCommunicationStepSize"),
-        "{err}"
-    );
-    assert!(err.contains("give a stop time of 1 or 1.1 s"), "{err}");
+    let err = failed(&o);
+    assert_contains(&err, "canHandleVariableCommunicationStepSize");
+    assert_contains(&err, "give a stop time of 1 or 1.1 s");
     assert!(simulate("1.0").status.success());
     let study = dir.path().join("s.toml");
     fs::write(
@@ -739,12 +691,8 @@ fn a_shorter_last_step_is_refused_for_an_fmu_that_cannot_vary_its_step() {
     )
     .unwrap();
     let o = run_study(&study, &dir.path().join("out"), &[]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("canHandleVariableCommunicationStepSize"),
-        "{err}"
-    );
+    let err = failed(&o);
+    assert_contains(&err, "canHandleVariableCommunicationStepSize");
 }
 
 /// An FMU whose `<ModelStructure/>` is empty although it has outputs was read as having no
@@ -761,12 +709,10 @@ fn an_empty_model_structure_with_outputs_is_an_invalid_model_description() {
     let o = run(&["simulate", utf8(&fmu), "--stop", "1", "--step", "0.5"]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains(
-            "invalid modelDescription.xml: variable 'x' (index 1) has causality=\"output\", \
-             but ModelStructure/Outputs does not list it"
-        ),
-        "{err}"
+    assert_contains(
+        &err,
+        "invalid modelDescription.xml: variable 'x' (index 1) has causality=\"output\", \
+             but ModelStructure/Outputs does not list it",
     );
     assert!(!err.contains("nothing to record"), "{err}");
 }
@@ -793,7 +739,7 @@ fn simulate_output_time_writes_the_time_column_once() {
     // x = exp(-t) exactly at the communication points (the C FMU's exact update).
     let x: f64 = lines[2].split(',').nth(1).unwrap().parse().unwrap();
     assert!((x - (-0.1f64).exp()).abs() < 1e-12, "{x}");
-    assert!(err.contains("--output time adds no second one"), "{err}");
+    assert_contains(&err, "--output time adds no second one");
     // Only the time: the FMU's independent variable, one column.
     let o = run(&[&args[..], &["--output", "time"]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
@@ -817,8 +763,5 @@ fn simulate_without_a_default_step_takes_the_step_fmpy_takes() {
     let rows: Vec<&str> = out.lines().skip(1).collect();
     assert_eq!(rows.len(), 501, "0 to 1 s by 0.002 s");
     assert_eq!(rows[1].split(',').next(), Some("0.002"));
-    assert!(
-        err.contains("communication step 0.002 s (500 steps"),
-        "{err}"
-    );
+    assert_contains(&err, "communication step 0.002 s (500 steps");
 }

@@ -8,7 +8,8 @@ use std::process::Output;
 use uq_driver::fmu::Fmu;
 
 use crate::support::{
-    csv_records, read, run, run_args, stderr, stdout, study_head, test_fmus, utf8, write_toml,
+    assert_contains, csv_records, failed, read, run, run_args, stderr, stdout, study_head,
+    test_fmus, utf8, write_toml,
 };
 
 /// A Monte Carlo study of the Once FMU: x ~ U(0, 2), y recorded on [0, 1] by 0.1.
@@ -29,10 +30,9 @@ fn once_study(dir: &Path, fmu: &Path) -> PathBuf {
 
 #[test]
 fn an_fmu_instantiable_once_per_process_runs_on_every_thread_with_a_library_copy_each() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Once") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = once_study(dir.path(), &fmu);
     let mut files = Vec::new();
     for threads in ["1", "4"] {
@@ -104,48 +104,44 @@ fn private_copies_of_a_library_keep_globals_apart() {
 }
 
 /// Runs a study of the Once FMU with `method`, `parameter` (a `[[parameters]]` body for x)
-/// and `fixed` (the `[fixed]` body) into `dir/out` with `--no-report` and `extra` arguments;
-/// returns that folder and the run.
+/// and `fixed` (the `[fixed]` body) into `out` of a new temporary folder with `--no-report`
+/// and `extra` arguments; returns that folder, the FMU, `out` and the run, or `None` when the
+/// test FMUs cannot be built.
 fn run_once(
-    dir: &Path,
-    fmu: &Path,
     [method, parameter, fixed]: [&str; 3],
     extra: &[&str],
-) -> (PathBuf, Output) {
+) -> Option<(tempfile::TempDir, PathBuf, PathBuf, Output)> {
+    let (fmu, dir) = test_fmus::test_fmu_and_dir("Once")?;
     let study = write_toml(
-        dir,
+        dir.path(),
         "s",
         &format!(
             "{}\
              [method]\n{method}\n[[parameters]]\nname = \"x\"\n{parameter}\n\
              [fixed]\n{fixed}\n[outputs]\nvariables = [\"y\"]\n",
-            study_head("s", fmu, 7, "stop = 0.3\nstep = 0.1")
+            study_head("s", &fmu, 7, "stop = 0.3\nstep = 0.1")
         ),
     );
-    let out = dir.join("out");
+    let out = dir.path().join("out");
     let mut args = run_args(&study, &out, &["--no-report"]);
     args.extend_from_slice(extra);
     let o = run(&args);
-    (out, o)
+    Some((dir, fmu, out, o))
 }
 
 #[test]
 fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
     // x declares [-10, 10]; N(0, 6) puts about 10 % of the draws outside.
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, _, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 200",
             "distribution = \"normal\"\nmean = 0\nstd = 6",
             "step_delay = 0",
         ],
         &[],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
     let points = read(&out.join("points.csv"));
@@ -167,64 +163,51 @@ fn design_points_outside_the_declared_min_max_are_warned_with_their_weight() {
     // Printed before the runs, and not a second time with the final warnings.
     assert_eq!(stderr.matches(&want).count(), 1, "{stderr}");
     let summary = read(&out.join("summary.json"));
-    assert!(summary.contains(&want), "{summary}");
+    assert_contains(&summary, &want);
 }
 
 #[test]
 fn a_distribution_wholly_outside_the_declared_min_max_is_refused_before_any_run() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, fmu, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 4",
             "distribution = \"uniform\"\nlow = 20\nhigh = 30",
             "step_delay = 0",
         ],
         &[],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(!o.status.success(), "{stderr}");
-    assert!(
-        stderr.contains(
-            "random parameter 'x' takes values in [20, 30], wholly outside the range [-10, 10]"
-        ),
-        "{stderr}"
+    assert_contains(
+        &stderr,
+        "random parameter 'x' takes values in [20, 30], wholly outside the range [-10, 10]",
     );
     assert!(!out.join("store").exists());
     // simulate --set outside the range: a warning, and the run.
     let o = run(&["simulate", utf8(&fmu), "--set", "x=12"]);
     let stderr = crate::support::stderr(&o);
     assert!(o.status.success(), "{stderr}");
-    assert!(
-        stderr.contains("x = 12 is outside the range [-10, 10]"),
-        "{stderr}"
-    );
+    assert_contains(&stderr, "x = 12 is outside the range [-10, 10]");
     let o = run(&["inspect", utf8(&fmu)]);
     let stdout = stdout(&o);
-    assert!(stdout.contains("range [-10, 10] slope"), "{stdout}");
+    assert_contains(&stdout, "range [-10, 10] slope");
 }
 
 #[test]
 fn huge_and_escaped_fmu_log_messages_are_cut_before_reaching_points_csv_and_the_store() {
-    let Some(fmu) = test_fmus::test_fmu("Once") else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
     // Every step logs 1 MB (a colour escape first); points with x > 1 fail with such a message.
-    let (out, o) = run_once(
-        dir.path(),
-        &fmu,
+    let Some((_dir, _, out, o)) = run_once(
         [
             "kind = \"mc\"\nsamples = 12",
             "distribution = \"uniform\"\nlow = 0\nhigh = 2",
             "log_bytes = 1000000\nfail_above = 1",
         ],
         &["--allow-failures"],
-    );
+    ) else {
+        return;
+    };
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
     let points = read(&out.join("points.csv"));
@@ -261,7 +244,7 @@ fn inspect_prints_a_huge_start_value_in_exponent_form() {
         .lines()
         .find(|l| l.trim_start().starts_with("fail_above"))
         .expect("fail_above listed");
-    assert!(line.contains(" 1e300 "), "{line}");
+    assert_contains(line, " 1e300 ");
     assert!(line.len() < 200, "{line}");
 }
 
@@ -281,8 +264,7 @@ fn simulate_set_of_an_integer_outside_its_range_is_refused_as_a_fixed_one_is() {
         "--stop",
         "0.1",
     ]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
+    let err = failed(&o);
     assert!(
         err.contains("'misbehave' is an Integer declared with min = 0, max = 12")
             && err.contains("the value 13 given for it is outside that range"),

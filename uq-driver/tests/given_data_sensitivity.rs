@@ -7,9 +7,9 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-use crate::study_chaos::{borehole_parameters, run_functions};
+use crate::study_chaos::{borehole_parameters, run_functions, run_ishigami};
 use crate::support::csv::Csv;
-use crate::support::{benchmarks, read, summary, test_fmus, uniform};
+use crate::support::{assert_contains, benchmarks, read, summary, test_fmus};
 
 /// An unreplicated Latin hypercube of 2 000 runs.
 const LHS_2000: &str = "kind = \"lhs\"\nsamples = 2000";
@@ -27,19 +27,21 @@ fn first_order(out: &Path, p: &str) -> (f64, [f64; 2]) {
 /// The Ishigami function's inputs, uniform on [-π, π].
 const ISHIGAMI_INPUTS: [&str; 3] = ["x1", "x2", "x3"];
 
-/// Runs the Ishigami function (function 1 of the test FMU) by `method` into `dir/name`.
-fn ishigami(dir: &Path, name: &str, method: &str) -> PathBuf {
-    run_functions(dir, name, 1, &uniform(&ISHIGAMI_INPUTS, -PI, PI), method)
+/// Runs the Ishigami function (function 1 of the test FMU) by `method` into `name` of a new
+/// temporary folder; returns the folder and `name`, or `None` when the test FMUs cannot be
+/// built.
+fn ishigami(name: &str, method: &str) -> Option<(tempfile::TempDir, PathBuf)> {
+    let dir = test_fmus::dir_if_built()?;
+    let out = run_ishigami(dir.path(), name, method);
+    Some((dir, out))
 }
 
 #[test]
 fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
-    if test_fmus::built().is_none() {
+    let Some((_dir, out)) = ishigami("ishigami", LHS_2000) else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let names = ISHIGAMI_INPUTS;
-    let out = ishigami(dir.path(), "ishigami", LHS_2000);
     // Closed form (a = 7, b = 0.1): V1 = (1 + b pi^4 / 5)^2 / 2, V2 = a^2 / 8, V3 = 0.
     let (a, b) = (7.0f64, 0.1f64);
     let var = a * a / 8.0 + b * PI.powi(4) / 5.0 + b * b * PI.powi(8) / 18.0 + 0.5;
@@ -92,12 +94,10 @@ fn lhs_of_2000_runs_gives_the_ishigami_first_order_indices_within_0_05() {
 
 #[test]
 fn the_page_of_an_lhs_study_has_the_scatter_plots_and_the_given_data_bars() {
-    if test_fmus::built().is_none() {
+    let Some((_dir, out)) = ishigami("scatter", "kind = \"lhs\"\nsamples = 200") else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let names = ISHIGAMI_INPUTS;
-    let out = ishigami(dir.path(), "scatter", "kind = \"lhs\"\nsamples = 200");
     let page = read(&out.join("index.html"));
     assert!(
         page.contains("Y_scatter.svg"),
@@ -265,8 +265,5 @@ fn correlated_inputs_give_the_first_order_indices_of_the_physical_inputs() {
         assert!((rho - spearman_exact).abs() < 0.03, "Spearman {p} = {rho}");
     }
     let warnings = sum["warnings"].to_string();
-    assert!(
-        warnings.contains("those of the physical parameters"),
-        "{warnings}"
-    );
+    assert_contains(&warnings, "those of the physical parameters");
 }

@@ -15,7 +15,10 @@ use uq_driver::spec::FixedValue;
 use uq_driver::study::simulate;
 
 use crate::support::csv::Csv;
-use crate::support::{built_fmu, read, run_ok, run_study, run_study_ok, stderr, summary, utf8};
+use crate::support::{
+    assert_contains, built_fmu, failed, read, run_sharded, run_study, run_study_ok, summary, utf8,
+    write_file,
+};
 
 /// Settings of the fast configuration.
 const DURATION: f64 = 60.0;
@@ -29,6 +32,14 @@ const TOLERANCE: f64 = 0.1;
 
 fn bogie_fmu() -> PathBuf {
     built_fmu("Bogie")
+}
+
+/// A new temporary folder with the study `s.toml` of [`study_text`] by `method` between
+/// [`LOW`] and [`HIGH`].
+fn study_in_new_dir(method: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_file(dir.path(), "s.toml", study_text(method, LOW, HIGH));
+    (dir, study)
 }
 
 /// A study of the bogie's hunting speed: `method` (TOML inline table), the bracket.
@@ -80,9 +91,7 @@ fn hunts_directly(fmu: &Fmu, params: &[(&str, f64)], speed: f64) -> bool {
 
 #[test]
 fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
-    let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(&study, study_text("kind = \"nominal\"", LOW, HIGH)).unwrap();
+    let (dir, study) = study_in_new_dir("kind = \"nominal\"");
     let out = dir.path().join("out");
     let stdout = run_study_ok(&study, &out, &[]);
     let (_, hunt) = samples(&out, "v_hunt");
@@ -126,13 +135,7 @@ fn bisection_critical_speed_against_a_direct_scan_of_constant_speed_runs() {
 
 #[test]
 fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_and_sharded() {
-    let dir = tempfile::tempdir().unwrap();
-    let study = dir.path().join("s.toml");
-    std::fs::write(
-        &study,
-        study_text("kind = \"scm\"\nnodes = 2\norder = 1", LOW, HIGH),
-    )
-    .unwrap();
+    let (dir, study) = study_in_new_dir("kind = \"scm\"\nnodes = 2\norder = 1");
     let base = dir.path().join("in-process");
     run_study_ok(&study, &base, &["-t", "2"]);
     let (text, hunt) = samples(&base, "v_hunt");
@@ -170,13 +173,7 @@ fn hunting_speed_uses_each_points_parameters_and_is_the_same_isolated_resumed_an
     assert!(stdout.contains("(3 resumed)"));
     assert_eq!(samples(&resumed, "v_hunt").0, text);
     // Two shards, merged.
-    let plan = dir.path().join("plan");
-    let (s, p) = (utf8(&study), utf8(&plan));
-    run_ok(&["plan", s, "--shards", "2", "--out", p]);
-    run_ok(&["run-shard", p, "--shard", "0"]);
-    run_ok(&["run-shard", p, "--shard", "1"]);
-    let merged = dir.path().join("merged");
-    run_ok(&["merge", p, "--out", utf8(&merged)]);
+    let merged = run_sharded(&study, dir.path(), 2, "merged");
     assert_eq!(samples(&merged, "v_hunt").0, text);
 }
 
@@ -198,13 +195,12 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
     ] {
         std::fs::write(&study, study_text("kind = \"nominal\"", low, high)).unwrap();
         let o = run_study(&study, &dir.path().join(format!("out{low}")), &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(
             err.contains("quantity 'v_hunt'") && err.contains(needle),
             "{err}"
         );
-        assert!(err.contains("widen the bracket"), "{err}");
+        assert_contains(&err, "widen the bracket");
     }
     // A weighted design with a point outside: the same message, and a hint.
     std::fs::write(
@@ -213,11 +209,10 @@ fn a_bracket_without_the_transition_is_a_clear_error() {
     )
     .unwrap();
     let o = run_study(&study, &dir.path().join("scm"), &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
-    assert!(
-        err.contains("widen the bracket (or use a method that can leave points out"),
-        "{err}"
+    let err = failed(&o);
+    assert_contains(
+        &err,
+        "widen the bracket (or use a method that can leave points out",
     );
 }
 
@@ -239,8 +234,7 @@ fn a_nested_study_whose_bracket_misses_the_transition_names_the_bracket() {
     assert!(text.contains("level = \"outer\""));
     std::fs::write(&study, text).unwrap();
     let o = run_study(&study, &dir.path().join("nested"), &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert!(
         err.contains("quantity 'v_hunt'")
             && err.contains("the top of the bracket (high = 69)")
@@ -286,8 +280,7 @@ fn settings_that_do_not_fit_the_fmu_are_refused_before_any_run() {
         std::fs::write(&study, text).unwrap();
         let out = dir.path().join("out");
         let o = run_study(&study, &out, &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(err.contains(needle), "{err} should mention {needle}");
         assert!(
             !out.join("store").exists()
@@ -370,9 +363,9 @@ fn suite_variants_that_leave_a_quantity_out_are_compared_by_name() {
         .unwrap();
     let text = uq_driver::results::numbers::to_spread(mean(1, 0), std_b);
     assert!(cells[4].contains(&text), "{text} not in {row_b}");
-    assert!(
-        html.contains("<th>mean end [m]</th><th>Std end [m]</th><th>mean peak [m]</th>"),
-        "{html}"
+    assert_contains(
+        &html,
+        "<th>mean end [m]</th><th>Std end [m]</th><th>mean peak [m]</th>",
     );
     assert_eq!(&cells[6..], ["></td>", "></td>"], "{row_b}");
 }

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    built_fmu, edit, read, read_json, run, run_study, run_study_ok, stderr, succeeded, test_fmus,
-    utf8, write_toml,
+    assert_contains, built_fmu, edit, failed, read, read_json, run, run_study, run_study_ok,
+    stderr, succeeded, test_fmus, utf8, write_toml,
 };
 
 fn features() -> Option<PathBuf> {
@@ -21,9 +21,12 @@ fn read_csv(text: &str) -> Csv {
     Csv::parse(text).numeric()
 }
 
-fn simulate(fmu: &Path, args: &[&str]) -> (String, String) {
+/// `uq-driver simulate FMU` with the arguments `line` (split at white space) and then `extra`,
+/// which must succeed; returns its standard output and standard error.
+fn simulate(fmu: &Path, line: &str, extra: &[&str]) -> (String, String) {
     let mut all = vec!["simulate", utf8(fmu)];
-    all.extend_from_slice(args);
+    all.extend(line.split_whitespace());
+    all.extend_from_slice(extra);
     let o = run(&all);
     let stderr = stderr(&o);
     assert!(o.status.success(), "{stderr}");
@@ -35,18 +38,8 @@ fn integer_boolean_enumeration_and_string_parameters_reach_the_fmu() {
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "int_param=-17",
-            "--set",
-            "bool_param=true",
-            "--set",
-            "enum_param=3",
-            "--set",
-            "string_param=grüße, 世界",
-            "--step",
-            "0.5",
-        ],
+        "--set int_param=-17 --set bool_param=true --set enum_param=3 --step 0.5",
+        &["--set", "string_param=grüße, 世界"],
     );
     let csv = read_csv(&out);
     assert_eq!(csv.col("int_out"), [-17.0; 3]);
@@ -61,7 +54,7 @@ fn integer_boolean_enumeration_and_string_parameters_reach_the_fmu() {
 fn simulate_without_outputs_records_every_number_and_names_the_string_it_skips() {
     // An FMU with only non-Real outputs wrote a CSV with only `time`, silently.
     let Some(fmu) = features() else { return };
-    let (out, err) = simulate(&fmu, &["--step", "0.5"]);
+    let (out, err) = simulate(&fmu, "--step 0.5", &[]);
     let csv = read_csv(&out);
     for name in [
         "u_echo",
@@ -102,8 +95,7 @@ fn wrong_values_for_typed_variables_are_refused_clearly() {
         ("nothere=1", "no variable named 'nothere'"),
     ] {
         let o = run(&["simulate", f, "--set", set]);
-        let err = stderr(&o);
-        assert!(!o.status.success());
+        let err = failed(&o);
         assert!(err.contains(needle), "{set}: {err}");
     }
     let o = run(&["simulate", f, "--output", "string_out"]);
@@ -123,20 +115,8 @@ fn input_signals_are_applied_as_fmpy_applies_them() {
     .unwrap();
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--input",
-            utf8(&input),
-            "--step",
-            "0.1",
-            "--output",
-            "u_echo",
-            "--output",
-            "u_integral",
-            "--output",
-            "k_echo",
-            "--output",
-            "flag_echo",
-        ],
+        "--step 0.1 --output u_echo --output u_integral --output k_echo --output flag_echo",
+        &["--input", utf8(&input)],
     );
     let csv = read_csv(&out);
     let t = csv.col("time");
@@ -178,18 +158,8 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
     for (stop_at, last, rows) in [("0.55", 0.55, 7), ("0.5", 0.5, 6)] {
         let (out, err) = simulate(
             &fmu,
-            &[
-                "--set",
-                &format!("stop_at={stop_at}"),
-                "--set",
-                "u=2",
-                "--stop",
-                "2",
-                "--step",
-                "0.1",
-                "--output",
-                "u_integral",
-            ],
+            "--set u=2 --stop 2 --step 0.1 --output u_integral",
+            &["--set", &format!("stop_at={stop_at}")],
         );
         let csv = read_csv(&out);
         let t = csv.col("time");
@@ -198,10 +168,7 @@ fn an_fmu_that_ends_the_simulation_ends_simulate_there_not_in_an_error() {
         assert!(t.windows(2).all(|w| w[1] > w[0]), "no duplicate row");
         let integral = *csv.col("u_integral").last().unwrap();
         assert!((integral - 2.0 * last).abs() < 1e-12, "{integral}");
-        assert!(
-            err.contains(&format!("ended the simulation at t = {last} s")),
-            "{err}"
-        );
+        assert_contains(&err, &format!("ended the simulation at t = {last} s"));
     }
 }
 
@@ -211,17 +178,10 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
     let dir = tempfile::tempdir().unwrap();
     // stop_at uniform on [0.5, 2]: runs with stop_at < 1 end early (failed, allowed), the others
     // reach the stop time 1 s (stop_at = 1 exactly would end at the stop time: a whole run).
-    let study = write_toml(
+    let study = early_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 16\n\
-             [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
-             [fixed]\nu = 1\n[outputs]\nvariables = [\"u_integral\"]\n\
-             [analysis]\nallow_failures = true\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        "[outputs]\nvariables = [\"u_integral\"]\n[analysis]\nallow_failures = true\n",
     );
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
@@ -231,33 +191,50 @@ fn a_study_counts_a_run_the_fmu_ends_early_as_failed_and_keeps_runs_that_reach_t
         let stop_at: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
         if stop_at < 1.0 - 1e-9 {
             failed += 1;
-            assert!(line.contains("ended the simulation at t ="), "{line}");
+            assert_contains(line, "ended the simulation at t =");
         } else {
             assert!(line.ends_with(",ok"), "{line}");
         }
     }
     assert!(failed > 0 && failed < 16, "{points}");
     let summary = read(&out.join("summary.json"));
-    assert!(
-        summary.contains(&format!("\"failed_runs\": {failed}")),
-        "{summary}"
-    );
+    assert_contains(&summary, &format!("\"failed_runs\": {failed}"));
 }
 
 /// A study of the Features FMU over `stop_at` uniform on [0.5, 2] (runs with stop_at < 1 end
 /// before the stop time 1 s) at u = 1, with `rest` appended (its quantities, outputs).
 fn early_study(dir: &Path, fmu: &Path, rest: &str) -> PathBuf {
-    write_toml(
+    let experiment = "stop = 1.0\nstep = 0.1";
+    let rest = format!("[fixed]\nu = 1\n{rest}");
+    mc_study(
         dir,
-        "s",
-        &format!(
-            "name = \"early\"\nfmu = {:?}\n[experiment]\nstop = 1.0\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 16\n\
-             [[parameters]]\nname = \"stop_at\"\ndistribution = \"uniform\"\nlow = 0.5\nhigh = 2\n\
-             [fixed]\nu = 1\n{rest}",
-            utf8(fmu)
-        ),
+        fmu,
+        ["early", experiment],
+        16,
+        ("stop_at", 0.5, 2.0),
+        &rest,
     )
+}
+
+/// `s.toml` in `dir`: the Monte Carlo study `name` of the Features FMU `fmu` with the
+/// `[experiment]` keys `experiment`, `samples` runs over the one random parameter `parameter`
+/// uniform on [low, high], and `rest` appended.
+fn mc_study(
+    dir: &Path,
+    fmu: &Path,
+    [name, experiment]: [&str; 2],
+    samples: u32,
+    (parameter, low, high): (&str, f64, f64),
+    rest: &str,
+) -> PathBuf {
+    let text = format!(
+        "name = \"{name}\"\nfmu = {:?}\n[experiment]\n{experiment}\n\
+         [method]\nkind = \"mc\"\nsamples = {samples}\n\
+         [[parameters]]\nname = \"{parameter}\"\ndistribution = \"uniform\"\nlow = {low}\n\
+         high = {high}\n{rest}",
+        utf8(fmu)
+    );
+    write_toml(dir, "s", &text)
 }
 
 #[test]
@@ -297,10 +274,7 @@ fn a_run_the_fmu_ends_early_takes_the_if_ended_value_and_counts_beyond_the_limit
     let text = summary["quantities"]["peak"]["definition"]["text"]
         .as_str()
         .unwrap();
-    assert!(
-        text.contains("100 in a run the FMU ends before the stop time"),
-        "{text}"
-    );
+    assert_contains(text, "100 in a run the FMU ends before the stop time");
 }
 
 #[test]
@@ -341,16 +315,8 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
     let Some(fmu) = features() else { return };
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "u=1",
-            "--stop",
-            "1.05",
-            "--step",
-            "0.1",
-            "--output",
-            "u_integral",
-        ],
+        "--set u=1 --stop 1.05 --step 0.1 --output u_integral",
+        &[],
     );
     let csv = read_csv(&out);
     let t = csv.col("time");
@@ -359,11 +325,9 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
     assert_eq!(t[11], 1.05);
     assert!((csv.col("u_integral")[11] - 1.05).abs() < 1e-12);
     let o = run(&["simulate", utf8(&fmu), "--step", "0"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("--step 0: the communication step must be positive"),
-        "{}",
-        stderr(&o)
+    assert_contains(
+        &failed(&o),
+        "--step 0: the communication step must be positive",
     );
 }
 
@@ -371,21 +335,12 @@ fn a_stop_time_off_the_grid_ends_with_a_shorter_step() {
 fn csv_numbers_are_short_and_read_back_exactly() {
     // 2.2e-308 was written as a 326-character decimal.
     let Some(fmu) = features() else { return };
-    let (out, _) = simulate(
-        &fmu,
-        &["--set", "u=2.2e-308", "--step", "0.5", "--output", "u_echo"],
-    );
+    let (out, _) = simulate(&fmu, "--set u=2.2e-308 --step 0.5 --output u_echo", &[]);
     assert_eq!(out, "time,u_echo\n0,2.2e-308\n0.5,2.2e-308\n1,2.2e-308\n");
     let (out, _) = simulate(
         &fmu,
-        &[
-            "--set",
-            "u=1.7976931348623157e308",
-            "--step",
-            "1",
-            "--output",
-            "u_echo",
-        ],
+        "--set u=1.7976931348623157e308 --step 1 --output u_echo",
+        &[],
     );
     assert!(out.ends_with("1,1.7976931348623157e308\n"), "{out}");
 }
@@ -396,17 +351,15 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
     let dir = tempfile::tempdir().unwrap();
     // misbehave_at, an ordinary Real, is the random parameter; int_param, bool_param,
     // enum_param and string_param come from [fixed] in all their TOML forms.
-    let study = write_toml(
+    let study = mc_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"typed\"\nfmu = {:?}\n[experiment]\nstop = 0.2\nstep = 0.1\n\
-             [method]\nkind = \"mc\"\nsamples = 3\n\
-             [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
-             [fixed]\nint_param = -4\nbool_param = true\nenum_param = 1\nstring_param = \"abcdef\"\nu = 2\n\
-             [outputs]\nvariables = [\"int_out\", \"bool_out\", \"enum_out\", \"string_len\", \"u_gain\"]\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        ["typed", "stop = 0.2\nstep = 0.1"],
+        3,
+        ("gain", 1.0, 2.0),
+        "[fixed]\nint_param = -4\nbool_param = true\nenum_param = 1\nstring_param = \"abcdef\"\n\
+         u = 2\n[outputs]\nvariables = [\"int_out\", \"bool_out\", \"enum_out\", \"string_len\", \
+         \"u_gain\"]\n",
     );
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
@@ -424,8 +377,7 @@ fn study_fixed_values_of_every_type_and_integer_random_parameters_reach_the_fmu(
     edit(&study, "name = \"gain\"", "name = \"int_param\"");
     edit(&study, "int_param = -4\n", "");
     let o = run_study(&study, &out, &["--fresh"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert!(
         err.contains("random parameter 'int_param' is an Integer variable")
             && err.contains("not a whole number"),
@@ -438,17 +390,13 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
     let Some(fmu) = features() else { return };
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,1\n").unwrap();
-    let study = write_toml(
+    let study = mc_study(
         dir.path(),
-        "s",
-        &format!(
-            "name = \"inputs\"\nfmu = {:?}\n[experiment]\nstop = 1\nstep = 0.25\n\
-             [method]\nkind = \"mc\"\nsamples = 2\n\
-             [[parameters]]\nname = \"gain\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n\
-             [inputs]\nfile = \"signal.csv\"\n\
-             [outputs]\nvariables = [\"u_echo\"]\n",
-            utf8(&fmu)
-        ),
+        &fmu,
+        ["inputs", "stop = 1\nstep = 0.25"],
+        2,
+        ("gain", 1.0, 2.0),
+        "[inputs]\nfile = \"signal.csv\"\n[outputs]\nvariables = [\"u_echo\"]\n",
     );
     let out = dir.path().join("out");
     let run = |extra: &[&str]| run_study(&study, &out, extra);
@@ -459,8 +407,7 @@ fn a_study_applies_its_input_file_and_resumes_only_with_the_same_signals() {
     // Other signals change the records: the folder is not resumed with them.
     std::fs::write(dir.path().join("signal.csv"), "time,u\n0,0\n1,2\n").unwrap();
     let o = run(&[]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("different study"), "{}", stderr(&o));
+    assert_contains(&failed(&o), "different study");
     // A column that is not an input is refused with the file's name.
     std::fs::write(dir.path().join("signal.csv"), "time,u_echo\n0,0\n1,2\n").unwrap();
     let o = run(&["--fresh"]);
@@ -490,20 +437,8 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
     std::fs::write(&profile, text).unwrap();
     let (out, _) = simulate(
         &vt,
-        &[
-            "--set",
-            "irregularity=10",
-            "--set",
-            &format!("profile_file={}", profile.display()),
-            "--set",
-            "ramp_length=0",
-            "--stop",
-            "0.1",
-            "--step",
-            "0.001",
-            "--output",
-            "Z0_1",
-        ],
+        "--set irregularity=10 --set ramp_length=0 --stop 0.1 --step 0.001 --output Z0_1",
+        &["--set", &format!("profile_file={}", profile.display())],
     );
     let csv = read_csv(&out);
     let z = csv.col("Z0_1");
@@ -522,6 +457,5 @@ fn vehicle_track_measured_profile_is_set_from_the_command_line() {
         "--step",
         "0.001",
     ]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("/nonexistent/track.csv"));
+    assert_contains(&failed(&o), "/nonexistent/track.csv");
 }

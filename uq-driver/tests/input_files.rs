@@ -7,8 +7,11 @@ use std::path::Path;
 use std::process::Output;
 use std::time::Duration;
 
+use crate::support::refusal::assert_refused;
 use crate::support::wheel::{wheel_fmu, write_study};
-use crate::support::{built_fmu, driver, run, run_study, stderr, utf8};
+use crate::support::{
+    assert_contains, built_fmu, driver, run, run_study, stderr, utf8, write_file,
+};
 
 /// Runs `uq-driver args`, failing the test if it has not ended within 60 s (a FIFO opened
 /// for reading blocks for ever).
@@ -75,9 +78,9 @@ fn a_random_or_fixed_parameter_that_is_also_an_input_column_is_refused() {
     let o = run_study(&fixed, &dir.path().join("f"), &["--no-report"]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("'K' is given a value in [fixed] and also a column of the input file"),
-        "{err}"
+    assert_contains(
+        &err,
+        "'K' is given a value in [fixed] and also a column of the input file",
     );
     // simulate --set K=... --input k.csv.
     let k_csv = dir.path().join("k.csv");
@@ -92,12 +95,7 @@ fn a_random_or_fixed_parameter_that_is_also_an_input_column_is_refused() {
         "--input",
         utf8(&k_csv),
     ]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("'K' is given a value (--set) and also a column"),
-        "{err}"
-    );
+    assert_refused(&o, &["'K' is given a value (--set) and also a column"]);
     // The file alone drives K: accepted.
     let o = run(&[
         "simulate",
@@ -148,9 +146,7 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
     );
     let out = dir.path().join("out");
     let o = run_within(&["run", utf8(&study), "--out", utf8(&out), "--no-report"]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("is a FIFO (named pipe)"), "{err}");
+    assert_refused(&o, &["is a FIFO (named pipe)"]);
     // VehicleTrack's measured profile.
     let vt = built_fmu("VehicleTrack");
     for (file, kind) in [
@@ -160,12 +156,7 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
         let set = format!("profile_file={file}");
         let args = ["simulate", utf8(&vt), "--stop", "0.01", "--set"];
         let o = run_within(&[&args[..], &[&set, "--set", "irregularity=10"]].concat());
-        let err = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(
-            err.contains(&format!("profile_file '{file}': {kind}")),
-            "{err}"
-        );
+        assert_refused(&o, &[&format!("profile_file '{file}': {kind}")]);
     }
 }
 
@@ -174,12 +165,11 @@ fn input_and_profile_files_that_are_fifos_or_devices_are_refused_without_hanging
 #[test]
 fn errors_about_input_and_profile_files_never_quote_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let secret = dir.path().join("shadow");
-    std::fs::write(
-        &secret,
+    let secret = write_file(
+        dir.path(),
+        "shadow",
         "root:$6$SECRETHASH:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\n",
-    )
-    .unwrap();
+    );
     let vt = built_fmu("VehicleTrack");
     let set = format!("profile_file={}", utf8(&secret));
     let o = run(&[
@@ -192,40 +182,28 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
         "--set",
         "irregularity=10",
     ]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("line 2: expected two numbers"), "{err}");
+    let err = assert_refused(&o, &["line 2: expected two numbers"]);
     assert!(!err.contains("SECRET") && !err.contains("daemon"), "{err}");
     // An input file with a header of the wheel's variables, then a secret in a cell.
-    let input = dir.path().join("in.csv");
-    std::fs::write(&input, "time,K\n0,100\n1,SECRET-1\n").unwrap();
-    let o = run(&[
-        "simulate",
-        utf8(&wheel_fmu()),
-        "--stop",
-        "0.1",
-        "--input",
-        utf8(&input),
-    ]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("line 3, column 2"), "{err}");
-    assert!(!err.contains("SECRET"), "{err}");
+    // The wheel simulated with the input `text` is refused, the error without the secret.
+    let refused = |text: &str, needle: &str| {
+        let input = write_file(dir.path(), "in.csv", text);
+        let wheel = wheel_fmu();
+        let o = run(&[
+            "simulate",
+            utf8(&wheel),
+            "--stop",
+            "0.1",
+            "--input",
+            utf8(&input),
+        ]);
+        let err = assert_refused(&o, &[needle]);
+        assert!(!err.contains("SECRET"), "{err}");
+    };
+    refused("time,K\n0,100\n1,SECRET-1\n", "line 3, column 2");
     // A header that names no variable: the column's number, not its text.
-    std::fs::write(&input, "time,SECRET-2\n0,1\n").unwrap();
-    let o = run(&[
-        "simulate",
-        utf8(&wheel_fmu()),
-        "--stop",
-        "0.1",
-        "--input",
-        utf8(&input),
-    ]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("column 2 names no variable of the FMU"),
-        "{err}"
+    refused(
+        "time,SECRET-2\n0,1\n",
+        "column 2 names no variable of the FMU",
     );
-    assert!(!err.contains("SECRET"), "{err}");
 }

@@ -11,7 +11,8 @@ use std::process::Output;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    csv_records, read, run, run_args, run_ok, stderr, study_head, test_fmus, utf8, write_toml,
+    assert_contains, csv_records, failed, read, run, run_args, run_ok, stderr, study_head,
+    test_fmus, utf8, write_toml,
 };
 
 /// Eight Monte Carlo points with gain ~ U(1, 2), u = 0.7, stop 1 s, step 0.1 s; `fixed`
@@ -123,14 +124,8 @@ fn a_reset_that_returns_error_fails_no_point_in_process_or_in_workers() {
         assert!(c.statuses(name).iter().all(|s| s == "ok"), "{name}");
         let err = stderr(&o);
         assert_eq!(err.matches("warning: fmi2Reset failed").count(), 1, "{err}");
-        assert!(
-            err.contains("reset_bug = 1: fmi2Reset fails on purpose"),
-            "{err}"
-        );
-        assert!(
-            err.contains("every point now runs on a fresh instance"),
-            "{err}"
-        );
+        assert_contains(&err, "reset_bug = 1: fmi2Reset fails on purpose");
+        assert_contains(&err, "every point now runs on a fresh instance");
         check_closed_form(&c.out(name));
         csvs.push(c.csv(name, "u_integral.csv") + &c.csv(name, "u_gain.csv"));
     }
@@ -161,10 +156,7 @@ fn a_reset_that_forgets_start_values_gives_the_numbers_of_fresh_instances() {
         csvs.push(c.csv(name, "u_integral.csv"));
         // Kept in summary.json too (printed once, during the run).
         let summary = c.csv(name, "summary.json");
-        assert!(
-            summary.contains("differ from a fresh instance"),
-            "{summary}"
-        );
+        assert_contains(&summary, "differ from a fresh instance");
     }
     assert!(csvs.iter().all(|s| *s == csvs[0]));
 }
@@ -189,7 +181,7 @@ fn a_reset_that_fails_after_some_runs_only_gives_a_fresh_instance_and_one_warnin
         let err = stderr(&o);
         assert!(!err.contains("differ from a fresh"), "{err}");
         assert_eq!(err.matches("warning: fmi2Reset failed").count(), 1, "{err}");
-        assert!(err.contains("reset_bug = 3"), "{err}");
+        assert_contains(&err, "reset_bug = 3");
         check_closed_form(&c.out(name));
     }
     assert_eq!(
@@ -321,8 +313,8 @@ fn fmu_logging_brings_the_messages_of_an_fmu_that_logs_only_when_asked() {
         "{statuses:?}"
     );
     for s in statuses.iter().filter(|s| *s != "ok") {
-        assert!(s.contains("the FMU logged nothing"), "{s}");
-        assert!(s.contains("--fmu-logging"), "{s}");
+        assert_contains(s, "the FMU logged nothing");
+        assert_contains(s, "--fmu-logging");
         assert!(!s.contains(said), "{s}");
     }
     for (name, extra) in [
@@ -375,8 +367,7 @@ fn a_fatal_reset_in_the_self_check_keeps_the_fresh_run_and_stops_the_study() {
         return;
     };
     let o = c.try_run("t1", &["-t", "1"]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
+    let err = failed(&o);
     assert!(
         err.contains("reset self-check") && err.contains("After fmi2Fatal"),
         "{err}"

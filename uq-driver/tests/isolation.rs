@@ -13,8 +13,10 @@ use uq_driver::study::RunOptions;
 use uq_driver::uq::method::Design;
 use uq_driver::uq::Germ;
 
+use crate::support::refusal::assert_refused;
 use crate::support::{
-    built_fmu, csv_records, driver, edit, read, run_args, stderr, study_head, test_fmus, utf8,
+    assert_contains, built_fmu, csv_records, driver, edit, failed, read, run_args, stderr,
+    study_head, test_fmus, utf8,
 };
 
 /// Eight Monte Carlo points with misbehave_at ~ U(0.3, 1.8) and stop = 1: the points with
@@ -52,6 +54,14 @@ impl Case {
             .env("TMPDIR", self.tmp())
             .output()
             .expect("runs")
+    }
+
+    /// [`Case::run`], which must succeed.
+    #[track_caller]
+    fn run_ok(&self, extra: &[&str]) -> Output {
+        let o = self.run(extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        o
     }
 
     /// A private temporary folder, to see what the driver leaves behind.
@@ -101,8 +111,7 @@ impl Case {
 #[test]
 fn isolate_a_segfaulting_fmu_fails_its_points_with_the_signal_and_its_last_log_lines() {
     let Some(c) = case(2) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("killed by signal 11 (SIGSEGV");
     c.check_failed_with("misbehave = 2: segfaulting on purpose");
     assert_eq!(c.leftover_temp_folders(), 0);
@@ -111,16 +120,14 @@ fn isolate_a_segfaulting_fmu_fails_its_points_with_the_signal_and_its_last_log_l
 #[test]
 fn isolate_an_aborting_fmu_fails_its_points_with_sigabrt() {
     let Some(c) = case(3) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("signal 6 (SIGABRT");
 }
 
 #[test]
 fn isolate_an_fmu_calling_exit_fails_its_points_with_the_exit_status() {
     let Some(c) = case(4) else { return };
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("exited with status 0");
 }
 
@@ -128,8 +135,7 @@ fn isolate_an_fmu_calling_exit_fails_its_points_with_the_exit_status() {
 fn isolate_a_hanging_fmu_is_killed_after_the_timeout_and_the_study_goes_on() {
     let Some(c) = case(5) else { return };
     let t0 = Instant::now();
-    let o = c.run(&["--isolate", "--timeout-per-run", "0.5", "-t", "2"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate", "--timeout-per-run", "0.5", "-t", "2"]);
     c.check_failed_with("longer than --timeout-per-run 0.5 s");
     c.check_failed_with("misbehave = 5: blocking forever");
     assert!(t0.elapsed() < Duration::from_secs(30));
@@ -140,8 +146,7 @@ fn isolate_a_fatal_fmu_fails_only_its_own_points_on_a_fresh_worker() {
     // In one process an fmi2Fatal leaves the FMU unusable for every later point; a worker that
     // saw it is retired, so the points after it run on a fresh copy.
     let Some(c) = case(7) else { return };
-    let o = c.run(&["--isolate", "-t", "1"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate", "-t", "1"]);
     c.check_failed_with("returned Fatal");
 }
 
@@ -157,11 +162,10 @@ fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnabl
         let o = c.run(&["-t", threads]);
         assert!(!o.status.success(), "an in-process Fatal stops the study");
         let err = stderr(&o);
-        assert!(err.contains("After fmi2Fatal"), "{err}");
-        assert!(err.contains("--isolate"), "{err}");
+        assert_contains(&err, "After fmi2Fatal");
+        assert_contains(&err, "--isolate");
         assert!(!err.contains("an earlier call returned Fatal"), "{err}");
-        let o = c.run(&["--isolate", "-t", threads]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate", "-t", threads]);
         // Every point at or below 1 failed by its own Fatal, every other one is ok.
         c.check_failed_with("returned Fatal");
     }
@@ -171,13 +175,11 @@ fn in_process_fatal_stops_the_study_without_failing_the_points_it_made_unrunnabl
 fn isolate_errors_nan_and_warnings_behave_as_in_process() {
     for (mode, needle) in [(1, "returned Error"), (6, "non-finite value")] {
         let Some(c) = case(mode) else { return };
-        let o = c.run(&["--isolate"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate"]);
         c.check_failed_with(needle);
         // In-process gives the same statuses and the same numbers.
         let isolated = c.u_integral();
-        let o = c.run(&["--fresh"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--fresh"]);
         c.check_failed_with(needle);
         let in_process = c.u_integral();
         assert_eq!(isolated, in_process);
@@ -208,16 +210,14 @@ fn in_process_exit_during_a_study_is_reported_with_a_non_zero_status() {
     let Some(c) = case(4) else { return };
     for threads in ["1", "2"] {
         let o = c.run(&["-t", threads, "--fresh"]);
-        let err = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(err.contains("ended by a call to exit()"), "{err}");
-        assert!(err.contains("running point "), "{err}");
-        assert!(err.contains("--isolate"), "{err}");
+        assert_refused(
+            &o,
+            &["ended by a call to exit()", "running point ", "--isolate"],
+        );
         assert_eq!(c.leftover_temp_folders(), 0);
     }
     // The finished points are in the store: --isolate resumes and completes the study.
-    let o = c.run(&["--isolate"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--isolate"]);
     c.check_failed_with("exited with status 0");
 }
 
@@ -255,13 +255,11 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
     // Failures not allowed: the study stops and names --retry-failed.
     edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("--retry-failed"), "{}", stderr(&o));
+    assert_contains(&failed(&o), "--retry-failed");
     // The FMU is "fixed" (misbehave = 0 is a different study, so the fix is simulated by the
     // same study with failures allowed): a plain re-run keeps the failures and says so ...
     edit(&c.study, "allow_failures = false", "allow_failures = true");
-    let o = c.run(&[]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = c.run_ok(&[]);
     assert!(
         stderr(&o).contains("not run again (--retry-failed"),
         "{}",
@@ -271,8 +269,7 @@ fn failed_points_are_retried_with_retry_failed_and_the_message_names_it() {
     assert!(failed_before >= 2);
     // ... and --retry-failed runs them again (they fail again here: same FMU), with no point
     // counted twice in the store.
-    let o = c.run(&["--retry-failed"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = c.run_ok(&["--retry-failed"]);
     assert!(
         String::from_utf8_lossy(&o.stdout).contains(&format!("({} resumed)", 8 - failed_before)),
         "{}",
@@ -329,8 +326,7 @@ fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let o = c.run(&["--isolate"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert!(
         err.contains("is in use by another uq-driver run")
             && err.contains(&format!("pid {}", first.id())),
@@ -342,7 +338,7 @@ fn two_runs_in_one_output_folder_the_second_is_refused_naming_the_first() {
     let o = c.run(&["--isolate", "--timeout-per-run", "0.5"]);
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("no longer running"), "{err}");
+    assert_contains(&err, "no longer running");
     assert!(!lock.exists(), "released at the end");
 }
 
@@ -352,9 +348,8 @@ fn an_output_path_that_is_a_file_is_said_to_be_not_a_folder() {
     let Some(c) = case(0) else { return };
     std::fs::write(&c.out, "x").unwrap();
     let o = c.run(&[]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
-    assert!(err.contains("exists and is not a folder"), "{err}");
+    let err = failed(&o);
+    assert_contains(&err, "exists and is not a folder");
     assert!(!err.contains("File exists"), "{err}");
 }
 
@@ -364,8 +359,7 @@ fn error_causes_are_printed_once() {
     let Some(c) = case(1) else { return };
     edit(&c.study, "allow_failures = true", "allow_failures = false");
     let o = c.run(&["-t", "1"]);
-    let err = stderr(&o);
-    assert!(!o.status.success());
+    let err = failed(&o);
     assert_eq!(err.matches("fails on purpose").count(), 1, "{err}");
     let o = crate::support::run(&["inspect", "/nonexistent/M.fmu"]);
     let err = stderr(&o);
@@ -455,7 +449,7 @@ fn integral_design_values_set_an_integer_random_parameter() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("not a whole number"), "{err}");
+    assert_contains(&err, "not a whole number");
 }
 
 #[test]
@@ -470,7 +464,7 @@ fn model_description_of_an_extracted_folder_is_refused_by_size_before_it_is_read
     let err = uq_driver::fmu::Fmu::open(dir.path())
         .unwrap_err()
         .to_string();
-    assert!(err.contains("more than the limit"), "{err}");
+    assert_contains(&err, "more than the limit");
 }
 
 /// Runs uq-driver with `args` (and `TMPDIR` = `tmp`), killing it after `limit`: a regression
@@ -522,8 +516,7 @@ fn isolate_an_fmu_writing_garbage_to_fd_3_neither_hangs_nor_garbles_the_answers(
     // The same numbers as in-process with a well-behaved FMU (mode 9 changes no value).
     let isolated = c.u_integral();
     edit(&c.study, "misbehave = 9", "misbehave = 0");
-    let o = c.run(&["--fresh", "-t", "1"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    c.run_ok(&["--fresh", "-t", "1"]);
     let in_process = c.u_integral();
     assert_eq!(isolated, in_process);
 }
@@ -569,14 +562,13 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
                 .expect("ends");
             let err = stderr(&o);
             assert_eq!(o.status.signal(), Some(sig), "{err}");
-            assert!(err.contains(&format!("killed by {name}")), "{err}");
-            assert!(err.contains("running point "), "{err}");
-            assert!(err.contains("misbehave_at = "), "{err}");
-            assert!(err.contains("--isolate"), "{err}");
+            assert_contains(&err, &format!("killed by {name}"));
+            assert_contains(&err, "running point ");
+            assert_contains(&err, "misbehave_at = ");
+            assert_contains(&err, "--isolate");
         }
         // The finished points are kept: --isolate resumes and completes the study.
-        let o = c.run(&["--isolate"]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        c.run_ok(&["--isolate"]);
         c.check_failed_with(name);
     }
 }
@@ -584,10 +576,9 @@ fn in_process_crash_says_which_point_crashed_and_keeps_the_signal_as_exit_status
 #[test]
 fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
     // `simulate` exited 0 with no CSV and no message.
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("f4.csv");
     let o = run_limited(
         &[
@@ -602,19 +593,15 @@ fn simulate_an_fmu_calling_exit_fails_with_a_message_and_a_non_zero_status() {
         Duration::from_secs(60),
     )
     .expect("ends");
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("called exit()"), "{err}");
-    assert!(err.contains("Features.fmu"), "{err}");
+    assert_refused(&o, &["called exit()", "Features.fmu"]);
 }
 
 #[test]
 fn simulate_to_stdout_keeps_what_the_fmu_prints_out_of_the_csv() {
     // The FMU's printf output was interleaved with the CSV rows on stdout.
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let o = run_limited(
         &[
             "simulate",

@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 
 use crate::support::refusal::assert_refused;
 use crate::support::wheel::{self, wheel_fmu};
-use crate::support::{driver, run, run_ok, run_study, stderr, utf8};
+use crate::support::{
+    driver, plan_and_run_shards, run, run_ok, run_study, stderr, utf8, write_file,
+};
 
 fn study(dir: &Path, name: &str, experiment: &str, method: &str) -> PathBuf {
     wheel::write_study(dir, name, name, 42, experiment, method, "")
@@ -234,8 +236,7 @@ fn a_long_study_needs_yes() {
     .replace("kind = \"nominal\"", "kind = \"lhs\"\nsamples = 99000")
     .replace("stop = 6.0", "stop = 60.0")
     .replace("variables = [\"Zc_acc\", \"P1\"]", "variables = []");
-    let p = dir.path().join("long.toml");
-    std::fs::write(&p, text).unwrap();
+    let p = write_file(dir.path(), "long.toml", text);
     let out = dir.path().join("out");
     let o = run_study(&p, &out, &["--threads", "1"]);
     assert_refused(
@@ -266,8 +267,7 @@ fn merge_checks_the_memory_of_the_analysis_as_run_does() {
     );
     let plan = dir.path().join("plan");
     let p = utf8(&plan);
-    run_ok(&["plan", utf8(&path), "--shards", "1", "--out", p]);
-    run_ok(&["run-shard", p, "--shard", "0"]);
+    plan_and_run_shards(&path, &plan, 1);
     let merged = dir.path().join("merged");
     let m = utf8(&merged);
     let o = driver()

@@ -14,7 +14,7 @@ use uq_driver::spec::{Experiment, Study, StudyError};
 use uq_driver::study::{run_study, Outcome, RunError, RunOptions, StudyRunError};
 use uq_driver::study::{simulate, PointError};
 
-use crate::support::wheel;
+use crate::support::{assert_contains, wheel};
 
 fn study(method: &str) -> Study {
     let experiment = "start = 0.0\nstop = 1.0\nstep = 0.01";
@@ -54,30 +54,30 @@ fn run_study_refuses_a_study_changed_into_an_invalid_one() {
         step: 0.1,
     };
     let m = invalid_message(run_study(&s, &out, &opts()));
-    assert!(m.contains("start < stop"), "{m}");
+    assert_contains(&m, "start < stop");
 
     for step in [0.0, f64::NAN] {
         let mut s = base.clone();
         s.experiment.step = step;
         let m = invalid_message(run_study(&s, &out, &opts()));
-        assert!(m.contains("step"), "{m}");
+        assert_contains(&m, "step");
         assert!(!m.contains("memory"), "{m}");
     }
 
     let mut s = base.clone();
     s.parameters.clear();
     let m = invalid_message(run_study(&s, &out, &opts()));
-    assert!(m.contains("no random parameters"), "{m}");
+    assert_contains(&m, "no random parameters");
 
     let mut s = base.clone();
     s.outputs.clear();
     let m = invalid_message(run_study(&s, &out, &opts()));
-    assert!(m.contains("nothing to analyse"), "{m}");
+    assert_contains(&m, "nothing to analyse");
 
     let mut s = base.clone();
     s.parameters[1].name = "K".into();
     let m = invalid_message(run_study(&s, &out, &opts()));
-    assert!(m.contains("listed twice"), "{m}");
+    assert_contains(&m, "listed twice");
 
     // Nothing was written for any of them.
     assert!(!out.exists());

@@ -7,19 +7,17 @@
 
 use std::path::Path;
 
-use crate::study_nested::{hashed_normal, nested_text, pair, SEEDS, X1_X2};
+use crate::study_nested::{hashed_normal, nested_text, pair, population, X1_X2};
 use crate::support::csv::Csv;
 use crate::support::{run_beside, summary, test_fmus, write_toml};
 
 /// sigma_h² = 1.5: the outer share is 1.5 / 4.5 = 1/3 over the whole population of seeds.
 const SIGMA_H: f64 = 1.224_744_871_391_589;
 
-/// The true (Std, outer share) of y over the seeds 1..=SEEDS.
+/// The true (Std, outer share) of y over the seeds of the range (`study_nested::SEEDS`).
 fn truth() -> (f64, f64) {
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
-    let n = h.len() as f64;
-    let m = h.iter().sum::<f64>() / n;
-    let var_outer = SIGMA_H * SIGMA_H * h.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
+    let (_, _, var_h) = population();
+    let var_outer = SIGMA_H * SIGMA_H * var_h;
     let total = 3.0 + var_outer;
     (total.sqrt(), var_outer / total)
 }

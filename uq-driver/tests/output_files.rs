@@ -8,7 +8,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use crate::support::wheel::{self, write_study};
-use crate::support::{read, run, run_study, stderr, stdout, study_head, test_fmus, utf8};
+use crate::support::{
+    assert_contains, qoi, read, run, run_study, stderr, stdout, study_head, test_fmus, utf8,
+    write_file,
+};
 
 fn text(o: &Output) -> String {
     format!("{}{}", stdout(o), stderr(o))
@@ -25,15 +28,14 @@ fn is_link(p: &Path) -> bool {
 fn a_symlink_planted_as_the_lock_file_is_refused_and_its_target_kept() {
     let dir = tempfile::tempdir().unwrap();
     let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, "");
-    let victim = dir.path().join("passwd");
-    std::fs::write(&victim, "root:x:0:0:VICTIM:/root:/bin/sh\n").unwrap();
+    let victim = write_file(dir.path(), "passwd", "root:x:0:0:VICTIM:/root:/bin/sh\n");
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
     symlink(&victim, out.join("uq-driver.lock")).unwrap();
     let o = run_study(&study, &out, &[]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
-    assert!(t.contains("symbolic link"), "{t}");
+    assert_contains(&t, "symbolic link");
     assert!(!t.contains("VICTIM"), "the target's content is echoed: {t}");
     assert_eq!(read(&victim), "root:x:0:0:VICTIM:/root:/bin/sh\n");
     assert!(!out.join("store").exists(), "refused before any run");
@@ -77,21 +79,9 @@ fn symlinks_planted_as_summary_json_and_points_csv_are_replaced_not_written_thro
 #[test]
 fn quantity_names_with_slashes_or_the_folders_own_names_stay_inside_and_apart() {
     let dir = tempfile::tempdir().unwrap();
-    let qoi = r#"
-[[qoi]]
-kind = "final"
-name = "../../escape_y"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "points"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "/tmp/uq-driver-abs-test"
-signal = "q"
-"#;
-    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let names = ["../../escape_y", "points", "/tmp/uq-driver-abs-test"];
+    let qoi = names.map(|n| qoi("final", n, "q")).concat();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, &qoi);
     let out = dir.path().join("a").join("b").join("out");
     std::fs::create_dir_all(&out).unwrap();
     let o = run_study(&study, &out, &[]);
@@ -154,17 +144,8 @@ fn every_figure_links_to_its_section_of_the_guide_page_written_beside_the_report
 #[test]
 fn two_names_that_would_share_a_file_are_refused_before_any_run() {
     let dir = tempfile::tempdir().unwrap();
-    let qoi = r#"
-[[qoi]]
-kind = "final"
-name = "y"
-signal = "q"
-[[qoi]]
-kind = "final"
-name = "y_pdf"
-signal = "q"
-"#;
-    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, qoi);
+    let qoi = ["y", "y_pdf"].map(|n| qoi("final", n, "q")).concat();
+    let study = write_study(dir.path(), "s", "s", 1, EXPERIMENT, METHOD, &qoi);
     let out = dir.path().join("out");
     let o = run_study(&study, &out, &[]);
     let t = text(&o);
@@ -184,7 +165,7 @@ fn no_report_names_the_folder_not_an_index_html_it_did_not_write() {
     assert!(!out.join("index.html").exists());
     assert!(!t.contains("index.html: "), "{t}");
     assert!(!t.contains("report: "), "{t}");
-    assert!(t.contains("--no-report"), "{t}");
+    assert_contains(&t, "--no-report");
 }
 
 #[test]
@@ -193,10 +174,9 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
     // runs to analyse, left only store/: the per-point messages could not be read. Now
     // points.csv is written with every point's status (the Features FMU fails its step at
     // t = misbehave_at with mode 1, an fmi2Error).
-    let Some(fmu) = test_fmus::test_fmu("Features") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Features") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     for (name, extra, failures) in [
         ("stopped", "", "stopped at the first failure"),
         (
@@ -225,7 +205,7 @@ fn a_study_stopped_by_failed_points_still_writes_every_points_status() {
         let o = run_study(&study, &out, &["-t", "1"]);
         let all = text(&o);
         assert!(!o.status.success(), "{all}");
-        assert!(all.contains(failures), "{all}");
+        assert_contains(&all, failures);
         let points = std::fs::read_to_string(out.join("points.csv")).unwrap_or_default();
         assert!(
             points.starts_with("index,misbehave_at,status"),

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use crate::support::csv::Csv;
 use crate::support::wheel;
-use crate::support::{read, run_study_ok};
+use crate::support::{assert_contains, qoi, read, run_study_ok};
 
 /// The values of `<quantity>_samples.csv` (`run,<quantity>`), by run.
 fn samples(path: &Path) -> Vec<f64> {
@@ -29,23 +29,12 @@ fn points(path: &Path) -> Vec<(f64, f64)> {
 #[test]
 fn min_and_max_quantities_meet_the_wheel_closed_form() {
     let dir = tempfile::tempdir().unwrap();
-    let extra = r#"
-[[qoi]]
-kind = "min"
-name = "q_min"
-signal = "q"
-[[qoi]]
-kind = "max"
-name = "q_max_late"
-signal = "q"
-from = 1.5
-to = 3.0
-[[qoi]]
-kind = "min"
-name = "q_min_late"
-signal = "q"
-from = 1.5
-"#;
+    let extra = format!(
+        "{}{}from = 1.5\nto = 3.0\n{}from = 1.5\n",
+        qoi("min", "q_min", "q"),
+        qoi("max", "q_max_late", "q"),
+        qoi("min", "q_min_late", "q")
+    );
     let study = wheel::write_study(
         dir.path(),
         "mm",
@@ -53,7 +42,7 @@ from = 1.5
         3,
         wheel::EXPERIMENT,
         "kind = \"lhs\"\nsamples = 12",
-        extra,
+        &extra,
     );
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &[]);
@@ -101,5 +90,5 @@ from = 1.5
         );
     }
     let summary = read(&out.join("summary.json"));
-    assert!(summary.contains("smallest value of q"), "{summary}");
+    assert_contains(&summary, "smallest value of q");
 }

@@ -11,7 +11,8 @@ use serde_json::Value;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    run, run_killed, run_study, run_study_ok, stderr, study_head, summary, test_fmus, write_toml,
+    assert_contains, failed, run, run_killed, run_study, run_study_ok, stderr, study_head, summary,
+    test_fmus, write_toml,
 };
 
 /// `P(Z > z)` of a standard normal, by the Lentz continued fraction of Mills' ratio for
@@ -117,10 +118,9 @@ fn f(v: &Value) -> f64 {
 
 #[test]
 fn form_and_sorm_give_the_exact_probability_of_a_linear_sum_of_correlated_normals() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let (inputs, mean, sd) = correlated_normals();
     // P(q > a) = 1e-4 and P(q < b) = 1e-3 exactly.
     let (pa, pb) = (1e-4, 1e-3);
@@ -180,10 +180,9 @@ fn form_and_sorm_give_the_exact_probability_of_a_linear_sum_of_correlated_normal
 
 #[test]
 fn importance_sampling_after_form_covers_the_exact_probability_within_its_cov() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let (inputs, mean, sd) = correlated_normals();
     let exact = 1e-4;
     let a = mean + sd * normal_isf(exact);
@@ -218,10 +217,9 @@ fn importance_sampling_after_form_covers_the_exact_probability_within_its_cov() 
 
 #[test]
 fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // Two standard normal inputs: y is chi-square with 2 degrees of freedom,
     // P(y > b) = exp(-b/2) = 1e-4 at b = 2 ln 1e4 (a circle: FORM's single design point
     // does not describe it).
@@ -257,10 +255,9 @@ fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
 
 #[test]
 fn a_limit_never_reached_gives_a_zero_probability_with_an_upper_bound() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // x1, x2 uniform on [0, 1]: their sum never exceeds 2.5.
     let inputs = two_inputs("distribution = \"uniform\"\nlow = 0\nhigh = 1");
     let p = study(
@@ -283,10 +280,9 @@ fn a_limit_never_reached_gives_a_zero_probability_with_an_upper_bound() {
 
 #[test]
 fn a_failed_run_during_form_is_an_error_naming_the_point() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let fmu = test_fmus::test_fmu("Once").expect("the Once test FMU");
     // Once: y = x t, so y(1) = x; every step with x > 2 fails with fmi2Error. FORM's first
     // full step goes to x = 3, the limit.
@@ -299,10 +295,9 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     let p = write_toml(dir.path(), "failed", &text);
     let out = dir.path().join("failed");
     let o = run_study(&p, &out, &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
-    assert!(err.contains("P(q > 3)"), "{err}");
-    assert!(err.contains("failed at x = "), "{err}");
+    let err = failed(&o);
+    assert_contains(&err, "P(q > 3)");
+    assert_contains(&err, "failed at x = ");
     let x: f64 = err
         .split("failed at x = ")
         .nth(1)
@@ -315,13 +310,15 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     assert!(x > 2.0, "the point named is x = {x}");
     // Run again: the failed run is answered from the store, the same error.
     let again = stderr(&run_study(&p, &out, &[]));
-    assert!(again.contains("failed at x = "), "{again}");
+    assert_contains(&again, "failed at x = ");
 }
 
 /// Kills `study` once its store holds about 300 runs of 10 001 values, resumes it, and
 /// compares the probabilities with those of an uninterrupted run.
 fn resumed_after_a_kill_gives_the_uninterrupted_numbers(kind: &str, method: &str) {
-    let dir = tempfile::tempdir().unwrap();
+    let Some(dir) = test_fmus::dir_if_built() else {
+        return;
+    };
     let (inputs, mean, sd) = correlated_normals();
     let a = mean + sd * normal_isf(1e-3);
     let fmu = test_fmus::test_fmu("Functions").expect("the Functions test FMU");
@@ -358,9 +355,6 @@ fn resumed_after_a_kill_gives_the_uninterrupted_numbers(kind: &str, method: &str
 
 #[test]
 fn importance_sampling_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
-    if test_fmus::built().is_none() {
-        return;
-    }
     resumed_after_a_kill_gives_the_uninterrupted_numbers(
         "is",
         "kind = \"importance_sampling\"\ntarget_cov = 0.02\nbatch = 50",
@@ -369,9 +363,6 @@ fn importance_sampling_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
 
 #[test]
 fn subset_simulation_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
-    if test_fmus::built().is_none() {
-        return;
-    }
     resumed_after_a_kill_gives_the_uninterrupted_numbers(
         "subset",
         "kind = \"subset\"\nsamples_per_level = 500",
@@ -380,10 +371,9 @@ fn subset_simulation_resumed_after_a_kill_gives_the_uninterrupted_numbers() {
 
 #[test]
 fn morris_ranks_the_inputs_of_a_linear_sum_by_their_scatter() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // y = x1 + … + x4 with uniform inputs of widths 1, 2, 3, 4: every elementary effect of
     // x_i, per unit of its probability level, is its width, so μ*_i = i and σ_i = 0.
     let inputs: String = (1..=4)
@@ -416,10 +406,9 @@ fn morris_ranks_the_inputs_of_a_linear_sum_by_their_scatter() {
 
 #[test]
 fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // y = x1 + x2, standard normal: a chaos of order 2 fits it exactly, yet a count of its
     // draws beyond the last few runs is extrapolation as far as the runs can tell.
     let inputs = two_inputs("distribution = \"normal\"\nmean = 0\nstd = 1");
@@ -460,20 +449,19 @@ fn a_chaos_count_with_few_runs_beyond_the_limit_has_no_interval() {
                 "{beyond} runs beyond: {e}"
             );
             let w = e["warnings"][0].as_str().unwrap();
-            assert!(w.contains("importance_sampling"), "{w}");
+            assert_contains(w, "importance_sampling");
         } else {
             assert!(e["ci_95"].is_array(), "{beyond} runs beyond: {e}");
         }
     }
-    assert!(text.contains("no interval"), "{text}");
+    assert_contains(&text, "no interval");
 }
 
 #[test]
 fn a_chaos_tail_beyond_its_runs_names_its_design_point_and_sampling_there_finds_the_exact_p() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // y = x1 · … · x8 with ln xᵢ ~ N(0, s²), s = 0.7/√8: ln y ~ N(0, 0.7²), so
     // P(y > L) = Φ(−ln L / 0.7) exactly; at 1e-4 none of 400 runs lies beyond, on average
     // 0.04 of them.
@@ -555,10 +543,9 @@ fn a_chaos_tail_beyond_its_runs_names_its_design_point_and_sampling_there_finds_
 
 #[test]
 fn a_reliability_study_is_refused_by_plan_shards_and_told_to_run_on_one_machine() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let inputs = two_inputs("distribution = \"normal\"\nmean = 0\nstd = 1");
     for kind in ["form", "importance_sampling", "subset"] {
         let p = study(
@@ -581,8 +568,8 @@ fn a_reliability_study_is_refused_by_plan_shards_and_told_to_run_on_one_machine(
         ]);
         let err = stderr(&o);
         assert!(!o.status.success(), "{kind}: planned in shards");
-        assert!(err.contains("cannot be split into shards"), "{err}");
-        assert!(err.contains("uq-driver run"), "{err}");
+        assert_contains(&err, "cannot be split into shards");
+        assert_contains(&err, "uq-driver run");
         assert!(
             !out.join("plan.json").exists(),
             "{kind}: a plan was written"

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use crate::support::csv::Csv;
 use crate::support::wheel::wheel_fmu;
 use crate::support::{
-    final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok, stderr, study_head,
-    summary, utf8, write_toml,
+    assert_contains, failed, final_quantity, fmu_dir, read, run, run_builtin, run_ok, run_study_ok,
+    stderr, study_head, summary, utf8, write_file, write_toml,
 };
 
 /// A wheel study: `parameters` and `method` as TOML, output q, quantities `q_end` (final q)
@@ -37,6 +37,47 @@ limits = [10.0]
         outputs = final_quantity("q", "q_end")
     );
     write_toml(dir, name, &text)
+}
+
+/// K ~ N(100, 10²), the wheel's stiffness.
+const K: &str = "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0";
+
+/// K ~ N(100, 10²) and C ~ N(20, (0.1 × 20)²), the wheel's stiffness and damping.
+const K_AND_C: &str = "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
+                       [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1";
+
+/// A new temporary folder, where [`study`] `name` runs into `out` with the arguments `extra`;
+/// returns the folder, `out` and the standard output.
+fn run_wheel(
+    name: &str,
+    method: &str,
+    parameters: &str,
+    extra: &[&str],
+) -> (tempfile::TempDir, PathBuf, String) {
+    run_in_new_dir(|dir| study(dir, name, method, parameters), extra)
+}
+
+/// The text of the wheel study `name` over [0, `stop`] s in steps of 0.01 s by `method`, K
+/// (as [`K`]) its random parameter, the one output `output` and `rest` appended.
+fn k_study([name, stop, method, output]: [&str; 4], rest: &str) -> String {
+    format!(
+        "name = \"{name}\"\nfmu = \"{}\"\n[experiment]\nstop = {stop}\nstep = 0.01\n\
+         [method]\n{method}\n{K}\n[outputs]\nvariables = [\"{output}\"]\n{rest}",
+        wheel_fmu().display()
+    )
+}
+
+/// A new temporary folder, where the study file that `write` writes into it runs into `out`
+/// with the arguments `extra`; returns the folder, `out` and the standard output.
+fn run_in_new_dir(
+    write: impl FnOnce(&Path) -> PathBuf,
+    extra: &[&str],
+) -> (tempfile::TempDir, PathBuf, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let s = write(dir.path());
+    let out = dir.path().join("out");
+    let stdout = run_study_ok(&s, &out, extra);
+    (dir, out, stdout)
 }
 
 /// Every `.svg` of `dir` parses as XML (quick-xml, to the end) with an `<svg>` root, every
@@ -84,20 +125,12 @@ fn plots_are_well_formed(dir: &Path) -> usize {
 
 #[test]
 fn a_single_run_has_no_density_and_says_so() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "one-run",
-        "kind = \"nominal\"",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = dir.path().join("out");
-    let stdout = run_study_ok(&s, &out, &[]);
-    assert!(stdout.contains("q_end = "), "{stdout}");
-    assert!(stdout.contains("(nominal run;"), "{stdout}");
-    assert!(
-        stdout.contains("is below the limit 1 m (nominal run; no probability)"),
-        "{stdout}"
+    let (_dir, out, stdout) = run_wheel("one-run", "kind = \"nominal\"", K, &[]);
+    assert_contains(&stdout, "q_end = ");
+    assert_contains(&stdout, "(nominal run;");
+    assert_contains(
+        &stdout,
+        "is below the limit 1 m (nominal run; no probability)",
     );
     for f in [
         "q_pdf.svg",
@@ -113,14 +146,14 @@ fn a_single_run_has_no_density_and_says_so() {
     // A nominal run is a value against each limit, not a probability
     // ("0 of 1 runs exceeded 1 (95 % upper bound of P: 0.950)"), and its inputs were held at
     // their means, not sampled.
-    assert!(
-        html.contains("from the one nominal run (every parameter at its mean)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "from the one nominal run (every parameter at its mean)",
     );
     assert!(html.contains("no density"));
-    assert!(
-        html.contains("is below the limit 1 m (nominal run; no probability)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "is below the limit 1 m (nominal run; no probability)",
     );
     for wrong in [
         "upper bound of P",
@@ -131,12 +164,9 @@ fn a_single_run_has_no_density_and_says_so() {
     ] {
         assert!(!html.contains(wrong), "{wrong} on a nominal page:\n{html}");
     }
-    assert!(html.contains("<th>value used</th>"), "{html}");
-    assert!(
-        html.contains("normal, mean 100, std 10 (cov 0.1) (not sampled)"),
-        "{html}"
-    );
-    assert!(html.contains("1 model run ("), "{html}");
+    assert_contains(&html, "<th>value used</th>");
+    assert_contains(&html, "normal, mean 100, std 10 (cov 0.1) (not sampled)");
+    assert_contains(&html, "1 model run (");
     assert!(!html.contains("1 model runs"), "{html}");
     assert!(!html.contains("Some("), "Rust debug text in the page");
     assert!(!html.contains("Normal {"), "Rust debug text in the page");
@@ -149,37 +179,31 @@ fn a_single_run_has_no_density_and_says_so() {
 
 #[test]
 fn zero_spread_and_no_exceedance_read_as_such() {
-    let dir = tempfile::tempdir().unwrap();
     // The largest RK4 step h around 1.5 ms always gives 7 substeps per 0.01 s step: every run
     // computes the same q, bit for bit.
-    let s = study(
-        dir.path(),
+    let (_dir, out, printed) = run_wheel(
         "zero-spread",
         "kind = \"lhs\"\nsamples = 20",
         "[[parameters]]\nname = \"h\"\nmean = 0.0015\nstd = 1e-7",
+        &[],
     );
-    let out = dir.path().join("out");
-    let printed = run_study_ok(&s, &out, &[]);
     assert!(
         !out.join("q_pdf.svg").exists(),
         "heat map of a deterministic output"
     );
     assert!(!out.join("q_end_pdf.svg").exists());
     let html = read(&out.join("index.html"));
-    assert!(
-        html.contains("every one of the 20 runs gives the same value"),
-        "{html}"
-    );
+    assert_contains(&html, "every one of the 20 runs gives the same value");
     assert!(html.contains("q has the same value in every run at every time"));
     // No run exceeds the limit: a count with its upper bound, not "0 ± 0".
-    assert!(
-        html.contains("0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)"),
-        "{html}"
+    assert_contains(
+        &html,
+        "0 of 20 runs exceeded 1 m (95 % upper bound of P: 0.139)",
     );
     // The terminal says the same, the limit with its unit.
-    assert!(
-        printed.contains("P(q_end > 1 m): 0 of 20 runs exceeded 1 m (95 % upper bound"),
-        "{printed}"
+    assert_contains(
+        &printed,
+        "P(q_end > 1 m): 0 of 20 runs exceeded 1 m (95 % upper bound",
     );
     assert!(!html.contains("± 0"), "{html}");
     let s = summary(&out);
@@ -195,16 +219,7 @@ fn zero_spread_and_no_exceedance_read_as_such() {
 
 #[test]
 fn units_reach_axes_summary_and_sidecar() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "units",
-        "kind = \"scm\"\nnodes = 3",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (_dir, out, _) = run_wheel("units", "kind = \"scm\"\nnodes = 3", K_AND_C, &[]);
     let s = summary(&out);
     assert_eq!(s["outputs"]["q"]["unit"], "m");
     assert_eq!(s["quantities"]["q_peak"]["unit"], "m");
@@ -251,19 +266,14 @@ fn units_reach_axes_summary_and_sidecar() {
     assert!(v[0] <= v[2] + 1e-12 && v[1] <= v[3] + 1e-12, "{v:?}");
     // Inputs as written.
     let html = read(&out.join("index.html"));
-    assert!(html.contains("normal, mean 20, std 2 (cov 0.1)"), "{html}");
+    assert_contains(&html, "normal, mean 20, std 2 (cov 0.1)");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
 #[test]
 fn no_report_export_and_compare() {
     let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "lhs",
-        "kind = \"lhs\"\nsamples = 30",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
+    let s = study(dir.path(), "lhs", "kind = \"lhs\"\nsamples = 30", K);
     let a = dir.path().join("a");
     run_study_ok(&s, &a, &["--no-report"]);
     assert!(a.join("q.csv").exists() && a.join("summary.json").exists());
@@ -322,9 +332,8 @@ fn no_report_export_and_compare() {
     // While a run holds the folder, export refuses instead of reading a store being written.
     let held = uq_driver::internals::store::FolderLock::acquire(&a).unwrap();
     let o = run(&["export", utf8(&a), "--runs"]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
-    assert!(err.contains("is in use by another uq-driver run"), "{err}");
+    let err = failed(&o);
+    assert_contains(&err, "is in use by another uq-driver run");
     drop(held);
 
     let b = dir.path().join("b");
@@ -332,7 +341,7 @@ fn no_report_export_and_compare() {
     let page = dir.path().join("page");
     run_ok(&["compare", utf8(&a), utf8(&b), "--out", utf8(&page)]);
     let html = read(&page.join("index.html"));
-    assert!(html.contains("href=\"../b/index.html\""), "{html}");
+    assert_contains(&html, "href=\"../b/index.html\"");
     assert!(html.contains("Quantity q_end"));
     plots_are_well_formed(&page);
 }
@@ -345,61 +354,42 @@ fn names_are_forgiven_or_suggested() {
     let out = run(&["run", "wheel-sgn", "--out", "/nonexistent/x"]);
     let err = stderr(&out);
     assert!(!out.status.success());
-    assert!(
-        err.contains("did you mean the built-in study wheel-sgm?"),
-        "{err}"
-    );
-    // A misspelt key and a misspelt variable.
+    assert_contains(&err, "did you mean the built-in study wheel-sgm?");
+    // A misspelt key and a misspelt variable; cov = 15 is most likely 15 %.
     let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "typo",
-        "kind = \"scm\"\nnodse = 3",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = run(&["run", utf8(&s), "--out", "/nonexistent/x"]);
-    let err = stderr(&out);
-    assert!(err.contains("hint: did you mean `nodes`?"), "{err}");
-    let s = study(
-        dir.path(),
-        "var",
-        "kind = \"scm\"\nnodes = 2",
-        "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("v"))]);
-    let err = stderr(&out);
-    assert!(err.contains("'Kk': did you mean 'K'?"), "{err}");
-    // cov = 15 is most likely 15 %.
-    let s = study(
-        dir.path(),
-        "cov",
-        "kind = \"scm\"\nnodes = 2",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15",
-    );
-    let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join("c"))]);
-    let err = stderr(&out);
-    assert!(err.contains("did you mean cov = 0.15?"), "{err}");
+    let kk = "[[parameters]]\nname = \"Kk\"\nmean = 100.0\nstd = 10.0";
+    let cov = "[[parameters]]\nname = \"K\"\nmean = 100.0\ncov = 15";
+    for (name, method, parameters, hint) in [
+        ("typo", "nodse = 3", K, "hint: did you mean `nodes`?"),
+        ("var", "nodes = 2", kk, "'Kk': did you mean 'K'?"),
+        ("cov", "nodes = 2", cov, "did you mean cov = 0.15?"),
+    ] {
+        let s = study(
+            dir.path(),
+            name,
+            &format!("kind = \"scm\"\n{method}"),
+            parameters,
+        );
+        let out = run(&["run", utf8(&s), "--out", utf8(&dir.path().join(name))]);
+        assert_contains(&stderr(&out), hint);
+    }
 }
 
 #[test]
 fn a_missing_fmu_lists_every_place_searched() {
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("s.toml");
-    std::fs::write(
-        &p,
+    let p = write_file(
+        dir.path(),
+        "s.toml",
         "name = \"s\"\nfmu = \"Nowhere.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.1\n\
          [method]\nkind = \"scm\"\nnodes = 2\n[[parameters]]\nname = \"K\"\nmean = 1.0\nstd = 0.1\n\
          [outputs]\nvariables = [\"q\"]\n",
-    )
-    .unwrap();
+    );
     let out = run(&["run", utf8(&p), "--out", utf8(&dir.path().join("o"))]);
     let err = stderr(&out);
-    assert!(
-        err.contains("FMU Nowhere.fmu not found; looked in:"),
-        "{err}"
-    );
+    assert_contains(&err, "FMU Nowhere.fmu not found; looked in:");
     assert!(err.contains(&dir.path().join("Nowhere.fmu").display().to_string()));
-    assert!(err.contains("share/railuq/fmu/Nowhere.fmu"), "{err}");
+    assert_contains(&err, "share/railuq/fmu/Nowhere.fmu");
     assert!(err.contains(&fmu_dir().join("Nowhere.fmu").display().to_string()));
 }
 
@@ -408,22 +398,12 @@ fn a_one_letter_signal_is_described_after_its_name() {
     // With `signal = "a"` the definition read "pea (Acceleration q'')k-to-peak
     // (max − min) of a over 0.5–2 s" in summary.json, on the page and on the terminal: the
     // description went after the first "a" of the sentence, inside "peak".
-    let dir = tempfile::tempdir().unwrap();
-    let p = write_toml(
-        dir.path(),
-        "a",
-        &format!(
-            "name = \"a\"\nfmu = \"{}\"\n[experiment]\nstop = 2.0\nstep = 0.01\n\
-             [method]\nkind = \"lhs\"\nsamples = 10\n\
-             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-             [outputs]\nvariables = [\"a\"]\n\
-             [[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
-             to = 2.0\nlimits = [1.0]\n",
-            wheel_fmu().display()
-        ),
+    let text = k_study(
+        ["a", "2.0", "kind = \"lhs\"\nsamples = 10", "a"],
+        "[[qoi]]\nkind = \"range\"\nname = \"a_range\"\nsignal = \"a\"\nfrom = 0.5\n\
+         to = 2.0\nlimits = [1.0]\n",
     );
-    let out = dir.path().join("out");
-    let stdout = run_study_ok(&p, &out, &[]);
+    let (_dir, out, stdout) = run_in_new_dir(|dir| write_toml(dir, "a", &text), &[]);
     let expected = "peak-to-peak (max − min) of a (Acceleration q'') over 0.5–2 s";
     let s = summary(&out);
     assert_eq!(
@@ -434,7 +414,7 @@ fn a_one_letter_signal_is_described_after_its_name() {
         s["quantities"]["a_range"]["definition"]["settings"]["signal_description"],
         "Acceleration q''"
     );
-    assert!(stdout.contains(expected), "{stdout}");
+    assert_contains(&stdout, expected);
     let html = read(&out.join("index.html"));
     assert!(
         html.contains(&expected.replace('\'', "&#39;")),
@@ -447,31 +427,18 @@ fn a_one_letter_signal_is_described_after_its_name() {
 fn a_suite_variant_page_names_its_suite_and_the_reference_row_shows_no_zero_difference() {
     // A variant's page was headed "railuq study scm" with no word of
     // its suite and no way back; the suite table gave the reference "0.000e0" against itself.
-    let dir = tempfile::tempdir().unwrap();
-    let p = write_toml(
-        dir.path(),
-        "s",
-        &format!(
-            "name = \"two\"\nfmu = \"{}\"\n[experiment]\nstop = 1.0\nstep = 0.01\n\
-             [method]\nkind = \"scm\"\nnodes = 2\n\
-             [[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-             [outputs]\nvariables = [\"q\"]\n\
-             [[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
-             [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
-            wheel_fmu().display()
-        ),
+    let text = k_study(
+        ["two", "1.0", "kind = \"scm\"\nnodes = 2", "q"],
+        "[[variants]]\nname = \"scm\"\n[variants.method]\nkind = \"scm\"\nnodes = 3\n\
+         [[variants]]\nname = \"lhs\"\n[variants.method]\nkind = \"lhs\"\nsamples = 20\n",
     );
-    let out = dir.path().join("out");
-    run_study_ok(&p, &out, &[]);
+    let (_dir, out, _) = run_in_new_dir(|dir| write_toml(dir, "s", &text), &[]);
     let page = read(&out.join("lhs/index.html"));
-    assert!(
-        page.contains("railuq study lhs, a variant of the suite"),
-        "{page}"
-    );
-    assert!(page.contains("href=\"../index.html\""), "{page}");
+    assert_contains(&page, "railuq study lhs, a variant of the suite");
+    assert_contains(&page, "href=\"../index.html\"");
     let suite = read(&out.join("index.html"));
     assert!(!suite.contains("0.000e0"), "{suite}");
-    assert!(suite.contains("(reference)"), "{suite}");
+    assert_contains(&suite, "(reference)");
 }
 
 #[test]
@@ -480,10 +447,7 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
     // FMU declares" (there is no FMU), and its description promised a system "given below"
     // that the page did not show.
     let (_dir, out, stdout) = run_builtin("wheel-sgm");
-    assert!(
-        stdout.contains("the Galerkin system solved once"),
-        "{stdout}"
-    );
+    assert_contains(&stdout, "the Galerkin system solved once");
     let html = read(&out.join("index.html"));
     for wrong in [
         "1 model runs",
@@ -492,23 +456,16 @@ fn an_sgm_page_shows_its_system_and_claims_no_fmu_units_or_runs() {
     ] {
         assert!(!html.contains(wrong), "{wrong}:\n{html}");
     }
-    assert!(html.contains("No model runs"), "{html}");
-    assert!(html.contains("declares no unit"), "{html}");
-    assert!(
-        html.contains("<td>M (constant part)</td><td>[[10]]</td>"),
-        "{html}"
-    );
-    assert!(html.contains("K += K · [[1]]"), "{html}");
+    assert_contains(&html, "No model runs");
+    assert_contains(&html, "declares no unit");
+    assert_contains(&html, "<td>M (constant part)</td><td>[[10]]</td>");
+    assert_contains(&html, "K += K · [[1]]");
     // `export --runs` of this folder failed with "cannot read
     // .../store/manifest.json: No such file or directory"; an SGM study ran no model.
     assert!(!out.join("points.csv").exists() && !out.join("store").exists());
     let o = run(&["export", utf8(&out), "--runs"]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
-    assert!(
-        err.contains("an SGM study has no model runs to export"),
-        "{err}"
-    );
+    let err = failed(&o);
+    assert_contains(&err, "an SGM study has no model runs to export");
     assert!(!err.contains("No such file"), "{err}");
     assert!(!out.join("runs").exists());
 }
@@ -577,8 +534,7 @@ fn sobol_sampling_study(dir: &Path) -> PathBuf {
         dir,
         "sobol",
         "kind = \"sobol_sampling\"\nsamples = 256\nbase = \"qmc\"\nreplicates = 8",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
+        K_AND_C,
     );
     let out = dir.join("out");
     run_study_ok(&s, &out, &[]);
@@ -627,10 +583,10 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
     let runs = csv_column(&out.join("q_peak_convergence.csv"), "runs");
     assert_eq!(*runs.last().unwrap(), 512.0, "A and B of 256 base rows");
     let band = read(&out.join("q_peak_convergence.svg"));
-    assert!(band.contains("iid standard errors"), "{band}");
+    assert_contains(&band, "iid standard errors");
     // Scalar densities are per unit of the quantity .
     let pdf = read(&out.join("q_peak_pdf.svg"));
-    assert!(pdf.contains("probability density [1/m]"), "{pdf}");
+    assert_contains(&pdf, "probability density [1/m]");
     assert!(plots_are_well_formed(&out) >= 6);
 }
 
@@ -639,16 +595,7 @@ fn sobol_sampling_bars_have_intervals_and_convergence_ends_at_the_statistic() {
 /// chaos order has whole-number ticks and a dot at every order.
 #[test]
 fn std_over_time_and_chaos_convergence_read_as_such() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "stdplot",
-        "kind = \"scm\"\nnodes = 4",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0\n\
-         [[parameters]]\nname = \"C\"\nmean = 20.0\ncov = 0.1",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (_dir, out, _) = run_wheel("stdplot", "kind = \"scm\"\nnodes = 4", K_AND_C, &[]);
     let html = read(&out.join("index.html"));
     assert!(html.contains("q_std.svg"), "Std plot not on the page");
     let std = read(&out.join("q_std.svg"));
@@ -771,15 +718,7 @@ fn units_csv_names_every_column_written_and_no_other() {
 fn nominal_studies_write_no_header_only_density_files() {
     // A nominal study wrote `q_pdf.csv` and `q_end_pdf.csv` with a header
     // and no rows, although the README says none is written for a deterministic result.
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        "nom",
-        "kind = \"nominal\"",
-        "[[parameters]]\nname = \"K\"\nmean = 100.0\nstd = 10.0",
-    );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &[]);
+    let (_dir, out, _) = run_wheel("nom", "kind = \"nominal\"", K, &[]);
     for f in ["q_pdf.csv", "q_end_pdf.csv", "q_peak_pdf.csv"] {
         assert!(!out.join(f).exists(), "{f} written for a nominal study");
     }
@@ -800,16 +739,13 @@ fn summary_json_gives_each_inputs_own_mean_and_std() {
     // The README promised a truncated normal's own mean and Std in summary.json;
     // only the page had them. K: N(100, 10²) truncated to [95, ∞): α = −0.5, λ = φ(α)/(1 − Φ(α)),
     // mean = 100 + 10 λ, variance = 10² (1 + α λ − λ²), with Φ(−0.5) from the normal table.
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
+    let (_dir, out, _) = run_wheel(
         "moments",
         "kind = \"lhs\"\nsamples = 8",
         "[[parameters]]\nname = \"K\"\ndistribution = \"truncated_normal\"\nmean = 100.0\nstd = 10.0\nlow = 95.0\nhigh = inf\n\
          [[parameters]]\nname = \"C\"\ndistribution = \"lognormal\"\nmean = 20.0\nstd = 2.0",
+        &["--no-report"],
     );
-    let out = dir.path().join("out");
-    run_study_ok(&s, &out, &["--no-report"]);
     let summary = summary(&out);
     let p = &summary["parameters"];
     let alpha: f64 = -0.5;

@@ -13,6 +13,8 @@ use uq_driver::uq::method::Estimate;
 use uq_driver::uq::method::{Method, Sampling};
 use uq_driver::uq::{Distribution, RandomInputs, RandomParameter};
 
+use crate::support::assert_contains;
+
 fn unit_inputs(d: usize, low: f64, high: f64) -> RandomInputs {
     RandomInputs::independent(
         (0..d)
@@ -284,7 +286,7 @@ fn sobol_sampling_qmc_base_intervals_are_student_t_on_the_replicate_spread() {
         let summary = m.summary(d);
         let kind = summary.details["intervals"].as_str().unwrap();
         assert!(kind.starts_with("replicates"), "{kind}");
-        assert!(kind.contains(&format!("R = {r} ")), "{kind}");
+        assert_contains(kind, &format!("R = {r} "));
         assert_eq!(summary.details["replicates"], r);
     }
 }

@@ -11,6 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use uq_driver::internals::store::{self, Manifest, Record, Store};
 
+use crate::support::assert_contains;
+
 fn manifest(n_points: usize, n_values: usize) -> Manifest {
     Manifest {
         study_hash: "study".into(),
@@ -30,6 +32,25 @@ fn ok(i: usize, n_values: usize) -> Record {
 
 fn records_path(dir: &Path) -> std::path::PathBuf {
     dir.join("store").join("records.bin")
+}
+
+/// A store of [`manifest`]`(n_points, n_values)` written by [`write_store`] into a new
+/// temporary folder: the manifest, the folder, the records' byte ranges and the bytes of the
+/// records file.
+fn written_store(
+    n_points: usize,
+    n_values: usize,
+) -> (
+    Manifest,
+    tempfile::TempDir,
+    Vec<std::ops::Range<usize>>,
+    Vec<u8>,
+) {
+    let m = manifest(n_points, n_values);
+    let dir = tempfile::tempdir().unwrap();
+    let ranges = write_store(dir.path(), &m);
+    let clean = fs::read(records_path(dir.path())).unwrap();
+    (m, dir, ranges, clean)
 }
 
 /// A store of `n` finished points written through the public API; returns each record's byte
@@ -64,10 +85,7 @@ fn expected(i: usize, n_values: usize) -> Record {
 #[test]
 fn flipped_byte_in_record_1_of_1000_keeps_the_other_999() {
     // Before: the resume kept record 0 and silently dropped the 999 after the damage.
-    let m = manifest(1000, 3);
-    let dir = tempfile::tempdir().unwrap();
-    let ranges = write_store(dir.path(), &m);
-    let clean = fs::read(records_path(dir.path())).unwrap();
+    let (m, dir, ranges, clean) = written_store(1000, 3);
     for byte in ranges[1].clone() {
         for bit in [0u8, 7] {
             let mut bytes = clean.clone();
@@ -93,18 +111,12 @@ fn flipped_byte_in_record_1_of_1000_keeps_the_other_999() {
             let header_intact = byte - ranges[1].start >= 25;
             assert_eq!(r.rerun == vec![1], header_intact, "{where_}: {r}");
             let text = r.summary().unwrap();
-            assert!(text.contains("skipped 1 damaged stretch"), "{text}");
-            assert!(text.contains("kept 999 valid records"), "{text}");
+            assert_contains(&text, "skipped 1 damaged stretch");
+            assert_contains(&text, "kept 999 valid records");
             if header_intact {
-                assert!(
-                    text.contains("point 1 lost its record and will be run again"),
-                    "{text}"
-                );
+                assert_contains(&text, "point 1 lost its record and will be run again");
             } else {
-                assert!(
-                    text.contains("among the 1 points without a result"),
-                    "{text}"
-                );
+                assert_contains(&text, "among the 1 points without a result");
             }
             assert!(r.backup.is_some(), "damage before the end is rewritten");
             drop(s);
@@ -277,10 +289,7 @@ fn old_format_store_is_converted_and_kept_as_records_v1() {
 
 #[test]
 fn torn_tail_is_cut_and_its_point_reported() {
-    let m = manifest(5, 2);
-    let dir = tempfile::tempdir().unwrap();
-    let ranges = write_store(dir.path(), &m);
-    let clean = fs::read(records_path(dir.path())).unwrap();
+    let (m, dir, ranges, clean) = written_store(5, 2);
     let last = ranges[4].clone();
     for cut in last.start + 1..last.end {
         fs::write(records_path(dir.path()), &clean[..cut]).unwrap();

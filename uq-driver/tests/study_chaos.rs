@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    benchmarks, final_quantity, run, run_beside, run_ok, run_study, stderr, study_head, summary,
-    test_fmus, uniform, utf8, write_toml,
+    assert_contains, benchmarks, failed, final_quantity, run, run_beside, run_ok, run_study,
+    stderr, study_head, summary, test_fmus, uniform, utf8, write_toml,
 };
 
 /// A study on the Functions FMU: `function`, the random parameters and the method (TOML),
@@ -41,18 +41,20 @@ pub(crate) fn run_functions(
     run_beside(&study(dir, name, function, parameters, method), &[])
 }
 
+/// [`run_functions`] of the Ishigami function (function 1), x1, x2 and x3 uniform on [-π, π].
+pub(crate) fn run_ishigami(dir: &Path, name: &str, method: &str) -> PathBuf {
+    let pi = std::f64::consts::PI;
+    run_functions(dir, name, 1, &uniform(&["x1", "x2", "x3"], -pi, pi), method)
+}
+
 #[test]
 fn ishigami_sobol_indices_within_0_01_by_sparse_regression_with_200_runs() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let pi = std::f64::consts::PI;
-    let out = run_functions(
+    };
+    let out = run_ishigami(
         dir.path(),
         "ishigami",
-        1,
-        &uniform(&["x1", "x2", "x3"], -pi, pi),
         "kind = \"pce_regression\"\ndesign = \"qmc\"\nsamples = 200\norder = 14\nsparse = true",
     );
     let (first, total) = benchmarks::ishigami_indices();
@@ -92,19 +94,14 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     // Before: SCM mapped uniform inputs through the normal to Gauss–Hermite nodes: on 12
     // nodes per input the Ishigami mean came out 4.09 (true 3.5), and its only accuracy
     // indicator (order_difference, 0.0024) said it had converged.
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let pi = std::f64::consts::PI;
+    };
     let (mean, var) = benchmarks::ishigami_moments();
     let (first, total) = benchmarks::ishigami_indices();
-    let params = uniform(&["x1", "x2", "x3"], -pi, pi);
-    let askey = run_functions(
+    let askey = run_ishigami(
         dir.path(),
         "scm-askey",
-        1,
-        &params,
         "kind = \"scm\"\nnodes = 12\norder = 11",
     );
     let q = &summary(&askey)["quantities"]["Y"];
@@ -128,11 +125,9 @@ fn scm_of_uniform_inputs_meets_ishigami_and_the_hermite_mapping_warns_of_its_cha
     let warnings = summary(&askey)["warnings"].to_string();
     assert!(!warnings.contains("the chaos holds"), "{warnings}");
 
-    let hermite = run_functions(
+    let hermite = run_ishigami(
         dir.path(),
         "scm-hermite",
-        1,
-        &params,
         "kind = \"scm\"\nnodes = 12\norder = 8\nchaos = \"hermite\"",
     );
     let sum = summary(&hermite);
@@ -436,8 +431,7 @@ fn chaos_methods_refuse_integer_inputs_and_sampling_runs_them() {
     ] {
         let s = study(dir.path(), "int", 4, params, method);
         let o = run_study(&s, &dir.path().join("o"), &[]);
-        assert!(!o.status.success());
-        let err = stderr(&o);
+        let err = failed(&o);
         assert!(
             err.contains("integer_uniform") && err.contains("'x1'"),
             "{err}"
@@ -490,8 +484,7 @@ fn regression_on_a_points_file_is_exact_and_an_edited_file_is_not_resumed() {
     rows.pop();
     std::fs::write(dir.path().join("pts.csv"), rows.join("\n")).unwrap();
     let o = run_study(&s, &out, &[]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("different study"));
+    assert_contains(&failed(&o), "different study");
 }
 
 #[test]
@@ -553,10 +546,7 @@ fn a_chaos_whose_own_error_estimate_is_large_warns_and_a_converged_one_does_not(
         "kind = \"sparse_grid\"\nlevel = 2",
     );
     let warnings = summary(&out)["warnings"].to_string();
-    assert!(
-        warnings.contains("no truncation-error estimate"),
-        "{warnings}"
-    );
+    assert_contains(&warnings, "no truncation-error estimate");
 }
 
 #[test]
@@ -655,27 +645,20 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     // per input (the quadrature's Std is off by more than 5 % of the closed form's) against
     // 12 nodes (converged).
     let dir = tempfile::tempdir().unwrap();
-    let pi = std::f64::consts::PI;
     let (_, var) = benchmarks::ishigami_moments();
-    let params = uniform(&["x1", "x2", "x3"], -pi, pi);
     // Y2: Ishigami's largest value is 1 + 7 + 0.1 π⁴ ≈ 17.7, so 20 is beyond every run; 0 is
     // within them.
     let limits = "\n[[qoi]]\nkind = \"final\"\nname = \"Y2\"\nsignal = \"y\"\nlimits = [20.0, 0.0]";
-    let coarse = run_functions(
+    let coarse = run_ishigami(
         dir.path(),
         "scm4",
-        1,
-        &params,
         &format!("kind = \"scm\"\nnodes = 4{limits}"),
     );
     let s = summary(&coarse);
     let std = s["quantities"]["Y"]["std"].as_f64().unwrap();
     assert!((std / var.sqrt() - 1.0).abs() > 0.05, "std {std}");
     let warnings = s["warnings"].to_string();
-    assert!(
-        warnings.contains("Y: the top order of the chaos holds"),
-        "{warnings}"
-    );
+    assert_contains(&warnings, "Y: the top order of the chaos holds");
     let q = &s["quantities"]["Y2"];
     let (min, max) = (q["min"].as_f64().unwrap(), q["max"].as_f64().unwrap());
     let beyond = &q["exceedance_counts"][0]["beyond_runs"];
@@ -691,13 +674,7 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
         "the page says where P comes from"
     );
 
-    let fine = run_functions(
-        dir.path(),
-        "scm12",
-        1,
-        &params,
-        "kind = \"scm\"\nnodes = 12",
-    );
+    let fine = run_ishigami(dir.path(), "scm12", "kind = \"scm\"\nnodes = 12");
     let s = summary(&fine);
     let std = s["quantities"]["Y"]["std"].as_f64().unwrap();
     assert!((std / var.sqrt() - 1.0).abs() < 1e-5, "std {std}");

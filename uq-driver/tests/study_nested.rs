@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 
 use crate::support::csv::Csv;
 use crate::support::{
-    assert_same_files, final_quantity, read_json, run, run_beside, run_ok, run_study_ok,
-    study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, assert_same_files, final_quantity, read_json, run, run_beside, run_ok,
+    run_sharded, run_study_ok, study_head, summary, test_fmus, uniform, utf8, write_file,
+    write_toml,
 };
 
 /// The outer parameter's range: `seed ~ integer_uniform(1, SEEDS)`.
@@ -31,6 +32,15 @@ pub(crate) fn hashed_normal(seed: i64) -> f64 {
     let u1 = ((splitmix64_next(&mut state) >> 11) as f64 + 0.5) * 2f64.powi(-53);
     let u2 = (splitmix64_next(&mut state) >> 11) as f64 * 2f64.powi(-53);
     (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
+}
+
+/// The population of tracks: h of every seed of the range, its mean and its variance.
+pub(crate) fn population() -> (Vec<f64>, f64, f64) {
+    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let n = h.len() as f64;
+    let mean = h.iter().sum::<f64>() / n;
+    let var = h.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+    (h, mean, var)
 }
 
 /// The complementary error function (Numerical Recipes' `erfcc`, fractional error below
@@ -75,6 +85,14 @@ fn study(dir: &Path, fmu: &Path, name: &str, outer: &str, inner: &str) -> PathBu
     study_with(dir, fmu, name, outer, inner, 3, "[3.0]")
 }
 
+/// The built `Functions`, a new temporary folder and there the study `name` of [`study`]
+/// (`[outer, inner]` its methods), or `None` when the test FMUs cannot be built.
+fn nested_study(name: &str, [outer, inner]: [&str; 2]) -> Option<(tempfile::TempDir, PathBuf)> {
+    let (fmu, dir) = test_fmus::test_fmu_and_dir("Functions")?;
+    let s = study(dir.path(), &fmu, name, outer, inner);
+    Some((dir, s))
+}
+
 /// x1 and x2 ~ N(0, 1).
 pub(crate) const X1_X2: &str = "[[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
                      [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n";
@@ -96,7 +114,7 @@ fn study_with(
 /// The text of a two-level study `name` of `Functions` (function 4) with the study seed
 /// `seed`: the method `nested` of `outer` and `inner`; `seed` the outer parameter, the inner
 /// `parameters` and the `[fixed]` values `fixed` besides the function; `y` and its final value
-/// `y_end` with the limits `limits` (a TOML array).
+/// `y_end` with the limits `limits` (a TOML array; none when empty).
 pub(crate) fn nested_text(
     name: &str,
     fmu: &Path,
@@ -118,10 +136,14 @@ high = {SEEDS}
 level = "outer"
 {parameters}[fixed]
 function = 4
-{fixed}{outputs}limits = {limits}
-"#,
+{fixed}{outputs}{limits}"#,
         head = study_head(name, fmu, seed, "stop = 0.2\nstep = 0.1"),
-        outputs = final_quantity("y", "y_end")
+        outputs = final_quantity("y", "y_end"),
+        limits = if limits.is_empty() {
+            String::new()
+        } else {
+            format!("limits = {limits}\n")
+        }
     )
 }
 
@@ -139,11 +161,8 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
     let Some(fmu) = test_fmus::test_fmu("Functions") else {
         return;
     };
-    // The population of tracks: h over every seed of the range.
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let (h, h_mean, var_outer) = population();
     let n = h.len() as f64;
-    let h_mean = h.iter().sum::<f64>() / n;
-    let var_outer = h.iter().map(|x| (x - h_mean).powi(2)).sum::<f64>() / n;
     let var_inner = 3.0;
     let (f_inner, f_outer) = (
         var_inner / (var_inner + var_outer),
@@ -232,22 +251,17 @@ fn nested_variance_split_of_the_two_level_fmu_meets_the_closed_form() {
 /// corrected split meets the closed form all the same.
 #[test]
 fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((_dir, s)) = nested_study(
+        "two-level-mc",
+        [
+            "{ kind = \"lhs\", samples = 3000 }",
+            "{ kind = \"mc\", samples = 6 }",
+        ],
+    ) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        &fmu,
-        "two-level-mc",
-        "{ kind = \"lhs\", samples = 3000 }",
-        "{ kind = \"mc\", samples = 6 }",
-    );
     let out = run_beside(&s, &[]);
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
-    let n = h.len() as f64;
-    let m = h.iter().sum::<f64>() / n;
-    let var_outer = h.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
+    let (_, _, var_outer) = population();
     let f_outer = var_outer / (3.0 + var_outer);
     let split = &summary(&out)["quantities"]["y_end"]["variance_split"];
     let outer = split["outer"].as_f64().unwrap();
@@ -264,17 +278,15 @@ fn a_sampled_inner_design_has_its_sampling_error_taken_out_of_the_outer_share() 
 /// into three shards and merged: every (outer, inner) point is one record of the store.
 #[test]
 fn a_nested_study_is_the_same_resumed_and_sharded() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((dir, s)) = nested_study(
+        "two-level-shards",
+        [
+            "{ kind = \"qmc\", samples = 4, replicates = 2 }",
+            "{ kind = \"lhs\", samples = 5 }",
+        ],
+    ) else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let s = study(
-        dir.path(),
-        &fmu,
-        "two-level-shards",
-        "{ kind = \"qmc\", samples = 4, replicates = 2 }",
-        "{ kind = \"lhs\", samples = 5 }",
-    );
     let s = utf8(&s);
     let whole = dir.path().join("whole");
     run_ok(&["run", s, "--out", utf8(&whole), "-t", "2"]);
@@ -295,14 +307,7 @@ fn a_nested_study_is_the_same_resumed_and_sharded() {
     let o = run_ok(&["run", s, "--out", r, "-t", "1"]);
     assert!(o.contains("(17 resumed)"), "{o}");
 
-    let plan = dir.path().join("plan");
-    let p = utf8(&plan);
-    run_ok(&["plan", s, "--shards", "3", "--out", p]);
-    for k in ["0", "1", "2"] {
-        run_ok(&["run-shard", p, "--shard", k]);
-    }
-    let merged = dir.path().join("merged");
-    run_ok(&["merge", p, "--out", utf8(&merged)]);
+    let merged = run_sharded(Path::new(s), dir.path(), 3, "merged");
 
     for other in [&resumed, &merged] {
         assert_same_files(&whole, other, &files);
@@ -316,10 +321,9 @@ fn conditional_sobol_indices_of_an_outer_sample_without_inner_variance_are_nan_n
     // Before: the S_<p> columns of <q>_conditional.csv wrote 0 where the inner variance is
     // zero (the indices are 0/0 there). Here y = x1 + x2² + h(seed) with x1, x2 fixed and the
     // inner input x3, which function 4 ignores: every outer sample has no inner variance.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let text = nested_text(
         "flat-inner",
         &fmu,
@@ -353,10 +357,9 @@ fn a_sparse_inner_chaos_writes_a_rectangular_conditional_table_on_the_union_of_i
     // had rows of 31 to 44 fields under the first sample's 41 labels, no `loo` column, and
     // the inner chaos's error warnings were dropped. Ishigami (function 1) with its `a` and
     // `b` outer: the terms LARS keeps depend on them.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let pi = PI;
     let inner_params = uniform(&["x1", "x2", "x3"], -pi, pi);
     let head = |name: &str, method: &str, params: &str, fixed: &str| {
@@ -377,8 +380,11 @@ function = 1
     let outer_params = "[[parameters]]\nname = \"a\"\ndistribution = \"uniform\"\nlow = 2.0\n\
                         high = 9.0\nlevel = \"outer\"\n[[parameters]]\nname = \"b\"\n\
                         distribution = \"uniform\"\nlow = 0.0\nhigh = 0.3\nlevel = \"outer\"\n";
-    let s = dir.path().join("nested.toml");
-    std::fs::write(&s, head("ishigami-nested", method, outer_params, "")).unwrap();
+    let s = write_file(
+        dir.path(),
+        "nested.toml",
+        head("ishigami-nested", method, outer_params, ""),
+    );
     let out = dir.path().join("out");
     run_study_ok(&s, &out, &[]);
     let table = Csv::read(&out.join("y_end_conditional.csv")).rectangular();
@@ -458,8 +464,11 @@ function = 1
     std::fs::write(dir.path().join("own.csv"), own).unwrap();
     let alone = "kind = \"pce_regression\"\npoints = \"own.csv\"\norder = 6\nsparse = true";
     let fixed = format!("a = {}\nb = {}\n", r[col("a")], r[col("b")]);
-    let s1 = dir.path().join("alone.toml");
-    std::fs::write(&s1, head("ishigami-alone", alone, "", &fixed)).unwrap();
+    let s1 = write_file(
+        dir.path(),
+        "alone.toml",
+        head("ishigami-alone", alone, "", &fixed),
+    );
     let out1 = dir.path().join("alone");
     run_study_ok(&s1, &out1, &[]);
     let sur = read_json(&out1.join("surrogate.json"));
@@ -507,13 +516,13 @@ fn few_outer_samples_give_an_exceedance_interval_that_covers_at_its_level() {
     let Some(fmu) = test_fmus::test_fmu("Functions") else {
         return;
     };
-    let h: Vec<f64> = (1..=SEEDS).map(hashed_normal).collect();
+    let (h, h_mean, _) = population();
     let n = h.len() as f64;
     let p_true: Vec<f64> = [1.0, 3.0]
         .iter()
         .map(|c| h.iter().map(|x| inner_exceedance(c - x)).sum::<f64>() / n)
         .collect();
-    let mean_true = 1.0 + h.iter().sum::<f64>() / n;
+    let mean_true = 1.0 + h_mean;
     let dir = tempfile::tempdir().unwrap();
     let (mut covered, mut mean_covered, mut t_kind) = ([0; 2], 0, 0);
     let seeds = 40;
@@ -560,10 +569,9 @@ fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extr
     // the count line printed the pooled-draw P beside the interval of the mean of the
     // conditional P. y = x1 + x2² + h ≥ −4.3 or so in every run: −30 is below all of them,
     // 40 above all.
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let s = study_with(
         dir.path(),
         &fmu,
@@ -594,10 +602,7 @@ fn every_outer_sample_exceeding_gives_a_lower_bound_below_one_and_names_the_extr
         stdout.contains("below every model run") && stdout.contains("extrapolation alone"),
         "{stdout}"
     );
-    assert!(
-        stdout.contains("95 % lower bound of P, one-sided"),
-        "{stdout}"
-    );
+    assert_contains(&stdout, "95 % lower bound of P, one-sided");
     // One probability per limit: the count's P is the two-level table's, and with the same
     // number of draws from every outer sample the count itself gives it.
     for (c, e) in q["exceedance_counts"]

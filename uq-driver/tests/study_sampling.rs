@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::wheel::{self, read_csv, reference, reference_sobol};
 use crate::support::{
-    assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_ok, run_study_ok,
-    study_head, summary, test_fmus, uniform, utf8, write_toml,
+    assert_contains, assert_same_files, benchmarks, edit, final_quantity, run_builtin, run_sharded,
+    run_study_ok, study_head, summary, test_fmus, uniform, write_toml,
 };
 
 const TIMES: [f64; 5] = [0.5, 1.0, 2.0, 3.0, 5.0];
@@ -157,13 +157,7 @@ fn a_sharded_qmc_study_gives_the_files_of_the_whole_study() {
     );
     let whole = dir.path().join("whole");
     run_study_ok(&study, &whole, &[]);
-    let plan = dir.path().join("plan");
-    let result = dir.path().join("result");
-    run_ok(&["plan", utf8(&study), "--shards", "3", "--out", utf8(&plan)]);
-    for k in ["0", "1", "2"] {
-        run_ok(&["run-shard", utf8(&plan), "--shard", k]);
-    }
-    run_ok(&["merge", utf8(&plan), "--out", utf8(&result)]);
+    let result = run_sharded(&study, dir.path(), 3, "result");
     assert_same_files(&whole, &result, &["q.csv", "q_pdf.csv", "points.csv"]);
 }
 
@@ -296,10 +290,9 @@ function = {function}
 
 #[test]
 fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, 8192);
     let out = dir.path().join("ishigami");
     run_study_ok(&study, &out, &[]);
@@ -328,7 +321,7 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
     let method = &summary(&out)["method"];
     assert_eq!(method["replicates"], 8);
     let kind = method["intervals"].as_str().unwrap();
-    assert!(kind.contains("R = 8 independently scrambled"), "{kind}");
+    assert_contains(kind, "R = 8 independently scrambled");
     // Over time, y is constant after initialization: the same indices at every time.
     let csv = read_csv(&out.join("y_sobol.csv"));
     assert_eq!(csv.at(0.1, "S_x1"), q["first"]["x1"].as_f64().unwrap());
@@ -337,10 +330,9 @@ fn sobol_sampling_on_the_functions_fmu_meets_the_ishigami_indices() {
 
 #[test]
 fn sobol_sampling_on_the_functions_fmu_meets_the_g_function_first_order_indices() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = functions_study(dir.path(), &fmu, 3, 8, 0.0, 1.0, 4096);
     let out = dir.path().join("g");
     run_study_ok(&study, &out, &[]);
@@ -415,10 +407,9 @@ fn clopper_pearson_by_bisection(k: usize, n: usize) -> (f64, f64) {
 /// 0.977). It is counted over the 2N runs of A and B alone.
 #[test]
 fn sobol_sampling_counts_its_exceedance_over_the_independent_a_and_b_runs() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let n = 64;
     let study = functions_study(dir.path(), &fmu, 1, 3, -PI, PI, n);
     // The limit belongs to the [[qoi]] table: right after its signal.

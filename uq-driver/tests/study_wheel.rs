@@ -10,7 +10,7 @@ use crate::support::csv::Csv;
 use crate::support::wheel::{self, read_csv, reference, wheel_fmu};
 use crate::support::{
     assert_same_files, run, run_builtin, run_killed, run_ok, run_study, run_study_ok, stderr,
-    summary, utf8,
+    summary, utf8, write_file,
 };
 
 fn study_file(dir: &Path, name: &str, method: &str, extra: &str) -> PathBuf {
@@ -138,8 +138,7 @@ fn failed_points_stop_the_study_or_are_counted_when_allowed() {
         "name = \"C\"\nmean = 20.0\ncov = 0.1",
         "name = \"m\"\nmean = 1.0\nstd = 1.0",
     );
-    let study = dir.path().join("fail.toml");
-    std::fs::write(&study, text).unwrap();
+    let study = write_file(dir.path(), "fail.toml", text);
     let out = run_study(&study, &dir.path().join("a"), &[]);
     assert!(!out.status.success());
     let err = stderr(&out);
@@ -165,8 +164,7 @@ fn failed_points_stop_the_study_or_are_counted_when_allowed() {
 #[test]
 fn bad_inputs_give_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let bad_fmu = dir.path().join("bad.fmu");
-    std::fs::write(&bad_fmu, b"this is not a zip").unwrap();
+    let bad_fmu = write_file(dir.path(), "bad.fmu", b"this is not a zip");
     let text = std::fs::read_to_string(study_file(
         dir.path(),
         "x",
@@ -261,8 +259,7 @@ name = "lhs-200"
 method = { kind = "lhs", samples = 200 }
 "#
     );
-    let study = dir.path().join("suite.toml");
-    std::fs::write(&study, small).unwrap();
+    let study = write_file(dir.path(), "suite.toml", small);
     let out = dir.path().join("o");
     run_study_ok(&study, &out, &[]);
     let cmp = read_csv(&out.join("q_compare.csv"));
@@ -321,12 +318,11 @@ fn sparse_regression_chaos_on_100_runs_matches_the_reference() {
         "fmu = \"Wheel.fmu\"",
         &format!("fmu = {:?}", utf8(&wheel_fmu())),
     );
-    let file = dir.path().join("columns.toml");
-    std::fs::write(
-        &file,
+    let file = write_file(
+        dir.path(),
+        "columns.toml",
         format!("{text}\n[analysis]\nfunctional = \"columns\"\n"),
-    )
-    .unwrap();
+    );
     let columns = dir.path().join("columns");
     run_study_ok(&file, &columns, &[]);
     check_reference(&columns, |s| (1e-3 * s, 1e-2 * s), loo_below_5_percent);

@@ -7,7 +7,9 @@ use std::fs;
 use std::path::Path;
 
 use crate::support::wheel::{self, read_csv};
-use crate::support::{run, run_ok, run_study, stderr, utf8};
+use crate::support::{
+    assert_contains, failed, plan_and_run_shards, run, run_ok, run_study, stderr, utf8,
+};
 use uq_driver::internals::store::{decode, encode, Record};
 
 /// A small MC study of the wheel with seed `seed`.
@@ -23,13 +25,6 @@ fn wheel_mc(dir: &Path, file: &str, seed: u64) -> std::path::PathBuf {
     )
 }
 
-fn plan_and_run(study: &Path, plan: &Path) {
-    run_ok(&["plan", utf8(study), "--shards", "2", "--out", utf8(plan)]);
-    for k in ["0", "1"] {
-        run_ok(&["run-shard", utf8(plan), "--shard", k]);
-    }
-}
-
 fn records(dir: &Path) -> std::path::PathBuf {
     dir.join("store").join("records.bin")
 }
@@ -40,8 +35,8 @@ fn records(dir: &Path) -> std::path::PathBuf {
 fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
-    plan_and_run(&wheel_mc(dir.path(), "a", 42), &a);
-    plan_and_run(&wheel_mc(dir.path(), "b", 43), &b);
+    plan_and_run_shards(&wheel_mc(dir.path(), "a", 42), &a, 2);
+    plan_and_run_shards(&wheel_mc(dir.path(), "b", 43), &b, 2);
     let shard0 = |p: &Path| p.join("shards").join("0");
     fs::copy(records(&shard0(&b)), records(&shard0(&a))).unwrap();
     let o = run(&["merge", utf8(&a), "--no-report"]);
@@ -51,15 +46,10 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
         err.contains("shard 0") && err.contains("does not belong to this plan"),
         "{err}"
     );
-    assert!(err.contains("records of another study or FMU"), "{err}");
+    assert_contains(&err, "records of another study or FMU");
     // run-shard does not resume it either.
     let o = run(&["run-shard", utf8(&a), "--shard", "0"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("records of another study"),
-        "{}",
-        stderr(&o)
-    );
+    assert_contains(&failed(&o), "records of another study");
 
     // The same in a study folder: the run is not resumed from another study's records.
     let (x, y) = (dir.path().join("x"), dir.path().join("y"));
@@ -68,12 +58,7 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
     run_ok(&["run", utf8(&sb), "--out", utf8(&y), "--no-report"]);
     fs::copy(records(&y), records(&x)).unwrap();
     let o = run_study(&sa, &x, &["--no-report"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("copied from another folder"),
-        "{}",
-        stderr(&o)
-    );
+    assert_contains(&failed(&o), "copied from another folder");
 }
 
 /// plan.json's study edited after planning (seed 42 → 43) was merged without a word: the
@@ -82,7 +67,7 @@ fn a_records_file_of_another_study_in_a_shard_folder_is_refused() {
 fn an_edited_study_in_plan_json_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let plan = dir.path().join("plan");
-    plan_and_run(&wheel_mc(dir.path(), "s", 42), &plan);
+    plan_and_run_shards(&wheel_mc(dir.path(), "s", 42), &plan, 2);
     let path = plan.join("plan.json");
     let text = fs::read_to_string(&path).unwrap();
     assert!(text.contains("seed = 42"));

@@ -8,42 +8,11 @@ use std::io::Read;
 
 use crate::support::test_fmus;
 
-const FMI2_CS_FUNCTIONS: [&str; 34] = [
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
+/// The FMI 2.0 C ABI shared with the railuq crate's ABI test; this test takes its list of the 34
+/// functions.
+#[allow(dead_code)] // the C types, used by that test only
+#[path = "../../tests/common/fmi2.rs"]
+mod fmi2;
 
 fn entry(archive: &mut zip::ZipArchive<fs::File>, name: &str) -> Vec<u8> {
     let mut bytes = Vec::new();
@@ -104,7 +73,7 @@ fn test_fmu_binaries_export_the_34_functions_and_report_fmi_2_0() {
         fs::write(&so, entry(&mut archive, &so_name)).unwrap();
         // SAFETY: loading our own test library runs no initialisers beyond the C runtime's.
         let lib = unsafe { libloading::Library::new(&so) }.unwrap();
-        for function in FMI2_CS_FUNCTIONS {
+        for function in fmi2::FMI2_CS_SYMBOLS {
             // SAFETY: only the presence of the symbol is checked; it is not called.
             let symbol = unsafe { lib.get::<*const ()>(function.as_bytes()) };
             assert!(symbol.is_ok(), "{name} does not export {function}");

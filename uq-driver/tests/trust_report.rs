@@ -2,34 +2,37 @@
 //! nested study and its convergence over the study's own runs, a page that links summary.json,
 //! densities of a non-negative quantity. On the C test FMU `Functions`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use crate::study_nested::{nested_text, X1_X2};
 use crate::support::csv::Csv;
 use crate::support::{
-    final_quantity, read, run_study, run_study_ok, stderr, study_head, summary, test_fmus,
-    write_toml,
+    assert_contains, final_quantity, read, run_study, run_study_ok, stderr, study_head, summary,
+    test_fmus, write_toml,
 };
 
-/// `Functions` with function 5 (y = x1 + … + x8), x1 and x2 normal: a Monte Carlo study.
-fn linear_study(dir: &Path, fmu: &Path) -> std::path::PathBuf {
+/// `name.toml` in `dir`: a study of `Functions` with the function `function` by `method`, x1
+/// and x2 ~ N(0, 1), and `y` and its final value `y_end`.
+fn functions_study(dir: &Path, fmu: &Path, name: &str, method: &str, function: u32) -> PathBuf {
     let text = format!(
-        "{head}[method]\nkind = \"mc\"\nsamples = 8\n\
-         [[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
-         [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n\
-         [fixed]\nfunction = 5\n{outputs}",
-        head = study_head("linear", fmu, 3, "stop = 0.2\nstep = 0.1"),
+        "{head}[method]\n{method}\n{X1_X2}[fixed]\nfunction = {function}\n{outputs}",
+        head = study_head(name, fmu, 3, "stop = 0.2\nstep = 0.1"),
         outputs = final_quantity("y", "y_end")
     );
-    write_toml(dir, "linear", &text)
+    write_toml(dir, name, &text)
+}
+
+/// `Functions` with function 5 (y = x1 + … + x8), x1 and x2 normal: a Monte Carlo study.
+fn linear_study(dir: &Path, fmu: &Path) -> PathBuf {
+    functions_study(dir, fmu, "linear", "kind = \"mc\"\nsamples = 8", 5)
 }
 
 /// `run` had no `--seed` / `--set`: a changed seed or sample size meant editing the file.
 #[test]
 fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let study = linear_study(dir.path(), &fmu);
     let out = dir.path().join("out");
     let args = [
@@ -61,12 +64,9 @@ fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
     // Keys are checked as the study file's own are.
     let e = run_study(&study, &dir.path().join("e1"), &["--set", "method.zzz=1"]);
     let text = stderr(&e);
-    assert!(text.contains("unknown field `zzz`"), "{text}");
+    assert_contains(&text, "unknown field `zzz`");
     // Named by the setting, not by a line of the rewritten text.
-    assert!(
-        text.contains("linear.toml (with --set method.zzz=1): unknown"),
-        "{text}"
-    );
+    assert_contains(&text, "linear.toml (with --set method.zzz=1): unknown");
     let e = run_study(
         &study,
         &dir.path().join("e2"),
@@ -83,22 +83,15 @@ fn run_seed_and_set_override_the_study_and_are_kept_with_it() {
 /// 256-run study, and the terminal never printed the inner/outer variance split.
 #[test]
 fn nested_study_prints_its_variance_split_and_converges_over_its_own_runs() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // 16 outer samples × 16 inner collocation points (4 × 4 Gauss–Hermite): 256 runs.
-    let text = format!(
-        "{head}[method]\nkind = \"nested\"\nouter = {{ kind = \"mc\", samples = 16 }}\n\
-         inner = {{ kind = \"scm\", nodes = 4 }}\n\
-         [[parameters]]\nname = \"seed\"\ndistribution = \"integer_uniform\"\nlow = 1\n\
-         high = 20000\nlevel = \"outer\"\n\
-         [[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
-         [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n\
-         [fixed]\nfunction = 4\n{outputs}",
-        head = study_head("two-level", &fmu, 3, "stop = 0.2\nstep = 0.1"),
-        outputs = final_quantity("y", "y_end")
-    );
+    let methods = [
+        "{ kind = \"mc\", samples = 16 }",
+        "{ kind = \"scm\", nodes = 4 }",
+    ];
+    let text = nested_text("two-level", &fmu, 3, methods, [X1_X2, ""], "");
     let study = write_toml(dir.path(), "two-level", &text);
     let out = dir.path().join("out");
     let stdout = run_study_ok(&study, &out, &[]);
@@ -127,21 +120,18 @@ fn nested_study_prints_its_variance_split_and_converges_over_its_own_runs() {
 /// The density of a non-negative quantity spilled below 0.
 #[test]
 fn the_density_of_a_non_negative_quantity_has_no_mass_below_zero() {
-    let Some(fmu) = test_fmus::test_fmu("Functions") else {
+    let Some((fmu, dir)) = test_fmus::test_fmu_and_dir("Functions") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     // Function 6: y = x1² + … + x8², here x1² + x2² (a chi-square with 2 degrees of freedom,
     // density e^(-y/2)/2, 1/2 at 0).
-    let text = format!(
-        "{head}[method]\nkind = \"lhs\"\nsamples = 4000\n\
-         [[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
-         [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n\
-         [fixed]\nfunction = 6\n{outputs}",
-        head = study_head("squares", &fmu, 3, "stop = 0.2\nstep = 0.1"),
-        outputs = final_quantity("y", "y_end")
+    let study = functions_study(
+        dir.path(),
+        &fmu,
+        "squares",
+        "kind = \"lhs\"\nsamples = 4000",
+        6,
     );
-    let study = write_toml(dir.path(), "squares", &text);
     let out = dir.path().join("out");
     run_study_ok(&study, &out, &["--no-report"]);
     let pdf = Csv::read(&out.join("y_end_pdf.csv")).numeric();

@@ -15,8 +15,8 @@ use std::process::Output;
 
 use crate::support::csv::Csv;
 use crate::support::{
-    final_quantity, run, run_args, run_beside, run_study, stderr, stdout, study_head, summary,
-    test_fmus, write_toml,
+    assert_contains, failed, final_quantity, run, run_args, run_beside, run_study, stderr, stdout,
+    study_head, summary, test_fmus, write_toml,
 };
 
 /// A study on the test FMU `model` (1 s or 0.1 s long), with `body` (fixed values, parameters,
@@ -65,10 +65,9 @@ fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 
 #[test]
 fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     for (name, method) in [
         ("sg", "kind = \"sparse_grid\"\nlevel = 3"),
         ("scm", "kind = \"scm\"\nnodes = 4"),
@@ -133,10 +132,9 @@ fn chaos_methods_write_no_standard_error_of_the_mean_instead_of_zero() {
 /// standard error of the mean, the number where it has one.
 #[test]
 fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let variants =
         "[[variants]]\nname = \"sg\"\nmethod = { kind = \"sparse_grid\", level = 2 }\n\n\
                     [[variants]]\nname = \"mc\"\nmethod = { kind = \"mc\", samples = 100 }\n";
@@ -163,10 +161,9 @@ fn suite_comparison_writes_nan_for_a_chaos_variant_standard_error() {
 
 #[test]
 fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // x1, x2 ~ U(−1, 2): a third of the points have x1 <= 0, as the user chose.
     let s = study(
         dir.path(),
@@ -184,10 +181,9 @@ fn no_sign_warning_for_a_uniform_input_whose_support_includes_zero() {
 
 #[test]
 fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // misbehave = 6: NaN outputs from misbehave_at on: the points with misbehave_at within
     // the 1 s run fail, about 40 % of them.
     let body = "[fixed]\nmisbehave = 6\n[[parameters]]\nname = \"gain\"\n\
@@ -212,24 +208,20 @@ fn study_stopped_by_failures_counts_only_the_failures_it_saw() {
     let o = args("2", &["--allow-failures"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let (_, rows) = csv(&out.join("points.csv"));
-    let failed: Vec<usize> = rows
+    let failed_points: Vec<usize> = rows
         .iter()
         .filter(|r| r[3].contains("failed"))
         .map(|r| r[0].parse().unwrap())
         .collect();
-    let n_failed = failed.len();
+    let n_failed = failed_points.len();
     assert!(n_failed > 2 && n_failed < 64, "{n_failed} failed");
     let stdout = stdout(&o);
-    assert!(
-        stdout.contains(&format!("{n_failed} points failed")),
-        "{stdout}"
-    );
+    assert_contains(&stdout, &format!("{n_failed} points failed"));
     // One thread: the points run in design order up to the first failure, then the study
     // stops; the message says so instead of "1 of 64 points failed".
-    let f = failed[0];
+    let f = failed_points[0];
     let o = args("1", &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     let want = format!(
         "stopped at the first failure of 64 points (runs not started: {}; how many of those \
          would fail is not known); first: point {f} with",
@@ -273,10 +265,9 @@ fn number_after(text: &str, after: &str) -> usize {
 
 #[test]
 fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // The Functions FMU declares function with min = 1, max = 8.
     let body = function4(X1_X2, false).replace("function = 4", "function = 9");
     let s = study(
@@ -289,8 +280,7 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
     );
     let out = dir.path().join("f9.out");
     let o = run_study(&s, &out, &[]);
-    assert!(!o.status.success());
-    let err = stderr(&o);
+    let err = failed(&o);
     assert!(
         err.contains("'function' is an Integer declared with min = 1, max = 8")
             && err.contains("the value 9 given for it is outside that range"),
@@ -312,10 +302,9 @@ fn fixed_integer_outside_its_declared_range_is_refused_before_any_run() {
 
 #[test]
 fn sobol_indices_of_an_output_without_variance_are_nan_not_zero() {
-    if test_fmus::built().is_none() {
+    let Some(dir) = test_fmus::dir_if_built() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     // y = 1.79 in every run whatever x3, x4: Var = 0, so S = V_i / Var is 0/0.
     for (name, method) in [
         ("sg", "kind = \"sparse_grid\"\nlevel = 4"),

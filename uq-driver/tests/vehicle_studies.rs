@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::support::{built_fmu, read, run_builtin, run_ok, summary, utf8};
+use crate::support::{built_fmu, read, run_builtin, run_ok, summary, utf8, write_file};
 
 /// The entry `quantities.<name>` of a study's summary.json.
 fn quantity(out: &Path, name: &str) -> serde_json::Value {
@@ -88,13 +88,12 @@ fn vehicle_curve_safety_reports_its_running_safety_quantities() {
     let dir = tempfile::tempdir().unwrap();
     let text = run_ok(&["show", "vehicle-curve-safety"]);
     assert!(text.contains("samples = 200\n"));
-    let study = dir.path().join("curve.toml");
-    std::fs::write(
-        &study,
+    let study = write_file(
+        dir.path(),
+        "curve.toml",
         text.replace("samples = 200\n", "samples = 3\n")
             .replace("stop = 15.0", "stop = 5.0"),
-    )
-    .unwrap();
+    );
     let out = dir.path().join("out");
     run_ok(&["run", utf8(&study), "--out", utf8(&out)]);
     // Bounds the three curved runs of 5 s (2 s past the transition) stay within on any curve
@@ -126,8 +125,7 @@ fn derailment_study(dir: &Path, edits: &[(&str, &str)]) -> std::path::PathBuf {
         assert!(text.contains(from), "{from}");
         text = text.replace(from, to);
     }
-    let study = dir.join("derail.toml");
-    std::fs::write(&study, text).unwrap();
+    let study = write_file(dir, "derail.toml", text);
     let out = dir.join("out");
     run_ok(&["run", utf8(&study), "--out", utf8(&out), "--yes"]);
     out

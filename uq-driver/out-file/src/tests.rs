@@ -3,6 +3,15 @@
 use super::*;
 use std::os::unix::fs::symlink;
 
+/// A new temporary folder holding `victim.txt` ("precious\n"), the file a planted link
+/// points to; returns the folder and the victim's path.
+fn with_victim() -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, "precious\n").unwrap();
+    (dir, victim)
+}
+
 fn leftovers(dir: &Path) -> Vec<String> {
     std::fs::read_dir(dir)
         .unwrap()
@@ -28,10 +37,8 @@ fn a_symlink_planted_as_a_sub_folder_is_refused_not_written_through() {
 
 #[test]
 fn temporary_files_left_by_a_killed_run_are_removed_and_nothing_else() {
-    let dir = tempfile::tempdir().unwrap();
+    let (dir, victim) = with_victim();
     let d = dir.path();
-    let victim = d.join("victim.txt");
-    std::fs::write(&victim, "precious\n").unwrap();
     std::fs::write(d.join(format!("{TEMP_PREFIX}abc.part")), "half").unwrap();
     symlink(&victim, d.join(format!("{TEMP_PREFIX}link.part"))).unwrap();
     std::fs::create_dir(d.join(format!("{TEMP_PREFIX}dir.part"))).unwrap();
@@ -57,9 +64,7 @@ fn temporary_files_left_by_a_killed_run_are_removed_and_nothing_else() {
 
 #[test]
 fn a_symlink_planted_as_an_output_file_is_replaced_not_written_through() {
-    let dir = tempfile::tempdir().unwrap();
-    let victim = dir.path().join("victim.txt");
-    std::fs::write(&victim, "precious\n").unwrap();
+    let (dir, victim) = with_victim();
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
     let planted = out.join("summary.json");
@@ -76,9 +81,7 @@ fn a_symlink_planted_as_an_output_file_is_replaced_not_written_through() {
 
 #[test]
 fn a_hard_link_planted_as_an_output_file_keeps_its_other_name_unchanged() {
-    let dir = tempfile::tempdir().unwrap();
-    let victim = dir.path().join("victim.txt");
-    std::fs::write(&victim, "precious\n").unwrap();
+    let (dir, victim) = with_victim();
     let planted = dir.path().join("points.csv");
     std::fs::hard_link(&victim, &planted).unwrap();
     let mut f = OutFile::create(&planted, 16).unwrap();

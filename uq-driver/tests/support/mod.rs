@@ -64,6 +64,14 @@ pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Asserts that the run `o` failed, showing its output if not; returns its standard error.
+#[track_caller]
+pub fn failed(o: &Output) -> String {
+    let err = stderr(o);
+    assert!(!o.status.success(), "succeeded:\n{}\n{err}", stdout(o));
+    err
+}
+
 /// Asserts that `o` (of `uq-driver what`) succeeded, showing its output if not; returns its
 /// standard output.
 pub fn succeeded(o: &Output, what: &dyn std::fmt::Debug) -> String {
@@ -109,6 +117,25 @@ pub fn run_builtin(name: &str) -> (tempfile::TempDir, PathBuf, String) {
     (dir, out, stdout)
 }
 
+/// `uq-driver plan STUDY --shards N --out PLAN`, then `run-shard` of each of the `shards`.
+pub fn plan_and_run_shards(study: &Path, plan: &Path, shards: usize) {
+    let n = shards.to_string();
+    run_ok(&["plan", utf8(study), "--shards", &n, "--out", utf8(plan)]);
+    for k in 0..shards {
+        run_ok(&["run-shard", utf8(plan), "--shard", &k.to_string()]);
+    }
+}
+
+/// `study` planned in `shards` shards into `dir/plan`, each run, and merged into
+/// `dir/<merged>`; returns that folder.
+pub fn run_sharded(study: &Path, dir: &Path, shards: usize, merged: &str) -> PathBuf {
+    let plan = dir.join("plan");
+    plan_and_run_shards(study, &plan, shards);
+    let out = dir.join(merged);
+    run_ok(&["merge", utf8(&plan), "--out", utf8(&out)]);
+    out
+}
+
 /// Starts `uq-driver run STUDY --out OUT` with `extra` arguments and kills it once its store
 /// holds more than `bytes` of records; it must not finish before, and must get there within a
 /// minute.
@@ -151,9 +178,14 @@ pub fn study_head(name: &str, fmu: &Path, seed: u64, experiment: &str) -> String
 /// `[outputs]` with the one variable `signal`, and a quantity `name`: its final value.
 pub fn final_quantity(signal: &str, name: &str) -> String {
     format!(
-        "[outputs]\nvariables = [\"{signal}\"]\n\
-         [[qoi]]\nkind = \"final\"\nname = \"{name}\"\nsignal = \"{signal}\"\n"
+        "[outputs]\nvariables = [\"{signal}\"]\n{}",
+        qoi("final", name, signal)
     )
+}
+
+/// A `[[qoi]]` table: the quantity `name` of the kind `kind` of the output `signal`.
+pub fn qoi(kind: &str, name: &str, signal: &str) -> String {
+    format!("[[qoi]]\nkind = \"{kind}\"\nname = \"{name}\"\nsignal = \"{signal}\"\n")
 }
 
 /// Random parameters `names`, each uniform on [`low`, `high`] (`[[parameters]]` tables).
@@ -170,8 +202,13 @@ pub fn uniform(names: &[&str], low: f64, high: f64) -> String {
 
 /// Writes `text` to `dir/<name>.toml`; returns its path.
 pub fn write_toml(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(format!("{name}.toml"));
-    std::fs::write(&p, text).unwrap();
+    write_file(dir, &format!("{name}.toml"), text)
+}
+
+/// Writes `bytes` to the file `dir/name`; returns its path.
+pub fn write_file(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     p
 }
 
@@ -180,6 +217,12 @@ pub fn edit(path: &Path, from: &str, to: &str) {
     let text = read(path);
     assert!(text.contains(from), "no {from:?} in {}", path.display());
     std::fs::write(path, text.replace(from, to)).unwrap();
+}
+
+/// Asserts that `text` contains `needle`, showing the text if not.
+#[track_caller]
+pub fn assert_contains(text: &str, needle: &str) {
+    assert!(text.contains(needle), "no {needle:?} in:\n{text}");
 }
 
 /// A text file.

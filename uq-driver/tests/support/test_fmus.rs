@@ -58,6 +58,18 @@ pub fn test_fmu(model_name: &str) -> Option<PathBuf> {
     }
 }
 
+/// [`test_fmu`] and a new temporary folder for the test's files.
+pub fn test_fmu_and_dir(model_name: &str) -> Option<(PathBuf, tempfile::TempDir)> {
+    Some((test_fmu(model_name)?, tempfile::tempdir().unwrap()))
+}
+
+/// A new temporary folder for a test of the test FMUs, or `None` when they cannot be built
+/// (as for [`built`]).
+pub fn dir_if_built() -> Option<tempfile::TempDir> {
+    built()?;
+    Some(tempfile::tempdir().unwrap())
+}
+
 /// Every test FMU by model name, or `None` as for [`test_fmu`].
 pub fn built() -> Option<&'static BTreeMap<String, PathBuf>> {
     static BUILT: OnceLock<Result<BTreeMap<String, PathBuf>, String>> = OnceLock::new();

@@ -638,11 +638,17 @@ static fmi2Status status_unavailable(Instance *inst, const char *function, fmi2S
     return fmi2Discard;
 }
 
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    BEGIN(GetStatus)
-    (void)value;
-    return status_unavailable(inst, "fmi2GetStatus", s);
-}
+/* fmi2Get<Kind>Status of a type `Type` for which this FMU has no status kind. */
+#define NO_STATUS(Kind, Type)                                                                 \
+    fmi2Status fmi2Get##Kind##Status(fmi2Component c, const fmi2StatusKind s, Type *value) {  \
+        BEGIN(GetStatus)                                                                      \
+        (void)value;                                                                          \
+        return status_unavailable(inst, "fmi2Get" #Kind "Status", s);                         \
+    }
+
+NO_STATUS(, fmi2Status)
+NO_STATUS(Integer, fmi2Integer)
+NO_STATUS(String, fmi2String)
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
     BEGIN(GetStatus)
@@ -652,22 +658,10 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
     return fmi2OK;
 }
 
-fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    BEGIN(GetStatus)
-    (void)value;
-    return status_unavailable(inst, "fmi2GetIntegerStatus", s);
-}
-
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     BEGIN(GetStatus)
     REQUIRE_NOT_NULL(GetBooleanStatus, value)
     if (s != fmi2Terminated) return status_unavailable(inst, "fmi2GetBooleanStatus", s);
     *value = inst->terminated;
     return fmi2OK;
-}
-
-fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    BEGIN(GetStatus)
-    (void)value;
-    return status_unavailable(inst, "fmi2GetStringStatus", s);
 }

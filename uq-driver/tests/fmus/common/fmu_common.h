@@ -89,6 +89,12 @@ typedef struct {
 /* Provided by the model. */
 extern const ModelInfo MODEL;
 
+/* The definition of MODEL in a model whose GUID, VARIABLES, Data and hooks set_defaults,
+ * calculate, initialize and step have these names; `reset` is its reset hook (or NULL). */
+#define DEFINE_MODEL(reset)                                                                   \
+    const ModelInfo MODEL = {GUID,         VARIABLES, sizeof VARIABLES / sizeof VARIABLES[0], \
+                             sizeof(Data), set_defaults, calculate, initialize, step, reset}
+
 struct Instance {
     fmi2CallbackFunctions cb;
     char *name;

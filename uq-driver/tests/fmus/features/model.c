@@ -362,14 +362,4 @@ static fmi2Status step(Instance *inst, double h) {
     return status;
 }
 
-const ModelInfo MODEL = {
-    GUID,
-    VARIABLES,
-    sizeof VARIABLES / sizeof VARIABLES[0],
-    sizeof(Data),
-    set_defaults,
-    calculate,
-    initialize,
-    step,
-    reset,
-};
+DEFINE_MODEL(reset);

@@ -234,14 +234,4 @@ static fmi2Status step(Instance *inst, double h) {
     return fmi2OK;
 }
 
-const ModelInfo MODEL = {
-    GUID,
-    VARIABLES,
-    sizeof VARIABLES / sizeof VARIABLES[0],
-    sizeof(Data),
-    set_defaults,
-    calculate,
-    initialize,
-    step,
-    NULL,
-};
+DEFINE_MODEL(NULL);
