@@ -149,20 +149,16 @@ test: venv lint win64-toolchain build fmu docs
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
-# The FMU crate's tests run on a debug build that carries the test-only panic trigger
-# (tests/fmi_abi.rs); the packaged FMUs in target/fmu come from the release build without it.
-# The Vehicle's dynamics tests (tens of simulated seconds each) run in release mode, as do the
-# driver's tests: they run real studies. The release run of the Vehicle's tests names the same
-# packages as `build` (`--workspace --exclude railuq-python`, running only the railuq tests the
-# filter selects): cargo unifies the dependencies' features over the packages named, and
-# `-p railuq` alone compiled about twenty dependencies (nalgebra, rustfft, syn, ...) a second
-# time in release.
+# Every Rust test runs in release mode, on the very libraries that are built and packaged: the
+# FMU crate's ABI tests load target/release/librailuq.so (its panic boundary is proven by a test
+# hook that the test arms by an environment variable in a child process of its own), and the
+# Vehicle's dynamics (tens of simulated seconds per test) and the driver's real studies need the
+# speed. The command names the same packages as `build` (`--workspace --exclude railuq-python`):
+# cargo unifies the dependencies' features over the packages named, and a narrower selection
+# compiled about twenty dependencies (nalgebra, rustfft, syn, ...) a second time in release.
 test-rust:
-	env $(ZIG_ENV) $(CARGO) build -p railuq --lib --features test-panic
-	env $(ZIG_ENV) $(CARGO) test -p railuq --features test-panic
-	env $(ZIG_ENV) $(CARGO) test --release --workspace --exclude railuq-python --lib models::vehicle::
 	FMI2_HEADERS="$(FMI2_HEADERS)" RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" \
-	  env $(ZIG_ENV) $(CARGO) test --release -p uq-driver -p out-file -p in-file
+	  env $(ZIG_ENV) $(CARGO) test --release --workspace --exclude railuq-python
 
 test-python: venv wheel
 	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python

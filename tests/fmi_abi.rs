@@ -3,12 +3,14 @@
 //! C function pointers with C data (NUL-terminated strings, raw arrays, a C callbacks struct).
 //!
 //! ```text
-//! cargo build -p railuq --lib --features test-panic
-//! cargo test  -p railuq --features test-panic --test fmi_abi
+//! cargo test -p railuq --test fmi_abi             # target/debug/librailuq.so
+//! cargo test --release -p railuq --test fmi_abi   # target/release/librailuq.so, the shipped one
 //! ```
 //!
-//! The library is `target/debug/librailuq.so` (or `$CARGO_TARGET_DIR/debug/librailuq.so`), or
-//! the file named by the environment variable `RAILUQ_SO`.
+//! The library is `target/<profile>/librailuq.so` of the profile the test is built in (or under
+//! `$CARGO_TARGET_DIR`), or the file named by the environment variable `RAILUQ_SO`. The panic
+//! boundary is proven on that same library: the test arms its test hook
+//! (`RAILUQ_FMU_TEST_PANIC=1`) in a child process of its own.
 //!
 //! Everything ABI-related is defined here from the FMI 2.0 headers, not imported from the
 //! crate: the only things taken from `railuq` are the GUID, the serialized-state checksum (to
@@ -242,11 +244,16 @@ unsafe fn sym<T: Copy>(lib: &Library, path: &Path, name: &str) -> T {
 
 impl Fmu {
     fn load() -> Fmu {
-        let path = fmi2::library_path("debug");
+        let profile = if cfg!(debug_assertions) {
+            "debug"
+        } else {
+            "release"
+        };
+        let path = fmi2::library_path(profile);
         assert!(
             path.is_file(),
-            "{} does not exist: build it first with \
-             `cargo build -p railuq --lib --features test-panic`, or set RAILUQ_SO",
+            "{} does not exist: build it first with `cargo build -p railuq --lib` (in the \
+             profile of this test), or set RAILUQ_SO",
             path.display()
         );
         use libloading::os::unix::{Library as UnixLibrary, RTLD_LOCAL, RTLD_NOW};
@@ -1585,21 +1592,42 @@ fn foreign_truncated_and_corrupted_states_are_refused() {
 
 // ================================================================ 10. panic boundary
 
-#[cfg(feature = "test-panic")]
 #[test]
 fn a_panic_inside_the_fmu_is_fatal_not_an_abort() {
     let panic_value = railuq::fmi2::TEST_PANIC_VALUE;
     assert_eq!(panic_value, -7.0e77);
+    let armed = std::env::var_os(railuq::fmi2::TEST_PANIC_ENV).is_some_and(|v| v == "1");
+    if !armed && !cfg!(feature = "test-panic") {
+        // Unarmed, the value is an ordinary number to the shipped library.
+        let inst = Inst::new("unarmed");
+        let s = inst.set(VR_K, panic_value);
+        assert_ne!(s, FATAL, "unarmed: {:#?}", inst.log());
+        assert!(
+            !inst.log().iter().any(|e| e.message.contains("panic")),
+            "{:#?}",
+            inst.log()
+        );
+        // The hook is armed by the environment of the process that loads the library: this
+        // test runs again, alone, in a child process that has it.
+        let name = "a_panic_inside_the_fmu_is_fatal_not_an_abort";
+        let out = std::process::Command::new(std::env::current_exe().expect("test executable"))
+            .args(["--exact", name, "--test-threads=1", "--nocapture"])
+            .env(railuq::fmi2::TEST_PANIC_ENV, "1")
+            .output()
+            .expect("run the test again with the hook armed");
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            out.status.success() && text.contains("1 passed"),
+            "the armed run failed ({}):\n{text}",
+            out.status
+        );
+        return;
+    }
     let fmu = fmu();
-    let image = std::fs::read(&fmu.path).expect("read the library");
-    let marker = b"forced panic (test-panic feature)";
-    assert!(
-        image.windows(marker.len()).any(|w| w == marker),
-        "{} was built without the `test-panic` feature: rebuild it with \
-         `cargo build -p railuq --lib --features test-panic` (or point RAILUQ_SO at such a build)",
-        fmu.path.display()
-    );
-
     let inst = Inst::new("panic");
     inst.init(0.0, None);
     inst.run(0.0, 0.01, 50);
@@ -1607,8 +1635,8 @@ fn a_panic_inside_the_fmu_is_fatal_not_an_abort() {
     assert_eq!(
         s,
         FATAL,
-        "fmi2SetReal({panic_value}) returned {s}, not fmi2Fatal: is {} built with \
-         `--features test-panic`? log {:#?}",
+        "fmi2SetReal({panic_value}) returned {s}, not fmi2Fatal with the test hook armed \
+         ({}): log {:#?}",
         fmu.path.display(),
         inst.log()
     );

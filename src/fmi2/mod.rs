@@ -19,5 +19,4 @@ pub mod types;
 pub mod uri;
 pub mod xml;
 
-#[cfg(feature = "test-panic")]
-pub use functions::TEST_PANIC_VALUE;
+pub use functions::{TEST_PANIC_ENV, TEST_PANIC_VALUE};

@@ -9,6 +9,10 @@
 //! binary again (`library.rs`, a host that exits during a study). An FMU loaded in-process is
 //! extracted to a folder of its own on each `Fmu::open`, so tests never share its globals.
 //!
+//! libtest starts the tests in the order of their names, two at a time on two cores: a test of
+//! ten seconds or more (the Vehicle's built-in nominal study) sits in a module early in that
+//! order, so that it does not run alone at the end while the other thread idles.
+//!
 //! `autotests = false` (Cargo.toml): a file of `tests/` that is not declared below is not
 //! compiled at all, so [`every_file_of_the_tests_folder_is_a_module_of_this_binary`] checks that
 //! none is left out.
@@ -16,6 +20,7 @@
 mod support;
 
 mod analysis_blocks;
+mod builtin_vehicle_studies;
 mod calculated_strings;
 mod chaos_sizes;
 mod cli_options;
@@ -49,7 +54,6 @@ mod tampered_folders;
 mod test_fmus;
 mod trust_report;
 mod undefined_numbers;
-mod vehicle_studies;
 
 /// The `.rs` files of the folder `dir` (below `tests/`) but `skip`, without their extension.
 fn rust_files(dir: &str, skip: &str) -> Vec<String> {

@@ -12,9 +12,20 @@ use crate::fmi2::logger::Category;
 use crate::fmi2::state::Func;
 use crate::fmi2::types::*;
 
-/// With the `test-panic` feature, setting any Real to this value panics inside the FMU.
-#[cfg(feature = "test-panic")]
+/// Setting any Real to this value panics inside the FMU when the test hook is armed, to prove
+/// the panic boundary of the very library that is shipped: the call returns fmi2Fatal and the
+/// host goes on. Armed by the environment variable [`TEST_PANIC_ENV`] set to `1` in the process
+/// that loads the FMU (read only when the value is seen), or always by the `test-panic`
+/// feature. Unarmed, the value is an ordinary finite number.
 pub const TEST_PANIC_VALUE: f64 = -7.0e77;
+
+/// The environment variable that arms the test hook of [`TEST_PANIC_VALUE`].
+pub const TEST_PANIC_ENV: &str = "RAILUQ_FMU_TEST_PANIC";
+
+/// Whether the test hook of [`TEST_PANIC_VALUE`] is armed.
+pub(super) fn test_panic_armed() -> bool {
+    cfg!(feature = "test-panic") || std::env::var_os(TEST_PANIC_ENV).is_some_and(|v| v == "1")
+}
 
 pub(super) fn guard<R>(on_panic: R, f: impl FnOnce() -> R) -> R {
     catch_unwind(AssertUnwindSafe(f)).unwrap_or(on_panic)
