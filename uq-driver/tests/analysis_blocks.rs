@@ -119,7 +119,7 @@ fn tiny_analysis_blocks_give_the_same_files_sobol_sampling_qmc_replicates() {
 #[test]
 fn a_killed_study_resumed_with_tiny_blocks_gives_the_uninterrupted_files() {
     let dir = tempfile::tempdir().unwrap();
-    let method = "kind = \"lhs\"\nsamples = 20000";
+    let method = "kind = \"lhs\"\nsamples = 10000";
     let study = wheel::write_study(dir.path(), "r", "r", 3, wheel::EXPERIMENT, method, "");
     let full = dir.path().join("full");
     run_study(&study, &full, &[]);
@@ -129,7 +129,7 @@ fn a_killed_study_resumed_with_tiny_blocks_gives_the_uninterrupted_files() {
         &study,
         &part,
         &["--threads", "1", "--no-report"],
-        5_000 * 4_037,
+        2_500 * 4_037,
     );
     assert!(!part.join("q.csv").exists(), "killed before the end");
     run_study(&study, &part, &[TINY]);

@@ -268,6 +268,13 @@ pub fn tensor_grid(nodes_per_dim: &[usize]) -> Result<TensorGrid, QuadratureErro
     for &n in nodes_per_dim {
         check_nodes(n)?;
     }
+    // Too many points are refused before any rule is computed (a rule of n nodes is an n × n
+    // eigenproblem: three of 1000 nodes took seconds).
+    nodes_per_dim
+        .iter()
+        .try_fold(1usize, |t, &n| t.checked_mul(n))
+        .filter(|&t| t <= MAX_TENSOR_POINTS)
+        .ok_or(QuadratureError::TooManyPoints)?;
     let rules: Vec<(Vec<f64>, Vec<f64>)> = nodes_per_dim
         .iter()
         .map(|&n| gauss_hermite(n))
