@@ -133,29 +133,19 @@ run: build fmu
 	$(DRIVER) compare out/wheel-scm out/wheel-lhs-10000 --out out
 	@echo "reports: out/index.html (both compared), out/wheel-scm/index.html, out/wheel-lhs-10000/index.html"
 
-# clippy and rustdoc build in a target folder of their own (LINT_DIR): they share no artifact
-# with the release build, and with their own folder (and so their own cargo lock) `make test`
-# runs them beside it.
-LINT_DIR := target/lint
 lint:
 	$(CARGO) fmt --all -- --check
 	@# cargo fmt misses files it does not reach through `mod` (macro-declared modules, fuzz
 	@# targets, benches' helpers): every tracked .rs file is checked on its own too.
 	git ls-files -z '*.rs' | xargs -0 rustfmt --edition 2021 --check
-	env $(ZIG_ENV) $(CARGO) clippy --target-dir $(LINT_DIR) --workspace --all-targets -- -D warnings
-	RUSTDOCFLAGS="-D warnings" env $(ZIG_ENV) $(CARGO) doc --target-dir $(LINT_DIR) -p uq-driver --no-deps
-	$(PYTHON) uq-driver/api_items.py $(LINT_DIR)/doc/uq_driver/all.html 250
+	env $(ZIG_ENV) $(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" env $(ZIG_ENV) $(CARGO) doc -p uq-driver --no-deps
+	$(PYTHON) uq-driver/api_items.py target/doc/uq_driver/all.html 250
 
 fmt:
 	$(CARGO) fmt --all
 
-# The lint and the builds (release, then win64) run side by side, two jobs on the cores:
-# each alone leaves a core idle for long stretches (one large crate compiling). Their
-# output comes whole, each when it ends.
-test: venv win64-toolchain
-	@echo "make test: lint and build side by side; the output of each follows when it ends"
-	$(MAKE) --no-print-directory -j2 --output-sync=target lint fmu
-	$(MAKE) --no-print-directory docs
+test: venv lint win64-toolchain build fmu docs
 	$(MAKE) test-rust
 	$(MAKE) test-python
 
