@@ -265,9 +265,21 @@ impl Pce {
     /// `n` draws of every output of the surrogate, one row per draw: row `i` is the chaos at
     /// point `i` of [`germ_draws`] (a function of `(seed, i)` only).
     pub fn sample(&self, n: usize, seed: u64) -> DMatrix<f64> {
-        self.basis
-            .design_matrix(&germ_draws(self.basis.families(), n, seed))
-            * &self.coeffs
+        // The design matrix of `germ_draws`, built row by row in two buffers, without a
+        // vector per draw (a nested study draws millions).
+        let families = self.basis.families();
+        let laws: Vec<_> = families.iter().map(Family::law).collect();
+        let mut z = vec![0.0; families.len()];
+        let mut psi = vec![0.0; self.basis.len()];
+        let mut m = DMatrix::<f64>::zeros(n, self.basis.len());
+        for i in 0..n {
+            germ_draw(families, &laws, seed, i, &mut z);
+            self.basis.eval(&z, &mut psi);
+            for (k, v) in psi.iter().enumerate() {
+                m[(i, k)] = *v;
+            }
+        }
+        m * &self.coeffs
     }
 
     /// First-order Sobol' indices of output `col`, one per germ dimension: the variance
