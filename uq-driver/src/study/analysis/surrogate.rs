@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use nalgebra::{DMatrix, DMatrixViewMut};
 use rayon::prelude::*;
 
-use crate::uq::pce::{germ_draw, Basis, Pce};
+use crate::uq::pce::{basis_at_germ_draws, Basis, Pce};
 
 /// Rows of germ points evaluated per parallel task.
 const ROWS_PER_TASK: usize = 512;
@@ -95,18 +95,15 @@ fn product(psi: &DMatrix<f64>, pce: &Pce, n: usize, j: usize, out: &mut [f64]) {
 /// `basis.design_matrix(&germ_draws(basis.families(), n, seed))`, rows computed in parallel.
 fn basis_at_germs(basis: &Basis, n: usize, seed: u64) -> DMatrix<f64> {
     let terms = basis.len();
-    let laws: Vec<_> = basis.families().iter().map(|f| f.law()).collect();
     // Row-major per task, then transposed into the column-major matrix.
     let rows: Vec<Vec<f64>> = (0..n.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
         .map(|task| {
             let (i0, i1) = (task * ROWS_PER_TASK, ((task + 1) * ROWS_PER_TASK).min(n));
             let mut block = vec![0.0; (i1 - i0) * terms];
-            let mut z = vec![0.0; basis.families().len()];
-            for (i, row) in (i0..i1).zip(block.chunks_exact_mut(terms.max(1))) {
-                germ_draw(basis.families(), &laws, seed, i, &mut z);
-                basis.eval(&z, row);
-            }
+            basis_at_germ_draws(basis, seed, i0..i1, |i, psi| {
+                block[(i - i0) * terms..][..terms].copy_from_slice(psi)
+            });
             block
         })
         .collect();

@@ -265,20 +265,10 @@ impl Pce {
     /// `n` draws of every output of the surrogate, one row per draw: row `i` is the chaos at
     /// point `i` of [`germ_draws`] (a function of `(seed, i)` only).
     pub fn sample(&self, n: usize, seed: u64) -> DMatrix<f64> {
-        // The design matrix of `germ_draws`, built row by row in two buffers, without a
-        // vector per draw (a nested study draws millions).
-        let families = self.basis.families();
-        let laws: Vec<_> = families.iter().map(Family::law).collect();
-        let mut z = vec![0.0; families.len()];
-        let mut psi = vec![0.0; self.basis.len()];
         let mut m = DMatrix::<f64>::zeros(n, self.basis.len());
-        for i in 0..n {
-            germ_draw(families, &laws, seed, i, &mut z);
-            self.basis.eval(&z, &mut psi);
-            for (k, v) in psi.iter().enumerate() {
-                m[(i, k)] = *v;
-            }
-        }
+        basis_at_germ_draws(&self.basis, seed, 0..n, |i, psi| {
+            m.row_mut(i).copy_from_slice(psi)
+        });
         m * &self.coeffs
     }
 
@@ -361,6 +351,25 @@ pub fn germ_draw(families: &[Family], laws: &[Distribution], seed: u64, i: usize
             Family::Hermite => rng::standard_normal(&mut r),
             _ => law.inverse_cdf(rng::uniform_open01(&mut r)),
         };
+    }
+}
+
+/// The basis at points `rows` of [`germ_draws`]: `put(i, psi)` for each point `i`, `psi` the
+/// basis there (one buffer reused from point to point, no vector per point).
+pub(crate) fn basis_at_germ_draws(
+    basis: &Basis,
+    seed: u64,
+    rows: std::ops::Range<usize>,
+    mut put: impl FnMut(usize, &[f64]),
+) {
+    let families = basis.families();
+    let laws: Vec<_> = families.iter().map(Family::law).collect();
+    let mut z = vec![0.0; families.len()];
+    let mut psi = vec![0.0; basis.len()];
+    for i in rows {
+        germ_draw(families, &laws, seed, i, &mut z);
+        basis.eval(&z, &mut psi);
+        put(i, &psi);
     }
 }
 
