@@ -77,9 +77,7 @@ pub use multistart::{form_multistart, MultiStart, MultiStartResult};
 pub use sorm::{sorm, Sorm, SormResult};
 pub use subset::{subset_simulation, Spread, Subset, SubsetResult};
 
-use rand_chacha::ChaCha20Rng;
-
-use crate::uq::rng;
+use crate::uq::rng::{self, ChaCha20};
 
 /// Which use a random stream serves: the top byte of its stream index, so that the draws of
 /// different purposes never share a stream under one seed.
@@ -98,13 +96,13 @@ pub(crate) enum Purpose {
 
 /// The stream of `index` (below `2^56`) for `purpose` under `seed`:
 /// `rng::stream(seed, purpose << 56 | index)`.
-pub(crate) fn stream(seed: u64, purpose: Purpose, index: u64) -> ChaCha20Rng {
+pub(crate) fn stream(seed: u64, purpose: Purpose, index: u64) -> ChaCha20 {
     debug_assert!(index < 1 << 56);
     rng::stream(seed, (purpose as u64) << 56 | index)
 }
 
 /// `d` independent standard normals from `rng` (by inversion, one word each).
-pub(crate) fn normals(rng: &mut ChaCha20Rng, d: usize) -> Vec<f64> {
+pub(crate) fn normals(rng: &mut ChaCha20, d: usize) -> Vec<f64> {
     (0..d).map(|_| rng::standard_normal(rng)).collect()
 }
 

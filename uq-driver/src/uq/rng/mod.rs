@@ -4,10 +4,11 @@
 //! study seed, so that results never depend on the number of threads or on the
 //! order in which samples are processed.
 //!
-//! The generator is ChaCha20 ([`rand_chacha::ChaCha20Rng`]): a stable,
-//! documented, portable algorithm whose output for a given key, stream and
-//! position is fixed by its specification, unlike `rand::rngs::StdRng` whose
-//! algorithm may change between releases. The conversion of a `u64` word to a
+//! The generator is ChaCha20 ([`ChaCha20`], the output of `rand_chacha::ChaCha20Rng`
+//! word for word, computed one block at a time): a stable, documented, portable
+//! algorithm whose output for a given key, stream and position is fixed by its
+//! specification, unlike `rand::rngs::StdRng` whose algorithm may change between
+//! releases. The conversion of a `u64` word to a
 //! uniform in (0, 1) is `rand_distr::Open01`; the tests pin it against its
 //! closed form, so a release of `rand` that changed it would be noticed.
 //!
@@ -19,21 +20,22 @@
 //! every design a function of (seed, index) only.
 
 use rand::{RngCore, SeedableRng};
-use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution as _, Open01};
+
+mod chacha;
+pub use chacha::ChaCha20;
 
 use crate::uq::special::norm_ppf;
 
 /// The random stream of sample `index` under study seed `seed`.
 ///
-/// The generator is ChaCha20 keyed by `ChaCha20Rng::seed_from_u64(seed)`, with
-/// its 64-bit stream number set to `index` (position 0). Distinct indices give
-/// independent, non-overlapping streams of 2^68 bytes each. The output is
-/// stable: it is pinned by a value-stability test.
-pub fn stream(seed: u64, index: u64) -> ChaCha20Rng {
-    let mut rng = ChaCha20Rng::seed_from_u64(seed);
-    rng.set_stream(index);
-    rng
+/// The generator is ChaCha20 keyed by `seed_from_u64(seed)` (as
+/// `rand_chacha::ChaCha20Rng::seed_from_u64`), with its 64-bit stream number set
+/// to `index` (position 0). Distinct indices give independent, non-overlapping
+/// streams of 2^68 bytes each. The output is stable: it is pinned by a
+/// value-stability test.
+pub fn stream(seed: u64, index: u64) -> ChaCha20 {
+    ChaCha20::seed_from_u64(seed).with_stream(index)
 }
 
 /// A uniform draw strictly inside (0, 1): `rand_distr::Open01` on one `u64`.
