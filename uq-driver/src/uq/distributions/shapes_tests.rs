@@ -192,15 +192,16 @@ fn moments_by_quadrature_match_the_closed_forms() {
 fn inversion_draws_have_the_right_mean() {
     // Midpoint rule on the unit interval through the quantile: the mean of F^-1 over n
     // equal cells converges to E X (a check of the quantile against the closed-form mean).
+    // With 20 000 cells the largest error is 4e-5 Std (Weibull of shape 0.7, its tail cell).
     for m in continuous() {
-        let n = 200_000;
+        let n = 20_000;
         let mean = (0..n)
             .map(|k| m.inverse_cdf((k as f64 + 0.5) / n as f64))
             .sum::<f64>()
             / n as f64;
         let sd = variance(&m).sqrt();
         assert!(
-            (mean - m.mean()).abs() < 2e-3 * sd,
+            (mean - m.mean()).abs() < 2e-4 * sd,
             "{m:?}: {mean} vs {}",
             m.mean()
         );

@@ -36,35 +36,45 @@ fn two_dof() -> LinearSystem {
 }
 
 /// Independent deterministic solve of one realisation: plain RK4 on [q, v] with its own
-/// small step, written here separately from the Galerkin code.
+/// small step, written here separately from the Galerkin code (fixed-size 2 × 2 matrices:
+/// 512 realisations of 8 000 steps, no allocation per step).
 fn realisation(sys: &LinearSystem, xi: &[f64], times: &[f64]) -> Vec<[f64; 2]> {
-    let (m, c, k) = (sys.m.at(xi), sys.c.at(xi), sys.k.at(xi));
+    use nalgebra::{Matrix2, Vector2};
+    let fixed = |a: DMatrix<f64>| Matrix2::from_iterator(a.iter().copied());
+    let (m, c, k) = (
+        fixed(sys.m.at(xi)),
+        fixed(sys.c.at(xi)),
+        fixed(sys.k.at(xi)),
+    );
     let minv = m.try_inverse().unwrap();
-    let f = |t: f64, q: &DVector<f64>, v: &DVector<f64>| {
-        let mut rhs = DVector::zeros(2);
-        for (amp, w) in &sys.force {
-            rhs += amp * w.at(t);
-        }
-        &minv * (rhs - &c * v - &k * q)
+    let force: Vec<(Vector2<f64>, &Waveform)> = sys
+        .force
+        .iter()
+        .map(|(amp, w)| (Vector2::new(amp[0], amp[1]), w))
+        .collect();
+    let f = |t: f64, q: Vector2<f64>, v: Vector2<f64>| {
+        let rhs: Vector2<f64> = force.iter().map(|(amp, w)| amp * w.at(t)).sum();
+        minv * (rhs - c * v - k * q)
     };
-    let mut q = DVector::from_column_slice(sys.q0.at(xi).as_slice());
-    let mut v = DVector::from_column_slice(sys.v0.at(xi).as_slice());
+    let (q0, v0) = (sys.q0.at(xi), sys.v0.at(xi));
+    let mut q = Vector2::new(q0[0], q0[1]);
+    let mut v = Vector2::new(v0[0], v0[1]);
     let h = 2.5e-4;
     let mut out = vec![[q[0], q[1]]];
     let mut t = times[0];
     for w in times.windows(2) {
         let n = ((w[1] - w[0]) / h).round() as usize;
         for _ in 0..n {
-            let a1 = f(t, &q, &v);
-            let a2 = f(t + h / 2.0, &(&q + &v * (h / 2.0)), &(&v + &a1 * (h / 2.0)));
+            let a1 = f(t, q, v);
+            let a2 = f(t + h / 2.0, q + v * (h / 2.0), v + a1 * (h / 2.0));
             let a3 = f(
                 t + h / 2.0,
-                &(&q + (&v + &a1 * (h / 2.0)) * (h / 2.0)),
-                &(&v + &a2 * (h / 2.0)),
+                q + (v + a1 * (h / 2.0)) * (h / 2.0),
+                v + a2 * (h / 2.0),
             );
-            let a4 = f(t + h, &(&q + (&v + &a2 * (h / 2.0)) * h), &(&v + &a3 * h));
-            q += (&v * 6.0 + (&a1 + &a2 + &a3) * h) * (h / 6.0);
-            v += (&a1 + &a2 * 2.0 + &a3 * 2.0 + &a4) * (h / 6.0);
+            let a4 = f(t + h, q + (v + a2 * (h / 2.0)) * h, v + a3 * h);
+            q += (v * 6.0 + (a1 + a2 + a3) * h) * (h / 6.0);
+            v += (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0);
             t += h;
         }
         out.push([q[0], q[1]]);
