@@ -345,25 +345,45 @@ impl Basis {
         self.set.is_empty()
     }
 
-    /// Univariate values `table[i][k] = p^(i)_k(t_i)` up to the largest degree used.
-    fn univariate(&self, t: &[f64]) -> Vec<Vec<f64>> {
-        self.families
+    /// `out[k] = Psi_k(t)` for every basis function, `t` a germ point.
+    ///
+    /// The univariate values are computed once per dimension into one table, on the stack
+    /// for small bases (this runs once per surrogate draw: millions of times in a nested
+    /// study).
+    pub fn eval(&self, t: &[f64], out: &mut [f64]) {
+        const VALUES: usize = 64;
+        const DIMS: usize = 16;
+        let total: usize = self.max_deg.iter().map(|m| m + 1).sum();
+        let d = self.families.len();
+        if total <= VALUES && d <= DIMS {
+            let (mut table, mut start) = ([0.0; VALUES], [0usize; DIMS]);
+            self.eval_in(t, out, &mut table[..total], &mut start[..d]);
+        } else {
+            self.eval_in(t, out, &mut vec![0.0; total], &mut vec![0; d]);
+        }
+    }
+
+    /// [`Self::eval`] with the table of univariate values `p^(i)_k(t_i)` (up to the largest
+    /// degree used in dimension `i`) at `table[start[i] + k]`.
+    fn eval_in(&self, t: &[f64], out: &mut [f64], table: &mut [f64], start: &mut [usize]) {
+        let mut at = 0;
+        for (((f, &m), &ti), s) in self
+            .families
             .iter()
             .zip(&self.max_deg)
             .zip(t)
-            .map(|((f, &m), &ti)| {
-                let mut v = vec![0.0; m + 1];
-                f.eval_all(ti, &mut v);
-                v
-            })
-            .collect()
-    }
-
-    /// `out[k] = Psi_k(t)` for every basis function, `t` a germ point.
-    pub fn eval(&self, t: &[f64], out: &mut [f64]) {
-        let table = self.univariate(t);
+            .zip(&mut *start)
+        {
+            *s = at;
+            f.eval_all(ti, &mut table[at..at + m + 1]);
+            at += m + 1;
+        }
         for (o, a) in out.iter_mut().zip(self.set.indices()) {
-            *o = a.iter().enumerate().map(|(i, &ai)| table[i][ai]).product();
+            *o = a
+                .iter()
+                .zip(&*start)
+                .map(|(&ai, &s)| table[s + ai])
+                .product();
         }
     }
 
@@ -551,6 +571,39 @@ mod tests {
         // (√a + √b)² ≤ 10: (1,1), (1,2), (2,1), (1,3), (3,1), (1,4), (4,1), (2,2), (2,3),
         // (3,2)) and 1 140 triples (only (1,1,1), whose norm is 9).
         assert_eq!(MultiIndexSet::hyperbolic(20, 10, 0.5).unwrap().len(), 3241);
+    }
+
+    #[test]
+    fn eval_is_the_product_of_the_univariate_values_on_the_stack_and_on_the_heap() {
+        // Two dimensions (the table on the stack) and 20 (on the heap): every basis function
+        // against the product of `eval_all` values computed here, one dimension at a time.
+        for (d, p) in [(2, 5), (20, 2)] {
+            let families: Vec<Family> = (0..d)
+                .map(|i| match i % 3 {
+                    0 => Family::Hermite,
+                    1 => Family::Legendre,
+                    _ => Family::Laguerre { shape: 2.5 },
+                })
+                .collect();
+            let set = MultiIndexSet::total_degree(d, p).unwrap();
+            let basis = Basis::new(families.clone(), set.clone()).unwrap();
+            let t: Vec<f64> = (0..d).map(|i| 0.3 + 0.17 * i as f64).collect();
+            let mut out = vec![0.0; basis.len()];
+            basis.eval(&t, &mut out);
+            for (k, a) in set.indices().iter().enumerate() {
+                let want: f64 = a
+                    .iter()
+                    .zip(&families)
+                    .zip(&t)
+                    .map(|((&ai, f), &ti)| {
+                        let mut v = vec![0.0; ai + 1];
+                        f.eval_all(ti, &mut v);
+                        v[ai]
+                    })
+                    .product();
+                assert_eq!(out[k], want, "d {d}, index {a:?}");
+            }
+        }
     }
 
     #[test]
