@@ -272,14 +272,21 @@ pub fn tensor_grid(nodes_per_dim: &[usize]) -> Result<TensorGrid, QuadratureErro
     // eigenproblem: three of 1000 nodes took seconds).
     nodes_per_dim
         .iter()
-        .try_fold(1usize, |t, &n| t.checked_mul(n))
-        .filter(|&t| t <= MAX_TENSOR_POINTS)
-        .ok_or(QuadratureError::TooManyPoints)?;
+        .try_fold(1, |total, &n| times_nodes(total, n))?;
     let rules: Vec<(Vec<f64>, Vec<f64>)> = nodes_per_dim
         .iter()
         .map(|&n| gauss_hermite(n))
         .collect::<Result<_, _>>()?;
     tensor_product(&rules)
+}
+
+/// The points of a tensor grid of `total` points times a dimension of `n` nodes, or
+/// [`QuadratureError::TooManyPoints`] beyond [`MAX_TENSOR_POINTS`].
+fn times_nodes(total: usize, n: usize) -> Result<usize, QuadratureError> {
+    total
+        .checked_mul(n)
+        .filter(|&t| t <= MAX_TENSOR_POINTS)
+        .ok_or(QuadratureError::TooManyPoints)
 }
 
 /// Tensor product of one-dimensional rules `(nodes, weights)`, one per dimension, in the
@@ -297,10 +304,7 @@ pub fn tensor_product(rules: &[(Vec<f64>, Vec<f64>)]) -> Result<TensorGrid, Quad
         if n == 0 {
             return Err(QuadratureError::ZeroNodes);
         }
-        total = total
-            .checked_mul(n)
-            .filter(|&t| t <= MAX_TENSOR_POINTS)
-            .ok_or(QuadratureError::TooManyPoints)?;
+        total = times_nodes(total, n)?;
     }
     let d = rules.len();
     let mut points = Vec::with_capacity(total);

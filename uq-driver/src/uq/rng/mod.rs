@@ -8,9 +8,9 @@
 //! word for word, computed one block at a time): a stable, documented, portable
 //! algorithm whose output for a given key, stream and position is fixed by its
 //! specification, unlike `rand::rngs::StdRng` whose algorithm may change between
-//! releases. The conversion of a `u64` word to a
-//! uniform in (0, 1) is `rand_distr::Open01`; the tests pin it against its
-//! closed form, so a release of `rand` that changed it would be noticed.
+//! releases. The conversion of a `u64` word to a uniform in (0, 1) is
+//! `rand_distr::Open01`; the tests pin it against its closed form, so a release of
+//! `rand` that changed it would be noticed.
 //!
 //! Designs draw every random coordinate as such a uniform and map it through the
 //! quantile function (inversion), never with the samplers of `rand_distr`
