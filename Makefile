@@ -161,7 +161,7 @@ test-rust:
 	  env $(ZIG_ENV) $(CARGO) test --release --workspace --exclude railuq-python
 
 test-python: venv wheel
-	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q tests/python
+	RAILUQ_FMU_DIR="$(CURDIR)/$(FMU_DIR)" $(VPY) -m pytest -q -n auto --dist loadfile tests/python
 
 # The Python package: a release wheel built by maturin (the venv's, on PATH; no download) by the
 # package's PEP 517 backend, carrying the FMUs of target/fmu, then installed into the venv

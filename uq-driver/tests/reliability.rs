@@ -171,6 +171,18 @@ fn form_and_sorm_give_the_exact_probability_of_a_linear_sum_of_correlated_normal
             );
             let imp: f64 = e["importance"].as_object().unwrap().values().map(f).sum();
             assert!((imp - 1.0).abs() < 1e-6, "importance factors sum to {imp}");
+            // The inputs' own importance: for a plain sum gamma_i is proportional to the
+            // input's Std, whatever the correlation (alpha is not: x1 and x3 carry x2, x4).
+            let gamma = e["importance_gamma"].as_object().unwrap();
+            let s2: f64 = (1..=8).map(|i| (0.5 + 0.1 * i as f64).powi(2)).sum();
+            for i in 1..=8 {
+                let want = (0.5 + 0.1 * i as f64).powi(2) / s2;
+                let got = f(&gamma[&format!("x{i}")]);
+                assert!(
+                    (got - want).abs() < 1e-4,
+                    "x{i}: gamma^2 {got}, want {want}"
+                );
+            }
         }
         // The one-line summary in the terminal names β and P.
         assert!(text.contains("β") && text.contains("P(q > "), "{text}");
@@ -248,7 +260,7 @@ fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
         "{got} ({ci:?}) for {exact}"
     );
     assert!(
-        e["design_point"].is_null() && e["importance"].is_null(),
+        e["design_point"].is_null() && e["importance"].is_null() && e["importance_gamma"].is_null(),
         "{e}"
     );
 }

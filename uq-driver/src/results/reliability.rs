@@ -34,6 +34,12 @@ pub struct LimitProbability {
     /// FORM's importance factors `α_i²` by parameter name (sum 1; with correlated inputs
     /// those of the independent coordinates in the order of `[[parameters]]`).
     pub importance: Option<BTreeMap<String, f64>>,
+    /// The importance of each input at FORM's design point, `γ_i²` by parameter name (sum 1):
+    /// `γ = L⁻ᵀα / |L⁻ᵀα|` with `L` the Cholesky factor of the inputs' normal-space
+    /// correlation (Der Kiureghian's importance vector). Equal to `importance` for
+    /// independent inputs; with correlated ones it ranks the inputs themselves (for a linear
+    /// quantity of normal inputs `γ_i ∝ c_i σ_i`, whatever the correlation).
+    pub importance_gamma: Option<BTreeMap<String, f64>>,
     /// Model runs this probability took (or the runs / draws counted, for a sampling
     /// method).
     pub runs: usize,
@@ -103,6 +109,7 @@ impl LimitProbability {
             beta: r.beta,
             design_point: r.design_point.as_ref().map(|(_, x)| label(x)),
             importance: r.importance.as_deref().map(label),
+            importance_gamma: r.importance_gamma.as_deref().map(label),
             runs: r.runs as usize,
             method: r.method.to_owned(),
             upper_95: r.upper_95,
@@ -141,6 +148,7 @@ impl LimitProbability {
             beta: generalised_beta(p),
             design_point: None,
             importance: None,
+            importance_gamma: None,
             runs: of,
             method: method.to_owned(),
             upper_95: (k == 0).then_some(upper_95),

@@ -216,6 +216,27 @@ impl RandomInputs {
         x
     }
 
+    /// The importance of each input at a design point whose unit direction in the independent
+    /// standard normal space is `alpha`: `gamma_i^2` (sum 1), with
+    /// `gamma = L^-T alpha / |L^-T alpha|` and `L` the Cholesky factor of the normal-space
+    /// correlation (Der Kiureghian 2005, the importance vector: `alpha^T J_{u,x} D`, where
+    /// the marginal maps' slopes cancel). With independent inputs `gamma = alpha` exactly.
+    /// Unlike `alpha_i^2`, which credits an input with what it shares with the inputs before
+    /// it, `gamma_i^2` ranks the inputs themselves: for a linear quantity of correlated
+    /// normal inputs `gamma_i` is proportional to `c_i sigma_i`, whatever the correlation.
+    pub fn importance(&self, alpha: &[f64]) -> Vec<f64> {
+        let mut w = alpha.to_vec();
+        if let Some(c) = &self.correlation {
+            // Back substitution of L^T w = alpha (L lower triangular).
+            for i in (0..w.len()).rev() {
+                let s: f64 = (i + 1..w.len()).map(|k| c.cholesky[(k, i)] * w[k]).sum();
+                w[i] = (alpha[i] - s) / c.cholesky[(i, i)];
+            }
+        }
+        let n2: f64 = w.iter().map(|v| v * v).sum();
+        w.iter().map(|v| v * v / n2).collect()
+    }
+
     /// The design coordinates in `germ` of the physical values `x` (the inverse of
     /// [`RandomInputs::to_physical`]).
     pub fn to_germ(&self, germ: Germ, x: &[f64]) -> Vec<f64> {

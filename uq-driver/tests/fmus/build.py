@@ -78,15 +78,24 @@ def compile_binary(folder, identifier, headers, out, cc):
 
 
 def pack(folder, identifier, binary, fmu):
-    """Writes the .fmu (deflate, forward slashes, files only) atomically."""
+    """Writes the .fmu (deflate, forward slashes, files only) atomically. The archive carries a
+    fixed date, so that the same sources give the same bytes: a second build (another test
+    process building at the same time) replaces the file with an identical one, and a study
+    that checks the FMU's SHA-256 on resuming sees no change."""
     partial = fmu.with_name(f".{fmu.name}.{os.getpid()}")
     with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
-        z.write(folder / "modelDescription.xml", "modelDescription.xml")
-        z.write(binary, f"binaries/linux64/{identifier}.so")
+        def add(path, name):
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if name.endswith(".so") else 0o644) << 16
+            z.writestr(info, path.read_bytes())
+
+        add(folder / "modelDescription.xml", "modelDescription.xml")
+        add(binary, f"binaries/linux64/{identifier}.so")
         resources = folder / "resources"
         for path in sorted(resources.rglob("*")) if resources.is_dir() else []:
             if path.is_file():
-                z.write(path, "resources/" + path.relative_to(resources).as_posix())
+                add(path, "resources/" + path.relative_to(resources).as_posix())
     os.replace(partial, fmu)
 
 

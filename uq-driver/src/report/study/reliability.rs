@@ -3,6 +3,7 @@
 //! the nominal point, the convergence of importance sampling and subset simulation (P
 //! against runs), and Morris's μ* and σ as ranked bars.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::super::svg::{BarChart, BarGroup};
@@ -36,7 +37,7 @@ pub(super) fn section(
         rows.extend(limit_rows(r, &label, summary, names));
         let tag = format!("{}_{}", stem(name), k + 1);
         if let Some(imp) = &r.importance {
-            importance_bars(dir, &tag, &label, imp, names)?;
+            importance_bars(dir, &tag, &label, imp, correlated_gamma(r), names)?;
             images.push(format!("{tag}_importance.svg"));
         }
         if convergence(dir, &tag, &label, r)? {
@@ -148,11 +149,14 @@ fn limit_rows(
         for (n, p) in names.iter().zip(&summary.parameters) {
             let unit = summary.units.get(*n).map(String::as_str);
             let median = p.distribution.inverse_cdf(0.5);
-            let imp = r
+            let mut imp = r
                 .importance
                 .as_ref()
                 .and_then(|i| i.get(*n))
                 .map_or(String::new(), |a| format!(", α² = {}", sig(*a)));
+            if let Some(g) = correlated_gamma(r).and_then(|g| g.get(*n)) {
+                imp.push_str(&format!(", γ² = {}", sig(*g)));
+            }
             rows.push(vec![
                 format!("{label}: design point {n} (nominal: median)"),
                 format!(
@@ -166,30 +170,50 @@ fn limit_rows(
     rows
 }
 
-/// `<q>_<k>_importance.svg`: FORM's importance factors α² per input, largest first.
+/// The inputs' importance `γ²` where it differs from `α²` (correlated inputs).
+fn correlated_gamma(r: &LimitProbability) -> Option<&BTreeMap<String, f64>> {
+    r.importance_gamma
+        .as_ref()
+        .filter(|g| Some(*g) != r.importance.as_ref())
+}
+
+/// `<q>_<k>_importance.svg`: FORM's importance factors α² per input, largest first, and
+/// beside them the inputs' importance γ² when the inputs are correlated.
 fn importance_bars(
     dir: &Path,
     tag: &str,
     label: &str,
-    importance: &std::collections::BTreeMap<String, f64>,
+    importance: &BTreeMap<String, f64>,
+    gamma: Option<&BTreeMap<String, f64>>,
     names: &[&str],
 ) -> Result<(), ReportError> {
-    let mut order: Vec<(&str, f64)> = names
-        .iter()
-        .map(|n| (*n, importance.get(*n).copied().unwrap_or(f64::NAN)))
-        .collect();
+    let value = |m: &BTreeMap<String, f64>, n: &str| m.get(n).copied().unwrap_or(f64::NAN);
+    let mut order: Vec<(&str, f64)> = names.iter().map(|n| (*n, value(importance, n))).collect();
     order.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut groups = vec![BarGroup {
+        label: "α²".into(),
+        color: palette(0).into(),
+        values: order.iter().map(|(_, v)| *v).collect(),
+        intervals: vec![None; order.len()],
+    }];
+    if let Some(g) = gamma {
+        groups.push(BarGroup {
+            label: "γ² (the inputs, with their correlation)".into(),
+            color: palette(1).into(),
+            values: order.iter().map(|(n, _)| value(g, n)).collect(),
+            intervals: vec![None; order.len()],
+        });
+    }
+    let y_label = match gamma {
+        None => "α² (share of β²) [-]",
+        Some(_) => "α² (share of β²), γ² [-]",
+    };
     BarChart {
         title: format!("{label}: importance factors at the design point"),
-        y_label: "α² (share of β²) [-]".into(),
+        y_label: y_label.into(),
         x_label: "parameter".into(),
         categories: order.iter().map(|(n, _)| n.to_string()).collect(),
-        groups: vec![BarGroup {
-            label: "α²".into(),
-            color: palette(0).into(),
-            values: order.iter().map(|(_, v)| *v).collect(),
-            intervals: vec![None; order.len()],
-        }],
+        groups,
         y_range: Some((0.0, 1.0)),
         interval_label: String::new(),
     }

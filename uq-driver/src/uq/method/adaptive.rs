@@ -160,6 +160,9 @@ pub(crate) struct LimitResult {
     pub design_point: Option<(Vec<f64>, Vec<f64>)>,
     /// FORM's importance factors `α_i²` (sum 1).
     pub importance: Option<Vec<f64>>,
+    /// The inputs' importance `γ_i²` at FORM's design point (sum 1; equal to `importance`
+    /// for independent inputs; [`RandomInputs::importance`]).
+    pub importance_gamma: Option<Vec<f64>>,
     /// The first run of this target and how many it made.
     pub first_run: u64,
     /// Runs of this target.
@@ -191,6 +194,7 @@ impl LimitResult {
             beta: None,
             design_point: None,
             importance: None,
+            importance_gamma: None,
             first_run,
             runs: 0,
             form: None,
@@ -210,11 +214,13 @@ impl LimitResult {
             .ok_or_else(|| ReliabilityError::Invalid("FORM gave no design point".into()))
     }
 
-    /// Takes FORM's design point, importance factors and index.
-    pub(crate) fn with_form(&mut self, f: &FormResult) {
+    /// Takes FORM's design point, importance factors and index; `inputs` give the importance
+    /// of the inputs under their correlation.
+    pub(crate) fn with_form(&mut self, f: &FormResult, inputs: &RandomInputs) {
         self.beta = Some(f.beta);
         self.design_point = f.x_star.clone().map(|x| (f.u_star.clone(), x));
         self.importance = Some(f.importance.clone());
+        self.importance_gamma = Some(inputs.importance(&f.alpha));
     }
 
     /// The run index after this target's last run.

@@ -7,7 +7,9 @@
 //! (forward) or `2d + 1` (central) points run as one parallel batch. Reported:
 //! `β = α·u*` (signed), `P = Φ(−β)`, the design point in physical units `x* = T(u*)`, the
 //! importance factors `α_i²` (`α = −∇g/|∇g|`; with correlated inputs those of the
-//! independent coordinates, in study order), the runs and the history of the iteration.
+//! independent coordinates, in study order), the inputs' importance `γ_i²` (the same for
+//! independent inputs; with correlated ones `γ = L⁻ᵀα / |L⁻ᵀα|`,
+//! `RandomInputs::importance`), the runs and the history of the iteration.
 //!
 //! `P = Φ(−β)` is exact when `g` is linear in `u`, and for a monotone map of a linear `g`
 //! (e.g. a lognormal response); otherwise it is the first-order approximation, with no
@@ -223,7 +225,7 @@ impl Form {
             f
         };
         out.probability = f.probability;
-        out.with_form(&f);
+        out.with_form(&f, inputs);
         out.form = Some(f);
         Ok(out)
     }
@@ -393,6 +395,68 @@ mod tests {
         let exact = norm_sf(3.98);
         assert!(r.limits[0].probability < 0.1 * 0.003);
         assert!((r.limits[0].probability - exact).abs() < 0.01 * exact);
+    }
+
+    #[test]
+    fn correlated_inputs_are_ranked_by_their_own_scale_not_by_their_order() {
+        // q = sum c_i x_i, x normal with correlation R: in u (x = m + D L u) the gradient of
+        // q is L^T D c, so alpha = L^T D c / |.|, which credits the first input with what it
+        // shares with the others; the inputs' importance is gamma_i^2 = (c_i s_i)^2 / sum,
+        // whatever R (Der Kiureghian 2005).
+        use crate::uq::random_inputs::{Correlation, CorrelationPair};
+        let (m, s, c) = ([1.0, 2.0, 3.0], [0.5, 0.3, 0.8], [1.0, 2.0, -0.25]);
+        let params: Vec<RandomParameter> = (0..3)
+            .map(|i| {
+                RandomParameter::new(format!("x{i}"), Distribution::normal(m[i], s[i]).unwrap())
+            })
+            .collect();
+        let pair = |a: &str, b: &str, rho: f64| CorrelationPair {
+            between: [a.into(), b.into()],
+            rho,
+        };
+        let pairs = vec![pair("x0", "x1", 0.7), pair("x1", "x2", -0.4)];
+        let inputs = RandomInputs {
+            correlation: Correlation::new(&params, pairs).unwrap(),
+            parameters: params,
+        };
+        // The exact sd of q: c^T D R D c.
+        let r = [[1.0, 0.7, 0.0], [0.7, 1.0, -0.4], [0.0, -0.4, 1.0]];
+        let cs: Vec<f64> = (0..3).map(|i| c[i] * s[i]).collect();
+        let var: f64 = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| cs[i] * r[i][j] * cs[j])
+            .sum();
+        let mean: f64 = (0..3).map(|i| c[i] * m[i]).sum();
+        let limit = mean + var.sqrt() * norm_isf(1e-4);
+        let t = above("q", limit);
+        let mut model = Analytic::new(&inputs, move |x: &[f64]| {
+            vec![Ok(x.iter().zip(&c).map(|(a, b)| a * b).sum())]
+        });
+        let res = Form::default()
+            .run(&mut model, &inputs, &t, &["q".into()], 1)
+            .unwrap();
+        let l = &res.limits[0];
+        assert!((l.probability - 1e-4).abs() < 1e-6, "{}", l.probability);
+        let alpha2 = l.importance.as_ref().unwrap();
+        let gamma2 = l.importance_gamma.as_ref().unwrap();
+        let sum: f64 = cs.iter().map(|v| v * v).sum();
+        for i in 0..3 {
+            let want = cs[i] * cs[i] / sum;
+            assert!(
+                (gamma2[i] - want).abs() < 1e-6,
+                "{gamma2:?} against {want} at {i}"
+            );
+        }
+        // The two rankings differ: the test sees which one is reported.
+        let off = (0..3)
+            .map(|i| (alpha2[i] - gamma2[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(off > 0.05, "{alpha2:?} {gamma2:?}");
+        // Independent inputs: gamma is alpha, to the bit.
+        let independent = RandomInputs::independent(inputs.parameters.clone());
+        let a = [0.6, -0.8, 0.0];
+        let want: Vec<f64> = a.iter().map(|v| v * v).collect();
+        assert_eq!(independent.importance(&a), want);
     }
 
     #[test]
