@@ -549,11 +549,7 @@ pub fn analyse_runs(
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
     let mut quantity_chaos = Vec::new();
-    let scalars = study
-        .qoi
-        .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
-    for (qi, (name, q)) in scalars.enumerate() {
+    for (qi, (name, q)) in study.scalar_quantities().enumerate() {
         let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
             return Err(quantity_error(&name, q, &qr, None));

@@ -90,11 +90,7 @@ pub fn analyse(
         out.analysed.outputs.push(stats);
     }
     let base = study.outputs.len() * nt;
-    let scalars = study
-        .qoi
-        .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
-    for (qi, (name, q)) in scalars.enumerate() {
+    for (qi, (name, q)) in study.scalar_quantities().enumerate() {
         let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
             return Err(quantity_error(&name, q, &qr, None));
