@@ -26,8 +26,8 @@ mod truncation_checks;
 
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use chaos_guide::guide_tails;
-pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
+pub(crate) use error::{output_error, quantity_error};
 #[cfg(test)]
 pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
