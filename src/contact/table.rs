@@ -175,8 +175,9 @@ impl ContactTable {
     }
 }
 
-/// Splits a line of a table file into fields: commas, semicolons, tabs or spaces separate them.
-fn fields(line: &str) -> Vec<&str> {
+/// Splits a line of a data file (a contact table, a profile, a measured track or track
+/// irregularity) into fields: commas, semicolons, tabs or spaces separate them.
+pub(crate) fn fields(line: &str) -> Vec<&str> {
     line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
         .filter(|s| !s.is_empty())
         .collect()
