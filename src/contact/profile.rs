@@ -346,10 +346,7 @@ fn parse_csv(text: &str) -> Result<(Vec<f64>, Vec<f64>), ProfileError> {
         if s.is_empty() || s.starts_with('#') {
             continue;
         }
-        let fields: Vec<&str> = s
-            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-            .filter(|f| !f.is_empty())
-            .collect();
+        let fields = super::table::fields(s);
         let nums: Option<Vec<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
         match nums {
             Some(v) if v.len() == 2 => {

@@ -82,6 +82,20 @@ impl TableRow {
             q0: v[11],
         }
     }
+
+    /// The first of the columns that must be positive (N0, a, b, r, q0) that is not, with its
+    /// value (N for N0, m for the others).
+    fn not_positive(&self) -> Option<(&'static str, f64)> {
+        [
+            ("N0", self.n0),
+            ("a", self.a),
+            ("b", self.b),
+            ("r", self.r),
+            ("q0", self.q0),
+        ]
+        .into_iter()
+        .find(|&(_, v)| v <= 0.0)
+    }
 }
 
 /// Why a contact table is refused.
@@ -128,20 +142,12 @@ impl ContactTable {
                     COLUMNS[k]
                 )));
             }
-            for (name, v) in [
-                ("N0", row.n0),
-                ("a", row.a),
-                ("b", row.b),
-                ("r", row.r),
-                ("q0", row.q0),
-            ] {
-                if v <= 0.0 {
-                    return Err(TableError::Invalid(format!(
-                        "row {} (y = {}): {name} = {v} must be > 0",
-                        i + 1,
-                        row.y
-                    )));
-                }
+            if let Some((name, v)) = row.not_positive() {
+                return Err(TableError::Invalid(format!(
+                    "row {} (y = {}): {name} = {v} must be > 0",
+                    i + 1,
+                    row.y
+                )));
             }
             if i > 0 {
                 let d = row.y - rows[i - 1].y;
@@ -169,8 +175,9 @@ impl ContactTable {
     }
 }
 
-/// Splits a line of a table file into fields: commas, semicolons, tabs or spaces separate them.
-fn fields(line: &str) -> Vec<&str> {
+/// Splits a line of a data file (a contact table, a profile, a measured track or track
+/// irregularity) into fields: commas, semicolons, tabs or spaces separate them.
+pub(crate) fn fields(line: &str) -> Vec<&str> {
     line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
         .filter(|s| !s.is_empty())
         .collect()
@@ -253,16 +260,8 @@ impl ContactTable {
                 v[c] = x;
             }
             let row = TableRow::from_values(v);
-            for (name, x) in [
-                ("N0", row.n0),
-                ("a", row.a),
-                ("b", row.b),
-                ("r", row.r),
-                ("q0", row.q0),
-            ] {
-                if x <= 0.0 {
-                    return Err(line_err(line, format!("column '{name}' must be > 0")));
-                }
+            if let Some((name, _)) = row.not_positive() {
+                return Err(line_err(line, format!("column '{name}' must be > 0")));
             }
             match rows.len() {
                 0 => first_line = line,

@@ -136,10 +136,7 @@ impl Variable {
         start: i32,
         description: &'static str,
     ) -> Variable {
-        Variable {
-            start: Start::Integer(Some(start)),
-            ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
-        }
+        Variable::fixed_parameter(name, vr, Start::Integer(Some(start)), description)
     }
 
     /// A fixed String parameter with a start value.
@@ -149,8 +146,18 @@ impl Variable {
         start: &'static str,
         description: &'static str,
     ) -> Variable {
+        Variable::fixed_parameter(name, vr, Start::String(Some(start)), description)
+    }
+
+    /// A fixed parameter with the start value `start` (of any type), no unit and no bounds.
+    const fn fixed_parameter(
+        name: &'static str,
+        vr: u32,
+        start: Start,
+        description: &'static str,
+    ) -> Variable {
         Variable {
-            start: Start::String(Some(start)),
+            start,
             ..Variable::real_parameter(name, vr, 0.0, Variability::Fixed, None, description)
         }
     }

@@ -22,6 +22,7 @@
 
 use super::contact::Running;
 use super::equations::Track;
+use crate::contact::table::fields;
 use crate::models::vehicle_track::irregularity::{RandomProfile, SampleKey, Spectrum};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -108,11 +109,7 @@ impl MeasuredTrack {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let nums: Option<Vec<f64>> = line
-                .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-                .filter(|s| !s.is_empty())
-                .map(|s| s.parse().ok())
-                .collect();
+            let nums: Option<Vec<f64>> = fields(line).iter().map(|s| s.parse().ok()).collect();
             match nums {
                 Some(v) if v.len() >= 3 => {
                     if v[..3].iter().any(|x| !x.is_finite()) {

@@ -254,12 +254,7 @@ impl DstI {
 
     /// Plans a DST-I of `size` points on the FFT path `path`.
     pub fn with_path(size: usize, path: FftPath) -> Result<Self, String> {
-        let n = size + 1;
-        if size == 0 || !n.is_power_of_two() {
-            return Err(format!(
-                "DST-I size {size}: size + 1 must be a power of two (e.g. 63, 127, 255, 511)"
-            ));
-        }
+        let n = dst_points(size)?;
         let m = n / 2;
         let fft = path.plan(m)?;
         let scratch = vec![C64::default(); fft.get_inplace_scratch_len()];
@@ -405,6 +400,18 @@ impl DstI {
     }
 }
 
+/// n = N + 1 of a DST-I of N = `size` points, or why it cannot be planned: `size + 1` must
+/// be a power of two ≥ 2.
+fn dst_points(size: usize) -> Result<usize, String> {
+    let n = size + 1;
+    if size == 0 || !n.is_power_of_two() {
+        return Err(format!(
+            "DST-I size {size}: size + 1 must be a power of two (e.g. 63, 127, 255, 511)"
+        ));
+    }
+    Ok(n)
+}
+
 /// The plain DST-I on the own radix-2 [`Fft`]: the reference implementation the fast
 /// [`DstI`] is tested against (and what the plain kernel of the track uses).
 #[derive(Clone, Debug)]
@@ -426,12 +433,7 @@ pub struct PlainDstI {
 impl PlainDstI {
     /// Plans a DST-I of `size` points; `size + 1` must be a power of two ≥ 2.
     pub fn new(size: usize) -> Result<Self, String> {
-        let n = size + 1;
-        if size == 0 || !n.is_power_of_two() {
-            return Err(format!(
-                "DST-I size {size}: size + 1 must be a power of two (e.g. 63, 127, 255, 511)"
-            ));
-        }
+        let n = dst_points(size)?;
         let m = n / 2;
         Ok(Self {
             size,

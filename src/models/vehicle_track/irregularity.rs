@@ -35,6 +35,7 @@
 #![forbid(unsafe_code)]
 
 use super::fft::{Complex, Fft};
+use crate::contact::table::fields;
 use crate::models::data_file::{read_data_file, resolve};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -258,11 +259,7 @@ impl MeasuredProfile {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let fields: Vec<&str> = line
-                .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-                .filter(|s| !s.is_empty())
-                .collect();
-            let nums: Option<Vec<f64>> = fields.iter().map(|s| s.parse().ok()).collect();
+            let nums: Option<Vec<f64>> = fields(line).iter().map(|s| s.parse().ok()).collect();
             match nums {
                 Some(v) if v.len() >= 2 => {
                     if !(v[0].is_finite() && v[1].is_finite()) {

@@ -30,7 +30,7 @@ pub use variables::*;
 use super::Start;
 use super::{InitContext, Model, ModelError, ModelInfo, StateReader, StateWriter};
 use crate::models::table::table_accessors;
-use coupling::{accelerations, Sim};
+use coupling::Sim;
 use irregularity::{IrregularityKind, RandomProfile};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -197,29 +197,11 @@ impl Model for VehicleTrack {
             sim.zhai.v = input.f64s(Some(dim))?;
             sim.zhai.a = input.f64s(Some(dim))?;
             sim.zhai.a_prev = input.f64s(Some(dim))?;
-            // Refresh the reported forces from the restored state.
-            let hv = model.p.half_vehicle();
-            let mut scratch = vec![0.0; dim];
-            let run = sim.run;
-            let Sim {
-                track,
-                contact,
-                exc,
-                zhai,
-                diag,
-                ..
-            } = &mut sim;
-            accelerations(
-                &hv,
-                track,
-                contact,
-                exc,
-                &run,
-                &zhai.x,
-                &zhai.v,
-                &mut scratch,
-                diag,
-            );
+            // Refresh the reported forces from the restored state; the restored accelerations
+            // stay as they were saved.
+            let restored = sim.zhai.a.clone();
+            sim.update_accelerations(&model.p.half_vehicle());
+            sim.zhai.a = restored;
             model.sim = Some(sim);
         } else if initialized != 0 {
             return Err(ModelError::CorruptState("bad initialization flag".into()));

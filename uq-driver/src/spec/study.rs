@@ -194,15 +194,18 @@ impl Study {
         Ok(())
     }
 
-    /// The scalar quantities in record order, each with its limits above and below.
-    pub(crate) fn quantity_limits(&self) -> Vec<(String, Vec<f64>, Vec<f64>)> {
+    /// The scalar quantities in record order, each named, with the quantity of interest it
+    /// comes from.
+    pub(crate) fn scalar_quantities(&self) -> impl Iterator<Item = (String, &QoiSpec)> {
         self.qoi
             .iter()
-            .flat_map(|q| {
-                q.quantity_names()
-                    .into_iter()
-                    .map(move |n| (n, q.limits().to_vec(), q.limits_below().to_vec()))
-            })
+            .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)))
+    }
+
+    /// The scalar quantities in record order, each with its limits above and below.
+    pub(crate) fn quantity_limits(&self) -> Vec<(String, Vec<f64>, Vec<f64>)> {
+        self.scalar_quantities()
+            .map(|(n, q)| (n, q.limits().to_vec(), q.limits_below().to_vec()))
             .collect()
     }
 

@@ -58,11 +58,7 @@ pub(crate) fn run_adaptive(
     ranges::check_supports(study, &fmu).map_err(RunError::from)?;
     let inputs = study.random_inputs();
     let d = inputs.len();
-    let quantities: Vec<(String, &QoiSpec)> = study
-        .qoi
-        .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)))
-        .collect();
+    let quantities: Vec<(String, &QoiSpec)> = study.scalar_quantities().collect();
     let names: Vec<String> = quantities.iter().map(|(n, _)| n.clone()).collect();
     let targets = study
         .adaptive_targets()

@@ -165,6 +165,14 @@ impl Frame {
         }
     }
 
+    /// A frame with room for the legend `entries` right of the plot area
+    /// ([`Frame::legend_outside`]), the image tall enough for them.
+    pub fn with_legend(x: Axis, y: Axis, entries: &[LegendEntry]) -> Self {
+        let mut frame = Self::new(x, y, legend_width(entries));
+        frame.fit_legend(entries);
+        frame
+    }
+
     /// Makes the image tall enough for a legend right of the plot area.
     pub fn fit_legend(&mut self, entries: &[LegendEntry]) {
         self.total_h = self
@@ -407,6 +415,20 @@ impl Frame {
             self.top + 4.0,
             false,
         );
+    }
+
+    /// The `<svg>` element opened ([`Frame::open`]) and the grid drawn ([`Frame::grid`]).
+    pub fn open_with_grid(&self) -> String {
+        let mut out = String::new();
+        self.open(&mut out);
+        self.grid(&mut out);
+        out
+    }
+
+    /// The legend `entries` drawn right of the plot area and the `<svg>` element closed.
+    pub fn close_with_legend(&self, out: &mut String, entries: &[LegendEntry]) {
+        self.legend_outside(out, entries);
+        out.push_str("</svg>\n");
     }
 }
 

@@ -205,11 +205,8 @@ impl LinePlot {
         }
         legend.retain(|e| !e.label.is_empty());
 
-        let mut frame = Frame::new(x_axis, y_axis, legend_width(&legend));
-        frame.fit_legend(&legend);
-        let mut out = String::new();
-        frame.open(&mut out);
-        frame.grid(&mut out);
+        let frame = Frame::with_legend(x_axis, y_axis, &legend);
+        let mut out = frame.open_with_grid();
         out.push_str("<g class=\"bands\" clip-path=\"url(#plot-area)\">\n");
         for b in &self.bands {
             frame.band(&mut out, b);
@@ -220,8 +217,7 @@ impl LinePlot {
         }
         out.push_str("</g>\n");
         frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
-        frame.legend_outside(&mut out, &legend);
-        out.push_str("</svg>\n");
+        frame.close_with_legend(&mut out, &legend);
         out
     }
 
@@ -309,11 +305,8 @@ impl DensityPlot {
         }
         legend.retain(|e| !e.label.is_empty());
 
-        let mut frame = Frame::new(x_axis, y_axis, legend_width(&legend));
-        frame.fit_legend(&legend);
-        let mut out = String::new();
-        frame.open(&mut out);
-        frame.grid(&mut out);
+        let frame = Frame::with_legend(x_axis, y_axis, &legend);
+        let mut out = frame.open_with_grid();
         histogram(&frame, &mut out, bars);
         out.push_str("<g class=\"series\" clip-path=\"url(#plot-area)\">\n");
         for s in &self.curves {
@@ -323,8 +316,7 @@ impl DensityPlot {
         markers(&frame, &mut out, &self.markers);
         let y_label = density_label(&self.x_label);
         frame.axes(&mut out, &self.title, &self.x_label, &y_label);
-        frame.legend_outside(&mut out, &legend);
-        out.push_str("</svg>\n");
+        frame.close_with_legend(&mut out, &legend);
         out
     }
 
@@ -470,14 +462,11 @@ impl BarChart {
             legend.push(LegendEntry::line(label, "#222", false));
         }
         legend.retain(|e| !e.label.is_empty());
-        let mut frame = Frame::new(x_axis.clone(), y_axis, legend_width(&legend));
-        frame.fit_legend(&legend);
+        let mut frame = Frame::with_legend(x_axis.clone(), y_axis, &legend);
         if rotate {
             frame.add_below(longest as f64 * 6.4 * 0.6);
         }
-        let mut out = String::new();
-        frame.open(&mut out);
-        frame.grid(&mut out);
+        let mut out = frame.open_with_grid();
         out.push_str("<g class=\"bars\" clip-path=\"url(#plot-area)\">\n");
         let k = self.groups.len().max(1) as f64;
         let bar_w = slot * 0.8 / k;
@@ -537,8 +526,7 @@ impl BarChart {
         } else {
             frame.axes(&mut out, &self.title, &self.x_label, &self.y_label);
         }
-        frame.legend_outside(&mut out, &legend);
-        out.push_str("</svg>\n");
+        frame.close_with_legend(&mut out, &legend);
         out
     }
 

@@ -79,6 +79,15 @@ pub enum AnalysisError {
     NoDraws(String),
 }
 
+/// What turns the estimator's refusal of output `name` into the error of the analysis (for
+/// `map_err`).
+pub(crate) fn output_error(name: &str) -> impl Fn(MethodError) -> AnalysisError + Copy + '_ {
+    move |source| AnalysisError::Output {
+        name: name.to_owned(),
+        source,
+    }
+}
+
 /// The error of scalar quantity `name` (its runs `qr`) that has no value at any run
 /// (`source` `None`) or whose estimator refused its values (`source`, e.g. a weighted design
 /// with points left without a value). A `hunting_speed` whose runs missed the transition names

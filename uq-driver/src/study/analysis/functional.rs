@@ -32,7 +32,7 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::blocks::{self, BLOCK_ALIGN};
 use super::runs::Runs;
-use super::AnalysisError;
+use super::{output_error, AnalysisError};
 use crate::results::FunctionalFit;
 use crate::uq::method::{
     ChaosError, Design, Estimate, InvalidSettings, MethodError, Sampling, Sobol, SobolIntervals,
@@ -395,10 +395,7 @@ pub(super) fn pca_estimate(
     if m >= modes.distinct {
         return Ok(None);
     }
-    let fail = |source| AnalysisError::Output {
-        name: name.to_owned(),
-        source,
-    };
+    let fail = output_error(name);
     let of_modes = method
         .estimate(design, &runs.rows, &modes.scores)
         .map_err(fail)?;

@@ -26,8 +26,8 @@ mod truncation_checks;
 
 pub(crate) use chaos_gap::{chaos_error_warnings, chaos_gap_warnings, series_error, CHAOS_ERROR};
 pub(crate) use chaos_guide::guide_tails;
-pub(crate) use error::quantity_error;
 pub use error::AnalysisError;
+pub(crate) use error::{output_error, quantity_error};
 #[cfg(test)]
 pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
@@ -549,11 +549,7 @@ pub fn analyse_runs(
     let base = study.outputs.len() * nt;
     let mut quantities = Vec::new();
     let mut quantity_chaos = Vec::new();
-    let scalars = study
-        .qoi
-        .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
-    for (qi, (name, q)) in scalars.enumerate() {
+    for (qi, (name, q)) in study.scalar_quantities().enumerate() {
         let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
             return Err(quantity_error(&name, q, &qr, None));

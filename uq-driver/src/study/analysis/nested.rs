@@ -24,8 +24,8 @@ use crate::results::{
 };
 use crate::spec::Study;
 use crate::study::analysis::{
-    nest_exceedance_count, output_stats, quantity_error, scalar_stats, series_error, surrogates_of,
-    Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
+    nest_exceedance_count, output_error, output_stats, quantity_error, scalar_stats, series_error,
+    surrogates_of, Analysed, AnalysisError, QuantityRuns, Runs, Settings, CHAOS_ERROR,
 };
 use crate::study::store::StoredRuns;
 use crate::uq::method::nested::split::{self, Split};
@@ -65,10 +65,7 @@ pub fn analyse(
     let runs = Runs::at_least(records, method.min_runs())?;
     let blocks = method
         .blocks(design)
-        .map_err(|source| AnalysisError::Output {
-            name: "(the nested design)".into(),
-            source,
-        })?;
+        .map_err(output_error("(the nested design)"))?;
     let mut out = NestedAnalysed {
         analysed: Analysed {
             outputs: Vec::new(),
@@ -90,11 +87,7 @@ pub fn analyse(
         out.analysed.outputs.push(stats);
     }
     let base = study.outputs.len() * nt;
-    let scalars = study
-        .qoi
-        .iter()
-        .flat_map(|q| q.quantity_names().into_iter().map(move |n| (n, q)));
-    for (qi, (name, q)) in scalars.enumerate() {
+    for (qi, (name, q)) in study.scalar_quantities().enumerate() {
         let qr = runs.quantity(base, qi)?;
         if qr.valid.is_empty() {
             return Err(quantity_error(&name, q, &qr, None));
@@ -139,10 +132,7 @@ fn output(
     settings: &Settings,
 ) -> Result<(OutputStats, OutputSplit, Option<String>), AnalysisError> {
     let nt = data.ncols();
-    let fail = |source| AnalysisError::Output {
-        name: name.to_owned(),
-        source,
-    };
+    let fail = output_error(name);
     let cond = method.conditional(blocks, rows, data).map_err(fail)?;
     let estimate = marginal(&cond, nt).map_err(fail)?;
     let splits: Vec<Split> = (0..nt).map(|j| Split::all(&cond.column(j))).collect();

@@ -4,7 +4,7 @@
 use super::blocks;
 use super::runs::Runs;
 use super::{chaos_columns, functional, given_data, series_columns, summarise};
-use super::{AnalysisError, Settings};
+use super::{output_error, AnalysisError, Settings};
 use crate::results::OutputStats;
 use crate::spec::Functional;
 use crate::uq::given_data::Bins;
@@ -45,10 +45,7 @@ pub(super) fn output_in_blocks(
     settings: &Settings,
 ) -> Result<(Estimate, OutputStats, Vec<u64>), AnalysisError> {
     let nt = times.len();
-    let fail = |source| AnalysisError::Output {
-        name: name.to_owned(),
-        source,
-    };
+    let fail = output_error(name);
     let a = settings.analysis;
     let per_column = method.chaos_per_column() && !method.whole_series();
     let pca = match per_column && a.functional == Functional::Pca && nt > 1 {

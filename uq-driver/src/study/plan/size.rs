@@ -413,10 +413,7 @@ pub fn check_simulation(time_points: f64, series: usize) -> Result<Footprint, Si
             grid: 4.0 * 8.0 * time_points,
             ..Memory::default()
         },
-        available: match available_memory() {
-            Some(b) => (b, true),
-            None => (ASSUMED_MEMORY, false),
-        },
+        available: memory_available(),
         time: None,
         disk: None,
     };
@@ -430,12 +427,18 @@ pub fn estimate(shape: &Shape, runs: Option<f64>) -> Footprint {
         runs,
         time_points: shape.time_points,
         memory: shape.memory(runs.unwrap_or(1.0)),
-        available: match available_memory() {
-            Some(b) => (b, true),
-            None => (ASSUMED_MEMORY, false),
-        },
+        available: memory_available(),
         time: None,
         disk: None,
+    }
+}
+
+/// The memory available to the process (bytes), and whether the system said so (else
+/// [`ASSUMED_MEMORY`]).
+fn memory_available() -> (f64, bool) {
+    match available_memory() {
+        Some(b) => (b, true),
+        None => (ASSUMED_MEMORY, false),
     }
 }
 

@@ -7,7 +7,7 @@ use crate::report::units::label;
 use crate::report::{palette, Band, LinePlot, ReportError, Series};
 use crate::results::Convergence;
 
-use super::over_time::ROUND_OFF;
+use super::over_time::{raise_to_round_off, round_off_line, ROUND_OFF};
 
 /// Convergence plots; returns the files written. Runs: `<name>_convergence.svg`, the running
 /// mean over the first n runs with ±2 iid standard errors (Std/√n of those runs), and
@@ -101,20 +101,8 @@ fn chaos_convergence(name: &str, unit: Option<&str>, c: &Convergence) -> LinePlo
         .fold(0.0, f64::max);
     let floor = ROUND_OFF * top;
     let mut clipped = false;
-    let mut clip = |y: &[f64]| -> Vec<f64> {
-        y.get(1..)
-            .unwrap_or_default()
-            .iter()
-            .map(|&v| {
-                if v.is_finite() && v < floor {
-                    clipped = true;
-                    floor
-                } else {
-                    v
-                }
-            })
-            .collect()
-    };
+    let mut clip =
+        |y: &[f64]| raise_to_round_off(y.get(1..).unwrap_or_default(), floor, &mut clipped);
     let (of_order, upto) = (clip(&c.std_of_order), clip(&c.std));
     p.series.push(
         Series::new(
@@ -136,16 +124,13 @@ fn chaos_convergence(name: &str, unit: Option<&str>, c: &Convergence) -> LinePlo
         .with_markers(),
     );
     if clipped && !x.is_empty() {
-        p.series.push(
-            Series::new(
-                format!("round-off level ({ROUND_OFF:e} × Std): zeros and smaller values are drawn on it"),
-                vec![x[0], x[x.len() - 1]],
-                vec![floor; 2],
-                "#999999",
-            )
-            .thin(1.0, 0.8)
-            .dashed(),
-        );
+        p.series.push(round_off_line(
+            format!(
+                "round-off level ({ROUND_OFF:e} × Std): zeros and smaller values are drawn on it"
+            ),
+            [x[0], x[x.len() - 1]],
+            floor,
+        ));
     }
     if top > 0.0 {
         let smallest = p

@@ -16,6 +16,30 @@ pub(super) const ROUND_OFF: f64 = 1e-13;
 /// the analysis's own threshold).
 const NO_SPREAD: f64 = 1e-9;
 
+/// `y` with every finite value below the round-off level `floor` (the unit of `y`) raised to
+/// it (on a log axis, round-off and zeros are drawn on that level); sets `clipped` when one
+/// was.
+pub(super) fn raise_to_round_off(y: &[f64], floor: f64, clipped: &mut bool) -> Vec<f64> {
+    y.iter()
+        .map(|&v| {
+            if v.is_finite() && v < floor {
+                *clipped = true;
+                floor
+            } else {
+                v
+            }
+        })
+        .collect()
+}
+
+/// The thin dashed grey line of the round-off level `floor` (the unit of the plotted values)
+/// from `x[0]` to `x[1]` (the unit of the horizontal axis), with the legend text `label`.
+pub(super) fn round_off_line(label: impl Into<String>, x: [f64; 2], floor: f64) -> Series {
+    Series::new(label, x.to_vec(), vec![floor; 2], "#999999")
+        .thin(1.0, 0.8)
+        .dashed()
+}
+
 /// `<V>_std.svg`: the Std over time, the Std of the chaos surrogate where the method gives
 /// one, and the chaos's truncation-error estimate (loo, order or level difference, a share
 /// of the variance ε) as the Std it stands for, √ε · Std, in the same unit. On a log axis
@@ -97,17 +121,8 @@ pub(in crate::report::study) fn std_plot(dir: &Path, s: &OutputStats) -> Result<
     plot.log_y = log;
     let mut clipped = false;
     for (name, y, color, dashed) in curves {
-        let y: Vec<f64> = if log {
-            y.iter()
-                .map(|&x| {
-                    if x.is_finite() && x < floor {
-                        clipped = true;
-                        floor
-                    } else {
-                        x
-                    }
-                })
-                .collect()
+        let y = if log {
+            raise_to_round_off(&y, floor, &mut clipped)
         } else {
             y
         };
@@ -115,17 +130,12 @@ pub(in crate::report::study) fn std_plot(dir: &Path, s: &OutputStats) -> Result<
         plot.series.push(if dashed { line.dashed() } else { line });
     }
     if clipped {
-        plot.series.push(
-            Series::new(
-                "round-off level (1e-13 × the largest Std): smaller values and zeros are \
-                 drawn on it",
-                vec![s.times[0], s.times[s.times.len() - 1]],
-                vec![floor; 2],
-                "#999999",
-            )
-            .thin(1.0, 0.8)
-            .dashed(),
-        );
+        plot.series.push(round_off_line(
+            "round-off level (1e-13 × the largest Std): smaller values and zeros are \
+             drawn on it",
+            [s.times[0], s.times[s.times.len() - 1]],
+            floor,
+        ));
     }
     if log {
         let lo = if clipped { floor } else { smallest.max(floor) };
