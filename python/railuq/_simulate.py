@@ -37,7 +37,11 @@ def simulate(
 
     Returns a pandas DataFrame with a ``time`` column and one column per variable when pandas
     is installed, else a dict of float64 numpy arrays (``"time"`` first). Where the FMU ends
-    the simulation early, the series end there (as in fmpy), with a note logged.
+    the simulation early, the series end there (as in fmpy), with a note logged. The FMU's
+    String calculated parameters, read after the run (e.g. ``solver.kernel``, the instruction
+    sets VehicleTrack's equations ran on: record it with a result), are the DataFrame's
+    ``attrs["calculated_strings"]``, a dict by name (empty when the FMU has none; not
+    returned without pandas).
 
     Raises :class:`railuq.FmuError` (the FMU cannot be opened), :class:`railuq.StudyError` (an
     unknown variable, a bad value or time grid) or :class:`railuq.RunError` (the run failed),
@@ -45,7 +49,7 @@ def simulate(
     """
     pairs = [(str(k), v) for k, v in (set or {}).items()]
     try:
-        names, times, series = _railuq.simulate(
+        names, times, series, strings = _railuq.simulate(
             os.fspath(fmu), pairs, [str(o) for o in (outputs or [])], start, stop, step
         )
     finally:
@@ -57,4 +61,6 @@ def simulate(
         import pandas as pd
     except ImportError:
         return columns
-    return pd.DataFrame(columns)
+    df = pd.DataFrame(columns)
+    df.attrs["calculated_strings"] = dict(strings)
+    return df

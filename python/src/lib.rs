@@ -61,10 +61,12 @@ fn cli_main(py: Python<'_>, args: Vec<String>) -> i32 {
     }
 }
 
-/// What [`simulate`] returns: the recorded variables' names, the times, a series per name.
-type Series = (Vec<String>, Vec<f64>, Vec<Vec<f64>>);
+/// What [`simulate`] returns: the recorded variables' names, the times, a series per name, and
+/// the FMU's String calculated parameters (name, value) read after the run.
+type Series = (Vec<String>, Vec<f64>, Vec<Vec<f64>>, Vec<(String, String)>);
 
-/// One run of an FMU, as `uq-driver simulate`: (names, times, series per name).
+/// One run of an FMU, as `uq-driver simulate`: (names, times, series per name, calculated
+/// strings).
 #[pyfunction]
 #[pyo3(signature = (fmu, set, outputs, start=None, stop=None, step=None))]
 fn simulate(
@@ -83,7 +85,7 @@ fn simulate(
     let sim = py
         .detach(|| uq_driver::cli::simulate(&fmu, &set, &outputs, start, stop, step))
         .map_err(|e| error(py, kind_of(&e), e))?;
-    Ok((sim.names, sim.times, sim.series))
+    Ok((sim.names, sim.times, sim.series, sim.calculated_strings))
 }
 
 /// The exception class for an error of the library (by its type, looking through the

@@ -140,6 +140,35 @@ def test_simulate_equals_uq_driver_simulate_bit_for_bit(tmp_path):
     assert len(df) == 151
 
 
+def test_simulate_returns_the_calculated_strings_fmpy_reads():
+    """VehicleTrack's solver.kernel (the instruction sets its equations ran on), read by fmpy
+    from the same FMU after one step, is in the DataFrame's attrs."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    fmu = railuq.fmu_path("VehicleTrack")
+    df = railuq.simulate(fmu, stop=0.002, step=0.001, outputs=["Zc"])
+    md = read_model_description(fmu)
+    vr = next(v.valueReference for v in md.modelVariables if v.name == "solver.kernel")
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="k")
+    slave.instantiate()
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.001)
+        kernel = slave.getString([vr])[0].decode()
+    finally:
+        slave.terminate()
+        slave.freeInstance()
+    assert kernel, "the FMU gave an empty solver.kernel"
+    assert df.attrs["calculated_strings"] == {"solver.kernel": kernel}
+    # The Wheel has none.
+    assert railuq.simulate(railuq.fmu_path("Wheel"), stop=0.1, step=0.1).attrs[
+        "calculated_strings"] == {}
+
+
 def test_simulate_without_pandas_returns_a_dict_of_float64_arrays(monkeypatch):
     monkeypatch.setitem(sys.modules, "pandas", None)  # `import pandas` raises ImportError
     cols = railuq.simulate(railuq.fmu_path("Wheel"), outputs=["q"], stop=0.5, step=0.1)

@@ -225,13 +225,14 @@ impl RandomInputs {
     /// it, `gamma_i^2` ranks the inputs themselves: for a linear quantity of correlated
     /// normal inputs `gamma_i` is proportional to `c_i sigma_i`, whatever the correlation.
     pub fn importance(&self, alpha: &[f64]) -> Vec<f64> {
+        let Some(c) = &self.correlation else {
+            return alpha.iter().map(|a| a * a).collect();
+        };
+        // Back substitution of L^T w = alpha (L lower triangular).
         let mut w = alpha.to_vec();
-        if let Some(c) = &self.correlation {
-            // Back substitution of L^T w = alpha (L lower triangular).
-            for i in (0..w.len()).rev() {
-                let s: f64 = (i + 1..w.len()).map(|k| c.cholesky[(k, i)] * w[k]).sum();
-                w[i] = (alpha[i] - s) / c.cholesky[(i, i)];
-            }
+        for i in (0..w.len()).rev() {
+            let s: f64 = (i + 1..w.len()).map(|k| c.cholesky[(k, i)] * w[k]).sum();
+            w[i] = (alpha[i] - s) / c.cholesky[(i, i)];
         }
         let n2: f64 = w.iter().map(|v| v * v).sum();
         w.iter().map(|v| v * v / n2).collect()

@@ -452,9 +452,9 @@ mod tests {
             .map(|i| (alpha2[i] - gamma2[i]).abs())
             .fold(0.0, f64::max);
         assert!(off > 0.05, "{alpha2:?} {gamma2:?}");
-        // Independent inputs: gamma is alpha, to the bit.
+        // Independent inputs: gamma^2 is alpha^2, to the bit (no renormalisation).
         let independent = RandomInputs::independent(inputs.parameters.clone());
-        let a = [0.6, -0.8, 0.0];
+        let a = [0.6, -0.7, 0.1];
         let want: Vec<f64> = a.iter().map(|v| v * v).collect();
         assert_eq!(independent.importance(&a), want);
     }
