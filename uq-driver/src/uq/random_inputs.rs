@@ -17,7 +17,7 @@
 
 use std::ops::Deref;
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use crate::uq::distributions::{Germ, RandomParameter};
@@ -228,13 +228,13 @@ impl RandomInputs {
         let Some(c) = &self.correlation else {
             return alpha.iter().map(|a| a * a).collect();
         };
-        // Back substitution of L^T w = alpha (L lower triangular).
-        let mut w = alpha.to_vec();
-        for i in (0..w.len()).rev() {
-            let s: f64 = (i + 1..w.len()).map(|k| c.cholesky[(k, i)] * w[k]).sum();
-            w[i] = (alpha[i] - s) / c.cholesky[(i, i)];
-        }
-        let n2: f64 = w.iter().map(|v| v * v).sum();
+        // L^T w = alpha; L has a positive diagonal (the Cholesky factor of a positive definite
+        // matrix), so the solve exists.
+        let w = c
+            .cholesky
+            .tr_solve_lower_triangular(&DVector::from_column_slice(alpha))
+            .expect("a Cholesky factor has a positive diagonal");
+        let n2 = w.norm_squared();
         w.iter().map(|v| v * v / n2).collect()
     }
 
