@@ -224,7 +224,7 @@ impl RandomInputs {
     /// Unlike `alpha_i^2`, which credits an input with what it shares with the inputs before
     /// it, `gamma_i^2` ranks the inputs themselves: for a linear quantity of correlated
     /// normal inputs `gamma_i` is proportional to `c_i sigma_i`, whatever the correlation.
-    pub fn importance(&self, alpha: &[f64]) -> Vec<f64> {
+    pub(crate) fn importance(&self, alpha: &[f64]) -> Vec<f64> {
         let Some(c) = &self.correlation else {
             return alpha.iter().map(|a| a * a).collect();
         };
