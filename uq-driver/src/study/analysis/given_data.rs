@@ -14,7 +14,7 @@ use nalgebra::DMatrix;
 use crate::results::RankCorrelation;
 use crate::uq::distributions::RandomParameter;
 use crate::uq::given_data::{self, Bins, LEVEL, RESAMPLES};
-use crate::uq::method::{Design, Sobol, SobolIntervals};
+use crate::uq::method::{Design, Sampling, Sobol, SobolIntervals};
 use crate::uq::rank_correlation::RankInputs;
 
 /// The longest series (time columns) whose first-order indices over time are estimated.
@@ -28,6 +28,19 @@ pub(crate) fn inputs_at(design: &Design, rows: &[usize]) -> Vec<Vec<f64>> {
     (0..d)
         .map(|i| rows.iter().map(|&r| design.values[r][i]).collect())
         .collect()
+}
+
+/// The bins of the runs at the design points `rows` (`inputs[i][k]`, the inputs at `rows[k]`),
+/// grouped by the replicate each row belongs to where `method`'s design is made of
+/// independent replicates.
+pub(crate) fn bins(method: &dyn Sampling, inputs: &[Vec<f64>], rows: &[usize]) -> Bins {
+    let bins = Bins::of(inputs);
+    match method.replicate_size() {
+        Some(size) if size > 0 => {
+            bins.with_replicates(rows.iter().map(|&r| (r / size) as u32).collect())
+        }
+        _ => bins,
+    }
 }
 
 /// The first-order indices of a series, estimated a block of time columns at a time.
@@ -68,12 +81,14 @@ impl<'a> SeriesIndices<'a> {
     }
 }
 
-/// A scalar quantity's sensitivity from its valid runs (`inputs[i][k]`, `values[k]`): its
+/// A scalar quantity's sensitivity from its valid runs (`inputs[i][k]`, `values[k]`, binned
+/// by `bins`, which [`bins`] made of the same runs): its
 /// first-order indices with bootstrap intervals (a [`Sobol`] of one column marked as given
 /// data) and its rank correlations labelled by the names of `parameters`; `None` below
 /// [`given_data::MIN_RUNS`] runs.
 pub(crate) fn scalar(
     inputs: &[Vec<f64>],
+    bins: &Bins,
     values: &[f64],
     parameters: &[RandomParameter],
     seed: u64,
@@ -82,7 +97,6 @@ pub(crate) fn scalar(
     if values.len() < given_data::MIN_RUNS || inputs.is_empty() {
         return None;
     }
-    let bins = Bins::of(inputs);
     let first = bins.first_order(values);
     let ci = bins.intervals(values, RESAMPLES, LEVEL, seed ^ BOOTSTRAP_SEED);
     let d = first.len();

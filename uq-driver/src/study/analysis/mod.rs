@@ -32,7 +32,6 @@ pub(crate) use error::{output_error, quantity_error};
 pub use exceedance::exceedance_count;
 pub use exceedance::{count_on_side, counted_probabilities, nest_exceedance_count};
 
-use crate::uq::given_data::Bins;
 use blocks::SeriesColumns;
 use columns::{column, Column};
 use convergence::convergence;
@@ -527,8 +526,13 @@ pub fn analyse_runs(
     let given = method.samples_the_law();
     // Over time only up to a length: a row of indices per time costs memory (see
     // `given_data::MAX_SERIES_TIMES`).
-    let bins = (given && nt <= given_data::MAX_SERIES_TIMES)
-        .then(|| Bins::of(&given_data::inputs_at(design, &runs.rows)));
+    let bins = (given && nt <= given_data::MAX_SERIES_TIMES).then(|| {
+        given_data::bins(
+            method,
+            &given_data::inputs_at(design, &runs.rows),
+            &runs.rows,
+        )
+    });
     let mut outputs = Vec::new();
     let mut estimates = Vec::new();
     // Per output, the hash of every column (a chaos fitted per column): a quantity equal to
@@ -567,7 +571,14 @@ pub fn analyse_runs(
         };
         let inputs = given.then(|| given_data::inputs_at(design, &qr.rows));
         let sensitivity = inputs.as_ref().and_then(|x| {
-            given_data::scalar(x, &qr.valid, &study.parameters, study.seed ^ qi as u64)
+            let bins = given_data::bins(method, x, &qr.rows);
+            given_data::scalar(
+                x,
+                &bins,
+                &qr.valid,
+                &study.parameters,
+                study.seed ^ qi as u64,
+            )
         });
         if let Some((sobol, _)) = &sensitivity {
             estimate.sobol = Some(sobol.clone());

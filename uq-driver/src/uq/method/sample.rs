@@ -161,6 +161,10 @@ impl<T: UnitCubeSample> Sampling for T {
     fn samples_the_law(&self) -> bool {
         true
     }
+
+    fn replicate_size(&self) -> Option<usize> {
+        self.replicates().map(|_| self.samples())
+    }
 }
 
 #[cfg(test)]

@@ -370,6 +370,13 @@ pub trait Sampling: Method {
         false
     }
 
+    /// Points per independent replicate where the design is made of replicates (design
+    /// point `i` in replicate `i / size`): the sensitivity from the runs measures the noise
+    /// of its bin means from their spread. `None` for the others.
+    fn replicate_size(&self) -> Option<usize> {
+        None
+    }
+
     /// The size of the chaos the estimator fits, for a method whose arrays grow with the
     /// chaos's terms (counted in the memory estimate before anything is built); `None` for the
     /// others, and when the sizes cannot be known (the method's own checks then refuse).
