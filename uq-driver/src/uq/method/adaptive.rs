@@ -177,6 +177,8 @@ pub(crate) struct LimitResult {
     pub importance_sampling: Option<ImportanceSamplingResult>,
     /// Subset simulation, where it ran.
     pub subset: Option<SubsetResult>,
+    /// Whether FORM's check at the mirrored design point suspects a second design point.
+    pub second_design_point_suspected: bool,
     /// For the user (each already prefixed with the target).
     pub warnings: Vec<String>,
 }
@@ -202,6 +204,7 @@ impl LimitResult {
             sorm: None,
             importance_sampling: None,
             subset: None,
+            second_design_point_suspected: false,
             warnings: Vec::new(),
         }
     }

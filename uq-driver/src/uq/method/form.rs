@@ -220,6 +220,7 @@ impl Form {
             out.warnings.extend(f.warnings.iter().cloned());
             if let Some(w) = mirror_check(g, &f, first + f.runs)? {
                 out.warnings.push(w);
+                out.second_design_point_suspected = true;
             }
             out.runs += 1;
             f

@@ -12,6 +12,12 @@
 //! 1e-6 (linear `g`). The sampling stops at `target_cov` (with at least 10 failing samples)
 //! or after `max_runs` samples, whichever comes first.
 //!
+//! With `[method.form] multistart = true`, where the search finds several design points of
+//! comparable probability (`Φ(−β_j)` within a factor 100 of the largest), the samples come
+//! from the mixture of normals around all of them, each drawn with probability `∝ Φ(−β_j)`
+//! (`importance_sampling.mixture` in `summary.json`): around the first alone, the failure
+//! domain near the others was missed, with an interval that did not show it.
+//!
 //! The reported `beta`, design point and importance factors are FORM's (`null` with a
 //! `centre`); `P`, its CoV and interval are the sampling's, which corrects FORM's `Φ(−β)`
 //! for the curvature of the surface.
@@ -28,7 +34,7 @@ use super::form::Form;
 use super::sorm::check_nested_form;
 use super::traits::{adaptive_method_items, Adaptive, Method, Problem};
 use crate::uq::random_inputs::RandomInputs;
-use crate::uq::reliability::{self, LimitState};
+use crate::uq::reliability::{self, LimitState, MixtureComponent, ReliabilityError};
 
 /// `kind = "importance_sampling"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -159,15 +165,42 @@ impl PerTarget for ImportanceSampling {
             None => None,
         };
         Ok(move |g: &mut dyn LimitState, t: &Target, first| {
-            let (mut out, c) = match &centre {
-                Some(c) => (LimitResult::new(t, "importance_sampling", first), c.clone()),
+            let (mut out, components) = match &centre {
+                Some(c) => (
+                    LimitResult::new(t, "importance_sampling", first),
+                    vec![MixtureComponent {
+                        centre: c.clone(),
+                        weight: 1.0,
+                    }],
+                ),
                 None => {
                     let out = self.form.analyse(g, t, first, inputs, seed)?;
-                    let c = out.form_analysis()?.u_star.clone();
-                    (out, c)
+                    let components = centres(&out)?;
+                    (out, components)
                 }
             };
-            let r = reliability::importance_sampling(g, &settings, &c, seed, out.next_run())?;
+            if out.second_design_point_suspected {
+                out.warnings.push(
+                    "importance sampling around this one design point: its estimate and \
+                     interval leave out failures near a second one (`[method.form] multistart = \
+                     true` samples around every design point found; `subset` needs none)"
+                        .into(),
+                );
+            }
+            if components.len() > 1 {
+                out.warnings.push(format!(
+                    "importance sampling draws from a mixture around the {} design points of \
+                     comparable probability, each with probability ∝ Φ(−β_j)",
+                    components.len()
+                ));
+            }
+            let r = reliability::importance_sampling_mixture(
+                g,
+                &settings,
+                &components,
+                seed,
+                out.next_run(),
+            )?;
             out.method = "importance_sampling";
             out.probability = r.probability;
             out.cov = r.cov;
@@ -177,6 +210,26 @@ impl PerTarget for ImportanceSampling {
             out.importance_sampling = Some(r);
             Ok(out)
         })
+    }
+}
+
+/// The centres of the sampling density after FORM: its design point, or where a multi-start
+/// search found several of comparable probability, all of them weighted by `Φ(−β_j)`.
+fn centres(out: &LimitResult) -> Result<Vec<MixtureComponent>, ReliabilityError> {
+    let relevant = reliability::MultiStart::default().relevant;
+    match &out.multistart {
+        Some(ms) if ms.several => Ok(ms
+            .comparable(relevant)
+            .into_iter()
+            .map(|f| MixtureComponent {
+                centre: f.u_star.clone(),
+                weight: f.probability,
+            })
+            .collect()),
+        _ => Ok(vec![MixtureComponent {
+            centre: out.form_analysis()?.u_star.clone(),
+            weight: 1.0,
+        }]),
     }
 }
 
@@ -208,6 +261,51 @@ mod tests {
             assert_eq!(l.runs, l.form.as_ref().unwrap().runs + 1 + is.runs);
             assert!(l.beta.is_some() && l.design_point.is_some());
         }
+    }
+
+    #[test]
+    fn a_symmetric_limit_state_after_multistart_is_sampled_around_both_design_points() {
+        // P(|x1 + x2| > 5) = 2 Φ(−5/√2) = 4.07e-4, half of it at each of ±(2.5, 2.5); around
+        // one design point the estimate was half of it, its interval excluding P.
+        let inputs = standard_inputs(2);
+        let exact = 2.0 * crate::uq::special::norm_sf(5.0 / 2f64.sqrt());
+        let t = above("s", 5.0);
+        let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok((x[0] + x[1]).abs())]);
+        // A single FORM search: about half of P, and a warning that says so.
+        let one = ImportanceSampling::default()
+            .run(&mut model, &inputs, &t, &["s".into()], 7)
+            .unwrap();
+        let l = &one.limits[0];
+        assert!(l.probability < 0.75 * exact, "{}", l.probability);
+        assert!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("leave out failures near a second one")),
+            "{:?}",
+            l.warnings
+        );
+        let mut settings = ImportanceSampling::default();
+        settings.form.multistart = true;
+        let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok((x[0] + x[1]).abs())]);
+        let r = settings
+            .run(&mut model, &inputs, &t, &["s".into()], 7)
+            .unwrap();
+        let l = &r.limits[0];
+        let is = l.importance_sampling.as_ref().unwrap();
+        assert_eq!(is.mixture.len(), 2, "{:?}", l.warnings);
+        let [lo, hi] = l.ci_95.unwrap();
+        assert!(
+            lo <= exact && exact <= hi,
+            "{} [{lo}, {hi}] vs {exact}",
+            l.probability
+        );
+        assert!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("mixture around the 2 design points")),
+            "{:?}",
+            l.warnings
+        );
     }
 
     #[test]

@@ -66,7 +66,11 @@ mod tests;
 pub use error::ReliabilityError;
 pub use form::{form, Form, FormResult};
 pub use gradient::{Differences, Scheme};
-pub use importance::{importance_sampling, ImportanceSampling, ImportanceSamplingResult};
+#[cfg(test)]
+pub(crate) use importance::importance_sampling;
+pub use importance::{
+    importance_sampling_mixture, ImportanceSampling, ImportanceSamplingResult, MixtureComponent,
+};
 pub use model::{
     Abort, LimitState, OnFailure, Outcome, PhysicalLimitState, Point, Side, Threshold,
 };

@@ -104,6 +104,22 @@ impl MultiStartResult {
     pub fn best(&self) -> Option<&FormResult> {
         self.design_points.first().map(|p| &p.form)
     }
+
+    /// The design points whose `Phi(-beta_j)` is at least `relevant` times the largest, by
+    /// increasing `beta` (those `several` counts with the same `relevant`).
+    pub(crate) fn comparable(&self, relevant: f64) -> Vec<&FormResult> {
+        comparable(&self.design_points, relevant).collect()
+    }
+}
+
+/// The points of `found` (by increasing `beta`) whose probability is at least `relevant`
+/// times the first's.
+fn comparable(found: &[DesignPoint], relevant: f64) -> impl Iterator<Item = &FormResult> {
+    let p_max = found.first().map_or(f64::INFINITY, |p| p.form.probability);
+    found
+        .iter()
+        .map(|p| &p.form)
+        .filter(move |f| f.probability >= relevant * p_max)
 }
 
 /// FORM from every start of `settings`, from run index `first_run`; `seed` for the random
@@ -186,17 +202,16 @@ pub fn form_multistart(
     let mut several = false;
     if let Some(best) = found.first() {
         let p_max = best.form.probability;
-        let comparable: Vec<f64> = found
-            .iter()
-            .filter(|p| p.form.probability >= settings.relevant * p_max)
-            .map(|p| p.form.beta)
+        let comparable: Vec<f64> = comparable(&found, settings.relevant)
+            .map(|p| p.beta)
             .collect();
         if comparable.len() > 1 {
             several = true;
             warnings.push(format!(
                 "{} distinct design points with comparable probabilities (beta = {}): \
                  Phi(-beta_min) = {p_max:.4e} misses part of the failure domain (their union \
-                 bound is {union_bound:.4e}); a sampling method (subset simulation) is needed",
+                 bound is {union_bound:.4e}); importance sampling after a multi-start FORM \
+                 samples around all of them, subset simulation needs no design point",
                 comparable.len(),
                 comparable
                     .iter()
