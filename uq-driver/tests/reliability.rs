@@ -248,12 +248,25 @@ fn subset_simulation_covers_the_chi_square_tail_of_a_sum_of_squares() {
         "kind = \"subset\"\nsamples_per_level = 2000",
     );
     let out = dir.path().join("ss");
-    run_study_ok(&p, &out, &[]);
+    let text = run_study_ok(&p, &out, &[]);
     let e = &reliability(&out)[0];
     assert_eq!(e["method"], "subset");
     let got = f(&e["p"]);
     let cov = f(&e["cov"]);
     assert!(cov < 0.3, "cov {cov}");
+    // `cov` takes the levels as independent and is too small; the line says so and gives
+    // the fully correlated value the interval is built on (the page says the same).
+    let upper = f(&e["subset"]["cov_upper"]);
+    assert!(upper > cov, "{upper} vs {cov}");
+    let words = format!(
+        "CoV {:.1} % with independent levels, {:.1} % with correlated ones (which the interval \
+         uses)",
+        100.0 * cov,
+        100.0 * upper
+    );
+    assert_contains(&text, &words);
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_contains(&page, &words);
     let ci = e["ci_95"].as_array().unwrap();
     assert!(
         f(&ci[0]) <= exact && exact <= f(&ci[1]),

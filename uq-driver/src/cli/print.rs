@@ -182,8 +182,8 @@ fn print_reliability(q: &ScalarStats) {
         if let Some([lo, hi]) = r.ci_95 {
             extra.push(format!("95 % interval {}–{}", sig(lo), sig(hi)));
         }
-        if let Some(c) = r.cov {
-            extra.push(format!("CoV {:.1} %", 100.0 * c));
+        if let Some(c) = r.cov_words() {
+            extra.push(c);
         }
         if let Some(u) = r.upper_95 {
             extra.push(format!("95 % upper bound {}", sig(u)));

@@ -94,8 +94,8 @@ fn sentence(r: &LimitProbability, label: &str, unit: Option<&str>) -> String {
     let mut s = format!("{label} = {}", sig(r.p));
     if let Some([lo, hi]) = r.ci_95 {
         s.push_str(&format!(" (95 % interval {}–{}", sig(lo), sig(hi)));
-        if let Some(c) = r.cov {
-            s.push_str(&format!(", CoV {:.1} %", 100.0 * c));
+        if let Some(c) = r.cov_words() {
+            s.push_str(&format!(", {c}"));
         }
         s.push(')');
     } else if let Some(u) = r.upper_95 {
