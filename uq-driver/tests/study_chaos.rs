@@ -681,3 +681,21 @@ fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_s
     let warnings = s["warnings"].to_string();
     assert!(!warnings.contains("top order"), "{warnings}");
 }
+
+/// On 2 nodes per input a chaos of order 1 has all its variance in its top order, whatever
+/// the model: it warned "the top order of the chaos holds 100.0 % ... has not converged"
+/// for every quantity, which says nothing of convergence.
+#[test]
+fn a_chaos_of_order_1_is_told_it_cannot_judge_its_convergence() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_ishigami(dir.path(), "scm2", "kind = \"scm\"\nnodes = 2");
+    let warnings = summary(&out)["warnings"].to_string();
+    assert_contains(&warnings, "Y: a chaos of order 1 (2 nodes per input)");
+    assert!(
+        !warnings.contains("the top order of the chaos holds"),
+        "{warnings}"
+    );
+}

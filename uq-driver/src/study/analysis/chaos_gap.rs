@@ -8,6 +8,7 @@ use crate::report::units::with_unit;
 use crate::results::numbers::computed;
 use crate::uq::method::pce_regression::FOLDS;
 use crate::uq::method::{ChaosError, ChaosErrorKind};
+use crate::uq::surrogate::NamedChaos;
 
 /// A chaos whose own truncation-error estimate (relative to the variance) exceeds this at some
 /// time, or for a quantity, is reported ([`chaos_error_warnings`]; a nested study's inner
@@ -110,7 +111,12 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
             Some(e) => {
                 if let Some((v, k)) = series_error(e, &o.std).filter(|w| w.0 > CHAOS_ERROR) {
                     out.push(match k {
-                        None => top_order_warning(&o.name, " over its series", v),
+                        None => top_order_warning(
+                            &o.name,
+                            " over its series",
+                            v,
+                            chaos_order(&a.output_chaos, &o.name),
+                        ),
                         Some(k) => {
                             let at = o
                                 .times
@@ -132,7 +138,8 @@ pub(crate) fn chaos_error_warnings(a: &Analysed, no_estimate: Option<&str>) -> V
         match &q.chaos_error {
             Some(e) if e.kind == ChaosErrorKind::OrderDifference.name() => {
                 if e.value.is_finite() && e.value > CHAOS_ERROR {
-                    out.push(top_order_warning(&q.name, "", e.value));
+                    let order = chaos_order(&a.quantity_chaos, &q.name);
+                    out.push(top_order_warning(&q.name, "", e.value, order));
                 }
             }
             Some(e)
@@ -214,15 +221,34 @@ fn error_warning(name: &str, at: &str, kind: &str, value: f64, raw: Option<f64>)
 /// or the chaos has not converged. exp(x) on 4 nodes had 7 % there and gave
 /// P(q > limit) = 3.7e-4 for a true 1e-3, and a negative 0.1 % quantile of a positive
 /// quantity, with no warning.
-fn top_order_warning(name: &str, at: &str, share: f64) -> String {
+/// A chaos of order 1 (2 nodes per input) holds all its variance in its top order whatever
+/// the model: it is told apart, since the share then says nothing of convergence.
+fn top_order_warning(name: &str, at: &str, share: f64, order: Option<usize>) -> String {
+    if order == Some(1) {
+        return format!(
+            "{name}: a chaos of order 1 (2 nodes per input) has all its variance in its top \
+             order{at} (order_difference {:.1} %), so it cannot tell whether it has converged: \
+             its quantiles, densities, P(q > limit) and Sobol' indices are those of a linear \
+             model; 3 or more nodes (order 2 or more) give a chaos that can judge itself",
+            100.0 * share
+        );
+    }
     format!(
         "{name}: the top order of the chaos holds {:.1} % of its variance{at} \
          (order_difference): unless the model is a polynomial of that order, the chaos has not \
          converged, and its quantiles, densities, P(q > limit) and Sobol' indices may be far \
-         off (the mean and Std are the quadrature's); raise `nodes` and `order` until this share \
-         is small",
+         off; the mean and Std come from the same nodes and may be off too; raise `nodes` and \
+         `order` until this share is small",
         100.0 * share
     )
+}
+
+/// The total order of the chaos named `name` among `chaoses`, if it is there.
+fn chaos_order(chaoses: &[NamedChaos], name: &str) -> Option<usize> {
+    chaoses
+        .iter()
+        .find(|c| c.name == name)
+        .map(|c| c.pce.basis.set().order())
 }
 
 /// The warning of one output (`times`) or quantity (`None`) whose Std is `std` by the method
