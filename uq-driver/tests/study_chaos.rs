@@ -634,6 +634,29 @@ fn a_chaos_of_correlated_non_normal_inputs_says_its_error_estimate_may_be_optimi
     }
 }
 
+/// `nodes = 1` was accepted by the study's checks (1 to 64), then the run stopped with "only
+/// 1 successful runs: nothing to analyse"; a sparse grid of level 0 (also one run) worked.
+#[test]
+fn scm_with_one_node_is_one_run_at_the_centre_and_says_it_estimates_no_scatter() {
+    if test_fmus::built().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_ishigami(dir.path(), "scm1", "kind = \"scm\"\nnodes = 1");
+    let s = summary(&out);
+    assert_eq!(s["model_runs"], 1);
+    // Ishigami at the centre of U(−π, π)³: sin 0 + 7 sin² 0 + 0.1 · 0 · sin 0 = 0.
+    let y = &s["quantities"]["Y"];
+    assert_eq!(
+        (y["mean"].as_f64(), y["std"].as_f64()),
+        (Some(0.0), Some(0.0))
+    );
+    assert_contains(
+        &s["warnings"].to_string(),
+        "`nodes = 1` is one run at the centre",
+    );
+}
+
 #[test]
 fn a_collocation_chaos_whose_top_order_holds_much_variance_warns_and_its_tails_say_so() {
     if test_fmus::built().is_none() {

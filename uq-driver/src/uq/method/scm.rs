@@ -121,9 +121,10 @@ impl Method for Scm {
     }
 }
 
-impl Sampling for Scm {
-    /// The tensor grid, last parameter varying fastest; weights sum to one.
-    fn make_design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+impl Scm {
+    /// The tensor grid of the inputs' Gauss rules (Gauss–Hermite when every input goes
+    /// through the normal map).
+    fn grid(&self, inputs: &RandomInputs) -> Result<Design, MethodError> {
         let families = self.chaos.families(inputs);
         if families.iter().all(|f| *f == Family::Hermite) {
             // Every input through the normal map: the Gauss–Hermite grid.
@@ -151,6 +152,28 @@ impl Sampling for Scm {
             Some(grid.weights),
             inputs,
         ))
+    }
+}
+
+impl Sampling for Scm {
+    /// One: `nodes = 1` is a single run at the centre of the inputs (a chaos of order 0: the
+    /// mean, Std 0), as a sparse grid of level 0 is; a weighted design never drops a point.
+    fn min_runs(&self) -> usize {
+        1
+    }
+
+    /// The tensor grid, last parameter varying fastest; weights sum to one.
+    fn make_design(&self, inputs: &RandomInputs, _seed: u64) -> Result<Design, MethodError> {
+        let mut design = self.grid(inputs)?;
+        if self.nodes == 1 {
+            design.warnings.push(
+                "scm with `nodes = 1` is one run at the centre of the inputs: a chaos of order \
+                 0, whose mean is the model there and whose Std is 0 (no scatter is estimated, \
+                 no Sobol' index); 2 or more nodes estimate the scatter"
+                    .into(),
+            );
+        }
+        Ok(design)
     }
 
     fn planned_runs(&self, dim: usize) -> Option<f64> {
