@@ -1,6 +1,6 @@
 //! Reading a study argument: files, built-in names, warnings, the FMU search.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
@@ -110,15 +110,51 @@ pub(crate) fn check_fmu_found(s: &Study) -> Result<()> {
         .as_ref()
         .and_then(|b| path.strip_prefix(b).ok())
         .unwrap_or(path);
-    let places: Vec<String> = fmu_candidates(&given.to_string_lossy(), s.base.as_deref())
+    // Each place once, as an absolute path (the study's folder and the working folder are
+    // often the same).
+    let mut places: Vec<PathBuf> = Vec::new();
+    for p in fmu_candidates(&given.to_string_lossy(), s.base.as_deref()) {
+        let p = std::path::absolute(&p).unwrap_or(p);
+        if !places.contains(&p) {
+            places.push(p);
+        }
+    }
+    let list: Vec<String> = places
         .iter()
         .map(|p| format!("  {}", p.display()))
         .collect();
     anyhow::bail!(
-        "{}: FMU {} not found; looked in:\n{}\n(set RAILUQ_FMU_DIR to the folder of the FMUs, \
-         e.g. target/fmu after `make fmu`)",
+        "{}: FMU {} not found; looked in:\n{}\n{}(set RAILUQ_FMU_DIR to the folder of the \
+         FMUs, e.g. target/fmu after `make fmu`)",
         s.origin,
         given.display(),
-        places.join("\n")
+        list.join("\n"),
+        similar_fmu(&places).map_or(String::new(), |p| format!("did you mean {}? ", p.display()))
     )
+}
+
+/// The FMU, in the folders of `places`, whose name is closest to the names of `places` (a
+/// misspelt file name), if one is close.
+fn similar_fmu(places: &[PathBuf]) -> Option<PathBuf> {
+    let wanted = places.first()?.file_name()?.to_string_lossy().into_owned();
+    let mut found: Vec<PathBuf> = Vec::new();
+    for dir in places.iter().filter_map(|p| p.parent()) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            continue;
+        };
+        found.extend(
+            entries
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("fmu"))),
+        );
+    }
+    let names: Vec<String> = found
+        .iter()
+        .filter_map(|p| Some(p.file_name()?.to_string_lossy().into_owned()))
+        .collect();
+    let best = suggest::closest(&wanted, names.iter().map(String::as_str))?;
+    found
+        .into_iter()
+        .find(|p| p.file_name().is_some_and(|n| n == best))
 }
