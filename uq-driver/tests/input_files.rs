@@ -206,4 +206,6 @@ fn errors_about_input_and_profile_files_never_quote_the_file() {
         "time,SECRET-2\n0,1\n",
         "column 2 names no variable of the FMU",
     );
+    // A misspelt column: the FMU's own name of the parameter it may mean.
+    refused("time,KK\n0,100\n", "them); did you mean `K`?");
 }

@@ -353,9 +353,18 @@ fn column_kind(
     number: usize,
 ) -> Result<(u32, ColumnKind), String> {
     let var = md.variable(name).ok_or_else(|| {
+        // The FMU's own name of a close input or tunable parameter, if any (the column's
+        // name is still not quoted).
+        let settable = md.variables.iter().filter(|v| {
+            v.causality == Causality::Input
+                || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
+        });
+        let hint = crate::suggest::closest(name, settable.map(|v| v.name.as_str()))
+            .map_or(String::new(), |n| format!("; did you mean `{n}`?"));
         format!(
             "column {number} names no variable of the FMU ({}): the columns after the time \
-             must be named after inputs or tunable parameters (`uq-driver inspect` lists them)",
+             must be named after inputs or tunable parameters (`uq-driver inspect` lists \
+             them){hint}",
             md.model_name
         )
     })?;
