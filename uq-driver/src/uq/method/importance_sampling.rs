@@ -277,13 +277,7 @@ mod tests {
             .unwrap();
         let l = &one.limits[0];
         assert!(l.probability < 0.75 * exact, "{}", l.probability);
-        assert!(
-            l.warnings
-                .iter()
-                .any(|w| w.contains("leave out failures near a second one")),
-            "{:?}",
-            l.warnings
-        );
+        assert_warned(l, "leave out failures near a second one");
         let mut settings = ImportanceSampling::default();
         settings.form.multistart = true;
         let mut model = Analytic::new(&inputs, |x: &[f64]| vec![Ok((x[0] + x[1]).abs())]);
@@ -299,11 +293,14 @@ mod tests {
             "{} [{lo}, {hi}] vs {exact}",
             l.probability
         );
+        assert_warned(l, "mixture around the 2 design points");
+    }
+
+    /// `l` has a warning with `words` in it.
+    fn assert_warned(l: &LimitResult, words: &str) {
         assert!(
-            l.warnings
-                .iter()
-                .any(|w| w.contains("mixture around the 2 design points")),
-            "{:?}",
+            l.warnings.iter().any(|w| w.contains(words)),
+            "no {words:?} in {:?}",
             l.warnings
         );
     }
