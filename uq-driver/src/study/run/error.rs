@@ -79,6 +79,22 @@ pub enum RunError {
     /// The output path exists and is not a folder.
     #[error("{}: the output path exists and is not a folder", .0.display())]
     NotAFolder(PathBuf),
+    /// The output folder cannot be created (or written): no folder can be made in it, or in
+    /// the nearest existing folder above it.
+    #[error(
+        "{}: the output folder cannot be created or written: no folder can be made in {} ({source}); \
+         give an output folder where you can write",
+        path.display(),
+        existing.display()
+    )]
+    OutDirNotWritable {
+        /// The output folder.
+        path: PathBuf,
+        /// The nearest existing folder at or above it, where the test failed.
+        existing: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// The output folder is locked by another run.
     #[error(transparent)]
     Lock(#[from] LockError),

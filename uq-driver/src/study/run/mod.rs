@@ -148,6 +148,36 @@ pub fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
     Ok(Fmu::open(path)?)
 }
 
+/// Checks, before a study is sized or run, that its output folder can be written: `dir`
+/// itself if it exists, else the nearest folder above it that exists, must let a folder be
+/// made in it. The test makes a hidden folder there and removes it at once: nothing is left
+/// behind, and `dir` is not created. Without it a folder that cannot be created (`/sys/x`,
+/// on a file system of size 0) was refused as "more than the 0.0 B free … use a larger
+/// disk".
+pub fn check_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.as_os_str().is_empty() {
+        return Err(RunError::NoOutDir);
+    }
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotAFolder(dir.to_path_buf()));
+    }
+    // The nearest existing path at or above `dir` ("." for a relative path's first part).
+    let existing = dir
+        .ancestors()
+        .map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p })
+        .find(|p| p.exists())
+        .unwrap_or(Path::new("."));
+    tempfile::Builder::new()
+        .prefix(".uq-driver-write-test-")
+        .tempdir_in(existing)
+        .map(drop)
+        .map_err(|source| RunError::OutDirNotWritable {
+            path: dir.to_path_buf(),
+            existing: existing.to_path_buf(),
+            source,
+        })
+}
+
 /// Creates the output folder, or checks that the existing path is one.
 pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
     if dir.as_os_str().is_empty() {
@@ -242,6 +272,33 @@ pub fn check_failures(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_out_folder_that_cannot_be_created_is_refused_as_such_not_as_a_full_disk() {
+        let dir = tempfile::tempdir().unwrap();
+        // A file where a folder of the path should be: nothing can be created under it.
+        let file = dir.path().join("file");
+        std::fs::write(&file, "x").unwrap();
+        let e = check_out_dir(&file.join("out")).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, RunError::OutDirNotWritable { .. }), "{text}");
+        assert!(text.contains("cannot be created or written"), "{text}");
+        assert!(!text.contains("disk"), "{text}");
+        // A folder to be made under an existing one passes, and is not made by the check;
+        // nothing is left behind.
+        let out = dir.path().join("a/b");
+        check_out_dir(&out).unwrap();
+        assert!(!out.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        check_out_dir(dir.path()).unwrap();
+        assert!(matches!(check_out_dir(&file), Err(RunError::NotAFolder(_))));
+        // A pseudo file system where no folder can be made (sysfs), where there is one.
+        let sys = Path::new("/sys/uq-driver-out");
+        if Path::new("/sys/kernel").is_dir() && !sys.exists() {
+            let text = check_out_dir(sys).unwrap_err().to_string();
+            assert!(text.contains("cannot be created or written"), "{text}");
+        }
+    }
 
     /// A study stopped at its first failures said "2 of 200 points failed" although
     /// 103 of them fail; the points not started are not counted as successes.
