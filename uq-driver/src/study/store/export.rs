@@ -89,11 +89,18 @@ fn suite_folder(dir: &Path, summary: &Value) -> Option<String> {
     else {
         return None;
     };
-    // Variants that ran the model (an intrusive method runs none: nothing to export).
+    // Variants that ran the model: an intrusive method (SGM) runs none (its folder's
+    // `summary.json` has no FMU, though its `model_runs` counts its one solve).
+    let ran_model = |folder: &str| {
+        std::fs::read(dir.join(folder).join("summary.json"))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
+            .is_none_or(|v| !v["fmu"].is_null())
+    };
     let with_runs: Vec<&str> = variants
         .iter()
-        .filter(|v| v["model_runs"].as_u64() != Some(0))
         .filter_map(|v| v["folder"].as_str())
+        .filter(|f| ran_model(f))
         .collect();
     let Some(first) = with_runs.first() else {
         return Some(format!(
@@ -447,11 +454,15 @@ mod tests {
             "reference": "lhs",
             "variants": [
                 { "name": "scm-3", "folder": "scm-3", "model_runs": 9 },
-                { "name": "sgm", "folder": "sgm", "model_runs": 0 },
+                { "name": "sgm", "folder": "sgm", "model_runs": 1 },
                 { "name": "lhs", "folder": "lhs", "model_runs": 500 },
             ],
         });
         std::fs::write(dir.path().join("summary.json"), summary.to_string()).unwrap();
+        // SGM's folder: no FMU, no runs to export.
+        std::fs::create_dir(dir.path().join("sgm")).unwrap();
+        let sgm = serde_json::json!({ "fmu": null, "method": { "kind": "sgm" }, "model_runs": 1 });
+        std::fs::write(dir.path().join("sgm/summary.json"), sgm.to_string()).unwrap();
         let e = runs(dir.path(), &dir.path().join("runs")).unwrap_err().to_string();
         assert!(!e.contains("older uq-driver"), "{e}");
         assert!(e.contains("a suite's folder (suite wheel)"), "{e}");
