@@ -266,6 +266,7 @@ pub fn check_failures(
             parameters,
             message: message.clone(),
         },
+        allow_failures_applies: !design.is_weighted(),
     })
 }
 
@@ -315,6 +316,7 @@ mod tests {
                 total: 200,
                 not_run,
                 first: first.clone(),
+                allow_failures_applies: true,
             }
             .to_string()
         };
@@ -336,5 +338,32 @@ mod tests {
         assert!(!two.contains("2 of 200 points failed"));
         // Every point run: the count is the whole truth.
         assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
+    }
+
+    /// SCM run with --allow-failures stopped at a failed point and still advised "(or
+    /// --allow-failures ...)": a weighted design cannot leave a point out, so the flag is not
+    /// offered there; a sampling design's message offers it.
+    #[test]
+    fn a_weighted_design_that_stops_at_a_failure_does_not_advise_allow_failures() {
+        let failed = |method: &str| {
+            let base = include_str!("../../../studies/wheel-scm.toml");
+            let text = base.replace("kind = \"scm\"\nnodes = 6\norder = 5", method);
+            let study = Study::parse(&text, "t.toml", None).unwrap();
+            let crate::uq::method::Evaluation::Sampling(m) = study.method().evaluation() else {
+                panic!("{method}: a sampling method");
+            };
+            let design = m.design(&study.random_inputs(), study.seed).unwrap();
+            let mut records: Vec<Option<Entry>> = vec![Some(Entry::Ok(0..0)); design.len()];
+            records[1] = Some(Entry::Failed("C < 0".into()));
+            // With --allow-failures given.
+            check_failures(&study, &design, &records, true, None)
+        };
+        let scm = failed("kind = \"scm\"\nnodes = 3").unwrap_err().to_string();
+        assert!(!scm.contains("(or --allow-failures"), "{scm}");
+        assert!(
+            scm.contains("--allow-failures does not apply: this method's design is weighted"),
+            "{scm}"
+        );
+        assert_eq!(failed("kind = \"lhs\"\nsamples = 20").unwrap(), 1);
     }
 }
