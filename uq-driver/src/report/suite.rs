@@ -109,8 +109,7 @@ fn probability_cell(e: &ExceedanceCount) -> String {
         })
     };
     let no_interval = no_interval.or_else(|| {
-        (e.exceeded == 0 && e.of > 0 && !e.upper_95.is_finite())
-            .then(|| "no interval".to_owned())
+        (e.exceeded == 0 && e.of > 0 && !e.upper_95.is_finite()).then(|| "no interval".to_owned())
     });
     match no_interval {
         Some(why) if e.exceeded == 0 => format!("0 (0 of {}, {why})", group_digits(e.of)),

@@ -328,7 +328,12 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
 fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
     let counts = [
         ("pdf_grid", a.pdf_grid, 2, "points of the density grid"),
-        ("pdf_times", a.pdf_times, 1, "time columns of the PDF evolution"),
+        (
+            "pdf_times",
+            a.pdf_times,
+            1,
+            "time columns of the PDF evolution",
+        ),
         (
             "surrogate_samples",
             a.surrogate_samples,

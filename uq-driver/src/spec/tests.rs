@@ -336,7 +336,10 @@ fn a_bad_analysis_value_is_refused_naming_its_key_and_rule() {
     let base = include_str!("../../studies/wheel-scm.toml");
     let with = |a: &str| format!("{base}\n[analysis]\n{a}\n");
     for (setting, needle) in [
-        ("pdf_times = 0", "analysis: pdf_times = 0: must be at least 1"),
+        (
+            "pdf_times = 0",
+            "analysis: pdf_times = 0: must be at least 1",
+        ),
         ("pdf_grid = 1", "analysis: pdf_grid = 1: must be at least 2"),
         (
             "surrogate_samples = 0",
@@ -354,7 +357,10 @@ fn a_bad_analysis_value_is_refused_naming_its_key_and_rule() {
             "quantiles = [-0.01]",
             "analysis: quantiles: level -0.01 must be in [0, 1]",
         ),
-        ("quantiles = [nan]", "analysis: quantiles: level NaN must be in [0, 1]"),
+        (
+            "quantiles = [nan]",
+            "analysis: quantiles: level NaN must be in [0, 1]",
+        ),
     ] {
         let err = Study::parse(&with(setting), "t.toml", None)
             .unwrap_err()

@@ -164,7 +164,13 @@ pub fn check_out_dir(dir: &Path) -> Result<(), RunError> {
     // The nearest existing path at or above `dir` ("." for a relative path's first part).
     let existing = dir
         .ancestors()
-        .map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p })
+        .map(|p| {
+            if p.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                p
+            }
+        })
         .find(|p| p.exists())
         .unwrap_or(Path::new("."));
     tempfile::Builder::new()

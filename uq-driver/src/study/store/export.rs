@@ -463,10 +463,15 @@ mod tests {
         std::fs::create_dir(dir.path().join("sgm")).unwrap();
         let sgm = serde_json::json!({ "fmu": null, "method": { "kind": "sgm" }, "model_runs": 1 });
         std::fs::write(dir.path().join("sgm/summary.json"), sgm.to_string()).unwrap();
-        let e = runs(dir.path(), &dir.path().join("runs")).unwrap_err().to_string();
+        let e = runs(dir.path(), &dir.path().join("runs"))
+            .unwrap_err()
+            .to_string();
         assert!(!e.contains("older uq-driver"), "{e}");
         assert!(e.contains("a suite's folder (suite wheel)"), "{e}");
-        let example = format!("uq-driver export {} --runs", dir.path().join("scm-3").display());
+        let example = format!(
+            "uq-driver export {} --runs",
+            dir.path().join("scm-3").display()
+        );
         assert!(e.contains(&example), "{e}");
         assert!(e.contains("(variants with runs: scm-3, lhs)"), "{e}");
         assert!(!dir.path().join("runs").exists());
