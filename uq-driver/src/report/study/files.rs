@@ -109,8 +109,8 @@ pub(super) fn sobol_csv_sentence(s: &OutputStats) -> &'static str {
     match &s.sobol {
         Some(sobol) if sobol.given_data => {
             "The indices are estimated from the runs themselves (given data): the CSV file \
-             has the first-order indices only; the method gives no total indices (a `sobol` \
-             study or a chaos gives them)."
+             has the first-order indices only; the method gives no total indices (sobol_sampling \
+             or a chaos method gives them)."
         }
         _ => "The total indices are in the CSV file.",
     }
