@@ -166,7 +166,8 @@ class Study:
         ``threads``: worker threads (default: all cores). ``progress``: show a progress bar
         and the library's notes (see :mod:`railuq._progress`); False: quiet, the notes go to
         the ``railuq`` logger. ``fresh``: discard earlier results in ``out``.
-        ``allow_failures``: Monte Carlo and LHS go on past failed points. ``report``: write
+        ``allow_failures``: Monte Carlo, LHS, QMC, pce_regression and sobol_sampling go on
+        past failed points (collocation and sparse grids stop). ``report``: write
         the plots and ``index.html`` (default: when ``out`` is given). ``yes``: start a
         study above the size limits without asking.
 

@@ -46,7 +46,7 @@ pub(crate) enum Command {
         /// Worker threads (default: all cores).
         #[arg(long, short, value_parser = parse_threads)]
         threads: Option<usize>,
-        /// MC/LHS: continue past failed points.
+        /// MC, LHS, QMC, pce_regression, sobol_sampling: continue past failed points (collocation and sparse grids stop: they cannot leave a point out).
         #[arg(long)]
         allow_failures: bool,
         #[command(flatten)]
@@ -60,7 +60,7 @@ pub(crate) enum Command {
         /// Output folder (default DIR/result).
         #[arg(long, short)]
         out: Option<PathBuf>,
-        /// MC/LHS: accept failed points and report how many.
+        /// MC, LHS, QMC, pce_regression, sobol_sampling: accept failed points and report how many (collocation and sparse grids stop: they cannot leave a point out).
         #[arg(long)]
         allow_failures: bool,
         /// Write the CSV files and summary.json only: no plots, no index.html (as `run`).
@@ -164,7 +164,7 @@ pub(crate) struct RunArgs {
     /// Worker threads (default: all cores).
     #[arg(long, short, value_parser = parse_threads)]
     pub(crate) threads: Option<usize>,
-    /// MC/LHS: continue past failed points and report how many failed.
+    /// MC, LHS, QMC, pce_regression, sobol_sampling: continue past failed points and report how many failed (collocation and sparse grids stop: they cannot leave a point out).
     #[arg(long)]
     pub(crate) allow_failures: bool,
     /// Discard earlier results in --out instead of resuming.

@@ -83,11 +83,41 @@ fn find<'a>(quantities: &'a [ScalarStats], name: &str) -> Option<&'a ScalarStats
 /// A probability in the table of variants: `0.3125`, or, when no draw exceeded, the 95 %
 /// upper bound with the count, `< 0.221 (0 of 12)`, as the variant's page gives it
 /// ("0.0000" from 12 runs read as certainty).
+///
+/// A count over a chaos's draws that has no interval (the limit beyond every model run, or
+/// only a few runs beyond it: `upper_95` is NaN) is shown as the variant's page words it,
+/// with the reason and "no interval": `0 (0 of 20 000, beyond every model run: no
+/// interval)`, not `< NaN`.
 fn probability_cell(e: &ExceedanceCount) -> String {
-    if e.exceeded == 0 && e.of > 0 {
-        format!("< {} (0 of {})", sig(e.upper_95), group_digits(e.of))
+    let no_interval = if let Some([_, largest]) = e.beyond_runs {
+        if e.ci_kind == "none_extrapolation" {
+            Some(if e.limit > largest {
+                "beyond every model run: no interval".to_owned()
+            } else {
+                "below every model run: no interval".to_owned()
+            })
+        } else {
+            None
+        }
     } else {
-        format!("{:.4}", e.p)
+        e.runs_in_tail.map(|[k, n]| {
+            format!(
+                "only {} of {} model runs beyond the limit: no interval",
+                group_digits(k),
+                group_digits(n)
+            )
+        })
+    };
+    let no_interval = no_interval.or_else(|| {
+        (e.exceeded == 0 && e.of > 0 && !e.upper_95.is_finite()).then(|| "no interval".to_owned())
+    });
+    match no_interval {
+        Some(why) if e.exceeded == 0 => format!("0 (0 of {}, {why})", group_digits(e.of)),
+        Some(why) => format!("{:.4} ({why})", e.p),
+        None if e.exceeded == 0 && e.of > 0 => {
+            format!("< {} (0 of {})", sig(e.upper_95), group_digits(e.of))
+        }
+        None => format!("{:.4}", e.p),
     }
 }
 
@@ -567,6 +597,40 @@ mod tests {
         assert_eq!(probability_cell(&none), "< 0.221 (0 of 12)");
         let some = exceedance_count(&[1.0, 3.0, 1.0, 1.0], 2.0, Draws::Runs);
         assert_eq!(probability_cell(&some), "0.2500");
+    }
+
+    #[test]
+    fn the_suite_table_shows_no_nan_when_a_chaos_count_has_no_interval() {
+        // 0 of 20 000 draws of a chaos above a limit beyond every run: no interval, and
+        // `upper_95` is NaN (the variant's page: "P = 0, no interval").
+        let mut beyond = exceedance_count(&[1.0; 20_000], 2.0, Draws::Chaos);
+        beyond.note_range(Draws::Chaos, [0.5, 1.5]);
+        assert!(beyond.upper_95.is_nan());
+        let cell = probability_cell(&beyond);
+        assert!(!cell.contains("NaN"), "{cell}");
+        assert_eq!(
+            cell,
+            format!(
+                "0 (0 of {}, beyond every model run: no interval)",
+                group_digits(20_000)
+            )
+        );
+        // Draws above a limit that only 3 of 40 runs reach.
+        let mut draws = vec![1.0; 100];
+        draws[0] = 3.0;
+        let mut tail = exceedance_count(&draws, 2.0, Draws::Chaos);
+        tail.note_tail(Draws::Chaos, 3, 40);
+        assert_eq!(
+            probability_cell(&tail),
+            "0.0100 (only 3 of 40 model runs beyond the limit: no interval)"
+        );
+        // Below every run.
+        let mut below = exceedance_count(&[3.0; 10], 2.0, Draws::Chaos);
+        below.note_range(Draws::Chaos, [2.5, 3.0]);
+        assert_eq!(
+            probability_cell(&below),
+            "1.0000 (below every model run: no interval)"
+        );
     }
 
     fn band(mean: f64, std: f64) -> OutputStats {

@@ -482,7 +482,7 @@ pub struct Summary {
     pub fixed: BTreeMap<String, FixedValue>,
     /// The FMU (null for intrusive methods).
     pub fmu: Option<FmuInfo>,
-    /// Model runs of the study (1 for intrusive methods).
+    /// Model runs of the study (1 for intrusive methods, which run no model: their one solve).
     pub model_runs: usize,
     /// Runs made by this invocation.
     pub runs_this_invocation: usize,

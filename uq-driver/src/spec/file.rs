@@ -176,7 +176,8 @@ pub struct Analysis {
     pub series_samples: usize,
     /// Quantile levels written to the CSV.
     pub quantiles: Vec<f64>,
-    /// Unweighted designs (MC/LHS): continue when some points fail and report how many.
+    /// Unweighted designs (MC, LHS, QMC, pce_regression, sobol_sampling): continue when some
+    /// points fail and report how many.
     pub allow_failures: bool,
     /// How a chaos method fits a series output: on the principal components of its runs
     /// (`pca`, the default) or column by column (`columns`).

@@ -323,17 +323,46 @@ fn check_quantities(cx: &Context, file: &StudyFile) -> Result<(), StudyError> {
     Ok(())
 }
 
+/// Checks `[analysis]`, naming the first key out of its range with its rule, e.g.
+/// `analysis: pdf_times = 0: must be at least 1 (...)`.
 fn check_analysis(cx: &Context, a: &Analysis) -> Result<(), StudyError> {
-    if a.pdf_grid < 2
-        || a.pdf_times < 1
-        || a.series_samples < 2
-        || a.surrogate_samples < 2
-        || a.quantiles.iter().any(|q| !(0.0..=1.0).contains(q))
-    {
+    let counts = [
+        ("pdf_grid", a.pdf_grid, 2, "points of the density grid"),
+        (
+            "pdf_times",
+            a.pdf_times,
+            1,
+            "time columns of the PDF evolution",
+        ),
+        (
+            "surrogate_samples",
+            a.surrogate_samples,
+            2,
+            "draws of a chaos for a scalar quantity",
+        ),
+        (
+            "series_samples",
+            a.series_samples,
+            2,
+            "draws of a chaos for the outputs over time",
+        ),
+    ];
+    for (key, value, least, what) in counts {
+        if value < least {
+            return Err(cx.invalid(
+                None,
+                format!("analysis: {key} = {value}: must be at least {least} ({what})"),
+            ));
+        }
+    }
+    // A level 0 is the smallest value, 1 the largest; NaN fails the range test too.
+    if let Some(q) = a.quantiles.iter().find(|q| !(0.0..=1.0).contains(*q)) {
         return Err(cx.invalid(
             None,
-            "analysis: pdf_grid >= 2, pdf_times >= 1, series_samples >= 2, \
-             surrogate_samples >= 2, quantiles in [0, 1]",
+            format!(
+                "analysis: quantiles: level {q} must be in [0, 1] (0 gives the smallest \
+                 value, 1 the largest)"
+            ),
         ));
     }
     // NaN fails the range test too.

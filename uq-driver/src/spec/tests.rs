@@ -330,6 +330,64 @@ fn quantile_levels_that_share_a_column_name_are_refused() {
     }
 }
 
+/// One bad `[analysis]` value was refused with the rules of every key, naming none.
+#[test]
+fn a_bad_analysis_value_is_refused_naming_its_key_and_rule() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let with = |a: &str| format!("{base}\n[analysis]\n{a}\n");
+    for (setting, needle) in [
+        (
+            "pdf_times = 0",
+            "analysis: pdf_times = 0: must be at least 1",
+        ),
+        ("pdf_grid = 1", "analysis: pdf_grid = 1: must be at least 2"),
+        (
+            "surrogate_samples = 0",
+            "analysis: surrogate_samples = 0: must be at least 2",
+        ),
+        (
+            "series_samples = 1",
+            "analysis: series_samples = 1: must be at least 2",
+        ),
+        (
+            "quantiles = [0.5, 1.5]",
+            "analysis: quantiles: level 1.5 must be in [0, 1]",
+        ),
+        (
+            "quantiles = [-0.01]",
+            "analysis: quantiles: level -0.01 must be in [0, 1]",
+        ),
+        (
+            "quantiles = [nan]",
+            "analysis: quantiles: level NaN must be in [0, 1]",
+        ),
+    ] {
+        let err = Study::parse(&with(setting), "t.toml", None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(needle), "{setting}: {err}");
+        // Only the offending key's rule, not every key's.
+        assert_eq!(err.matches("must be").count(), 1, "{setting}: {err}");
+    }
+}
+
+/// The quantile levels 0 and 1 (the smallest and the largest value) are accepted, as the
+/// reference documents: columns `q0` and `q100`.
+#[test]
+fn quantile_levels_zero_and_one_are_accepted_as_min_and_max() {
+    let base = include_str!("../../studies/wheel-scm.toml");
+    let s = Study::parse(
+        &format!("{base}\n[analysis]\nquantiles = [0.0, 0.5, 1.0]\n"),
+        "t.toml",
+        None,
+    )
+    .unwrap();
+    assert_eq!(s.analysis.quantiles, [0.0, 0.5, 1.0]);
+    let sorted = [1.0, 2.0, 7.0];
+    assert_eq!(crate::uq::moments::quantile(&sorted, 0.0), 1.0);
+    assert_eq!(crate::uq::moments::quantile(&sorted, 1.0), 7.0);
+}
+
 #[test]
 fn retained_variance_outside_zero_to_one_is_refused() {
     let base = include_str!("../../studies/wheel-scm.toml");

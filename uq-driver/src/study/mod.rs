@@ -43,7 +43,9 @@ use crate::spec::Study;
 /// passes [`Study::check`] (the fields of a [`Study`] are public: they are checked again) and
 /// the size check: too large to run, it is refused; large, it needs `opts.yes`. An empty
 /// `out_dir` is refused ([`RunError::NoOutDir`]), as are options that do not fit together
-/// ([`RunError::Options`]).
+/// ([`RunError::Options`]) and a folder that cannot be created or written
+/// ([`RunError::OutDirNotWritable`]; the test makes a hidden folder in it, or in the
+/// nearest existing folder above it, and removes it at once).
 pub fn run_study(
     study: &Study,
     out_dir: &Path,
@@ -54,6 +56,7 @@ pub fn run_study(
         return Err(RunError::NoOutDir.into());
     }
     opts.check()?;
+    run::check_out_dir(out_dir)?;
     plan::size::check(study, out_dir, opts)?;
     run::prepare_out_dir(out_dir)?;
     match &study.suite {

@@ -269,14 +269,24 @@ fn check_plan(
     Err(ShardError::Shard(format!("{}: {what}", dir.display())))
 }
 
+/// Why shard `k` of a plan of `shards` shards cannot run: `shard 3 does not exist: the plan
+/// has shards 0 to 2` (the last index written out, not Rust's exclusive range `0..3`).
+fn no_such_shard(k: usize, shards: usize) -> String {
+    match shards {
+        0 => format!("shard {k} does not exist: the plan has no shards"),
+        1 => format!("shard {k} does not exist: the plan has one shard, 0"),
+        n => format!(
+            "shard {k} does not exist: the plan has shards 0 to {}",
+            n - 1
+        ),
+    }
+}
+
 /// `uq-driver run-shard`: runs shard `k` of the plan in `dir`.
 pub fn run_shard(dir: &Path, k: usize, opts: &RunOptions) -> Result<RunOutcome, ShardError> {
     let p = load_plan(dir)?;
     if k >= p.shards {
-        return Err(ShardError::Usage(format!(
-            "shard {k} does not exist: the plan has shards 0..{}",
-            p.shards
-        )));
+        return Err(ShardError::Usage(no_such_shard(k, p.shards)));
     }
     let study = plan_study(&p)?;
     let fmu = open_fmu(&study)?;
@@ -474,6 +484,19 @@ pub fn write_sbatch(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_missing_shard_names_the_last_shard_not_an_exclusive_range() {
+        assert_eq!(
+            no_such_shard(3, 3),
+            "shard 3 does not exist: the plan has shards 0 to 2"
+        );
+        assert!(!no_such_shard(3, 3).contains(".."));
+        assert_eq!(
+            no_such_shard(1, 1),
+            "shard 1 does not exist: the plan has one shard, 0"
+        );
+    }
 
     #[test]
     fn the_array_job_runs_its_shards_with_the_options_given_to_slurm() {

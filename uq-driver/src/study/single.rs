@@ -216,7 +216,10 @@ fn correlated_sobol_warning(study: &Study, a: &Analysed) -> Option<String> {
     if correlated && indices && given_data {
         // Estimated from the runs: indices of the physical parameters, whatever their order.
         return Some(
-            "the inputs are correlated: the first-order Sobol' indices estimated from the runs              are those of the physical parameters, Var(E[Y | X_i]) / Var(Y): each includes what              the parameter carries of the parameters it is correlated with, so they may add up              to more than 1 and do not depend on the order of [[parameters]]"
+            "the inputs are correlated: the first-order Sobol' indices estimated from the runs \
+             are those of the physical parameters, Var(E[Y | X_i]) / Var(Y): each includes what \
+             the parameter carries of the parameters it is correlated with, so they may add up \
+             to more than 1 and do not depend on the order of [[parameters]]"
                 .into(),
         );
     }

@@ -102,6 +102,20 @@ pub(super) fn sobol_csv(dir: &Path, s: &OutputStats, names: &[&str]) -> Result<(
     )
 }
 
+/// What `<V>_sobol.csv` holds, for the page's paragraph on the Sobol' indices over time: the
+/// total indices beside the first-order ones, or, for indices from given data (`mc`, `lhs`,
+/// `qmc`: the runs binned by each parameter), the first-order ones only.
+pub(super) fn sobol_csv_sentence(s: &OutputStats) -> &'static str {
+    match &s.sobol {
+        Some(sobol) if sobol.given_data => {
+            "The indices are estimated from the runs themselves (given data): the CSV file \
+             has the first-order indices only; the method gives no total indices (sobol_sampling \
+             or a chaos method gives them)."
+        }
+        _ => "The total indices are in the CSV file.",
+    }
+}
+
 /// The index columns of `<V>_sobol.csv` after `time`: `S_<p>...,ST_<p>...`, then with
 /// intervals `S_<p>_lo,S_<p>_hi...,ST_<p>_lo,ST_<p>_hi...`.
 fn sobol_columns(names: &[&str], intervals: bool, total: bool) -> Vec<String> {
@@ -317,4 +331,58 @@ fn csv_cell(s: &str) -> String {
     let mut out = String::new();
     push_field(&mut out, s);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_page_promises_no_total_indices_for_given_data_sobol() {
+        let sobol = |given_data| Sobol {
+            first: vec![vec![0.25, 0.75]],
+            total: if given_data {
+                Vec::new()
+            } else {
+                vec![vec![0.25, 0.75]]
+            },
+            intervals: None,
+            given_data,
+        };
+        let mut s = OutputStats {
+            name: "y".into(),
+            times: vec![0.0],
+            mean: vec![1.0],
+            std: vec![0.5],
+            lower_3sigma: vec![-0.5],
+            upper_3sigma: vec![2.5],
+            quantiles: Vec::new(),
+            std_pce: None,
+            std_error_mean: None,
+            sobol: Some(sobol(true)),
+            pdf_times: Vec::new(),
+            pdf_grid: Vec::new(),
+            pdf: Vec::new(),
+            draws: crate::uq::method::Draws::Runs,
+            chaos_error: None,
+            deterministic: false,
+            unit: None,
+            convergence: None,
+            convergence_time: None,
+            functional: None,
+        };
+        let given = sobol_csv_sentence(&s);
+        assert!(!given.contains("total indices are in"), "{given}");
+        assert!(given.contains("first-order indices only"), "{given}");
+        // The CSV file written for given data has no ST_ column, as the sentence says.
+        let dir = tempfile::tempdir().unwrap();
+        sobol_csv(dir.path(), &s, &["a", "b"]).unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("y_sobol.csv")).unwrap();
+        assert_eq!(csv.lines().next(), Some("time,S_a,S_b"));
+        s.sobol = Some(sobol(false));
+        assert_eq!(
+            sobol_csv_sentence(&s),
+            "The total indices are in the CSV file."
+        );
+    }
 }

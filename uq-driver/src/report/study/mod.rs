@@ -392,9 +392,9 @@ fn output_section(
         text.push_str(
             "\n\nSobol' indices over time: the first-order index of each parameter (the share \
              of the variance it causes alone) stacked, and on top the share from interactions \
-             (1 − ΣS). Where the Std is zero the indices are undefined and left blank. The \
-             total indices are in the CSV file.",
+             (1 − ΣS). Where the Std is zero the indices are undefined and left blank. ",
         );
+        text.push_str(files::sobol_csv_sentence(s));
     }
     let overall = files::overall_sobol(s);
     if let Some((first, total)) = &overall {

@@ -51,9 +51,9 @@ pub enum RunError {
     /// Points failed and failures are not allowed.
     #[error(
         "{}; first: {first}. After fixing the cause, run again \
-         with --retry-failed to re-run the failed points (or --allow-failures, for Monte Carlo \
-         and LHS, to analyse the others)",
-        failure_count(*.failed, *.total, *.not_run)
+         with --retry-failed to re-run the failed points{}",
+        failure_count(*.failed, *.total, *.not_run),
+        allow_failures_hint(*.allow_failures_applies)
     )]
     PointsFailed {
         /// Number of failed points (among those run before the study stopped).
@@ -65,6 +65,11 @@ pub enum RunError {
         not_run: usize,
         /// The first failed point.
         first: FailedPoint,
+        /// Whether `--allow-failures` (`RunOptions::allow_failures`) would let the study
+        /// analyse the other points: true for an unweighted design (`mc`, `lhs`, `qmc`,
+        /// `pce_regression`, `sobol_sampling`), false for a weighted one (collocation, sparse
+        /// grids, a nominal run), which cannot leave a point out.
+        allow_failures_applies: bool,
     },
     /// A single run failed (`simulate`).
     #[error(transparent)]
@@ -79,6 +84,22 @@ pub enum RunError {
     /// The output path exists and is not a folder.
     #[error("{}: the output path exists and is not a folder", .0.display())]
     NotAFolder(PathBuf),
+    /// The output folder cannot be created (or written): no folder can be made in it, or in
+    /// the nearest existing folder above it.
+    #[error(
+        "{}: the output folder cannot be created or written: no folder can be made in {} ({source}); \
+         give an output folder where you can write",
+        path.display(),
+        existing.display()
+    )]
+    OutDirNotWritable {
+        /// The output folder.
+        path: PathBuf,
+        /// The nearest existing folder at or above it, where the test failed.
+        existing: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// The output folder is locked by another run.
     #[error(transparent)]
     Lock(#[from] LockError),
@@ -100,7 +121,8 @@ pub enum RunError {
          results store, point {point} is recorded as failed, and the points not finished are \
          run by a re-run. Run again with --isolate (RunOptions::isolate): there a Fatal fails \
          its point only and the study goes on (add --allow-failures, RunOptions::allow_failures, \
-         for Monte Carlo and LHS, to analyse the others)"
+         to analyse the others: mc, lhs, qmc, pce_regression and sobol_sampling; collocation \
+         and sparse grids cannot leave a point out)"
     )]
     Fatal {
         /// The point whose call returned fmi2Fatal.
@@ -203,6 +225,18 @@ impl PointError {
 
 /// What is known of the failures: "3 of 200 points failed" when every point was run, else
 /// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
+/// The end of [`RunError::PointsFailed`]'s message: `--allow-failures` offered only where it
+/// applies (an unweighted design); a weighted design is said to need every point, so that a
+/// study that already ran with the flag is not told to add it.
+fn allow_failures_hint(applies: bool) -> &'static str {
+    if applies {
+        " (or --allow-failures to analyse the others)"
+    } else {
+        "; --allow-failures does not apply: this method's design is weighted (collocation, a \
+         sparse grid), and no point can be left out of it"
+    }
+}
+
 fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
     if not_run == 0 {
         return format!("{failed} of {total} points failed");

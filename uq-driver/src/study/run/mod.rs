@@ -148,6 +148,48 @@ pub fn open_fmu(study: &Study) -> Result<Fmu, RunError> {
     Ok(Fmu::open(path)?)
 }
 
+/// Checks, before a study is sized or run, that its output folder can be written: `dir`
+/// itself if it exists, else the nearest folder above it that exists, must let a folder be
+/// made in it. The test makes a hidden folder there and removes it at once: nothing is left
+/// behind, and `dir` is not created. Without it a folder that cannot be created (`/sys/x`,
+/// on a file system of size 0) was refused as "more than the 0.0 B free … use a larger
+/// disk".
+pub fn check_out_dir(dir: &Path) -> Result<(), RunError> {
+    if dir.as_os_str().is_empty() {
+        return Err(RunError::NoOutDir);
+    }
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotAFolder(dir.to_path_buf()));
+    }
+    // The nearest existing path at or above `dir` ("." for a relative path's first part).
+    let existing = dir
+        .ancestors()
+        .map(|p| {
+            if p.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                p
+            }
+        })
+        .find(|p| p.exists())
+        .unwrap_or(Path::new("."));
+    let probe = existing.join(format!(".uq-driver-write-test-{}", std::process::id()));
+    match std::fs::create_dir(&probe) {
+        Ok(()) => {
+            // Best effort: the folder was made, which is all the check asks.
+            let _ = std::fs::remove_dir(&probe);
+            Ok(())
+        }
+        // Left by an earlier process of this id: the folder is not the problem.
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(source) => Err(RunError::OutDirNotWritable {
+            path: dir.to_path_buf(),
+            existing: existing.to_path_buf(),
+            source,
+        }),
+    }
+}
+
 /// Creates the output folder, or checks that the existing path is one.
 pub fn prepare_out_dir(dir: &Path) -> Result<(), RunError> {
     if dir.as_os_str().is_empty() {
@@ -236,12 +278,41 @@ pub fn check_failures(
             parameters,
             message: message.clone(),
         },
+        allow_failures_applies: !design.is_weighted(),
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_out_folder_that_cannot_be_created_is_refused_as_such_not_as_a_full_disk() {
+        let dir = tempfile::tempdir().unwrap();
+        // A file where a folder of the path should be: nothing can be created under it.
+        let file = dir.path().join("file");
+        std::fs::write(&file, "x").unwrap();
+        let e = check_out_dir(&file.join("out")).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, RunError::OutDirNotWritable { .. }), "{text}");
+        assert!(text.contains("cannot be created or written"), "{text}");
+        assert!(!text.contains("disk"), "{text}");
+        assert!(!text.contains("write-test"), "{text}");
+        // A folder to be made under an existing one passes, and is not made by the check;
+        // nothing is left behind.
+        let out = dir.path().join("a/b");
+        check_out_dir(&out).unwrap();
+        assert!(!out.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        check_out_dir(dir.path()).unwrap();
+        assert!(matches!(check_out_dir(&file), Err(RunError::NotAFolder(_))));
+        // A pseudo file system where no folder can be made (sysfs), where there is one.
+        let sys = Path::new("/sys/uq-driver-out");
+        if Path::new("/sys/kernel").is_dir() && !sys.exists() {
+            let text = check_out_dir(sys).unwrap_err().to_string();
+            assert!(text.contains("cannot be created or written"), "{text}");
+        }
+    }
 
     /// A study stopped at its first failures said "2 of 200 points failed" although
     /// 103 of them fail; the points not started are not counted as successes.
@@ -258,6 +329,7 @@ mod tests {
                 total: 200,
                 not_run,
                 first: first.clone(),
+                allow_failures_applies: true,
             }
             .to_string()
         };
@@ -279,5 +351,32 @@ mod tests {
         assert!(!two.contains("2 of 200 points failed"));
         // Every point run: the count is the whole truth.
         assert!(err(103, 0).starts_with("103 of 200 points failed; first: point 4"));
+    }
+
+    /// SCM run with --allow-failures stopped at a failed point and still advised "(or
+    /// --allow-failures ...)": a weighted design cannot leave a point out, so the flag is not
+    /// offered there; a sampling design's message offers it.
+    #[test]
+    fn a_weighted_design_that_stops_at_a_failure_does_not_advise_allow_failures() {
+        let failed = |method: &str| {
+            let base = include_str!("../../../studies/wheel-scm.toml");
+            let text = base.replace("kind = \"scm\"\nnodes = 6\norder = 5", method);
+            let study = Study::parse(&text, "t.toml", None).unwrap();
+            let crate::uq::method::Evaluation::Sampling(m) = study.method().evaluation() else {
+                panic!("{method}: a sampling method");
+            };
+            let design = m.design(&study.random_inputs(), study.seed).unwrap();
+            let mut records: Vec<Option<Entry>> = vec![Some(Entry::Ok(0..0)); design.len()];
+            records[1] = Some(Entry::Failed("C < 0".into()));
+            // With --allow-failures given.
+            check_failures(&study, &design, &records, true, None)
+        };
+        let scm = failed("kind = \"scm\"\nnodes = 3").unwrap_err().to_string();
+        assert!(!scm.contains("(or --allow-failures"), "{scm}");
+        assert!(
+            scm.contains("--allow-failures does not apply: this method's design is weighted"),
+            "{scm}"
+        );
+        assert_eq!(failed("kind = \"lhs\"\nsamples = 20").unwrap(), 1);
     }
 }

@@ -80,11 +80,51 @@ fn invalid(path: &Path, message: impl Into<String>) -> ExportError {
     FolderFileError::invalid(path, message).into()
 }
 
+/// When `summary` is a suite's (`suite` and `variants`, no study of its own), what to export
+/// instead: the folder holds one study folder per variant, each with its runs, e.g. `a suite's
+/// folder (suite wheel): export one of its variants' folders, e.g. `uq-driver export
+/// out/scm-3 --runs` (variants with runs: scm-3, lhs)`.
+fn suite_folder(dir: &Path, summary: &Value) -> Option<String> {
+    let (Some(suite), Some(variants)) = (summary["suite"].as_str(), summary["variants"].as_array())
+    else {
+        return None;
+    };
+    // Variants that ran the model: an intrusive method (SGM) runs none (its folder's
+    // `summary.json` has no FMU, though its `model_runs` counts its one solve).
+    let ran_model = |folder: &str| {
+        std::fs::read(dir.join(folder).join("summary.json"))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
+            .is_none_or(|v| !v["fmu"].is_null())
+    };
+    let with_runs: Vec<&str> = variants
+        .iter()
+        .filter_map(|v| v["folder"].as_str())
+        .filter(|f| ran_model(f))
+        .collect();
+    let Some(first) = with_runs.first() else {
+        return Some(format!(
+            "a suite's folder (suite {suite}) whose variants made no model runs: nothing to \
+             export"
+        ));
+    };
+    Some(format!(
+        "a suite's folder (suite {suite}), not a study's: each variant's runs are in its own \
+         folder; export one of them, e.g. `uq-driver export {} --runs` (variants with runs: \
+         {})",
+        dir.join(first).display(),
+        with_runs.join(", ")
+    ))
+}
+
 /// Writes `runs.csv` and `runs.npz` of the study in `dir` into `out`.
 pub fn runs(dir: &Path, out: &Path) -> Result<Exported, ExportError> {
     let sp = dir.join("summary.json");
     let summary: Value =
         serde_json::from_slice(&read(&sp)?).map_err(|e| invalid(&sp, format!("not JSON: {e}")))?;
+    if let Some(message) = suite_folder(dir, &summary) {
+        return Err(invalid(dir, message));
+    }
     if summary["fmu"].is_null() && summary["method"]["kind"].is_string() {
         // An intrusive method (SGM) solves its own system once: no runs, no store.
         let kind = summary["method"]["kind"].as_str().unwrap_or_default();
@@ -403,6 +443,38 @@ mod tests {
         assert_eq!(cols.len(), 2);
         assert_eq!(cols[0], ("k[2,1]".to_string(), vec![1.5, 3.0]));
         assert_eq!(cols[1], ("x".to_string(), vec![2.0, 4.0]));
+    }
+
+    #[test]
+    fn exporting_a_suite_folder_names_its_variant_folders() {
+        let dir = tempfile::tempdir().unwrap();
+        // The top of a suite's folder, as `run` writes it: no record_layout of its own.
+        let summary = serde_json::json!({
+            "suite": "wheel",
+            "reference": "lhs",
+            "variants": [
+                { "name": "scm-3", "folder": "scm-3", "model_runs": 9 },
+                { "name": "sgm", "folder": "sgm", "model_runs": 1 },
+                { "name": "lhs", "folder": "lhs", "model_runs": 500 },
+            ],
+        });
+        std::fs::write(dir.path().join("summary.json"), summary.to_string()).unwrap();
+        // SGM's folder: no FMU, no runs to export.
+        std::fs::create_dir(dir.path().join("sgm")).unwrap();
+        let sgm = serde_json::json!({ "fmu": null, "method": { "kind": "sgm" }, "model_runs": 1 });
+        std::fs::write(dir.path().join("sgm/summary.json"), sgm.to_string()).unwrap();
+        let e = runs(dir.path(), &dir.path().join("runs"))
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains("older uq-driver"), "{e}");
+        assert!(e.contains("a suite's folder (suite wheel)"), "{e}");
+        let example = format!(
+            "uq-driver export {} --runs",
+            dir.path().join("scm-3").display()
+        );
+        assert!(e.contains(&example), "{e}");
+        assert!(e.contains("(variants with runs: scm-3, lhs)"), "{e}");
+        assert!(!dir.path().join("runs").exists());
     }
 
     #[test]
