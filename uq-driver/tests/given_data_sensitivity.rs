@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use crate::study_chaos::{borehole_parameters, run_functions, run_ishigami};
 use crate::support::csv::Csv;
-use crate::support::{assert_contains, benchmarks, read, summary, test_fmus};
+use crate::support::{benchmarks, read, summary, test_fmus};
 
 /// An unreplicated Latin hypercube of 2 000 runs.
 const LHS_2000: &str = "kind = \"lhs\"\nsamples = 2000";
@@ -264,42 +264,19 @@ fn correlated_inputs_give_the_first_order_indices_of_the_physical_inputs() {
         assert!((s - 0.75).abs() < 0.05, "S_{p} = {s}");
         assert!((rho - spearman_exact).abs() < 0.03, "Spearman {p} = {rho}");
     }
-    let warnings = sum["warnings"].to_string();
-    assert_contains(&warnings, "those of the physical parameters");
-}
-
-/// The warning on correlated inputs' given-data indices had runs of 14 spaces where a string
-/// continuation was lost ("estimated from the runs              are those").
-#[test]
-fn the_correlated_inputs_warning_has_no_run_of_spaces() {
-    if test_fmus::built().is_none() {
-        return;
-    }
-    let params = "[[parameters]]\nname = \"x1\"\nmean = 0.0\nstd = 1.0\n\
-                  [[parameters]]\nname = \"x2\"\nmean = 0.0\nstd = 1.0\n\
-                  [[correlation]]\nbetween = [\"x1\", \"x2\"]\nrho = 0.5\n";
-    let dir = tempfile::tempdir().unwrap();
-    let out = run_functions(
-        dir.path(),
-        "correlated",
-        5,
-        params,
-        "kind = \"lhs\"\nsamples = 500",
-    );
-    let sum = summary(&out);
+    // The warning had runs of 14 spaces where a string continuation was lost ("estimated
+    // from the runs              are those").
     let warnings: Vec<&str> = sum["warnings"]
         .as_array()
         .unwrap()
         .iter()
         .filter_map(|w| w.as_str())
         .collect();
-    let correlated = warnings
-        .iter()
-        .find(|w| w.contains("those of the physical parameters"))
-        .expect("the warning on correlated inputs");
-    assert_contains(
-        correlated,
-        "estimated from the runs are those of the physical parameters",
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("estimated from the runs are those of the physical parameters")),
+        "{warnings:?}"
     );
     for w in &warnings {
         assert!(!w.contains("  "), "a run of spaces: {w:?}");

@@ -634,32 +634,7 @@ mod tests {
     }
 
     fn band(mean: f64, std: f64) -> OutputStats {
-        let times = vec![0.0, 1.0, 2.0];
-        let m = vec![mean; 3];
-        let sd = vec![std; 3];
-        let (lower_3sigma, upper_3sigma) = OutputStats::band(&m, &sd, 3.0);
-        OutputStats {
-            name: "y".into(),
-            times,
-            mean: m,
-            std: sd,
-            lower_3sigma,
-            upper_3sigma,
-            quantiles: Vec::new(),
-            std_pce: None,
-            std_error_mean: None,
-            sobol: None,
-            pdf_times: Vec::new(),
-            pdf_grid: Vec::new(),
-            pdf: Vec::new(),
-            draws: Draws::Runs,
-            chaos_error: None,
-            deterministic: false,
-            unit: None,
-            convergence: None,
-            convergence_time: None,
-            functional: None,
-        }
+        OutputStats::constant("y", vec![0.0, 1.0, 2.0], mean, std)
     }
 
     /// The suite page stacked ten identical mean ± 3σ bands, one per variant.

@@ -108,6 +108,37 @@ impl OutputStats {
             .map(|(m, s)| (m - k * s, m + k * s))
             .unzip()
     }
+
+    /// An output `name` of constant `mean` and `std` at `times`, with its ±3σ band and
+    /// nothing else (a fixture of the report's tests).
+    #[cfg(test)]
+    pub(crate) fn constant(name: &str, times: Vec<f64>, mean: f64, std: f64) -> OutputStats {
+        let m = vec![mean; times.len()];
+        let sd = vec![std; times.len()];
+        let (lower_3sigma, upper_3sigma) = OutputStats::band(&m, &sd, 3.0);
+        OutputStats {
+            name: name.into(),
+            times,
+            mean: m,
+            std: sd,
+            lower_3sigma,
+            upper_3sigma,
+            quantiles: Vec::new(),
+            std_pce: None,
+            std_error_mean: None,
+            sobol: None,
+            pdf_times: Vec::new(),
+            pdf_grid: Vec::new(),
+            pdf: Vec::new(),
+            draws: crate::uq::method::Draws::Runs,
+            chaos_error: None,
+            deterministic: false,
+            unit: None,
+            convergence: None,
+            convergence_time: None,
+            functional: None,
+        }
+    }
 }
 
 /// Statistics of one scalar quantity of interest.

@@ -349,28 +349,8 @@ mod tests {
             intervals: None,
             given_data,
         };
-        let mut s = OutputStats {
-            name: "y".into(),
-            times: vec![0.0],
-            mean: vec![1.0],
-            std: vec![0.5],
-            lower_3sigma: vec![-0.5],
-            upper_3sigma: vec![2.5],
-            quantiles: Vec::new(),
-            std_pce: None,
-            std_error_mean: None,
-            sobol: Some(sobol(true)),
-            pdf_times: Vec::new(),
-            pdf_grid: Vec::new(),
-            pdf: Vec::new(),
-            draws: crate::uq::method::Draws::Runs,
-            chaos_error: None,
-            deterministic: false,
-            unit: None,
-            convergence: None,
-            convergence_time: None,
-            functional: None,
-        };
+        let mut s = OutputStats::constant("y", vec![0.0], 1.0, 0.5);
+        s.sobol = Some(sobol(true));
         let given = sobol_csv_sentence(&s);
         assert!(!given.contains("total indices are in"), "{given}");
         assert!(given.contains("first-order indices only"), "{given}");

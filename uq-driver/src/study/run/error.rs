@@ -223,8 +223,6 @@ impl PointError {
     }
 }
 
-/// What is known of the failures: "3 of 200 points failed" when every point was run, else
-/// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
 /// The end of [`RunError::PointsFailed`]'s message: `--allow-failures` offered only where it
 /// applies (an unweighted design); a weighted design is said to need every point, so that a
 /// study that already ran with the flag is not told to add it.
@@ -237,6 +235,8 @@ fn allow_failures_hint(applies: bool) -> &'static str {
     }
 }
 
+/// What is known of the failures: "3 of 200 points failed" when every point was run, else
+/// "stopped after the first 2 failures of 200 points (runs not started: 190; ...)".
 fn failure_count(failed: usize, total: usize, not_run: usize) -> String {
     if not_run == 0 {
         return format!("{failed} of {total} points failed");
