@@ -188,6 +188,26 @@ fn value_and_gradient(
     Ok((g[0], fd.gradient(u, g[0], &pts[1..], &g[1..])))
 }
 
+/// `g` and its gradient at `u`, or the first failed run of their batch (a run the model
+/// could not make there: the line search then shortens its step).
+fn try_value_and_gradient(
+    runs: &mut Runs,
+    fd: &Differences,
+    u: &[f64],
+) -> Result<Result<(f64, Vec<f64>), ReliabilityError>, ReliabilityError> {
+    let mut pts = vec![u.to_vec()];
+    pts.extend(fd.points(u));
+    let g = match runs
+        .eval_each(pts.clone())?
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(g) => g,
+        Err(failed) => return Ok(Err(failed)),
+    };
+    Ok(Ok((g[0], fd.gradient(u, g[0], &pts[1..], &g[1..]))))
+}
+
 /// The gradient at `u` where `g(u) = g0` is known.
 fn gradient_at(
     runs: &mut Runs,
@@ -220,6 +240,7 @@ pub(crate) fn search(
     let mut history = Vec::new();
     let mut converged = false;
     let mut short_steps = 0usize;
+    let mut failed_trials = 0usize;
     let mut iterations = 0;
     loop {
         let gn = norm(&grad);
@@ -272,33 +293,59 @@ pub(crate) fn search(
         let m0 = merit(&u, g);
         let slope = dot(&u, &d) - c * g.abs();
         let armijo = |t: f64, v: &[f64], gv: f64| merit(v, gv) <= m0 + ARMIJO * t * slope;
-        // Full step, with its gradient in the same batch.
+        // Full step, with its gradient in the same batch. A run the model cannot make (a
+        // stiffness below zero far from the median, a solver that breaks down) is taken as a
+        // step too long: the line search shortens it, as it does for too little decrease.
         let trial = axpy(&u, 1.0, &d);
-        let (g1, grad1) = value_and_gradient(runs, fd, &trial)?;
-        min_g = min_g.min(g1);
-        if armijo(1.0, &trial, g1) {
-            (u, g, grad, step) = (trial, g1, grad1, 1.0);
-            continue;
+        let mut failure = None;
+        match try_value_and_gradient(runs, fd, &trial)? {
+            Ok((g1, grad1)) => {
+                min_g = min_g.min(g1);
+                if armijo(1.0, &trial, g1) {
+                    (u, g, grad, step) = (trial, g1, grad1, 1.0);
+                    continue;
+                }
+            }
+            Err(failed) => {
+                failed_trials += 1;
+                failure = Some(failed);
+            }
         }
         let mut t = 1.0;
         let mut accepted = None;
         for _ in 1..MAX_TRIALS {
             t *= BACKTRACK;
             let v = axpy(&u, t, &d);
-            let gv = runs.eval(vec![v.clone()], OnFailure::Error)?[0];
+            let gv = match runs.eval_each(vec![v.clone()])?.remove(0) {
+                Ok(gv) => gv,
+                Err(failed) => {
+                    failed_trials += 1;
+                    failure = Some(failed);
+                    continue;
+                }
+            };
             min_g = min_g.min(gv);
             let ok = armijo(t, &v, gv);
-            accepted = Some((v, gv));
+            accepted = Some((t, v, gv));
             if ok {
                 break;
             }
         }
-        let (v, gv) = accepted.expect("MAX_TRIALS > 1");
+        let Some((t, v, gv)) = accepted else {
+            // Every trial failed: the last failure, with its run and point.
+            return Err(failure.expect("a trial without a value failed"));
+        };
         if !armijo(t, &v, gv) {
             short_steps += 1;
         }
         grad = gradient_at(runs, fd, &v, gv)?;
         (u, g, step) = (v, gv, t);
+    }
+    if failed_trials > 0 {
+        warnings.push(format!(
+            "the model could not run at {failed_trials} trial point(s) of the line search (a \
+             value out of its range far from the median?): the steps were shortened"
+        ));
     }
     if short_steps > 0 {
         warnings.push(format!(
@@ -405,10 +452,11 @@ mod tests {
 
     #[test]
     fn a_failed_run_mid_form_is_an_error_naming_the_point() {
+        // Run 11, a finite-difference point of the start, where no step can be shortened.
         let mut calls = 0;
         let mut m = FnLimitState::new(2, |u: &[f64]| {
             calls += 1;
-            if calls == 5 {
+            if calls == 2 {
                 Err("the solver diverged".into())
             } else {
                 Ok(3.0 - u[0] - u[1] * u[1] * 0.1)
@@ -419,13 +467,50 @@ mod tests {
             ReliabilityError::RunFailed {
                 run, u, message, ..
             } => {
-                assert_eq!(*run, 14);
+                assert_eq!(*run, 11);
                 assert_eq!(u.len(), 2);
                 assert_eq!(message, "the solver diverged");
             }
             other => panic!("{other:?}"),
         }
-        assert!(e.to_string().contains("run 14 failed at u = ["), "{e}");
+        assert!(e.to_string().contains("run 11 failed at u = ["), "{e}");
+    }
+
+    /// A full step into a region where the model cannot run (a stiffness below zero far from
+    /// the median) stopped FORM with an error; it is a step too long, which the line search
+    /// shortens.
+    #[test]
+    fn a_step_where_the_model_cannot_run_is_shortened_not_an_error() {
+        // g = 2.5 − u1 − 0.3 u1², root u1 = (√4 − 1)/0.6 = 5/3; from the origin the HLRF
+        // step goes to u1 = 2.5, where the model fails (u1 > 2).
+        let g = |u: &[f64]| {
+            if u[0] > 2.0 {
+                Err("negative stiffness".into())
+            } else {
+                Ok(2.5 - u[0] - 0.3 * u[0] * u[0] + 0.0 * u[1])
+            }
+        };
+        let mut m = FnLimitState::new(2, g);
+        let f = form(&mut m, &Form::default(), 0).unwrap();
+        assert!(f.converged, "{:?}", f.warnings);
+        assert!((f.beta - 5.0 / 3.0).abs() < 1e-3, "beta {}", f.beta);
+        assert!(
+            f.warnings
+                .iter()
+                .any(|w| w.contains("could not run at 1 trial point")),
+            "{:?}",
+            f.warnings
+        );
+        // Where no trial of the line search can run, the last failure is the error.
+        let mut m = FnLimitState::new(2, |u: &[f64]| {
+            if u[0] > 1e-3 {
+                Err("negative stiffness".into())
+            } else {
+                Ok(2.5 - u[0] + 0.0 * u[1])
+            }
+        });
+        let e = form(&mut m, &Form::default(), 0).unwrap_err();
+        assert!(e.to_string().contains("negative stiffness"), "{e}");
     }
 
     #[test]

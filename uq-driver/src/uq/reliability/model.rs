@@ -303,6 +303,22 @@ impl<'m> Runs<'m> {
         points: Vec<Vec<f64>>,
         on_failure: OnFailure,
     ) -> Result<Vec<f64>, ReliabilityError> {
+        self.eval_each(points)?
+            .into_iter()
+            .map(|r| match (r, on_failure) {
+                (Ok(v), _) => Ok(v),
+                (Err(_), OnFailure::CountAsFailure) => Ok(f64::NEG_INFINITY),
+                (Err(e), OnFailure::Error) => Err(e),
+            })
+            .collect()
+    }
+
+    /// `g` at every point, each failed or non-finite run as its
+    /// [`ReliabilityError::RunFailed`] (an abort or a batch of the wrong size stops all).
+    pub(crate) fn eval_each(
+        &mut self,
+        points: Vec<Vec<f64>>,
+    ) -> Result<Vec<Result<f64, ReliabilityError>>, ReliabilityError> {
         if points.is_empty() {
             return Ok(Vec::new());
         }
@@ -322,29 +338,23 @@ impl<'m> Runs<'m> {
             });
         }
         self.next += batch.len() as u64;
-        let mut g = Vec::with_capacity(batch.len());
-        for (p, outcome) in batch.into_iter().zip(outcomes) {
-            let message = match outcome {
-                Ok(v) if v.is_finite() => {
-                    g.push(v);
-                    continue;
-                }
-                Ok(v) => format!("the value is {v}"),
-                Err(m) => m,
-            };
-            match on_failure {
-                OnFailure::CountAsFailure => g.push(f64::NEG_INFINITY),
-                OnFailure::Error => {
-                    return Err(ReliabilityError::RunFailed {
-                        run: p.run,
-                        x: self.model.physical(&p.u),
-                        u: p.u,
-                        message,
-                    })
-                }
-            }
-        }
-        Ok(g)
+        Ok(batch
+            .into_iter()
+            .zip(outcomes)
+            .map(|(p, outcome)| {
+                let message = match outcome {
+                    Ok(v) if v.is_finite() => return Ok(v),
+                    Ok(v) => format!("the value is {v}"),
+                    Err(m) => m,
+                };
+                Err(ReliabilityError::RunFailed {
+                    run: p.run,
+                    x: self.model.physical(&p.u),
+                    u: p.u,
+                    message,
+                })
+            })
+            .collect())
     }
 }
 
