@@ -725,7 +725,7 @@ fn a_chaos_of_order_1_is_told_it_cannot_judge_its_convergence() {
         return;
     };
     let warnings = s["warnings"].to_string();
-    assert_contains(&warnings, "Y: a chaos of order 1 (2 nodes per input)");
+    assert_contains(&warnings, "Y: a chaos of order 1 has all its variance");
     assert!(
         !warnings.contains("the top order of the chaos holds"),
         "{warnings}"

@@ -221,15 +221,16 @@ fn error_warning(name: &str, at: &str, kind: &str, value: f64, raw: Option<f64>)
 /// or the chaos has not converged. exp(x) on 4 nodes had 7 % there and gave
 /// P(q > limit) = 3.7e-4 for a true 1e-3, and a negative 0.1 % quantile of a positive
 /// quantity, with no warning.
-/// A chaos of order 1 (2 nodes per input) holds all its variance in its top order whatever
-/// the model: it is told apart, since the share then says nothing of convergence.
+/// A chaos of order 1 holds all its variance in its top order whatever the model: it is told
+/// apart, since the share then says nothing of convergence.
 fn top_order_warning(name: &str, at: &str, share: f64, order: Option<usize>) -> String {
     if order == Some(1) {
         return format!(
-            "{name}: a chaos of order 1 (2 nodes per input) has all its variance in its top \
-             order{at} (order_difference {:.1} %), so it cannot tell whether it has converged: \
-             its quantiles, densities, P(q > limit) and Sobol' indices are those of a linear \
-             model; 3 or more nodes (order 2 or more) give a chaos that can judge itself",
+            "{name}: a chaos of order 1 has all its variance in its top order{at} \
+             (order_difference {:.1} %), so it cannot tell whether it has converged: its \
+             quantiles, densities, P(q > limit) and Sobol' indices are those of a linear \
+             model; an `order` of 2 or more (with `nodes` above it: 2 nodes allow order 1 only) \
+             gives a chaos that can judge itself",
             100.0 * share
         );
     }

@@ -231,7 +231,7 @@ fn allow_failures_hint(applies: bool) -> &'static str {
         " (or --allow-failures to analyse the others)"
     } else {
         "; --allow-failures does not apply: this method's design is weighted (collocation, a \
-         sparse grid), and no point can be left out of it"
+         sparse grid, a nominal run), and no point can be left out of it"
     }
 }
 

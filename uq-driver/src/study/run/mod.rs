@@ -180,8 +180,12 @@ pub fn check_out_dir(dir: &Path) -> Result<(), RunError> {
             let _ = std::fs::remove_dir(&probe);
             Ok(())
         }
-        // Left by an earlier process of this id: the folder is not the problem.
-        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        // Left by an earlier process of this id (killed between the two calls): the folder
+        // is not the problem; remove the litter.
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            let _ = std::fs::remove_dir(&probe);
+            Ok(())
+        }
         Err(source) => Err(RunError::OutDirNotWritable {
             path: dir.to_path_buf(),
             existing: existing.to_path_buf(),

@@ -7,10 +7,14 @@ pub enum Abort {
     #[error("evaluation interrupted: {0}")]
     Interrupted(String),
     /// A stored run was at another point than the one now requested: the settings, the
-    /// seed, the model's values or the code changed since the runs were stored.
+    /// seed, the model's values or the code changed since the runs were stored, or a failed
+    /// run that the method had gone on past (a trial point of FORM's line search, a subset
+    /// sample counted as a failure) gave a value when `--retry-failed` ran it again.
     #[error(
         "stored run {run} was at u = {stored:?} but u = {requested:?} is requested now; \
-         the stored runs belong to another study (settings, seed, model or version)"
+         the stored runs belong to another study (settings, seed, model or version), or a \
+         failed run that --retry-failed ran again now gave a value where the method had gone on \
+         past its failure (run again without --retry-failed, or with --fresh)"
     )]
     ReplayMismatch {
         /// The run index.
