@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use crate::support::wheel;
 use crate::support::{
-    assert_contains, assert_same_files, failed, plan_and_run_shards, read, run_ok, run_study, utf8,
+    assert_contains, assert_same_files, driver, failed, plan_and_run_shards, read, run_ok,
+    run_study, stderr, utf8, write_file,
 };
 
 /// A short grid: the files, not the numbers, are under test.
@@ -157,4 +158,39 @@ fn list_lines_fit_in_100_characters() {
         words.contains("stochastic Galerkin method with Hermite chaos of total order 6 (28 terms)"),
         "{out}"
     );
+}
+
+/// A study in the working folder named its misspelt FMU twice ("Whel.fmu", "Whel.fmu": the
+/// study's folder and the working folder) and did not point at the `Wheel.fmu` beside it.
+#[test]
+fn a_misspelt_fmu_is_listed_once_per_place_with_the_fmu_it_may_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("Wheel.fmu"), b"").unwrap();
+    write_file(
+        dir.path(),
+        "s.toml",
+        "name = \"s\"\nfmu = \"Whel.fmu\"\n[experiment]\nstop = 1.0\nstep = 0.1\n\
+         [method]\nkind = \"scm\"\nnodes = 2\n[[parameters]]\nname = \"K\"\nmean = 1.0\nstd = 0.1\n\
+         [outputs]\nvariables = [\"q\"]\n",
+    );
+    let out = driver()
+        .current_dir(dir.path())
+        .args(["run", "s.toml", "--out", "o"])
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    let listed: Vec<&str> = err.lines().filter(|l| l.starts_with("  ")).collect();
+    let mut unique = listed.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(listed.len(), unique.len(), "{err}");
+    let here = dir.path().join("Whel.fmu");
+    assert!(
+        listed
+            .iter()
+            .any(|l| l.trim() == here.display().to_string()),
+        "{err}"
+    );
+    let wheel = dir.path().join("Wheel.fmu").display().to_string();
+    assert_contains(&err, &format!("did you mean {wheel}?"));
 }

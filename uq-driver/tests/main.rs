@@ -44,6 +44,7 @@ mod output_files;
 mod qoi_min_max;
 mod reliability;
 mod report_honest;
+mod small_chaos;
 mod sobol_sampling_intervals;
 mod store_recovery;
 mod study_chaos;
