@@ -182,10 +182,7 @@ fn value_and_gradient(
     fd: &Differences,
     u: &[f64],
 ) -> Result<(f64, Vec<f64>), ReliabilityError> {
-    let mut pts = vec![u.to_vec()];
-    pts.extend(fd.points(u));
-    let g = runs.eval(pts.clone(), OnFailure::Error)?;
-    Ok((g[0], fd.gradient(u, g[0], &pts[1..], &g[1..])))
+    try_value_and_gradient(runs, fd, u)?
 }
 
 /// `g` and its gradient at `u`, or the first failed run of their batch (a run the model
