@@ -585,6 +585,21 @@ def test_misbehave_7_fatal_and_8_warning(features_fmu, capsys):
     assert "fatal error on purpose" in out and "a warning on purpose" in out
 
 
+def test_misbehave_13_fails_above_the_bound_read_from_a_file(features_fmu, tmp_path, capsys):
+    bound = tmp_path / "bound.txt"
+    bound.write_text("2.5\n")
+    start = {"misbehave": 13, "misbehave_at": 0.3, "u": 1.0, "read_file": str(bound)}
+    res = simulate_fmu(features_fmu, start_values={**start, "gain": 2.5}, output_interval=0.1)
+    assert res["time"][-1] == pytest.approx(1.0)
+    assert res["u_gain"][-1] == pytest.approx(2.5)
+    with pytest.raises(FMICallException):
+        simulate_fmu(features_fmu, start_values={**start, "gain": 2.6}, output_interval=0.1)
+    assert "misbehave = 13: gain = 2.6 is above file_value = 2.5" in capsys.readouterr().out
+    bound.write_text("3\n")
+    res = simulate_fmu(features_fmu, start_values={**start, "gain": 2.6}, output_interval=0.1)
+    assert res["u_gain"][-1] == pytest.approx(2.6)
+
+
 RUN_IN_CHILD = textwrap.dedent("""
     import sys
     from fmpy import simulate_fmu

@@ -338,6 +338,55 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     assert_contains(&again, "failed at x = ");
 }
 
+#[test]
+fn retry_failed_keeps_a_form_step_the_search_went_on_past_and_gives_the_same_numbers() {
+    // A FORM trial step whose run had failed was shortened; once the cause was gone,
+    // `--retry-failed` ran it again, it gave a value, the search took the full step and asked
+    // for other points than the stored ones: the study stopped with "stored run N was at u =".
+    let Some(dir) = test_fmus::dir_if_built() else {
+        return;
+    };
+    let fmu = test_fmus::test_fmu("Features").expect("the Features test FMU");
+    // Features, misbehave = 13: a run fails where gain > the number in `bound.txt`; u = 1
+    // makes u_gain = gain, lognormal with median 1 and log-Std 0.25. For the limit 1.2 the
+    // design point is at u = 4 ln 1.2 (gain 1.2); FORM's first full step from the median
+    // lands at u = 0.8 (gain e^0.2 = 1.221), where the runs fail while the bound is 1.21,
+    // and which the line search accepts once it has a value.
+    let bound = dir.path().join("bound.txt");
+    std::fs::write(&bound, "1.21\n").unwrap();
+    let sigma = 0.25_f64;
+    let mean = (sigma * sigma / 2.0).exp();
+    let std = mean * ((sigma * sigma).exp() - 1.0).sqrt();
+    let text = format!(
+        "{head}[fixed]\nmisbehave = 13\nmisbehave_at = 0.1\nu = 1.0\nread_file = {bound:?}\n\
+         [[parameters]]\nname = \"gain\"\ndistribution = \"lognormal\"\nmean = {mean}\n\
+         std = {std}\n[outputs]\nvariables = [\"u_gain\"]\n[[qoi]]\nkind = \"final\"\n\
+         name = \"q\"\nsignal = \"u_gain\"\nlimits = [1.2]\n[method]\nkind = \"form\"\n",
+        head = study_head("bound", &fmu, 1, "start = 0.0\nstop = 0.2\nstep = 0.1"),
+    );
+    let p = write_toml(dir.path(), "bound", &text);
+    let out = dir.path().join("bound");
+    run_study_ok(&p, &out, &[]);
+    let exact = normal_sf((1.2_f64).ln() / sigma);
+    let p1 = reliability(&out)[0]["p"].as_f64().unwrap();
+    assert!((p1 / exact - 1.0).abs() < 1e-3, "FORM {p1}, exact {exact}");
+    let points = std::fs::read_to_string(out.join("points.csv")).unwrap();
+    let failed_runs = points.matches("is above file_value = 1.21").count();
+    assert!(failed_runs >= 1, "{points}");
+    // The cause gone: the failed step is not run again, and the numbers are the same.
+    std::fs::write(&bound, "100\n").unwrap();
+    let again = run_study(&p, &out, &["--retry-failed"]);
+    let err = stderr(&again);
+    assert!(again.status.success(), "{err}");
+    let n = match failed_runs {
+        1 => "1 failed run".to_owned(),
+        n => format!("{n} failed runs"),
+    };
+    assert_contains(&err, &format!("--retry-failed did not run {n} again (run "));
+    assert_eq!(reliability(&out)[0]["p"].as_f64().unwrap(), p1);
+    assert_eq!(summary(&out)["runs_this_invocation"], 0);
+}
+
 /// Kills `study` once its store holds about 300 runs of 10 001 values, resumes it, and
 /// compares the probabilities with those of an uninterrupted run.
 fn resumed_after_a_kill_gives_the_uninterrupted_numbers(kind: &str, method: &str) {

@@ -14,7 +14,11 @@
 //! stops the study), the others are run. The method being a deterministic function of its
 //! settings, its seed and the values it receives, the resumed study gives the numbers an
 //! uninterrupted one would, on any number of threads. A failed run is answered as failed
-//! (FORM then stops again with the same error) unless `--retry-failed` runs it again.
+//! (FORM then stops again with the same error) unless `--retry-failed` runs it again, which
+//! it does only for a run in the last batch the method asked for: once the method has gone
+//! on past a failure (a trial step of FORM's line search shortened, a subset level seeded
+//! without it), the runs it asked for next depend on that failure, and a value now would
+//! send it away from the stored runs. Those failures are kept, with a warning.
 //!
 //! # Values of the quantities
 //!
@@ -102,6 +106,7 @@ pub(crate) fn run_adaptive(
         base,
         retry_failed: opts.retry_failed,
         retried: BTreeSet::new(),
+        kept_failed: BTreeSet::new(),
         resumed: BTreeSet::new(),
         stopped: false,
         error: None,
@@ -114,6 +119,9 @@ pub(crate) fn run_adaptive(
     let result = match result {
         Ok(r) => r,
         Err(e) => {
+            if let Some(note) = model.kept_failed_note() {
+                progress::message(&format!("uq-driver: note: {note}"));
+            }
             if let Some(err) = model.error.take() {
                 return Err(err.into());
             }
@@ -200,6 +208,7 @@ fn finish(
     for s in &result.screening {
         warnings.extend(s.morris.warnings.iter().map(|w| format!("{}: {w}", s.name)));
     }
+    warnings.extend(model.kept_failed_note());
     let resumed = model.resumed.len();
     let (runs_store, _lock, notes) = model.session.into_warnings();
     drop(runs_store);
@@ -310,6 +319,8 @@ struct StudyModel<'a> {
     retry_failed: bool,
     /// Failed runs run again by this invocation (each once).
     retried: BTreeSet<usize>,
+    /// Failed runs that `--retry-failed` did not run again: the method had gone on past them.
+    kept_failed: BTreeSet<usize>,
     /// Runs answered from the store.
     resumed: BTreeSet<usize>,
     /// `max_new_points` stopped a batch.
@@ -329,6 +340,32 @@ impl StudyModel<'_> {
             .iter()
             .rposition(Option::is_some)
             .map_or(0, |i| i + 1)
+    }
+
+    /// Says which failed runs `--retry-failed` left as they were, and why.
+    fn kept_failed_note(&self) -> Option<String> {
+        let n = self.kept_failed.len();
+        if n == 0 {
+            return None;
+        }
+        let runs: Vec<String> = self
+            .kept_failed
+            .iter()
+            .take(8)
+            .map(usize::to_string)
+            .collect();
+        Some(format!(
+            "--retry-failed did not run {} again (run {}{}): the method had gone on past \
+             {}, and what it ran next depended on the failure; --fresh runs the study anew",
+            if n == 1 {
+                "1 failed run".to_owned()
+            } else {
+                format!("{n} failed runs")
+            },
+            runs.join(", "),
+            if n > 8 { ", ..." } else { "" },
+            if n == 1 { "it" } else { "them" }
+        ))
     }
 
     /// Stops the method with a runner error.
@@ -419,6 +456,15 @@ impl BatchModel for StudyModel<'_> {
 
     fn evaluate(&mut self, batch: &[Point]) -> Result<Vec<Vec<Outcome>>, Abort> {
         let mut jobs: Vec<(usize, Vec<f64>)> = Vec::new();
+        // A failed run is run again (`--retry-failed`) only if the method never asked for a
+        // run after its batch: once it has, what it asked for next may depend on the failure
+        // (a shortened step of FORM's line search, the seeds of a subset level), and a value
+        // now would send it elsewhere than the stored runs.
+        let last = batch.iter().map(|p| p.run as usize).max().unwrap_or(0);
+        let went_on = self
+            .stored_u
+            .get(last + 1..)
+            .is_some_and(|later| later.iter().any(Option::is_some));
         for p in batch {
             let k = p.run as usize;
             if k >= self.capacity {
@@ -441,6 +487,10 @@ impl BatchModel for StudyModel<'_> {
             }
             let run = match &self.session.runs.entries()[k] {
                 None => true,
+                Some(Entry::Failed(_)) if self.retry_failed && went_on => {
+                    self.kept_failed.insert(k);
+                    false
+                }
                 Some(Entry::Failed(_)) => self.retry_failed && self.retried.insert(k),
                 Some(Entry::Ok(_)) => false,
             };

@@ -7,14 +7,11 @@ pub enum Abort {
     #[error("evaluation interrupted: {0}")]
     Interrupted(String),
     /// A stored run was at another point than the one now requested: the settings, the
-    /// seed, the model's values or the code changed since the runs were stored, or a failed
-    /// run that the method had gone on past (a trial point of FORM's line search, a subset
-    /// sample counted as a failure) gave a value when `--retry-failed` ran it again.
+    /// seed, the model's values or the code changed since the runs were stored.
     #[error(
         "stored run {run} was at u = {stored:?} but u = {requested:?} is requested now; \
-         the stored runs belong to another study (settings, seed, model or version), or a \
-         failed run that --retry-failed ran again now gave a value where the method had gone on \
-         past its failure (run again without --retry-failed, or with --fresh)"
+         the stored runs belong to another study (settings, seed, model's values or \
+         uq-driver's version): run it with --fresh, or into another --out"
     )]
     ReplayMismatch {
         /// The run index.

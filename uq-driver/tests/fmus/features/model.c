@@ -20,6 +20,8 @@
  *     9 writes 12 bytes of garbage to file descriptor 3 and goes on
  *     10 starts a helper process that lives 20 s (holding every descriptor), then segfaults
  *     11 raises SIGTERM on itself   12 prints a line to stdout (fd 1) and goes on
+ *     13 returns fmi2Error (logged) if gain > file_value: a failure region whose bound is
+ *        read from a file, so that it can move between runs of a study
  *   reset_bug: a broken fmi2Reset, as FMUs from other tools have: 1 returns fmi2Error (logged),
  *   2 returns fmi2OK but forgets the start values (every variable keeps its value of the run
  *   before, u_integral included, which then starts where that run ended), 3 returns fmi2Error
@@ -50,7 +52,8 @@
 
 enum { MISBEHAVE_NONE, MISBEHAVE_ERROR, MISBEHAVE_SEGFAULT, MISBEHAVE_ABORT, MISBEHAVE_EXIT,
        MISBEHAVE_BLOCK, MISBEHAVE_NAN, MISBEHAVE_FATAL, MISBEHAVE_WARNING, MISBEHAVE_FD3,
-       MISBEHAVE_CHILD_SEGFAULT, MISBEHAVE_SIGTERM, MISBEHAVE_STDOUT, MISBEHAVE_LAST };
+       MISBEHAVE_CHILD_SEGFAULT, MISBEHAVE_SIGTERM, MISBEHAVE_STDOUT, MISBEHAVE_ABOVE,
+       MISBEHAVE_LAST };
 
 typedef struct {
     /* parameters */
@@ -329,6 +332,11 @@ static fmi2Status misbehave(Instance *inst, double end) {
         printf("Features: misbehave = 12 prints to stdout at t = %g\n", end);
         fflush(stdout);
         return fmi2OK;
+    case MISBEHAVE_ABOVE:
+        if (d->gain <= d->file_value) return fmi2OK;
+        M_ERROR(inst, "misbehave = 13: gain = %g is above file_value = %g at t = %g", d->gain,
+                d->file_value, end);
+        return fmi2Error;
     default: return fmi2OK; /* MISBEHAVE_NAN: applied in step() */
     }
 }
