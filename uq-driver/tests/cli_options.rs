@@ -194,3 +194,22 @@ fn a_misspelt_fmu_is_listed_once_per_place_with_the_fmu_it_may_mean() {
     let wheel = dir.path().join("Wheel.fmu").display().to_string();
     assert_contains(&err, &format!("did you mean {wheel}?"));
 }
+
+/// A misspelt key given by `--set` got the list of expected keys but no "did you mean", which
+/// the same key in the study file gets.
+#[test]
+fn a_misspelt_key_of_set_gets_a_did_you_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let o = crate::support::run(&[
+        "run",
+        "builtin:wheel-scm",
+        "--out",
+        utf8(&out),
+        "--set",
+        "method.node=3",
+    ]);
+    let err = failed(&o);
+    assert_contains(&err, "with --set method.node=3");
+    assert_contains(&err, "hint: did you mean `nodes`?");
+}

@@ -201,7 +201,11 @@ fn causes(e: &anyhow::Error) -> String {
 fn hints(e: &anyhow::Error) -> Vec<String> {
     let mut out = Vec::new();
     for cause in e.chain() {
-        if let Some(StudyError::Parse { message, .. }) = cause.downcast_ref::<StudyError>() {
+        // A parse error of a `--set` comes as `Invalid` (its place in the rewritten text
+        // would mean nothing to the user), with the parser's words.
+        if let Some(StudyError::Parse { message, .. } | StudyError::Invalid { message, .. }) =
+            cause.downcast_ref::<StudyError>()
+        {
             out.extend(suggest::for_serde_message(message));
         }
         // `transparent` errors hide their inner error from the chain: look inside.
