@@ -20,6 +20,14 @@ else:
     from ._lazy import numpy as np
 
 
+class Columns(dict):  # type: ignore[type-arg]
+    """The series of :func:`simulate` without pandas: a dict of float64 numpy arrays by
+    variable name (``"time"`` first), with an ``attrs`` dict as a pandas DataFrame has
+    (``attrs["calculated_strings"]``)."""
+
+    attrs: dict[str, Any]
+
+
 def simulate(
     fmu: PathLike,
     set: Mapping[str, bool | float | int | str] | None = None,
@@ -39,9 +47,9 @@ def simulate(
     is installed, else a dict of float64 numpy arrays (``"time"`` first). Where the FMU ends
     the simulation early, the series end there (as in fmpy), with a note logged. The FMU's
     String calculated parameters, read after the run (e.g. ``solver.kernel``, the instruction
-    sets VehicleTrack's equations ran on: record it with a result), are the DataFrame's
-    ``attrs["calculated_strings"]``, a dict by name (empty when the FMU has none; not
-    returned without pandas).
+    sets VehicleTrack's equations ran on: record it with a result), are
+    ``attrs["calculated_strings"]``, a dict by name (empty when the FMU has none), of the
+    DataFrame or, without pandas, of the dict.
 
     Raises :class:`railuq.FmuError` (the FMU cannot be opened), :class:`railuq.StudyError` (an
     unknown variable, a bad value or time grid) or :class:`railuq.RunError` (the run failed),
@@ -54,12 +62,13 @@ def simulate(
         )
     finally:
         forward_messages(None)
-    columns: dict[str, np.ndarray] = {"time": np.asarray(times, dtype=np.float64)}
+    columns = Columns(time=np.asarray(times, dtype=np.float64))
     for name, values in zip(names, series):
         columns[name] = np.asarray(values, dtype=np.float64)
     try:
         import pandas as pd
     except ImportError:
+        columns.attrs = {"calculated_strings": dict(strings)}
         return columns
     df = pd.DataFrame(columns)
     df.attrs["calculated_strings"] = dict(strings)

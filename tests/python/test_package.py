@@ -176,6 +176,12 @@ def test_simulate_without_pandas_returns_a_dict_of_float64_arrays(monkeypatch):
     for a in cols.values():
         assert isinstance(a, np.ndarray) and a.dtype == np.float64 and a.shape == (6,)
     assert np.allclose(cols["time"], np.linspace(0, 0.5, 6), rtol=0, atol=1e-12)
+    # The calculated strings were dropped without pandas: they are the dict's attrs.
+    assert isinstance(cols, dict) and cols.attrs == {"calculated_strings": {}}
+    vt = railuq.simulate(railuq.fmu_path("VehicleTrack"), stop=0.002, step=0.001,
+                         outputs=["Zc"])
+    assert set(vt.attrs["calculated_strings"]) == {"solver.kernel"}
+    assert vt.attrs["calculated_strings"]["solver.kernel"]
 
 
 def test_simulate_errors_carry_the_command_lines_message(tmp_path):
