@@ -70,6 +70,16 @@ pub fn silverman_from(n: usize, mean: f64, std: f64, iqr: f64) -> f64 {
     0.9 * spread * (n as f64).powf(-0.2)
 }
 
+/// `bandwidth` (units of the samples) where it is positive and finite, else
+/// [`silverman_bandwidth`] of the finite `samples`.
+fn bandwidth_or_silverman(bandwidth: f64, samples: &[f64]) -> f64 {
+    if bandwidth > 0.0 && bandwidth.is_finite() {
+        bandwidth
+    } else {
+        silverman_bandwidth(samples)
+    }
+}
+
 /// Gaussian kernel density estimate at the `grid` points:
 /// `sum_i w_i phi((x - x_i) / h) / h` with weights normalised to sum 1
 /// (equal weights when `weights` is `None`). Non-finite samples are ignored;
@@ -105,12 +115,7 @@ pub fn gaussian_kde(
         return vec![f64::NAN; grid.len()];
     }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
-        bandwidth
-    } else {
-        let xs: Vec<f64> = pairs.iter().map(|p| p.0).collect();
-        silverman_bandwidth(&xs)
-    };
+    let h = bandwidth_or_silverman(bandwidth, samples);
     let scale = 1.0 / (total * h);
     grid.iter()
         .map(|&g| {
@@ -154,11 +159,7 @@ pub fn gaussian_kde_binned(
     if grid.is_empty() || total == 0 {
         return vec![0.0; grid.len()];
     }
-    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
-        bandwidth
-    } else {
-        silverman_bandwidth(samples)
-    };
+    let h = bandwidth_or_silverman(bandwidth, samples);
     let (a, step) = if grid.len() > 1 {
         (
             grid[0],
@@ -240,11 +241,7 @@ pub fn gaussian_kde_cell_average(
     if n == 0 || total == 0 || !(lo.is_finite() && hi.is_finite()) {
         return vec![0.0; n];
     }
-    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
-        bandwidth
-    } else {
-        silverman_bandwidth(samples)
-    };
+    let h = bandwidth_or_silverman(bandwidth, samples);
     let grid = auto_grid(lo, hi, n);
     let step = if n > 1 {
         (grid[n - 1] - grid[0]) / (n - 1) as f64
@@ -365,11 +362,7 @@ pub(crate) fn bounded_kde(
     bound: Option<f64>,
     kind: KdeKind,
 ) -> Vec<f64> {
-    let h = if bandwidth > 0.0 && bandwidth.is_finite() {
-        bandwidth
-    } else {
-        silverman_bandwidth(samples)
-    };
+    let h = bandwidth_or_silverman(bandwidth, samples);
     let estimate = |xs: &[f64]| match kind {
         KdeKind::Points => gaussian_kde_binned(xs, lo, hi, n, h),
         KdeKind::CellAverages => gaussian_kde_cell_average(xs, lo, hi, n, h),
