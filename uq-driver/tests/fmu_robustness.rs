@@ -260,14 +260,14 @@ fn simulate_set_of_an_integer_outside_its_range_is_refused_as_a_fixed_one_is() {
         "simulate",
         utf8(&fmu),
         "--set",
-        "misbehave=13",
+        "misbehave=14",
         "--stop",
         "0.1",
     ]);
     let err = failed(&o);
     assert!(
-        err.contains("'misbehave' is an Integer declared with min = 0, max = 12")
-            && err.contains("the value 13 given for it is outside that range"),
+        err.contains("'misbehave' is an Integer declared with min = 0, max = 13")
+            && err.contains("the value 14 given for it is outside that range"),
         "{err}"
     );
 }
