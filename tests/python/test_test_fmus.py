@@ -659,7 +659,7 @@ def test_setting_rules(features_fmu, capsys):
         assert "at most 1023 allowed" in capsys.readouterr().out
         s.fmu.reset()
         s.set(string_param="x" * 1023)
-        for value, var in [(4, "enum_param"), (0, "enum_param"), (13, "misbehave")]:
+        for value, var in [(4, "enum_param"), (0, "enum_param"), (14, "misbehave")]:
             s.fmu.reset()
             with pytest.raises(FMICallException):
                 s.set(**{var: value})
