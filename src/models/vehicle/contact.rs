@@ -21,6 +21,7 @@
 //! track frame:  X = Fx − Fy ψ cos δ,  Y = Fx ψ + Fy cos(δ + σφ) − σ N sin(δ + σφ),
 //!               Z = σ Fy sin(δ + σφ) + N cos(δ + σφ)
 //! torques:      roll  σ aw (Z − Y φ),   spin −r (X + Y ψ),   yaw −σ aw (X + Y ψ)
+//!               roll_moment = 1: roll + r Y cos φ (the lateral force acts about r below the axle)
 //! ```
 //!
 //! A wheel whose normal force is at most 1 N exerts no force at all. The lateral position
@@ -97,6 +98,8 @@ pub struct ContactConst {
     pub mu: f64,
     /// Rolling radius of the table at y = 0, r_t (m): Ω0 = v / r_t.
     pub r_t: f64,
+    /// The roll moment includes that of the lateral forces, r Y cos φ.
+    pub lateral_roll: bool,
 }
 
 /// The wheel–rail forces of a wheelset with kinematics `k` and spin perturbation `beta`
@@ -126,6 +129,9 @@ pub fn wheelset_forces(
         out.force[1] += y;
         out.force[2] += z;
         out.roll += sigma * row.aw * (z - y * phi);
+        if c.lateral_roll {
+            out.roll += row.r * roll.1 * y;
+        }
         out.spin -= row.r * (x + y * psi);
         out.yaw -= sigma * row.aw * (x + y * psi);
         out.wheels[i] = w.1;

@@ -179,6 +179,7 @@ impl Car {
                 g_mod: p.g_mod,
                 mu: p.mu,
                 r_t,
+                lateral_roll: p.roll_moment == 1,
             },
         }
     }

@@ -364,7 +364,14 @@ impl Model for Vehicle {
         &INFO
     }
 
-    table_accessors!(TABLE; get_integer -> i32, set_integer(i32), get_string -> String);
+    table_accessors!(TABLE; get_integer -> i32, get_string -> String);
+
+    fn set_integer(&mut self, vr: u32, value: i32) -> SetResult {
+        let warning = TABLE.set_integer(self, vr, value)?;
+        // `roll_moment` changes the linearised car.
+        self.v_cr = OnceCell::new();
+        Ok(warning)
+    }
 
     fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
         if vr == VR_V_CR_LINEAR {

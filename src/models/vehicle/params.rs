@@ -115,6 +115,10 @@ pub struct Params {
     pub mu: f64,
     /// Shear modulus in Kalker's law (Pa).
     pub g_mod: f64,
+    /// The wheelset's roll moment: 0 that of the vertical contact forces about the lever arm
+    /// aw (as the reference implementation); 1 also that of the lateral contact forces about
+    /// the rolling radius r.
+    pub roll_moment: i32,
 }
 
 impl Params {
@@ -154,6 +158,7 @@ impl Params {
         d: [0.0; 6],
         mu: 0.0,
         g_mod: 0.0,
+        roll_moment: 0,
     };
 
     /// Mass (kg) of body `i`.

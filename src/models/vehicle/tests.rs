@@ -685,4 +685,5 @@ fn continuation_folds(table: &str, start: f64, threshold: f64) {
 /// The reference study's RSGEO table (S1002 on UIC60 at 1:40), a test fixture.
 const RSGEO: &str = include_str!("../../../tests/data/rsgeo_s1002_uic60_1in40.csv");
 
+mod roll_moment;
 mod tables;

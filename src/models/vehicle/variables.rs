@@ -29,6 +29,19 @@ fn speed(name: &'static str, value: f64) -> SetResult {
     Ok(None)
 }
 
+/// The roll moments the vehicle knows.
+fn roll_moment_code(name: &'static str, value: i32) -> SetResult {
+    if !matches!(value, 0 | 1) {
+        return Err(ModelError::invalid(
+            name,
+            value,
+            "must be 0 (the vertical contact forces about aw, as the reference) or 1 (also the \
+             lateral contact forces about the rolling radius r)",
+        ));
+    }
+    Ok(None)
+}
+
 /// The irregularity codes the vehicle knows.
 fn irregularity_code(name: &'static str, value: i32) -> SetResult {
     if !matches!(value, 0 | 2 | 3 | 10) {
@@ -110,6 +123,7 @@ variables! {
     real_parameter("irregularity_fade_in", VR_IRR_FADE_IN = 59, Some("m"), m.irr.fade_in, 20.0, Fixed, non_negative, "The irregularity fades in over this length ahead of the leading wheelset's start position; 0 = none [assumed]", min = 0.0),
     integer_parameter("irregularity", VR_IRREGULARITY = 70, m.irr.code, 0, irregularity_code, "Track irregularity: 0 none (default), 2 German low, 3 German high interference (random, lateral and vertical), 10 measured (irregularity_file)"),
     integer_parameter("seed", VR_SEED = 71, m.irr.seed, 1, any_integer, "Seed of the random phases of the irregularity"),
+    integer_parameter("roll_moment", VR_ROLL_MOMENT = 72, m.p.roll_moment, 0, roll_moment_code, "Wheelset roll moment: 0 the vertical contact forces about the lever arm aw (as the reference implementation), 1 also the lateral contact forces about the rolling radius r (the inner wheels' unloading dQQ on curves some 20-30 % higher) [ref: 0]"),
     string_parameter("contact_table", VR_CONTACT_TABLE = 80, m.contact_table, "", any_string, "Contact table file (CSV: y, N0, delta, a, b, aw, r, c11, c22, c23, zc, q0 in SI units, left wheel, y ascending in equal steps); a relative path is resolved in the FMU resources folder; empty = the built-in S1002/UIC60 1:40 table"),
     string_parameter("irregularity_file", VR_IRREGULARITY_FILE = 81, m.irr.file, "", any_string, "Measured track for irregularity = 10: lines of x [m], y [m] (alignment, left +), z [m] (vertical, up +); a relative path is resolved in the FMU resources folder"),
     string_parameter("wheel_profile", VR_WHEEL_PROFILE = 82, m.wheel_profile, "", any_string, "Wheel profile file (CSV: y, z in mm, y from the flange back, positive toward the field side, z up; the rolling circle 70 mm from the flange back): with contact_table empty, the contact table is computed from it and rail_profile at initialization (rails at 1:40, standard gauge, smoothed over 0.05 mm, as the built-in one); empty = S1002; a relative path is resolved in the FMU resources folder"),
