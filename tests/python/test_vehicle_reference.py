@@ -112,6 +112,6 @@ def test_roll_moment_1_matches_the_reference_with_the_lateral_forces_roll_moment
         assert abs(fmu[k] - before[k]) < 1e-5 * Q_STATIC, k
     reference = reference_curve(roll_lateral_moment=True)
     for k in FORCES:
-        # Measured: Q within 0.001 %, Y within 0.01 % (after 150 s); the reference without the
+        # Measured (150 s runs): Q within 0.001 %, Y within 0.01 %; the reference without the
         # moment is 1.3-3.0 % off, as above.
         assert reference[k] == pytest.approx(fmu[k], rel=1e-3), k

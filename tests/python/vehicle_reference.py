@@ -13,7 +13,11 @@ Vehicle, "Modelling choices"):
 
 - the wheelset's roll moment is that of the vertical contact forces about the lever arm aw
   (with the roll corrections); the lateral contact forces, which act r below the axle, add none.
-  Switchable: `Car(..., roll_lateral_moment=True)` adds their moment (the physical reading);
+  Here the vertical force's arm is the contact point's y turned by the roll,
+  s aw cos(phi) + r sin(phi), where the FMU writes s aw (Z - Y phi): the two differ in terms of
+  second order in the small roll, below 0.001 % in the steady wheel loads. Switchable:
+  `Car(..., roll_lateral_moment=True)` adds the lateral forces' moment (the physical reading,
+  the FMU's `roll_moment = 1`);
 - the creep forces are turned into the track frame by the wheelset's yaw psi as well as by
   delta +- phi (the spin torque uses the turned lateral force);
 - the suspension's lever arms turn with their bodies (small rotations, I + skew);

@@ -21,7 +21,7 @@
 //! track frame:  X = Fx − Fy ψ cos δ,  Y = Fx ψ + Fy cos(δ + σφ) − σ N sin(δ + σφ),
 //!               Z = σ Fy sin(δ + σφ) + N cos(δ + σφ)
 //! torques:      roll  σ aw (Z − Y φ),   spin −r (X + Y ψ),   yaw −σ aw (X + Y ψ)
-//!               roll_moment = 1: roll + r Y cos φ (the lateral force acts about r below the axle)
+//!               roll_moment = 1: roll + r (Y cos φ + Z sin φ) (the force acts r below the axle)
 //! ```
 //!
 //! A wheel whose normal force is at most 1 N exerts no force at all. The lateral position
@@ -98,7 +98,8 @@ pub struct ContactConst {
     pub mu: f64,
     /// Rolling radius of the table at y = 0, r_t (m): Ω0 = v / r_t.
     pub r_t: f64,
-    /// The roll moment includes that of the lateral forces, r Y cos φ.
+    /// The roll moment includes that of the contact force about the rolling radius,
+    /// r (Y cos φ + Z sin φ).
     pub lateral_roll: bool,
 }
 
@@ -130,7 +131,8 @@ pub fn wheelset_forces(
         out.force[2] += z;
         out.roll += sigma * row.aw * (z - y * phi);
         if c.lateral_roll {
-            out.roll += row.r * roll.1 * y;
+            // The whole contact force acts r below the axle, turned by the roll φ.
+            out.roll += row.r * (y * roll.1 + z * roll.0);
         }
         out.spin -= row.r * (x + y * psi);
         out.yaw -= sigma * row.aw * (x + y * psi);

@@ -356,8 +356,8 @@ impl Vehicle {
     }
 }
 
-/// Format version of [`Model::save`].
-const STATE_VERSION: u64 = 1;
+/// Format version of [`Model::save`] (2: the parameters include `roll_moment`).
+const STATE_VERSION: u64 = 2;
 
 impl Model for Vehicle {
     fn info(&self) -> &'static ModelInfo {
