@@ -1,5 +1,6 @@
 //! Hardening of the runner, against the Features test FMU's `misbehave` modes
-//! (1 error, 2 segfault, 3 abort, 4 exit(0), 5 hang, 6 NaN outputs, 7 fatal, 8 warning, at `misbehave_at`): `--isolate`, `--timeout-per-run`, an in-process `exit()`, `--retry-failed`,
+//! (1 error, 2 segfault, 3 abort, 4 exit(0), 5 hang, 6 NaN outputs, 7 fatal, 8 warning, at
+//! `misbehave_at`): `--isolate`, `--timeout-per-run`, an in-process `exit()`, `--retry-failed`,
 //! the output folder's lock, and the smaller items. Each test is named after the problem it pins.
 
 use std::path::{Path, PathBuf};
