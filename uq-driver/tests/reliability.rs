@@ -338,23 +338,16 @@ fn a_failed_run_during_form_is_an_error_naming_the_point() {
     assert_contains(&again, "failed at x = ");
 }
 
-#[test]
-fn retry_failed_keeps_a_form_step_the_search_went_on_past_and_gives_the_same_numbers() {
-    // A FORM trial step whose run had failed was shortened; once the cause was gone,
-    // `--retry-failed` ran it again, it gave a value, the search took the full step and asked
-    // for other points than the stored ones: the study stopped with "stored run N was at u =".
-    let Some(dir) = test_fmus::dir_if_built() else {
-        return;
-    };
+/// A FORM study on the Features test FMU with `misbehave = 13`: a run fails where gain > the
+/// number in the file `bound.txt` (written with `bound`); u = 1 makes u_gain = gain, lognormal
+/// with median 1 and log-Std 0.25, and the limit is 1.2 (the design point at u = 4 ln 1.2,
+/// gain 1.2). Returns the folder, the study file, the bound file and the output folder.
+fn bound_study(bound_value: f64) -> Option<(tempfile::TempDir, PathBuf, PathBuf, PathBuf)> {
+    let dir = test_fmus::dir_if_built()?;
     let fmu = test_fmus::test_fmu("Features").expect("the Features test FMU");
-    // Features, misbehave = 13: a run fails where gain > the number in `bound.txt`; u = 1
-    // makes u_gain = gain, lognormal with median 1 and log-Std 0.25. For the limit 1.2 the
-    // design point is at u = 4 ln 1.2 (gain 1.2); FORM's first full step from the median
-    // lands at u = 0.8 (gain e^0.2 = 1.221), where the runs fail while the bound is 1.21,
-    // and which the line search accepts once it has a value.
     let bound = dir.path().join("bound.txt");
-    std::fs::write(&bound, "1.21\n").unwrap();
-    let sigma = 0.25_f64;
+    std::fs::write(&bound, format!("{bound_value}\n")).unwrap();
+    let sigma = BOUND_SIGMA;
     let mean = (sigma * sigma / 2.0).exp();
     let std = mean * ((sigma * sigma).exp() - 1.0).sqrt();
     let text = format!(
@@ -366,6 +359,24 @@ fn retry_failed_keeps_a_form_step_the_search_went_on_past_and_gives_the_same_num
     );
     let p = write_toml(dir.path(), "bound", &text);
     let out = dir.path().join("bound");
+    Some((dir, p, bound, out))
+}
+
+/// The log-Std of the gain in [`bound_study`].
+const BOUND_SIGMA: f64 = 0.25;
+
+#[test]
+fn retry_failed_keeps_a_form_step_the_search_went_on_past_and_gives_the_same_numbers() {
+    // A FORM trial step whose run had failed was shortened; once the cause was gone,
+    // `--retry-failed` ran it again, it gave a value, the search took the full step and asked
+    // for other points than the stored ones: the study stopped with "stored run N was at u =".
+    // FORM's first full step from the median lands at u = 0.8 (gain e^0.2 = 1.221), where
+    // the runs fail while the bound is 1.21, and which the line search accepts once it has a
+    // value.
+    let Some((_dir, p, bound, out)) = bound_study(1.21) else {
+        return;
+    };
+    let sigma = BOUND_SIGMA;
     run_study_ok(&p, &out, &[]);
     let exact = normal_sf((1.2_f64).ln() / sigma);
     let p1 = reliability(&out)[0]["p"].as_f64().unwrap();
@@ -385,6 +396,26 @@ fn retry_failed_keeps_a_form_step_the_search_went_on_past_and_gives_the_same_num
     assert_contains(&err, &format!("--retry-failed did not run {n} again (run "));
     assert_eq!(reliability(&out)[0]["p"].as_f64().unwrap(), p1);
     assert_eq!(summary(&out)["runs_this_invocation"], 0);
+}
+
+#[test]
+fn retry_failed_runs_again_the_failure_that_stopped_form() {
+    // The runs at the median fail (gain 1 above the bound 0.5): FORM stops on them. Once the
+    // cause is gone, `--retry-failed` must run them again (they are the method's last batch)
+    // and FORM then finds the exact probability.
+    let Some((_dir, p, bound, out)) = bound_study(0.5) else {
+        return;
+    };
+    let err = failed(&run_study(&p, &out, &[]));
+    assert_contains(&err, "is above file_value = 0.5");
+    std::fs::write(&bound, "100\n").unwrap();
+    let again = run_study(&p, &out, &["--retry-failed"]);
+    let err = stderr(&again);
+    assert!(again.status.success(), "{err}");
+    assert!(!err.contains("did not run"), "{err}");
+    let exact = normal_sf((1.2_f64).ln() / BOUND_SIGMA);
+    let p1 = reliability(&out)[0]["p"].as_f64().unwrap();
+    assert!((p1 / exact - 1.0).abs() < 1e-3, "FORM {p1}, exact {exact}");
 }
 
 /// Kills `study` once its store holds about 300 runs of 10 001 values, resumes it, and
