@@ -319,7 +319,7 @@ struct StudyModel<'a> {
     retry_failed: bool,
     /// Failed runs run again by this invocation (each once).
     retried: BTreeSet<usize>,
-    /// Failed runs that `--retry-failed` did not run again: the method had gone on past them.
+    /// Failed runs that `--retry-failed` did not run again: the method asked for later runs after them.
     kept_failed: BTreeSet<usize>,
     /// Runs answered from the store.
     resumed: BTreeSet<usize>,
@@ -355,8 +355,8 @@ impl StudyModel<'_> {
             .map(usize::to_string)
             .collect();
         Some(format!(
-            "--retry-failed did not run {} again (run {}{}): the method had gone on past \
-             {}, and what it ran next depended on the failure; --fresh runs the study anew",
+            "--retry-failed did not run {} again (run {}{}): the method asked for later runs \
+             after {}, which depend on the failure; --fresh runs the study anew",
             if n == 1 {
                 "1 failed run".to_owned()
             } else {
