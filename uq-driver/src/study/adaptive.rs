@@ -37,6 +37,7 @@ use crate::fmu::Fmu;
 use crate::qoi::evaluate::Code;
 use crate::qoi::QoiSpec;
 use crate::report::{self, units, StudyReport};
+use crate::results::numbers::count;
 use crate::results::{LimitProbability, MorrisScreening, PointStatus, PointTable, ScalarStats};
 use crate::spec::Study;
 use crate::study::facts::{fmu_info, summary, RunFacts};
@@ -319,7 +320,8 @@ struct StudyModel<'a> {
     retry_failed: bool,
     /// Failed runs run again by this invocation (each once).
     retried: BTreeSet<usize>,
-    /// Failed runs that `--retry-failed` did not run again: the method asked for later runs after them.
+    /// Failed runs that `--retry-failed` did not run again: the method asked for later runs
+    /// after them.
     kept_failed: BTreeSet<usize>,
     /// Runs answered from the store.
     resumed: BTreeSet<usize>,
@@ -357,11 +359,7 @@ impl StudyModel<'_> {
         Some(format!(
             "--retry-failed did not run {} again (run {}{}): the method asked for later runs \
              after {}, which depend on the failure; --fresh runs the study anew",
-            if n == 1 {
-                "1 failed run".to_owned()
-            } else {
-                format!("{n} failed runs")
-            },
+            count(n, "failed run", "failed runs"),
             runs.join(", "),
             if n > 8 { ", ..." } else { "" },
             if n == 1 { "it" } else { "them" }
@@ -459,12 +457,10 @@ impl BatchModel for StudyModel<'_> {
         // A failed run is run again (`--retry-failed`) only if the method never asked for a
         // run after its batch: once it has, what it asked for next may depend on the failure
         // (a shortened step of FORM's line search, the seeds of a subset level), and a value
-        // now would send it elsewhere than the stored runs.
+        // now would send it elsewhere than the stored runs. Looked up once per batch, and only
+        // when a failed run is met (the scan runs over every later run index).
         let last = batch.iter().map(|p| p.run as usize).max().unwrap_or(0);
-        let went_on = self
-            .stored_u
-            .get(last + 1..)
-            .is_some_and(|later| later.iter().any(Option::is_some));
+        let mut went_on = None;
         for p in batch {
             let k = p.run as usize;
             if k >= self.capacity {
@@ -487,7 +483,14 @@ impl BatchModel for StudyModel<'_> {
             }
             let run = match &self.session.runs.entries()[k] {
                 None => true,
-                Some(Entry::Failed(_)) if self.retry_failed && went_on => {
+                Some(Entry::Failed(_))
+                    if self.retry_failed
+                        && *went_on.get_or_insert_with(|| {
+                            self.stored_u
+                                .get(last + 1..)
+                                .is_some_and(|later| later.iter().any(Option::is_some))
+                        }) =>
+                {
                     self.kept_failed.insert(k);
                     false
                 }
